@@ -1,0 +1,281 @@
+#pragma once
+// The gyrochar CAN protocol, version 1: one value type per frame kind, encode() and decode()
+// between those values and CanFrame, and the report schedule. docs/protocol.md is the specification,
+// docs/gyrochar.dbc describes the same frames for CAN tools (tests/dbc checks it against this codec).
+// The board firmware and the host decoder both use this codec; there is no other.
+//
+// Wire conventions: classic CAN, 29-bit identifiers (J1939 proprietary-B PGNs 0xFF40..0xFF50, the
+// sending node's address in the low byte), little-endian fields, IEEE-754 binary32 floats. Angles are
+// in the node's angle unit (MetaScaleMsg::angle_unit), times in seconds unless a name says otherwise.
+//
+// Every function is O(1) unless stated, allocates nothing, throws nothing and reads no clock.
+#include <cstddef>
+#include <cstdint>
+#include <variant>
+
+#include "gyrochar/can_frame.hpp"
+
+namespace gyrochar::protocol {
+
+inline constexpr std::uint8_t version = 1;
+inline constexpr std::size_t max_taus = 64;          // tau index is 6 bits
+inline constexpr std::uint8_t max_node_address = 0xFD;  // J1939: 0xFE null, 0xFF global
+
+// Identifier bases; the node address goes in the low byte (frame_id()).
+inline constexpr std::uint32_t status_id = 0x14FF4000;         // priority 5, every report
+inline constexpr std::uint32_t tau_stats_id = 0x18FF4100;      // priority 6, every report
+inline constexpr std::uint32_t metadata_id = 0x18FF4200;       // priority 6, slow cycle
+inline constexpr std::uint32_t ieee952_id = 0x18FF4300;        // priority 6, slow cycle
+inline constexpr std::uint32_t counter_input_id = 0x0CFF5000;  // priority 3, gyro electronics -> board
+
+constexpr std::uint32_t frame_id(std::uint32_t base, std::uint8_t node) { return base | node; }
+
+// ---------------------------------------------------------------------------------------------
+// Enumerations (VAL_ tables in the DBC carry the same names, see name())
+
+/// Power-law noise identified at a tau; the code is what goes on the wire.
+enum class NoiseType : std::uint8_t {
+  not_identified = 0,
+  white_pm = 1,         // alpha = +2: quantization noise (white angle noise)
+  flicker_pm = 2,       // alpha = +1
+  white_fm = 3,         // alpha =  0: angle random walk
+  flicker_fm = 4,       // alpha = -1: bias instability
+  random_walk_fm = 5,   // alpha = -2: rate random walk
+  flicker_walk_fm = 6,  // alpha = -3
+  random_run_fm = 7,    // alpha = -4: rate ramp
+};
+/// alpha (the exponent of f in the frequency-noise spectrum) of an identified noise type, +2..-4.
+/// Precondition: t != NoiseType::not_identified.
+constexpr int alpha(NoiseType t) { return 3 - static_cast<int>(t); }
+/// The noise type of alpha in -4..+2; NoiseType::not_identified for any other value.
+constexpr NoiseType noise_type(int alpha) {
+  return alpha < -4 || alpha > 2 ? NoiseType::not_identified : static_cast<NoiseType>(3 - alpha);
+}
+
+enum class NodeState : std::uint8_t {
+  starting = 0,    // configured, no samples yet
+  running = 1,     // samples arriving
+  input_lost = 2,  // no samples during the last report period
+};
+
+/// Unit of every angle on the wire: rates are angle unit per second, Q is in the angle unit.
+enum class AngleUnit : std::uint8_t { pulse = 0, rad = 1, urad = 2, deg = 3, arcsec = 4 };
+
+enum class InputSource : std::uint8_t {
+  unknown = 0,
+  gpio_quadrature = 1,
+  strobe_counter = 2,
+  can_counter = 3,
+  simulated = 4,
+};
+
+enum class DevKind : std::uint8_t { adev = 0, mdev = 1 };  // overlapping Allan, modified Allan
+
+/// IEEE Std 952 gyro error-model terms and their units (A = angle unit, time in s).
+enum class Ieee952Term : std::uint8_t {
+  quantization = 0,       // Q, A
+  angle_random_walk = 1,  // N, A/s^0.5
+  bias_instability = 2,   // B, A/s
+  rate_random_walk = 3,   // K, A/s^1.5
+  rate_ramp = 4,          // R, A/s^2
+};
+
+// ---------------------------------------------------------------------------------------------
+// Messages: one struct per frame kind. seq is the 8-bit report sequence number (wraps); a frame
+// belongs to the report whose status frame has the same seq. Counts are unsigned and saturate at
+// the field's maximum when encoded (see docs/protocol.md for each field's width).
+
+/// Status page 0, the heartbeat: first frame of every report.
+struct StatusMsg {
+  std::uint8_t seq = 0;
+  NodeState state = NodeState::starting;
+  std::uint8_t tau_count = 0;      // taus in this report, 0..max_taus
+  std::uint64_t sample_count = 0;  // tau0 samples since start; 40 bits, saturates
+  bool operator==(const StatusMsg&) const = default;
+};
+
+/// Status page 1: fault counters since start, every report. Each saturates at its maximum.
+struct StatusFaultsMsg {
+  std::uint8_t seq = 0;
+  std::uint32_t lost_edges = 0;         // 16 bits: illegal quadrature transitions, counter errors
+  std::uint32_t sample_gaps = 0;        // 16 bits: gaps in the sample stream (segments started)
+  std::uint32_t tx_dropped_frames = 0;  // 16 bits: report frames the node could not queue
+  std::uint32_t bus_off_events = 0;     // 6 bits
+  bool operator==(const StatusFaultsMsg&) const = default;
+};
+
+/// Tau statistics pages 0 (ADEV) and 1 (MDEV), every report, for every tau.
+struct TauDevMsg {
+  std::uint8_t seq = 0;
+  std::uint8_t tau_index = 0;    // 0..max_taus-1
+  DevKind kind = DevKind::adev;
+  float dev_angle_per_s = 0.0f;  // the deviation, >= 0, finite
+  double edf = 0.0;              // equivalent degrees of freedom; 0 = not available. On the wire as
+                                 // log2(edf) in 1/64 steps, clamped to [2^-3.98, 2^59.98]
+  NoiseType noise = NoiseType::not_identified;
+  bool valid = false;            // false: no estimate yet, or terms were lost (do not plot)
+  bool operator==(const TauDevMsg&) const = default;
+};
+
+/// Tau statistics page 2: number of overlapping Allan terms n, in the slow cycle.
+struct TauTermsMsg {
+  std::uint8_t seq = 0;
+  std::uint8_t tau_index = 0;
+  std::uint64_t n = 0;  // 48 bits, saturates
+  bool operator==(const TauTermsMsg&) const = default;
+};
+
+/// Tau statistics page 3: what tau index i means, in the slow cycle.
+struct TauInfoMsg {
+  std::uint8_t seq = 0;
+  std::uint8_t tau_index = 0;
+  std::uint64_t m = 1;            // tau = m * tau0; 1 <= m < 2^40
+  std::uint8_t stride_log2 = 0;   // terms are formed every 2^stride_log2 samples; 2^stride_log2 divides m
+  bool operator==(const TauInfoMsg&) const = default;
+};
+
+/// Metadata page 0.
+struct MetaSamplingMsg {
+  std::uint8_t seq = 0;
+  float tau0_s = 0.0f;              // sample interval, > 0, finite
+  std::uint16_t stride_factor = 1;  // S, a power of two
+  bool operator==(const MetaSamplingMsg&) const = default;
+};
+
+/// Metadata page 1.
+struct MetaClockMsg {
+  std::uint8_t seq = 0;
+  std::uint64_t uptime_ms = 0;  // 40 bits, saturates
+  std::uint8_t protocol_version = version;  // >= 1
+  bool operator==(const MetaClockMsg&) const = default;
+};
+
+/// Metadata page 2.
+struct MetaScaleMsg {
+  std::uint8_t seq = 0;
+  float angle_per_pulse = 1.0f;  // pulse weight in angle_unit, > 0, finite
+  AngleUnit angle_unit = AngleUnit::pulse;
+  InputSource input_source = InputSource::unknown;
+  bool operator==(const MetaScaleMsg&) const = default;
+};
+
+/// Metadata page 3.
+struct MetaConfigMsg {
+  std::uint8_t seq = 0;
+  std::uint32_t config_hash = 0;        // changes whenever the configuration does
+  std::uint16_t report_period_ms = 1000;  // 100..2000
+  bool operator==(const MetaConfigMsg&) const = default;
+};
+
+/// One IEEE-952 parameter of the latest fit, in the slow cycle.
+struct Ieee952Msg {
+  std::uint8_t seq = 0;
+  Ieee952Term term = Ieee952Term::quantization;
+  bool resolved = false;        // the fit resolved this term (value and uncertainty meaningful)
+  float value = 0.0f;           // >= 0, finite, in the term's unit (see Ieee952Term)
+  double rel_uncertainty = 0.0; // standard uncertainty / value, >= 0; on the wire in 0.01 % steps,
+                                // saturating at 655.35 %
+  bool operator==(const Ieee952Msg&) const = default;
+};
+
+/// Counter input: sent by the gyro's readout electronics to the board once per sample interval.
+struct CounterInputMsg {
+  std::uint32_t count = 0;  // accumulated pulses, wraps modulo 2^32 (differences are signed)
+  std::uint8_t seq = 0;     // +1 per frame, wraps
+  bool count_error = false;       // the electronics lost counts during this interval
+  bool sensor_not_ready = false;  // e.g. dither or laser not locked
+  bool operator==(const CounterInputMsg&) const = default;
+};
+
+using Message = std::variant<StatusMsg, StatusFaultsMsg, TauDevMsg, TauTermsMsg, TauInfoMsg,
+                             MetaSamplingMsg, MetaClockMsg, MetaScaleMsg, MetaConfigMsg, Ieee952Msg,
+                             CounterInputMsg>;
+
+// ---------------------------------------------------------------------------------------------
+// Codec
+
+enum class ProtocolError : std::uint8_t {
+  none = 0,
+  error_frame,    // the controller reported an error frame
+  not_extended,   // 11-bit identifier
+  fd_frame,       // CAN FD frame: protocol version 1 is classic CAN only
+  unknown_id,     // not one of the identifiers above (PGN or priority differ)
+  bad_address,    // node address 0xFE or 0xFF
+  wrong_length,   // data length differs from the frame kind's (8, counter input 6)
+  unknown_page,   // multiplexor value with no layout
+  reserved_bits,  // a reserved bit is set
+  out_of_range,   // a field holds a value outside its range (NaN, negative, zero m, ...)
+};
+
+/// Static name of a value, as in the DBC's VAL_ tables (errors: as spelled above); "invalid" for a
+/// value outside the enumeration. Never null, no allocation.
+const char* name(ProtocolError e);
+const char* name(NoiseType t);
+const char* name(NodeState s);
+const char* name(AngleUnit u);
+const char* name(InputSource s);
+const char* name(Ieee952Term t);
+
+/// Encodes one message sent by node `node` (0..max_node_address) into `frame`: a classic frame with
+/// an extended identifier, 8 data bytes (counter input: 6), unused data bytes zero.
+/// Returns ProtocolError::none, or bad_address / out_of_range when a field cannot be represented,
+/// in which case `frame` is left untouched. Counts saturate instead of failing.
+ProtocolError encode(const StatusMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const StatusFaultsMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const TauDevMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const TauTermsMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const TauInfoMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const MetaSamplingMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const MetaClockMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const MetaScaleMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const MetaConfigMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const Ieee952Msg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const Message& msg, std::uint8_t node, CanFrame& frame);
+
+struct Decoded {
+  ProtocolError error = ProtocolError::none;  // none: node and message are valid
+  std::uint8_t node = 0;                      // sender's address (low byte of the identifier)
+  Message message{};
+};
+
+/// Decodes any frame. Never fails hard: a frame that is not exactly a valid protocol frame gives the
+/// first reason found (in the order of ProtocolError). A frame decode() accepts is canonical:
+/// encode(decoded.message, decoded.node, f) reproduces it bit for bit.
+Decoded decode(const CanFrame& frame);
+
+// ---------------------------------------------------------------------------------------------
+// Report schedule (docs/protocol.md, "Report schedule"). Every report carries the fast frames
+// (status, faults, ADEV and MDEV of every tau); the slow list (metadata, tau info, terms, IEEE-952)
+// is cut into slow_cycle_reports equal parts, one part per report, chosen by seq. Both the node
+// (what to send) and the decoder (what to expect) derive a report's frames from seq and tau count.
+
+inline constexpr std::size_t slow_cycle_reports = 4;
+
+enum class Slot : std::uint8_t {
+  status, faults, adev, mdev, terms, tau_info, sampling, clock, scale, config, ieee952
+};
+struct ReportSlot {
+  Slot slot = Slot::status;
+  std::uint8_t index = 0;  // tau index (adev, mdev, terms, tau_info) or Ieee952Term (ieee952)
+};
+
+/// Number of frames in report `seq` for `tau_count` taus (<= max_taus).
+std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count);
+/// Frame `position` (< report_frame_count()) of report `seq`, in sending order: status, faults,
+/// ADEV and MDEV of tau 0, 1, ..., then this report's part of the slow list.
+ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position);
+
+/// Worst-case bits on the wire of a classic data frame with a 29-bit identifier and `data_bytes`
+/// (<= 8) data bytes, with the maximum number of stuff bits and the 3-bit interframe space:
+/// 67 + 8 data_bytes + floor((53 + 8 data_bytes) / 4); 160 for 8 bytes.
+constexpr std::uint32_t worst_case_frame_bits(std::uint32_t data_bytes) {
+  const std::uint32_t stuffed = 54 + 8 * data_bytes;  // SOF through CRC: the bits stuffing applies to
+  return stuffed + 13 + (stuffed - 1) / 4;            // + CRC delimiter, ACK, EOF, interframe space
+}
+
+/// Worst-case share of a bus of `bitrate_bps` taken by one node reporting `tau_count` taus every
+/// `report_period_s` seconds (the longest report of the slow cycle). O(slow_cycle_reports).
+double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps);
+
+}  // namespace gyrochar::protocol

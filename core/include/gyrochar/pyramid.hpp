@@ -1,0 +1,621 @@
+#pragma once
+// The recursive octave-tau pyramid: streaming overlapping Allan, modified Allan and overlapping
+// Hadamard variances (TVAR derives from MVAR) in fixed memory, with no heap.
+//
+// Notation (phase index e = 0, 1, 2, ...; tau = m * tau0):
+//   x_e     phase (for a gyro: angle; for counts data the accumulated pulses, x_0 = 0)
+//   P_e     prefix sum of phase, P_e = sum_{i<e} x_i
+//   AVAR term   a = x[e] - 2 x[e-m] + x[e-2m]
+//   HVAR term   h = x[e] - 3 x[e-m] + 3 x[e-2m] - x[e-3m]
+//   MVAR term   t = P[e+1] - 3 P[e+1-m] + 3 P[e+1-2m] - P[e+1-3m]
+//                 = sum_{i=j}^{j+m-1} (x[i+2m] - 2 x[i+m] + x[i])  with j = e+1-3m
+//   AVAR = sum a^2 / (2 n tau^2), MVAR = sum t^2 / (2 m^2 n tau^2), HVAR = sum h^2 / (6 n tau^2),
+//   TVAR = tau^2 MVAR / 3.
+//
+// History. Terms for tau = r * 2^L (1 <= r <= S, S the stride factor) are formed every 2^L phase
+// points ("level L"), so their stride is m/S (1 for m <= S: exactly the fully overlapped estimator,
+// with Stable32's number of terms n). They need x and P at ages m, 2m, 3m. Past phase points live in
+// a multi-resolution history: ring level 0 keeps the last 3S points; ring level l >= 1 keeps the
+// multiples of 2^l with ages in (3S 2^(l-1), 3S 2^l], i.e. 3S/2 entries. A point leaving level l
+// moves on to level l+1 if it is a multiple of 2^(l+1). Memory is therefore
+// 3S + (levels - 1) * 3S/2 entries, independent of run length, and the work per point is O(S)
+// amortized (level L runs every 2^L points).
+//
+// Gaps. A gap starts a new segment: no term spans it, sums and term counts go on, so the pooled
+// estimate stays unbiased and n counts only the terms actually formed.
+//
+// Arithmetic policies:
+//   CountArith  integer counts, exact. x is int64, P is a 128-bit two's complement integer, the sums
+//               of squares are unsigned 128-bit. Every term and every sum equals the exact integer
+//               computation whatever the run length, as long as (1) |x| < 2^63 (total pulses),
+//               (2) each term fits in 63 bits plus sign, (3) each sum of squares stays below 2^127.
+//               Each condition is checked: (1) flags the stream, (2) skips the term and counts it in
+//               TauResult::out_of_range, (3) sets TauResult::sum_overflow.
+//   FloatArith  floating phase (files). x is kept relative to a reference line through the first
+//               two points (second and third differences are unchanged by it), P is a double-double
+//               so the third differences of P do not cancel catastrophically; sums are double.
+#include <array>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include <cstring>
+
+#include "gyrochar/crc32.hpp"
+#include "gyrochar/wide.hpp"
+
+namespace gyrochar {
+
+enum class Stat : std::uint8_t { avar = 0, mvar = 1, hvar = 2 };
+inline constexpr std::size_t stat_count = 3;
+
+// ---------------------------------------------------------------------------------------------
+// Arithmetic policies
+
+struct CountArith {
+  struct Entry {
+    std::int64_t x = 0;  // phase x_e in pulses
+    Int128 p;            // P_{e+1} = sum_{i<=e} x_i
+  };
+  using Sum = UInt128;
+  using Increment = std::int32_t;  // pulses per tau0: the exactness bounds rely on |c| < 2^31
+  static constexpr bool exact = true;
+
+  static constexpr Int128 zero_prefix() { return {}; }
+  static constexpr Int128 add_prefix(Int128 p, std::int64_t x) { return p + widen(x); }
+
+  /// Second and third differences of x; false when a value does not fit in int64.
+  static constexpr bool x_terms(std::int64_t x0, std::int64_t x1, std::int64_t x2, std::int64_t x3,
+                                std::int64_t& a, std::int64_t& h) {
+    std::int64_t d1 = 0, d2 = 0, d3 = 0, e2 = 0;
+    unsigned bad = __builtin_sub_overflow(x0, x1, &d1);
+    bad |= __builtin_sub_overflow(x1, x2, &d2);
+    bad |= __builtin_sub_overflow(x2, x3, &d3);
+    bad |= __builtin_sub_overflow(d1, d2, &a);
+    bad |= __builtin_sub_overflow(d2, d3, &e2);
+    bad |= __builtin_sub_overflow(a, e2, &h);
+    return bad == 0;
+  }
+  static constexpr bool x_term2(std::int64_t x0, std::int64_t x1, std::int64_t x2, std::int64_t& a) {
+    std::int64_t d1 = 0, d2 = 0;
+    unsigned bad = __builtin_sub_overflow(x0, x1, &d1);
+    bad |= __builtin_sub_overflow(x1, x2, &d2);
+    bad |= __builtin_sub_overflow(d1, d2, &a);
+    return bad == 0;
+  }
+  /// Third difference of P; false when it does not fit in int64.
+  static constexpr bool p_term(Int128 p0, Int128 p1, Int128 p2, Int128 p3, std::int64_t& t) {
+    const Int128 d = (p0 - p3) + ((p2 - p1) + (p2 - p1) + (p2 - p1));
+    return narrow(d, t);
+  }
+  /// sum += v^2; returns a word whose top bit is set when the sum reached 2^127 (see add_high_word).
+  static constexpr std::uint64_t accumulate(Sum& sum, std::int64_t v) { return add_high_word(sum, square(v)); }
+  static constexpr double to_double(const Sum& s) { return gyrochar::to_double(s); }
+};
+
+struct FloatArith {
+  /// Double-double: value = hi + lo with |lo| <= ulp(hi)/2.
+  struct Prefix {
+    double hi = 0.0;
+    double lo = 0.0;
+  };
+  struct Entry {
+    double x = 0.0;  // phase relative to the reference line
+    Prefix p;        // P_{e+1} relative to the reference line's prefix sums
+  };
+  using Sum = double;
+  using Increment = double;
+  static constexpr bool exact = false;
+
+  static constexpr Prefix zero_prefix() { return {}; }
+
+  static constexpr Prefix add_prefix(Prefix a, double b) {  // Knuth two-sum, then renormalize
+    const double s = a.hi + b;
+    const double bb = s - a.hi;
+    const double err = (a.hi - (s - bb)) + (b - bb);
+    const double lo = a.lo + err;
+    const double hi = s + lo;
+    return {hi, lo - (hi - s)};
+  }
+  static constexpr double diff(Prefix a, Prefix b) { return (a.hi - b.hi) + (a.lo - b.lo); }
+
+  static constexpr bool x_terms(double x0, double x1, double x2, double x3, double& a, double& h) {
+    a = (x0 - x1) - (x1 - x2);
+    h = a - ((x1 - x2) - (x2 - x3));
+    return true;
+  }
+  static constexpr bool x_term2(double x0, double x1, double x2, double& a) {
+    a = (x0 - x1) - (x1 - x2);
+    return true;
+  }
+  static constexpr bool p_term(Prefix p0, Prefix p1, Prefix p2, Prefix p3, double& t) {
+    t = diff(p0, p3) + 3.0 * diff(p2, p1);
+    return true;
+  }
+  static constexpr std::uint64_t accumulate(Sum& sum, double v) {
+    sum += v * v;
+    return 0;
+  }
+  static constexpr double to_double(Sum s) { return s; }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Results
+
+/// Raw statistics of one tau. Variances follow from the sums (see variance()).
+template <class Sum>
+struct TauResult {
+  std::uint64_t m = 0;                         // averaging factor, tau = m * tau0
+  std::array<Sum, stat_count> sum{};           // sums of squared terms, indexed by Stat
+  std::array<std::uint64_t, stat_count> n{};   // number of terms, indexed by Stat
+  std::uint32_t out_of_range = 0;              // terms skipped: value beyond int64 (CountArith)
+  bool sum_overflow = false;                   // a sum of squares reached 2^127 (CountArith)
+};
+
+/// Variance in (phase unit / s)^2 from a TauResult: tau0_s the sample interval, unit the phase unit
+/// per x step (e.g. the pulse weight in rad for counts, 1 for phase in s). Returns 0 when n = 0.
+/// O(1), no allocation. TVAR is tvar_from_mvar().
+template <class Sum>
+constexpr double variance(const TauResult<Sum>& r, Stat stat, double tau0_s, double unit = 1.0) {
+  const auto i = static_cast<std::size_t>(stat);
+  if (r.n[i] == 0) return 0.0;
+  const double m = static_cast<double>(r.m);
+  const double tau = m * tau0_s;
+  double sum = 0.0;
+  if constexpr (sizeof(Sum) == sizeof(UInt128)) {
+    sum = gyrochar::to_double(r.sum[i]);
+  } else {
+    sum = r.sum[i];
+  }
+  const double scale[stat_count] = {2.0, 2.0 * m * m, 6.0};
+  return sum * unit * unit / (scale[i] * static_cast<double>(r.n[i]) * tau * tau);
+}
+
+constexpr double tvar_from_mvar(double mvar, double tau_s) { return tau_s * tau_s * mvar / 3.0; }
+
+// ---------------------------------------------------------------------------------------------
+// The pyramid over caller-owned storage
+
+enum class PyramidStatus : std::uint8_t {
+  ok,
+  bad_stride_factor,     // S must be a power of two, 2 <= S <= storage capacity
+  too_many_taus,         // more taus than the TauState storage holds
+  tau_not_representable, // m must be r * 2^L with r <= S; taus strictly increasing, m >= 1
+  history_too_small,     // storage cannot hold the history for the largest tau at this S
+  nonoverlapping_needs_m_le_s,  // the non-overlapped mode needs every m <= S
+};
+
+enum class RestoreStatus : std::uint8_t {
+  ok,
+  truncated,        // fewer bytes than the checkpoint needs
+  not_a_checkpoint, // wrong magic number
+  wrong_version,    // written by another checkpoint format version
+  corrupted,        // CRC mismatch
+  config_mismatch,  // another arithmetic, stride factor or tau list than the current configuration
+};
+
+struct PyramidConfig {
+  std::uint32_t stride_factor = 8;    // S
+  bool nonoverlapping = false;        // Stable32's non-overlapped ADEV/HDEV: only j = 0, m, 2m, ...
+};
+
+/// Entries of history needed for stride factor S and taus up to m_max. O(log m_max).
+constexpr std::size_t history_entries(std::uint32_t stride_factor, std::uint64_t m_max) {
+  std::size_t levels = 1;
+  while ((std::uint64_t{stride_factor} << (levels - 1)) < m_max) ++levels;
+  return 3u * stride_factor + (levels - 1) * (3u * stride_factor / 2);
+}
+
+template <class Arith>
+class Pyramid;
+
+/// Storage for a StaticPyramid: the history for the worst stride factor and the tau states.
+template <class Arith, unsigned Octaves, std::uint32_t MaxStride, std::size_t MaxTaus>
+struct PyramidStorage {
+  static_assert(Octaves >= 1 && Octaves <= 63, "taus up to 2^62");
+  static_assert(MaxStride >= 2 && std::has_single_bit(MaxStride), "stride factor: power of two >= 2");
+  static constexpr std::size_t history_capacity() {
+    std::size_t most = 0;
+    for (std::uint32_t s = 2; s <= MaxStride; s *= 2) {
+      const std::size_t n = history_entries(s, std::uint64_t{1} << (Octaves - 1));
+      if (n > most) most = n;
+    }
+    return most;
+  }
+  std::array<typename Arith::Entry, history_capacity()> history{};
+  std::array<typename Pyramid<Arith>::TauState, MaxTaus> taus{};
+};
+
+template <class Arith>
+class Pyramid {
+ public:
+  using Entry = typename Arith::Entry;
+  using Sum = typename Arith::Sum;
+  using Result = TauResult<Sum>;
+
+  /// Per-tau state, kept in caller-owned storage.
+  struct TauState {
+    Result result;
+    std::uint8_t level = 0;                   // terms formed when e is a multiple of 2^level
+    std::array<std::uint8_t, 3> ring_of{};    // ring holding the point of age k*m (k = 1..3)
+    std::array<std::uint32_t, 3> back{};      // its slot is head(ring) - back, modulo the ring size
+    std::uint64_t sticky = 0;                 // OR of the sums' high words: bit 63 = overflow
+  };
+
+  /// Binds the pyramid to storage owned by the caller, which must outlive it. No allocation.
+  Pyramid(std::span<Entry> history, std::span<TauState> taus) : history_(history), taus_(taus) {}
+
+  /// Configures the stride factor and the taus (strictly increasing m), and resets all state.
+  /// O(taus + history). Fails (returning why, state unusable until a successful configure) when
+  /// the taus or the stride do not fit the storage.
+  PyramidStatus configure(const PyramidConfig& config, std::span<const std::uint64_t> m_list) {
+    const std::uint32_t s = config.stride_factor;
+    if (s < 2 || !std::has_single_bit(s)) return PyramidStatus::bad_stride_factor;
+    if (m_list.size() > taus_.size()) return PyramidStatus::too_many_taus;
+    stride_ = s;
+    log2_stride_ = static_cast<unsigned>(std::countr_zero(s));
+    nonoverlapping_ = config.nonoverlapping;
+    ntaus_ = m_list.size();
+    unsigned max_level = 0;
+    std::uint64_t previous = 0;
+    for (std::size_t i = 0; i < ntaus_; ++i) {
+      const std::uint64_t m = m_list[i];
+      if (m <= previous || m > (std::uint64_t{1} << 62)) return PyramidStatus::tau_not_representable;
+      previous = m;
+      unsigned level = 0;
+      while ((std::uint64_t{s} << level) < m) ++level;
+      if (level >= 64 || (m & ((std::uint64_t{1} << level) - 1)) != 0)
+        return PyramidStatus::tau_not_representable;
+      if (nonoverlapping_ && level != 0) return PyramidStatus::nonoverlapping_needs_m_le_s;
+      TauState& t = taus_[i];
+      t = TauState{};
+      t.result.m = m;
+      t.level = static_cast<std::uint8_t>(level);
+      for (unsigned k = 1; k <= 3; ++k) {
+        const std::uint64_t age = k * m;
+        unsigned ring = 0;
+        while (3 * (std::uint64_t{s} << ring) < age) ++ring;
+        t.ring_of[k - 1] = static_cast<std::uint8_t>(ring);
+        // Ring 0 holds ages 1..3S: back = age. Ring l >= 1 holds ages (3S/2, 3S] * 2^l, whose
+        // distance in slots, age >> l, exceeds the ring size 3S/2 once: take it off.
+        const std::uint64_t back = ring == 0 ? age : (age >> ring) - 3u * s / 2;
+        t.back[k - 1] = static_cast<std::uint32_t>(back);
+      }
+      if (level > max_level) max_level = level;
+    }
+    ring_levels_ = max_level + 1;
+    fast_count_ = 0;
+    while (!nonoverlapping_ && fast_count_ < ntaus_ && taus_[fast_count_].level == 0 &&
+           (!Arith::exact || taus_[fast_count_].result.m <= fast_m_max))
+      ++fast_count_;
+    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.size())
+      return PyramidStatus::history_too_small;
+    restart();
+    return PyramidStatus::ok;
+  }
+
+  /// Forgets all data (sums, counts, history); keeps the configuration. O(taus).
+  void restart() {
+    for (std::size_t i = 0; i < ntaus_; ++i) {
+      Result& r = taus_[i].result;
+      r.sum = {};
+      r.n = {};
+      r.out_of_range = 0;
+      r.sum_overflow = false;
+      taus_[i].sticky = 0;
+    }
+    run_ = RunState{};
+    run_.steady_from = 3u * stride_;
+  }
+
+  /// Adds the next phase point (floating phase data). O(S) amortized; no allocation; never fails.
+  /// Counts data goes through add_increment(), which keeps the input bounds exactness relies on.
+  void add_phase_point(decltype(Entry{}.x) x)
+    requires(!Arith::exact)
+  {
+    push(x);
+  }
+  /// Adds the next increment of phase: a pulse count per tau0 (CountArith) or frequency * tau0
+  /// (FloatArith). The phase before the first increment of a segment is a phase point too, so N
+  /// increments give N + 1 phase points, as Stable32 treats frequency data. O(S) amortized.
+  /// CountArith: if the accumulated phase would pass 2^63 pulses, a new segment starts from 0 and
+  /// phase_overflowed() turns true.
+  void add_increment(typename Arith::Increment dx) {
+    if (run_.next_e == run_.segment_start) push(run_.x);
+    if constexpr (!Arith::exact) {
+      run_.x += dx;
+    } else {
+      if (__builtin_add_overflow(run_.x, std::int64_t{dx}, &run_.x)) {
+        run_.phase_overflow = true;
+        mark_gap();
+        run_.x = 0;
+        push(run_.x);
+        run_.x = dx;
+      }
+    }
+    push(run_.x);
+  }
+
+  /// The block API: add_increment() for each value of `block`, in order. O(S) amortized per value.
+  template <class T>
+  void add_increments(std::span<const T> block) {
+    for (const T v : block) add_increment(static_cast<typename Arith::Increment>(v));
+  }
+
+  /// Starts a new segment at the next phase point: no term will span the break. O(1).
+  void mark_gap() {
+    run_.segment_start = run_.next_e;
+    run_.steady_from = run_.segment_start + 3u * stride_;
+    run_.p_segment_start = run_.p;
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Checkpoints: the whole state as bytes (native byte order: restore on the same kind of board),
+  // with a format version and a CRC-32 at the end. The caller stores them (atomically).
+
+  static constexpr std::uint32_t checkpoint_magic = 0x43525947;  // "GYRC"
+  static constexpr std::uint16_t checkpoint_version = 1;
+
+  /// Bytes save() writes for the current configuration. O(1).
+  std::size_t checkpoint_size() const {
+    return header_bytes() + ntaus_ * sizeof(std::uint64_t) + sizeof(RunState) +
+           used_history() * sizeof(Entry) + ntaus_ * (sizeof(Result) + sizeof(std::uint64_t)) +
+           sizeof(std::uint32_t);
+  }
+
+  /// Writes the state into `out`; returns the bytes written, 0 when `out` is too small.
+  /// O(history + taus), no allocation, does not disturb accumulation.
+  std::size_t save(std::span<std::byte> out) const {
+    if (out.size() < checkpoint_size()) return 0;
+    std::byte* p = out.data();
+    const Header h = header();
+    p = put(p, &h, sizeof h);
+    for (std::size_t i = 0; i < ntaus_; ++i) p = put(p, &taus_[i].result.m, sizeof(std::uint64_t));
+    p = put(p, &run_, sizeof run_);
+    p = put(p, history_.data(), used_history() * sizeof(Entry));
+    for (std::size_t i = 0; i < ntaus_; ++i) {
+      p = put(p, &taus_[i].result, sizeof(Result));
+      p = put(p, &taus_[i].sticky, sizeof(std::uint64_t));
+    }
+    const std::uint32_t crc = crc32({out.data(), static_cast<std::size_t>(p - out.data())});
+    p = put(p, &crc, sizeof crc);
+    return static_cast<std::size_t>(p - out.data());
+  }
+
+  /// Restores a state written by save() under the same configuration (configure() first).
+  /// On success the restart is a gap: a new segment starts at the next point, sums and counts go
+  /// on. On failure nothing changes. O(history + taus), no allocation.
+  RestoreStatus restore(std::span<const std::byte> in) {
+    Header h{};
+    if (in.size() < sizeof h) return RestoreStatus::truncated;
+    std::memcpy(&h, in.data(), sizeof h);
+    if (h.magic != checkpoint_magic) return RestoreStatus::not_a_checkpoint;
+    if (h.version != checkpoint_version) return RestoreStatus::wrong_version;
+    const Header mine = header();
+    if (h.exact != mine.exact || h.entry_bytes != mine.entry_bytes || h.stride != mine.stride ||
+        h.ntaus != mine.ntaus || h.nonoverlapping != mine.nonoverlapping)
+      return RestoreStatus::config_mismatch;
+    const std::size_t size = checkpoint_size();
+    if (in.size() < size) return RestoreStatus::truncated;
+    std::uint32_t crc = 0;
+    std::memcpy(&crc, in.data() + size - sizeof crc, sizeof crc);
+    if (crc != crc32(in.first(size - sizeof crc))) return RestoreStatus::corrupted;
+    const std::byte* p = in.data() + sizeof h;
+    for (std::size_t i = 0; i < ntaus_; ++i) {
+      std::uint64_t m = 0;
+      p = get(p, &m, sizeof m);
+      if (m != taus_[i].result.m) return RestoreStatus::config_mismatch;
+    }
+    p = get(p, &run_, sizeof run_);
+    p = get(p, history_.data(), used_history() * sizeof(Entry));
+    for (std::size_t i = 0; i < ntaus_; ++i) {
+      p = get(p, &taus_[i].result, sizeof(Result));
+      p = get(p, &taus_[i].sticky, sizeof(std::uint64_t));
+    }
+    mark_gap();
+    return RestoreStatus::ok;
+  }
+
+  /// True once the accumulated pulse count passed 2^63 (CountArith); a gap was inserted there.
+  bool phase_overflowed() const { return run_.phase_overflow; }
+  /// Number of phase points added so far (over all segments).
+  std::uint64_t phase_points() const { return run_.next_e; }
+  std::size_t tau_count() const { return ntaus_; }
+  std::uint32_t stride_factor() const { return stride_; }
+  /// Statistics of tau i (0 <= i < tau_count()), valid at any time. O(1), no allocation.
+  Result result(std::size_t i) const {
+    Result r = taus_[i].result;
+    r.sum_overflow = (taus_[i].sticky >> 63) != 0;
+    return r;
+  }
+  /// Terms of tau i are formed every stride(i) phase points (1: fully overlapped).
+  std::uint64_t stride(std::size_t i) const { return std::uint64_t{1} << taus_[i].level; }
+  /// Copies all tau results into `out` (size >= tau_count()) without disturbing accumulation.
+  /// O(taus), no allocation. Returns the number copied.
+  std::size_t snapshot(std::span<Result> out) const {
+    std::size_t k = 0;
+    for (; k < ntaus_ && k < out.size(); ++k) out[k] = result(k);
+    return k;
+  }
+
+ private:
+  struct Header {
+    std::uint32_t magic = checkpoint_magic;
+    std::uint16_t version = checkpoint_version;
+    std::uint8_t exact = Arith::exact;
+    std::uint8_t nonoverlapping = 0;
+    std::uint32_t entry_bytes = sizeof(Entry);
+    std::uint32_t stride = 0;
+    std::uint64_t ntaus = 0;
+  };
+  Header header() const {
+    Header h;
+    h.nonoverlapping = nonoverlapping_ ? 1 : 0;
+    h.stride = stride_;
+    h.ntaus = ntaus_;
+    return h;
+  }
+  static constexpr std::size_t header_bytes() { return sizeof(Header); }
+  std::size_t used_history() const {
+    return 3u * stride_ + (ring_levels_ - 1) * (3u * stride_ / 2);
+  }
+  static std::byte* put(std::byte* p, const void* from, std::size_t n) {
+    std::memcpy(p, from, n);
+    return p + n;
+  }
+  static const std::byte* get(const std::byte* p, void* to, std::size_t n) {
+    std::memcpy(to, p, n);
+    return p + n;
+  }
+
+  void push(decltype(Entry{}.x) x) {
+    const std::uint64_t e = run_.next_e++;
+    run_.p = Arith::add_prefix(run_.p, x);
+    const Entry current{x, run_.p};
+    // Levels 0 .. countr_zero(e) run at e; their ring heads move on by one slot.
+    const unsigned fired = e == 0 ? 0 : static_cast<unsigned>(std::countr_zero(e)) + 1;
+    const unsigned moved = fired < ring_levels_ ? fired : ring_levels_;
+    for (unsigned ring = 0; ring < moved; ++ring) {
+      if (++run_.head[ring] == ring_size(ring)) run_.head[ring] = 0;
+    }
+    std::size_t i = 0;
+    if (e >= run_.steady_from) {
+      for (; i < fast_count_; ++i) fast_terms(taus_[i], current);
+    }
+    for (; i < ntaus_ && taus_[i].level < fired; ++i) form_terms(taus_[i], e, current);
+    insert(e, current);
+  }
+
+  // Steady state of a ring-0 tau (m <= S, whole history inside the segment). For counts, the input
+  // contract |increment| < 2^31 bounds |x[e] - x[e-k]| by k 2^31, so with m <= 2^15 the AVAR and HVAR
+  // terms stay below 2^50 and the MVAR term below 2m^2 2^31 <= 2^62: no range checks are needed.
+  void fast_terms(TauState& t, const Entry& now) {
+    const std::uint32_t head = run_.head[0], size = 3u * stride_;
+    auto back = [&](std::uint32_t b) -> const Entry& { return history_[head >= b ? head - b : head + size - b]; };
+    const Entry& e1 = back(t.back[0]);
+    const Entry& e2 = back(t.back[1]);
+    const Entry& e3 = back(t.back[2]);
+    Result& r = t.result;
+    const auto d1 = now.x - e1.x, d2 = e1.x - e2.x, d3 = e2.x - e3.x;
+    const auto a = d1 - d2;
+    const auto h = a - (d2 - d3);
+    decltype(Entry{}.x) mt{};
+    Arith::p_term(now.p, e1.p, e2.p, e3.p, mt);
+    t.sticky |= Arith::accumulate(r.sum[0], a) | Arith::accumulate(r.sum[1], mt) |
+                Arith::accumulate(r.sum[2], h);
+    ++r.n[0];
+    ++r.n[1];
+    ++r.n[2];
+  }
+
+  void form_terms(TauState& t, std::uint64_t e, const Entry& now) {
+    const std::uint64_t m = t.result.m;
+    const std::uint64_t span = e - run_.segment_start;  // points of this segment before e
+    if (span < 2 * m) return;
+    if (nonoverlapping_ && e % m != 0) return;
+    const Entry& e1 = at(t, 0);
+    const Entry& e2 = at(t, 1);
+    Result& r = t.result;
+    decltype(Entry{}.x) a{}, h{};
+    if (span < 3 * m) {
+      // Only the AVAR term fits; MVAR may still use P just before the segment start.
+      if (!Arith::x_term2(now.x, e1.x, e2.x, a)) {
+        ++r.out_of_range;
+      } else {
+        t.sticky |= Arith::accumulate(r.sum[0], a);
+        ++r.n[0];
+      }
+      if (span + 1 == 3 * m) mvar_term(t, now.p, e1.p, e2.p, run_.p_segment_start);
+      return;
+    }
+    const Entry& e3 = at(t, 2);
+    if (!Arith::x_terms(now.x, e1.x, e2.x, e3.x, a, h)) {
+      ++r.out_of_range;
+    } else {
+      t.sticky |= Arith::accumulate(r.sum[0], a);
+      ++r.n[0];
+      t.sticky |= Arith::accumulate(r.sum[2], h);
+      ++r.n[2];
+    }
+    mvar_term(t, now.p, e1.p, e2.p, e3.p);
+  }
+
+  template <class P>
+  static void mvar_term(TauState& ts, const P& p0, const P& p1, const P& p2, const P& p3) {
+    decltype(Entry{}.x) term{};
+    if (!Arith::p_term(p0, p1, p2, p3, term)) {
+      ++ts.result.out_of_range;
+      return;
+    }
+    ts.sticky |= Arith::accumulate(ts.result.sum[1], term);
+    ++ts.result.n[1];
+  }
+
+  // Ring 0 holds 3S entries from offset 0; ring l >= 1 holds 3S/2 entries from offset (l+1) 3S/2.
+  // run_.head[l] is the slot of phase point e >> l within ring l, i.e. (e >> l) mod ring_size(l).
+  std::uint32_t ring_size(unsigned ring) const { return ring == 0 ? 3u * stride_ : 3u * stride_ / 2; }
+  std::size_t ring_offset(unsigned ring) const { return ring == 0 ? 0 : (ring + 1) * (3u * stride_ / 2); }
+
+  // The point of age (k+1) m for tau t.
+  const Entry& at(const TauState& t, unsigned k) const {
+    const unsigned ring = t.ring_of[k];
+    const std::uint32_t head = run_.head[ring];
+    const std::uint32_t back = t.back[k];
+    const std::uint32_t slot = head >= back ? head - back : head + ring_size(ring) - back;
+    return history_[ring_offset(ring) + slot];
+  }
+
+  // Stores point e in ring 0; the point it replaces (age 3S) moves on to ring 1 if it is even,
+  // and so on: the point leaving ring l has age 3S 2^l and goes to ring l+1 at its head slot
+  // when it is a multiple of 2^(l+1), which is when e is.
+  void insert(std::uint64_t e, Entry entry) {
+    const std::uint64_t cascade_span = 3u * stride_;  // age at which a point leaves ring 0
+    for (unsigned ring = 0;; ++ring) {
+      Entry& cell = history_[ring_offset(ring) + run_.head[ring]];
+      const Entry evicted = cell;
+      cell = entry;
+      const unsigned next = ring + 1;
+      if (next >= ring_levels_ || (e & ((std::uint64_t{1} << next) - 1)) != 0) return;
+      if (e < (cascade_span << ring)) return;  // the replaced cell was never filled
+      entry = evicted;
+    }
+  }
+
+  std::span<Entry> history_;
+  std::span<TauState> taus_;
+  std::size_t ntaus_ = 0;
+  std::uint32_t stride_ = 8;
+  unsigned log2_stride_ = 3;
+  bool nonoverlapping_ = false;
+  unsigned ring_levels_ = 1;
+  std::size_t fast_count_ = 0;     // leading taus that take fast_terms() in the steady state
+  static constexpr std::uint64_t fast_m_max = std::uint64_t{1} << 15;
+
+  // Everything that changes while data flows (with history_ and the tau states: the checkpoint).
+  struct RunState {
+    std::uint64_t next_e = 0;         // index of the next phase point
+    std::uint64_t segment_start = 0;  // index of the current segment's first point
+    std::uint64_t steady_from = 0;    // from here on fast_terms() applies
+    decltype(Entry{}.p) p{};          // P of the next point
+    decltype(Entry{}.p) p_segment_start{};
+    decltype(Entry{}.x) x{};          // running phase for add_increment()
+    bool phase_overflow = false;
+    std::array<std::uint32_t, 64> head{};  // head[l]: slot of (e >> l) in ring l
+  };
+  RunState run_;
+};
+
+/// A pyramid that owns its storage: capacity fixed at compile time for taus up to 2^(Octaves-1)
+/// with any stride factor 2 <= S <= MaxStride. Not copyable (the base refers to the members).
+template <class Arith, unsigned Octaves, std::uint32_t MaxStride, std::size_t MaxTaus = Octaves>
+class StaticPyramid : private PyramidStorage<Arith, Octaves, MaxStride, MaxTaus>, public Pyramid<Arith> {
+  using Storage = PyramidStorage<Arith, Octaves, MaxStride, MaxTaus>;
+
+ public:
+  StaticPyramid() : Storage{}, Pyramid<Arith>(Storage::history, Storage::taus) {}
+  StaticPyramid(const StaticPyramid&) = delete;
+  StaticPyramid& operator=(const StaticPyramid&) = delete;
+};
+
+}  // namespace gyrochar

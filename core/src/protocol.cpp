@@ -1,0 +1,500 @@
+// The gyrochar CAN codec (docs/protocol.md). Each frame kind has one range check, check(), shared by
+// encode (before packing) and decode (after unpacking), so both accept exactly the same values.
+#include "gyrochar/protocol.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+namespace gyrochar::protocol {
+namespace {
+
+constexpr std::uint8_t report_len = 8;
+constexpr std::uint8_t counter_input_len = 6;
+constexpr std::uint32_t id_mask = 0x1FFFFFFF;
+constexpr std::uint64_t max_m = std::uint64_t{1} << 40;  // m < 2^40
+constexpr unsigned edf_code_bits = 12;
+constexpr double edf_codes_per_octave = 64.0;  // log2(edf) = code / 64 - 4; code 0: not available
+constexpr double edf_log2_offset = -4.0;
+constexpr double rel_uncertainty_step = 1e-4;  // 0.01 %
+constexpr std::uint16_t min_report_period_ms = 100;
+constexpr std::uint16_t max_report_period_ms = 2000;
+
+// --- little-endian fields --------------------------------------------------------------------
+
+void put(CanFrame& f, std::size_t offset, std::size_t bytes, std::uint64_t value) {
+  for (std::size_t i = 0; i < bytes; ++i) f.data[offset + i] = static_cast<std::uint8_t>(value >> (8 * i));
+}
+std::uint64_t get(const CanFrame& f, std::size_t offset, std::size_t bytes) {
+  std::uint64_t value = 0;
+  for (std::size_t i = 0; i < bytes; ++i) value |= std::uint64_t{f.data[offset + i]} << (8 * i);
+  return value;
+}
+void put_float(CanFrame& f, std::size_t offset, float value) { put(f, offset, 4, std::bit_cast<std::uint32_t>(value)); }
+float get_float(const CanFrame& f, std::size_t offset) {
+  return std::bit_cast<float>(static_cast<std::uint32_t>(get(f, offset, 4)));
+}
+std::uint64_t saturate(std::uint64_t value, unsigned bits) {
+  const std::uint64_t max = (std::uint64_t{1} << bits) - 1;
+  return value < max ? value : max;
+}
+std::uint8_t u8(unsigned value) { return static_cast<std::uint8_t>(value); }
+template <class E>
+unsigned code(E e) { return static_cast<unsigned>(e); }
+
+CanFrame blank(std::uint32_t base, std::uint8_t node, std::uint8_t len) {
+  CanFrame f;
+  f.id = frame_id(base, node);
+  f.extended = true;
+  f.len = len;
+  return f;
+}
+
+// --- quantized fields ------------------------------------------------------------------------
+
+std::uint16_t edf_code(double edf) {
+  if (edf == 0.0) return 0;
+  const double c = std::round(edf_codes_per_octave * (std::log2(edf) - edf_log2_offset));
+  const double max = double((1u << edf_code_bits) - 1);
+  return static_cast<std::uint16_t>(c < 1.0 ? 1.0 : c > max ? max : c);
+}
+double edf_from_code(unsigned c) {
+  return c == 0 ? 0.0 : std::exp2(c / edf_codes_per_octave + edf_log2_offset);
+}
+std::uint16_t rel_uncertainty_code(double rel) {
+  const double c = std::round(rel / rel_uncertainty_step);
+  return static_cast<std::uint16_t>(c > 65535.0 ? 65535.0 : c);
+}
+
+// --- ranges, shared by encode and decode -----------------------------------------------------
+
+bool nonnegative(double v) { return std::isfinite(v) && v >= 0.0; }
+bool positive(double v) { return std::isfinite(v) && v > 0.0; }
+constexpr ProtocolError ok_if(bool in_range) {
+  return in_range ? ProtocolError::none : ProtocolError::out_of_range;
+}
+
+ProtocolError check(const StatusMsg& m) {
+  return ok_if(m.state <= NodeState::input_lost && m.tau_count <= max_taus);
+}
+ProtocolError check(const StatusFaultsMsg&) { return ProtocolError::none; }
+ProtocolError check(const TauDevMsg& m) {
+  return ok_if(m.tau_index < max_taus && m.kind <= DevKind::mdev && nonnegative(m.dev_angle_per_s) &&
+               nonnegative(m.edf) && m.noise <= NoiseType::random_run_fm);
+}
+ProtocolError check(const TauTermsMsg& m) { return ok_if(m.tau_index < max_taus); }
+ProtocolError check(const TauInfoMsg& m) {
+  return ok_if(m.tau_index < max_taus && m.m >= 1 && m.m < max_m && m.stride_log2 < 40 &&
+               (m.m & ((std::uint64_t{1} << m.stride_log2) - 1)) == 0);
+}
+ProtocolError check(const MetaSamplingMsg& m) {
+  return ok_if(positive(m.tau0_s) && std::has_single_bit(m.stride_factor));
+}
+ProtocolError check(const MetaClockMsg& m) { return ok_if(m.protocol_version >= 1); }
+ProtocolError check(const MetaScaleMsg& m) {
+  return ok_if(positive(m.angle_per_pulse) && m.angle_unit <= AngleUnit::arcsec &&
+               m.input_source <= InputSource::simulated);
+}
+ProtocolError check(const MetaConfigMsg& m) {
+  return ok_if(m.report_period_ms >= min_report_period_ms && m.report_period_ms <= max_report_period_ms);
+}
+ProtocolError check(const Ieee952Msg& m) {
+  return ok_if(m.term <= Ieee952Term::rate_ramp && nonnegative(m.value) && !std::isnan(m.rel_uncertainty) &&
+               m.rel_uncertainty >= 0.0);
+}
+ProtocolError check(const CounterInputMsg&) { return ProtocolError::none; }
+
+// --- encoding --------------------------------------------------------------------------------
+
+/// Checks node and ranges, then packs with `pack` into a fresh frame that replaces `frame`.
+template <class Msg, class Pack>
+ProtocolError encode_with(const Msg& msg, std::uint8_t node, std::uint32_t base, std::uint8_t len,
+                          CanFrame& frame, Pack pack) {
+  if (node > max_node_address) return ProtocolError::bad_address;
+  if (const ProtocolError e = check(msg); e != ProtocolError::none) return e;
+  CanFrame f = blank(base, node, len);
+  pack(f);
+  frame = f;
+  return ProtocolError::none;
+}
+
+// Report frames: byte 0 bits 0-1 are the page (multiplexor), byte 1 is seq.
+void header(CanFrame& f, unsigned page, unsigned upper_bits, std::uint8_t seq) {
+  f.data[0] = u8(page | upper_bits << 2);
+  f.data[1] = seq;
+}
+
+// --- decoding --------------------------------------------------------------------------------
+
+template <class Msg>
+ProtocolError accept(const Msg& msg, Message& out) {
+  const ProtocolError e = check(msg);
+  if (e == ProtocolError::none) out = msg;
+  return e;
+}
+
+ProtocolError decode_status(const CanFrame& f, Message& out) {
+  const unsigned page = f.data[0] & 3u;
+  if (page == 0) {
+    if (f.data[0] & 0xF0u) return ProtocolError::reserved_bits;
+    StatusMsg m;
+    m.seq = f.data[1];
+    m.state = static_cast<NodeState>(f.data[0] >> 2 & 3u);
+    m.tau_count = f.data[2];
+    m.sample_count = get(f, 3, 5);
+    return accept(m, out);
+  }
+  if (page == 1) {
+    StatusFaultsMsg m;
+    m.seq = f.data[1];
+    m.bus_off_events = f.data[0] >> 2u;
+    m.lost_edges = static_cast<std::uint32_t>(get(f, 2, 2));
+    m.sample_gaps = static_cast<std::uint32_t>(get(f, 4, 2));
+    m.tx_dropped_frames = static_cast<std::uint32_t>(get(f, 6, 2));
+    return accept(m, out);
+  }
+  return ProtocolError::unknown_page;
+}
+
+ProtocolError decode_tau_stats(const CanFrame& f, Message& out) {
+  const unsigned page = f.data[0] & 3u;
+  const auto tau_index = u8(f.data[0] >> 2u);
+  if (page <= 1) {
+    const auto tail = static_cast<unsigned>(get(f, 6, 2));
+    TauDevMsg m;
+    m.seq = f.data[1];
+    m.tau_index = tau_index;
+    m.kind = static_cast<DevKind>(page);
+    m.dev_angle_per_s = get_float(f, 2);
+    m.edf = edf_from_code(tail & 0xFFFu);
+    m.noise = static_cast<NoiseType>(tail >> 12 & 7u);
+    m.valid = (tail >> 15) != 0;
+    return accept(m, out);
+  }
+  if (page == 2) {
+    TauTermsMsg m;
+    m.seq = f.data[1];
+    m.tau_index = tau_index;
+    m.n = get(f, 2, 6);
+    return accept(m, out);
+  }
+  TauInfoMsg m;
+  m.seq = f.data[1];
+  m.tau_index = tau_index;
+  m.m = get(f, 2, 5);
+  m.stride_log2 = f.data[7];
+  return accept(m, out);
+}
+
+ProtocolError decode_metadata(const CanFrame& f, Message& out) {
+  if (f.data[0] & 0xFCu) return ProtocolError::reserved_bits;
+  switch (f.data[0] & 3u) {
+    case 0: {
+      MetaSamplingMsg m;
+      m.seq = f.data[1];
+      m.tau0_s = get_float(f, 2);
+      m.stride_factor = static_cast<std::uint16_t>(get(f, 6, 2));
+      return accept(m, out);
+    }
+    case 1: {
+      MetaClockMsg m;
+      m.seq = f.data[1];
+      m.uptime_ms = get(f, 2, 5);
+      m.protocol_version = f.data[7];
+      return accept(m, out);
+    }
+    case 2: {
+      MetaScaleMsg m;
+      m.seq = f.data[1];
+      m.angle_per_pulse = get_float(f, 2);
+      m.angle_unit = static_cast<AngleUnit>(f.data[6]);
+      m.input_source = static_cast<InputSource>(f.data[7]);
+      return accept(m, out);
+    }
+    default: {
+      MetaConfigMsg m;
+      m.seq = f.data[1];
+      m.config_hash = static_cast<std::uint32_t>(get(f, 2, 4));
+      m.report_period_ms = static_cast<std::uint16_t>(get(f, 6, 2));
+      return accept(m, out);
+    }
+  }
+}
+
+ProtocolError decode_ieee952(const CanFrame& f, Message& out) {
+  const unsigned term = f.data[0] & 7u;
+  if (term > code(Ieee952Term::rate_ramp)) return ProtocolError::unknown_page;
+  if (f.data[0] & 0xF0u) return ProtocolError::reserved_bits;
+  Ieee952Msg m;
+  m.seq = f.data[1];
+  m.term = static_cast<Ieee952Term>(term);
+  m.resolved = (f.data[0] & 8u) != 0;
+  m.value = get_float(f, 2);
+  m.rel_uncertainty = static_cast<double>(get(f, 6, 2)) * rel_uncertainty_step;
+  return accept(m, out);
+}
+
+ProtocolError decode_counter_input(const CanFrame& f, Message& out) {
+  if (f.data[5] & 0xFCu) return ProtocolError::reserved_bits;
+  CounterInputMsg m;
+  m.count = static_cast<std::uint32_t>(get(f, 0, 4));
+  m.seq = f.data[4];
+  m.count_error = (f.data[5] & 1u) != 0;
+  m.sensor_not_ready = (f.data[5] & 2u) != 0;
+  return accept(m, out);
+}
+
+}  // namespace
+
+// --- names -----------------------------------------------------------------------------------
+
+const char* name(ProtocolError e) {
+  switch (e) {
+    case ProtocolError::none: return "none";
+    case ProtocolError::error_frame: return "error_frame";
+    case ProtocolError::not_extended: return "not_extended";
+    case ProtocolError::fd_frame: return "fd_frame";
+    case ProtocolError::unknown_id: return "unknown_id";
+    case ProtocolError::bad_address: return "bad_address";
+    case ProtocolError::wrong_length: return "wrong_length";
+    case ProtocolError::unknown_page: return "unknown_page";
+    case ProtocolError::reserved_bits: return "reserved_bits";
+    case ProtocolError::out_of_range: return "out_of_range";
+  }
+  return "invalid";
+}
+
+const char* name(NoiseType t) {
+  switch (t) {
+    case NoiseType::not_identified: return "not_identified";
+    case NoiseType::white_pm: return "white_pm";
+    case NoiseType::flicker_pm: return "flicker_pm";
+    case NoiseType::white_fm: return "white_fm";
+    case NoiseType::flicker_fm: return "flicker_fm";
+    case NoiseType::random_walk_fm: return "random_walk_fm";
+    case NoiseType::flicker_walk_fm: return "flicker_walk_fm";
+    case NoiseType::random_run_fm: return "random_run_fm";
+  }
+  return "invalid";
+}
+
+const char* name(NodeState s) {
+  switch (s) {
+    case NodeState::starting: return "starting";
+    case NodeState::running: return "running";
+    case NodeState::input_lost: return "input_lost";
+  }
+  return "invalid";
+}
+
+const char* name(AngleUnit u) {
+  switch (u) {
+    case AngleUnit::pulse: return "pulse";
+    case AngleUnit::rad: return "rad";
+    case AngleUnit::urad: return "urad";
+    case AngleUnit::deg: return "deg";
+    case AngleUnit::arcsec: return "arcsec";
+  }
+  return "invalid";
+}
+
+const char* name(InputSource s) {
+  switch (s) {
+    case InputSource::unknown: return "unknown";
+    case InputSource::gpio_quadrature: return "gpio_quadrature";
+    case InputSource::strobe_counter: return "strobe_counter";
+    case InputSource::can_counter: return "can_counter";
+    case InputSource::simulated: return "simulated";
+  }
+  return "invalid";
+}
+
+const char* name(Ieee952Term t) {
+  switch (t) {
+    case Ieee952Term::quantization: return "Q_quantization";
+    case Ieee952Term::angle_random_walk: return "N_angle_random_walk";
+    case Ieee952Term::bias_instability: return "B_bias_instability";
+    case Ieee952Term::rate_random_walk: return "K_rate_random_walk";
+    case Ieee952Term::rate_ramp: return "R_rate_ramp";
+  }
+  return "invalid";
+}
+
+// --- encode ----------------------------------------------------------------------------------
+
+ProtocolError encode(const StatusMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, status_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 0, code(msg.state), msg.seq);
+    f.data[2] = msg.tau_count;
+    put(f, 3, 5, saturate(msg.sample_count, 40));
+  });
+}
+
+ProtocolError encode(const StatusFaultsMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, status_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 1, static_cast<unsigned>(saturate(msg.bus_off_events, 6)), msg.seq);
+    put(f, 2, 2, saturate(msg.lost_edges, 16));
+    put(f, 4, 2, saturate(msg.sample_gaps, 16));
+    put(f, 6, 2, saturate(msg.tx_dropped_frames, 16));
+  });
+}
+
+ProtocolError encode(const TauDevMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, tau_stats_id, report_len, frame, [&](CanFrame& f) {
+    header(f, code(msg.kind), msg.tau_index, msg.seq);
+    put_float(f, 2, msg.dev_angle_per_s);
+    put(f, 6, 2, edf_code(msg.edf) | code(msg.noise) << 12 | (msg.valid ? 1u : 0u) << 15);
+  });
+}
+
+ProtocolError encode(const TauTermsMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, tau_stats_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 2, msg.tau_index, msg.seq);
+    put(f, 2, 6, saturate(msg.n, 48));
+  });
+}
+
+ProtocolError encode(const TauInfoMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, tau_stats_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 3, msg.tau_index, msg.seq);
+    put(f, 2, 5, msg.m);
+    f.data[7] = msg.stride_log2;
+  });
+}
+
+ProtocolError encode(const MetaSamplingMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, metadata_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 0, 0, msg.seq);
+    put_float(f, 2, msg.tau0_s);
+    put(f, 6, 2, msg.stride_factor);
+  });
+}
+
+ProtocolError encode(const MetaClockMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, metadata_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 1, 0, msg.seq);
+    put(f, 2, 5, saturate(msg.uptime_ms, 40));
+    f.data[7] = msg.protocol_version;
+  });
+}
+
+ProtocolError encode(const MetaScaleMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, metadata_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 2, 0, msg.seq);
+    put_float(f, 2, msg.angle_per_pulse);
+    f.data[6] = u8(code(msg.angle_unit));
+    f.data[7] = u8(code(msg.input_source));
+  });
+}
+
+ProtocolError encode(const MetaConfigMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, metadata_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 3, 0, msg.seq);
+    put(f, 2, 4, msg.config_hash);
+    put(f, 6, 2, msg.report_period_ms);
+  });
+}
+
+ProtocolError encode(const Ieee952Msg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, ieee952_id, report_len, frame, [&](CanFrame& f) {
+    f.data[0] = u8(code(msg.term) | (msg.resolved ? 8u : 0u));
+    f.data[1] = msg.seq;
+    put_float(f, 2, msg.value);
+    put(f, 6, 2, rel_uncertainty_code(msg.rel_uncertainty));
+  });
+}
+
+ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, counter_input_id, counter_input_len, frame, [&](CanFrame& f) {
+    put(f, 0, 4, msg.count);
+    f.data[4] = msg.seq;
+    f.data[5] = u8((msg.count_error ? 1u : 0u) | (msg.sensor_not_ready ? 2u : 0u));
+  });
+}
+
+ProtocolError encode(const Message& msg, std::uint8_t node, CanFrame& frame) {
+  return std::visit([&](const auto& m) { return encode(m, node, frame); }, msg);
+}
+
+// --- decode ----------------------------------------------------------------------------------
+
+Decoded decode(const CanFrame& frame) {
+  Decoded out;
+  const auto fail = [&](ProtocolError e) {
+    out.error = e;
+    return out;
+  };
+  if (frame.error) return fail(ProtocolError::error_frame);
+  if (!frame.extended) return fail(ProtocolError::not_extended);
+  if (frame.fd) return fail(ProtocolError::fd_frame);
+  const std::uint32_t base = frame.id & ~std::uint32_t{0xFF};
+  const bool known = frame.id <= id_mask && (base == status_id || base == tau_stats_id ||
+                                             base == metadata_id || base == ieee952_id ||
+                                             base == counter_input_id);
+  if (!known) return fail(ProtocolError::unknown_id);
+  out.node = u8(frame.id & 0xFFu);
+  if (out.node > max_node_address) return fail(ProtocolError::bad_address);
+  const std::uint8_t len = base == counter_input_id ? counter_input_len : report_len;
+  if (frame.len != len) return fail(ProtocolError::wrong_length);
+  switch (base) {
+    case status_id: out.error = decode_status(frame, out.message); break;
+    case tau_stats_id: out.error = decode_tau_stats(frame, out.message); break;
+    case metadata_id: out.error = decode_metadata(frame, out.message); break;
+    case ieee952_id: out.error = decode_ieee952(frame, out.message); break;
+    default: out.error = decode_counter_input(frame, out.message); break;
+  }
+  return out;
+}
+
+// --- schedule and bus load -------------------------------------------------------------------
+
+namespace {
+constexpr std::size_t fast_frames(std::size_t tau_count) { return 2 + 2 * tau_count; }
+constexpr std::size_t metadata_pages = 4;
+constexpr std::size_t ieee952_terms = 5;
+constexpr std::size_t slow_list_length(std::size_t tau_count) { return metadata_pages + 2 * tau_count + ieee952_terms; }
+constexpr std::size_t slow_part_length(std::size_t tau_count) {
+  return (slow_list_length(tau_count) + slow_cycle_reports - 1) / slow_cycle_reports;
+}
+std::size_t slow_part_begin(std::uint8_t seq, std::size_t tau_count) {
+  return seq % slow_cycle_reports * slow_part_length(tau_count);
+}
+
+/// Entry j of the slow list: metadata pages, tau info for every tau, terms for every tau, IEEE-952.
+ReportSlot slow_slot(std::size_t j, std::size_t tau_count) {
+  if (j < metadata_pages) {
+    constexpr Slot pages[metadata_pages] = {Slot::sampling, Slot::clock, Slot::scale, Slot::config};
+    return {pages[j], 0};
+  }
+  j -= metadata_pages;
+  if (j < tau_count) return {Slot::tau_info, u8(static_cast<unsigned>(j))};
+  j -= tau_count;
+  if (j < tau_count) return {Slot::terms, u8(static_cast<unsigned>(j))};
+  return {Slot::ieee952, u8(static_cast<unsigned>(j - tau_count))};
+}
+}  // namespace
+
+std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count) {
+  const std::size_t begin = slow_part_begin(seq, tau_count);
+  const std::size_t total = slow_list_length(tau_count);
+  const std::size_t part = begin >= total ? 0 : std::min(slow_part_length(tau_count), total - begin);
+  return fast_frames(tau_count) + part;
+}
+
+ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position) {
+  if (position == 0) return {Slot::status, 0};
+  if (position == 1) return {Slot::faults, 0};
+  if (position < fast_frames(tau_count)) {
+    const std::size_t k = position - 2;
+    return {k % 2 == 0 ? Slot::adev : Slot::mdev, u8(static_cast<unsigned>(k / 2))};
+  }
+  return slow_slot(slow_part_begin(seq, tau_count) + position - fast_frames(tau_count), tau_count);
+}
+
+double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps) {
+  std::size_t frames = 0;
+  for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) frames = std::max(frames, report_frame_count(seq, tau_count));
+  return static_cast<double>(frames) * worst_case_frame_bits(report_len) / report_period_s / bitrate_bps;
+}
+
+}  // namespace gyrochar::protocol

@@ -1,0 +1,68 @@
+#include "hal/fake/fake_can_bus.hpp"
+
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace gyrochar::hal {
+
+std::unique_ptr<FakeCanNode> FakeCanBus::attach(std::size_t rx_capacity) {
+  auto node = std::unique_ptr<FakeCanNode>(new FakeCanNode(*this, rx_capacity));
+  nodes_.push_back(node.get());
+  return node;
+}
+
+void FakeCanBus::deliver(const FakeCanNode* from, const CanFrame& frame) {
+  ++frames_;
+  for (FakeCanNode* n : nodes_) {
+    if (n == from) continue;
+    if (loss_ > 0 && std::uniform_real_distribution<double>(0, 1)(rng_) < loss_) continue;
+    n->push(frame);
+  }
+}
+
+void FakeCanBus::detach(FakeCanNode* node) { nodes_.erase(std::remove(nodes_.begin(), nodes_.end(), node), nodes_.end()); }
+
+FakeCanNode::FakeCanNode(FakeCanBus& bus, std::size_t rx_capacity) : bus_(bus), capacity_(rx_capacity) {
+  event_fd_ = eventfd(0, EFD_NONBLOCK | EFD_SEMAPHORE | EFD_CLOEXEC);
+  if (event_fd_ < 0) throw std::runtime_error("eventfd failed");
+}
+
+FakeCanNode::~FakeCanNode() {
+  bus_.detach(this);
+  if (event_fd_ >= 0) close(event_fd_);
+}
+
+SendResult FakeCanNode::send(const CanFrame& frame) {
+  if (bus_.down()) {
+    ++counters_.tx_dropped;
+    return SendResult::bus_down;
+  }
+  ++counters_.sent;
+  bus_.deliver(this, frame);
+  return SendResult::sent;
+}
+
+void FakeCanNode::push(const CanFrame& frame) {
+  if (rx_.size() >= capacity_) {
+    ++counters_.rx_dropped;
+    return;
+  }
+  rx_.push_back(frame);
+  const std::uint64_t one = 1;
+  [[maybe_unused]] const auto n = write(event_fd_, &one, sizeof one);
+}
+
+std::optional<CanFrame> FakeCanNode::receive() {
+  if (rx_.empty()) return std::nullopt;
+  std::uint64_t value = 0;
+  [[maybe_unused]] const auto n = read(event_fd_, &value, sizeof value);
+  CanFrame f = rx_.front();
+  rx_.pop_front();
+  ++counters_.received;
+  return f;
+}
+
+}  // namespace gyrochar::hal

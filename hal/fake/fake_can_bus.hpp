@@ -1,0 +1,62 @@
+#pragma once
+// An in-process CAN bus for host simulation and tests: any number of nodes attach to one bus and
+// each sees the others' frames (not its own, like a CAN controller without loopback). Loss and
+// bus-down are injected deterministically (seeded); each node has a bounded receive queue whose
+// overflows are counted, and an eventfd that is readable while frames wait, so the same epoll
+// loop runs on it as on SocketCAN.
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "hal/can_bus.hpp"
+
+namespace gyrochar::hal {
+
+class FakeCanNode;
+
+class FakeCanBus {
+ public:
+  explicit FakeCanBus(std::uint64_t seed = 1) : rng_(seed) {}
+  /// A new node on this bus; the bus must outlive it.
+  std::unique_ptr<FakeCanNode> attach(std::size_t rx_capacity = 4096);
+  /// Drops each frame with this probability (0..1).
+  void set_loss(double probability) { loss_ = probability; }
+  /// Takes the bus down (sends fail with bus_down) or brings it back.
+  void set_down(bool down) { down_ = down; }
+  bool down() const { return down_; }
+  std::uint64_t frames_on_bus() const { return frames_; }
+
+ private:
+  friend class FakeCanNode;
+  void deliver(const FakeCanNode* from, const CanFrame& frame);
+  void detach(FakeCanNode* node);
+  std::vector<FakeCanNode*> nodes_;
+  std::mt19937_64 rng_;
+  double loss_ = 0.0;
+  bool down_ = false;
+  std::uint64_t frames_ = 0;
+};
+
+class FakeCanNode final : public CanBus {
+ public:
+  ~FakeCanNode() override;
+  SendResult send(const CanFrame& frame) override;
+  std::optional<CanFrame> receive() override;
+  int fd() const override { return event_fd_; }
+  BusState state() const override { return bus_.down() ? BusState::down : BusState::active; }
+  const CanCounters& counters() const override { return counters_; }
+
+ private:
+  friend class FakeCanBus;
+  FakeCanNode(FakeCanBus& bus, std::size_t rx_capacity);
+  void push(const CanFrame& frame);
+  FakeCanBus& bus_;
+  std::size_t capacity_;
+  std::deque<CanFrame> rx_;
+  CanCounters counters_;
+  int event_fd_ = -1;
+};
+
+}  // namespace gyrochar::hal

@@ -1,0 +1,113 @@
+#include "hal/linux/socketcan.hpp"
+
+#include <linux/can.h>
+#include <linux/can/error.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+namespace gyrochar::hal {
+
+SocketCan::SocketCan(const std::string& interface) {
+  if (interface.empty() || interface.size() >= IFNAMSIZ)
+    throw std::runtime_error(interface + ": not a valid interface name");
+  fd_ = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+  if (fd_ < 0) throw std::runtime_error(std::string("cannot open a CAN socket: ") + std::strerror(errno));
+  ifreq ifr{};
+  std::strncpy(ifr.ifr_name, interface.c_str(), IFNAMSIZ - 1);
+  if (ioctl(fd_, SIOCGIFINDEX, &ifr) < 0) {
+    const int e = errno;
+    close(fd_);
+    throw std::runtime_error(interface + ": " + std::strerror(e));
+  }
+  const can_err_mask_t errors = CAN_ERR_MASK;
+  setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &errors, sizeof errors);
+  const int on = 1;
+  setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on);
+  setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on);  // refused on classic-only: fine
+  sockaddr_can addr{};
+  addr.can_family = AF_CAN;
+  addr.can_ifindex = ifr.ifr_ifindex;
+  if (bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) {
+    const int e = errno;
+    close(fd_);
+    throw std::runtime_error(interface + ": " + std::strerror(e));
+  }
+}
+
+SocketCan::~SocketCan() {
+  if (fd_ >= 0) close(fd_);
+}
+
+SendResult SocketCan::send(const CanFrame& f) {
+  canfd_frame raw{};
+  raw.can_id = f.id | (f.extended ? CAN_EFF_FLAG : 0u);
+  raw.len = f.len;
+  std::memcpy(raw.data, f.data.data(), f.len);
+  const std::size_t size = f.fd ? CANFD_MTU : CAN_MTU;
+  if (write(fd_, &raw, size) == static_cast<ssize_t>(size)) {
+    ++counters_.sent;
+    if (state_ == BusState::down) state_ = BusState::active;
+    return SendResult::sent;
+  }
+  ++counters_.tx_dropped;
+  if (errno == ENETDOWN || errno == ENXIO || errno == ENODEV) {
+    state_ = BusState::down;
+    return SendResult::bus_down;
+  }
+  return SendResult::queue_full;
+}
+
+std::optional<CanFrame> SocketCan::receive() {
+  canfd_frame raw{};
+  iovec iov{&raw, sizeof raw};
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(std::uint32_t))];
+  msghdr msg{};
+  msg.msg_iov = &iov;
+  msg.msg_iovlen = 1;
+  msg.msg_control = control;
+  msg.msg_controllen = sizeof control;
+  const ssize_t n = recvmsg(fd_, &msg, MSG_DONTWAIT);
+  if (n < static_cast<ssize_t>(CAN_MTU)) {
+    if (n < 0 && (errno == ENETDOWN || errno == ENODEV)) state_ = BusState::down;
+    return std::nullopt;
+  }
+  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
+    if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+      std::uint32_t dropped = 0;
+      std::memcpy(&dropped, CMSG_DATA(c), sizeof dropped);
+      counters_.rx_dropped = dropped;  // the kernel's running total for this socket
+    }
+  }
+  CanFrame f;
+  f.fd = n == static_cast<ssize_t>(CANFD_MTU);
+  f.extended = (raw.can_id & CAN_EFF_FLAG) != 0;
+  f.error = (raw.can_id & CAN_ERR_FLAG) != 0;
+  f.id = raw.can_id & (f.extended || f.error ? CAN_EFF_MASK : CAN_SFF_MASK);
+  f.len = raw.len > 64 ? 64 : raw.len;
+  std::memcpy(f.data.data(), raw.data, f.len);
+  if (f.error) {
+    ++counters_.error_frames;
+    if (f.id & CAN_ERR_BUSOFF) {
+      if (state_ != BusState::bus_off) ++counters_.bus_off_events;
+      state_ = BusState::bus_off;
+    } else if (f.id & CAN_ERR_RESTARTED) {
+      state_ = BusState::active;
+    } else if ((f.id & CAN_ERR_CRTL) && f.len > 1) {
+      if (raw.data[1] & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE)) state_ = BusState::passive;
+      else if (raw.data[1] & (CAN_ERR_CRTL_RX_WARNING | CAN_ERR_CRTL_TX_WARNING)) state_ = BusState::warning;
+      else if (raw.data[1] & CAN_ERR_CRTL_ACTIVE) state_ = BusState::active;
+    }
+  } else {
+    ++counters_.received;
+  }
+  return f;
+}
+
+}  // namespace gyrochar::hal

@@ -1,0 +1,33 @@
+#pragma once
+// Raw SocketCAN backend of hal::CanBus: non-blocking socket bound to one interface, error frames
+// enabled (bus state and bus-off events), SO_RXQ_OVFL for receive-queue drops, CAN FD frames
+// accepted where the interface allows. A full TX queue (ENOBUFS/EAGAIN) and a downed interface
+// (ENETDOWN) are counted, never waited for.
+#include <string>
+
+#include "hal/can_bus.hpp"
+
+namespace gyrochar::hal {
+
+class SocketCan final : public CanBus {
+ public:
+  /// Opens `interface` (e.g. "can0", "vcan0"). Throws std::runtime_error with the system's reason
+  /// when the interface does not exist or the socket cannot be made.
+  explicit SocketCan(const std::string& interface);
+  ~SocketCan() override;
+  SocketCan(const SocketCan&) = delete;
+  SocketCan& operator=(const SocketCan&) = delete;
+
+  SendResult send(const CanFrame& frame) override;
+  std::optional<CanFrame> receive() override;
+  int fd() const override { return fd_; }
+  BusState state() const override { return state_; }
+  const CanCounters& counters() const override { return counters_; }
+
+ private:
+  int fd_ = -1;
+  BusState state_ = BusState::active;
+  CanCounters counters_;
+};
+
+}  // namespace gyrochar::hal

@@ -1,0 +1,345 @@
+// gyrochar-analyze: Allan-family deviations of a recorded file, with EDF, confidence intervals,
+// noise identification and the IEEE-952 fit, computed by the same streaming core as the board.
+// This file is the command line: options, the read passes, progress and exit codes. The engine is
+// host_tools/lib/analysis.*, the output formats host_tools/lib/analysis_report.*.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "analysis.hpp"
+#include "analysis_report.hpp"
+#include "datafile.hpp"
+
+namespace {
+
+using namespace gyrochar;
+
+constexpr int exit_internal = 1;   // a bug or resource exhaustion
+constexpr int exit_bad_input = 2;  // bad options or data
+constexpr int exit_output = 3;     // the results could not be written
+
+bool progress_line_open = false;  // a progress line without its newline is on stderr
+
+[[noreturn]] void fail(int code, const std::string& what, const std::string& why) {
+  if (progress_line_open) std::fputc('\n', stderr);
+  std::fprintf(stderr, "gyrochar-analyze: %s: %s\n", what.c_str(), why.c_str());
+  std::exit(code);
+}
+[[noreturn]] void bad(const std::string& what, const std::string& why) { fail(exit_bad_input, what, why); }
+
+constexpr const char* footer = R"(Data type and units (the type is required: for a gyro "frequency" is rate and "phase" is angle):
+  --type phase   phase samples: --unit s (clock phase, the default; deviations as fractional
+                 frequency, TDEV in s) or an angle unit rad, mrad, urad, deg, arcsec (gyro angle)
+  --type freq    frequency samples, each the average over tau0: --unit 1 (fractional, the default),
+                 Hz with --nominal-hz F0 (y = (f - F0)/F0), or a rate unit deg/h, deg/s, rad/s
+  --type counts  integer pulses per tau0 (exact arithmetic); --pulse-weight gives the angle of one
+                 pulse with its unit: 1.5arcsec, "0.5 urad", or 1.5 with --pulse-unit arcsec
+  Gyro data (angle, rate, counts) come out in --rate-unit (TDEV in deg/h -> arcsec, deg/s -> deg,
+  rad/s -> rad); IEEE-952 parameters in Q arcsec, N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h/h.
+
+Input: one value per line, or --column C of lines split by blanks, commas or semicolons; '#'
+starts a comment; gzip is recognized by content; '-' reads standard input.
+
+Taus (averaging factors m, tau = m tau0) and memory:
+  octave        1, 2, 4, ... while a term fits (standard input: up to 2^39)
+  decade        1, 2, 4, 10, 20, 40, ... (regular files only: needs the number of values)
+  all           every m up to N/2 that the stride factor can form (regular files only; time grows
+                as N min(N, S): meant for short files)
+  1,10,100      a list of m (strictly increasing)
+  A regular file is read twice (count, then compute) so that the tau list fits it; standard input
+  and pipes are read once. Memory does not depend on the length of the data: the pyramid keeps
+  about 3S (1 + levels/2) points for stride factor S. --stride-factor full (the default) makes
+  every tau up to 2^16 fully overlapped (Stable32's estimators, same number of terms); taus above
+  2^16 are strided, their terms m/2^16 points apart, and their EDF is that of the strided
+  estimator. adev and hdev are Stable32's non-overlapped estimators at any tau.
+
+Examples:
+  gyrochar-analyze --type phase --tau0 1 --stats adev,oadev,mdev,tdev PHASE.DAT
+  gyrochar-analyze --type freq --tau0 1 --nominal-hz 10e6 --taus all --stats mdev ocxo.txt
+  gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec --rate-unit deg/h \
+                   --fit ieee952 --format json run.txt.gz
+  gyrochar-analyze --type phase --unit deg --tau0 0.01 --column 2 --stats oadev,mdev angle.csv
+  zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
+
+Exit codes: 0 success; 1 internal error; 2 bad options or data; 3 the output could not be written.
+Errors go to stderr as 'gyrochar-analyze: what: why'; data goes to stdout.)";
+
+std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> items;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, separator);) items.push_back(item);
+  return items;
+}
+
+std::vector<std::uint64_t> parse_tau_list(const std::string& text) {
+  std::vector<std::uint64_t> m;
+  for (const std::string& item : split(text, ',')) {
+    std::uint64_t v = 0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (ec != std::errc() || end != item.data() + item.size() || v == 0)
+      bad("--taus", "'" + item + "' is not octave, decade, all or a positive averaging factor");
+    if (!m.empty() && v <= m.back()) bad("--taus", "averaging factors must increase");
+    m.push_back(v);
+  }
+  if (m.empty()) bad("--taus", "empty list");
+  return m;
+}
+
+std::vector<DevStat> parse_stats(const std::string& text) {
+  std::vector<DevStat> stats;
+  for (const std::string& item : split(text, ',')) {
+    const auto s = parse_dev_stat(item);
+    if (!s) bad("--stats", "unknown statistic '" + item + "' (adev, oadev, mdev, tdev, hdev, ohdev)");
+    stats.push_back(*s);
+  }
+  if (stats.empty()) bad("--stats", "empty list");
+  return stats;
+}
+
+// "1.5arcsec", "1.5 arcsec" or "1.5" (unit from --pulse-unit) -> rad.
+double parse_pulse_weight_rad(const std::string& text, const std::string& pulse_unit, bool pulse_unit_given,
+                              std::string& described) {
+  double value = 0;
+  const char* const end = text.data() + text.size();
+  const auto [rest, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc() || !(value > 0) || !std::isfinite(value))
+    bad("--pulse-weight", "'" + text + "' is not a positive angle such as 1.5arcsec");
+  std::string unit(rest, end);
+  unit.erase(0, unit.find_first_not_of(' '));
+  if (unit.empty()) {
+    unit = pulse_unit;
+  } else if (pulse_unit_given && unit != pulse_unit) {
+    bad("--pulse-weight", "unit " + unit + " contradicts --pulse-unit " + pulse_unit);
+  }
+  const auto rad = angle_unit_rad(unit);
+  if (!rad) bad("--pulse-weight", "unknown angle unit '" + unit + "' (rad, mrad, urad, deg, arcsec)");
+  described = fmt::format("counts of {} {}", value, unit);
+  return value * *rad;
+}
+
+// Prints how far the reading got, every 2^20 values, when enabled; nothing for short inputs.
+class Progress {
+ public:
+  Progress(bool enabled, const char* stage, const DataFile& file) : enabled_(enabled), stage_(stage), file_(file) {}
+  ~Progress() {
+    if (progress_line_open) std::fputc('\n', stderr);
+    progress_line_open = false;
+  }
+  void value() {
+    if (!enabled_ || (++values_ & 0xFFFFF) != 0) return;
+    progress_line_open = true;
+    const std::uint64_t size = file_.size_bytes();
+    if (size > 0)
+      std::fprintf(stderr, "\rgyrochar-analyze: %s: %5.1f %%", stage_,
+                   100.0 * static_cast<double>(file_.bytes_read()) / static_cast<double>(size));
+    else
+      std::fprintf(stderr, "\rgyrochar-analyze: %s: %llu values", stage_, static_cast<unsigned long long>(values_));
+  }
+
+ private:
+  bool enabled_;
+  const char* stage_;
+  const DataFile& file_;
+  std::uint64_t values_ = 0;
+};
+
+[[noreturn]] void bad_data(const std::string& path, const DataFileError& e) {
+  bad(path == "-" ? "standard input" : path, e.line() ? fmt::format("line {}: {}", e.line(), e.what()) : e.what());
+}
+
+std::uint64_t count_values(const std::string& path, unsigned column, bool progress) {
+  try {
+    DataFile file(path, column);
+    Progress p(progress, "counting", file);
+    std::uint64_t n = 0;
+    for (double v = 0; file.next(v); ++n) p.value();
+    return n;
+  } catch (const DataFileError& e) {
+    bad_data(path, e);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV of a recorded file, with EDF,\n"
+               "confidence intervals, noise identification and the IEEE-952 gyro fit; streams any length.",
+               "gyrochar-analyze"};
+  app.footer(footer);
+  std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
+  std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
+  std::string format = "table", fit_text;
+  double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
+  unsigned column = 1;
+  bool progress = false;
+  app.add_option("file", path, "data file (plain or gzip), '-' for standard input")->required();
+  app.add_option("--type", type_text, "phase, freq or counts")->required();
+  app.add_option("--tau0", tau0_s, "sample interval in seconds")->required();
+  app.add_option("--unit", value_unit, "unit of phase (s or an angle) or freq (1, Hz or a rate) values");
+  app.add_option("--pulse-weight", pulse_weight_text, "angle of one pulse, with its unit (counts)");
+  app.add_option("--pulse-unit", pulse_unit, "unit of --pulse-weight when it has none")->capture_default_str();
+  app.add_option("--rate-unit", rate_text, "output unit of gyro data: deg/h, deg/s, rad/s")->capture_default_str();
+  app.add_option("--nominal-hz", nominal_hz, "freq values are in Hz around this nominal frequency");
+  app.add_option("--column", column, "column holding the values (1-based)")->capture_default_str();
+  app.add_option("--taus", taus_text, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
+  app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev")->capture_default_str();
+  app.add_option("--stride-factor", stride_text, "S, a power of two, or full")->capture_default_str();
+  app.add_option("--confidence", confidence, "confidence level of the intervals")->capture_default_str();
+  app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
+  app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves");
+  app.add_option("--format", format, "table, csv or json")->capture_default_str();
+  app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    bad("options", std::string(e.what()) + " (see --help)");
+  }
+
+  try {
+    // Options, checked before any data is read.
+    AnalysisOptions o;
+    if (type_text == "phase") o.type = DataType::phase;
+    else if (type_text == "freq") o.type = DataType::freq;
+    else if (type_text == "counts") o.type = DataType::counts;
+    else bad("--type", "must be phase, freq or counts, not '" + type_text + "'");
+    if (!(tau0_s > 0) || !std::isfinite(tau0_s)) bad("--tau0", "must be a positive number of seconds");
+    o.tau0_s = tau0_s;
+    if (column == 0) bad("--column", "columns are numbered from 1");
+    if (!(confidence > 0 && confidence < 1)) bad("--confidence", "must be between 0 and 1");
+    o.confidence = confidence;
+    o.stats = parse_stats(stats_text);
+    if (stride_text != "full") {
+      const auto [end, ec] = std::from_chars(stride_text.data(), stride_text.data() + stride_text.size(), o.stride_factor);
+      if (ec != std::errc() || end != stride_text.data() + stride_text.size() || o.stride_factor < 2 ||
+          (o.stride_factor & (o.stride_factor - 1)) != 0 || o.stride_factor > (1u << 24))
+        bad("--stride-factor", "must be a power of two from 2 to 2^24, or full");
+    }
+    if (alpha_text != "auto") {
+      int a = 0;
+      const auto [end, ec] = std::from_chars(alpha_text.data(), alpha_text.data() + alpha_text.size(), a);
+      if (ec != std::errc() || end != alpha_text.data() + alpha_text.size() || a < -4 || a > 2)
+        bad("--alpha", "must be auto or an integer from -4 to 2");
+      o.alpha = a;
+    }
+    if (format != "table" && format != "csv" && format != "json") bad("--format", "must be table, csv or json");
+    if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
+    if (!fit_text.empty() && std::find(o.stats.begin(), o.stats.end(), DevStat::oadev) == o.stats.end() &&
+        std::find(o.stats.begin(), o.stats.end(), DevStat::mdev) == o.stats.end())
+      bad("--fit", "needs oadev or mdev in --stats");
+
+    // Units: what the values are, and the output unit of gyro data.
+    ReportUnits units;
+    if (o.type == DataType::counts) {
+      if (!value_unit.empty()) bad("--unit", "counts take --pulse-weight instead");
+      if (pulse_weight_text.empty()) bad("--pulse-weight", "counts need the angle of one pulse, e.g. 1.5arcsec");
+      units.gyro = true;
+      units.phase_unit_si = parse_pulse_weight_rad(pulse_weight_text, pulse_unit, app.count("--pulse-unit") > 0, units.input);
+    } else {
+      if (!pulse_weight_text.empty() || app.count("--pulse-unit")) bad("--pulse-weight", "only applies to --type counts");
+      if (o.type == DataType::phase) {
+        if (value_unit.empty() || value_unit == "s") {
+          units.input = "phase in s";
+        } else if (const auto rad = angle_unit_rad(value_unit)) {
+          units.gyro = true;
+          units.phase_unit_si = *rad;
+          units.input = "angle in " + value_unit;
+        } else {
+          bad("--unit", "phase is in s or an angle unit (rad, mrad, urad, deg, arcsec), not '" + value_unit + "'");
+        }
+        if (app.count("--nominal-hz")) bad("--nominal-hz", "only applies to --type freq");
+      } else if (app.count("--nominal-hz")) {
+        if (!(nominal_hz > 0) || !std::isfinite(nominal_hz)) bad("--nominal-hz", "must be a positive frequency in Hz");
+        if (!value_unit.empty() && value_unit != "Hz") bad("--unit", "--nominal-hz means the values are in Hz");
+        units.input = fmt::format("frequency in Hz, nominal {} Hz", nominal_hz);
+      } else if (value_unit.empty() || value_unit == "1") {
+        units.input = "fractional frequency";
+      } else if (const auto rate = rate_unit(value_unit)) {
+        units.gyro = true;
+        units.phase_unit_si = rate->rad_per_s;
+        units.input = "rate in " + value_unit;
+      } else if (value_unit == "Hz") {
+        bad("--unit", "frequency in Hz needs --nominal-hz");
+      } else {
+        bad("--unit", "freq is in 1 (fractional), Hz or a rate unit (deg/h, deg/s, rad/s), not '" + value_unit + "'");
+      }
+    }
+    if (units.gyro) {
+      const auto rate = rate_unit(rate_text);
+      if (!rate) bad("--rate-unit", "unknown unit '" + rate_text + "' (deg/h, deg/s, rad/s)");
+      units.rate = *rate;
+    } else if (app.count("--rate-unit")) {
+      bad("--rate-unit", "only applies to gyro data (counts, or --unit with an angle or a rate)");
+    }
+
+    // Pass 1 (regular files only): the number of values, so the taus fit the data.
+    const bool show_progress = progress || isatty(STDERR_FILENO);
+    const std::string source = path == "-" ? "standard input" : path;
+    std::uint64_t n_phase = 0;  // unknown
+    if (is_regular_file(path)) {
+      const std::uint64_t n_values = count_values(path, column, show_progress);
+      if (n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
+      n_phase = o.type == DataType::phase ? n_values : n_values + 1;
+    }
+    if (taus_text == "octave") {
+      o.m_list = octave_taus(n_phase);
+    } else if (taus_text == "decade" || taus_text == "all") {
+      if (n_phase == 0) bad("--taus", taus_text + " needs the number of values: give a regular file, or use octave or a list");
+      o.m_list = taus_text == "decade" ? decade_taus(n_phase)
+                                       : all_taus(n_phase, resolve_stride_factor(o.stride_factor, n_phase / 2));
+    } else {
+      o.m_list = parse_tau_list(taus_text);
+    }
+    if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
+
+    // Pass 2: the analysis.
+    std::unique_ptr<Analyzer> analyzer;
+    try {
+      analyzer = std::make_unique<Analyzer>(o);
+    } catch (const std::invalid_argument& e) {
+      bad("--taus", e.what());
+    }
+    try {
+      DataFile file(path, column);
+      Progress p(show_progress, "analyzing", file);
+      for (double v = 0; file.next(v);) {
+        if (nominal_hz > 0) v = (v - nominal_hz) / nominal_hz;
+        try {
+          analyzer->add(v);
+        } catch (const std::exception& e) {  // invalid_argument (a bad count), range_error
+          bad(source, fmt::format("line {}: {}", file.line(), e.what()));
+        }
+        p.value();
+      }
+    } catch (const DataFileError& e) {
+      bad_data(path, e);
+    }
+    const Analysis a = analyzer->result();
+    if (a.n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
+    if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
+
+    Report report{a, o.type, o.tau0_s, o.confidence, units, {}};
+    if (!fit_text.empty()) report.fits = fit_curves(a, units, o.tau0_s);
+    const std::string text = format == "json" ? to_json(report).dump(2) + "\n"
+                             : format == "csv" ? format_csv(report)
+                                               : format_table(report);
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
+      fail(exit_output, "output", std::strerror(errno));
+  } catch (const std::exception& e) {
+    fail(exit_internal, "internal error", e.what());
+  }
+  return 0;
+}

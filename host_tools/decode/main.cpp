@@ -1,0 +1,334 @@
+// gyrochar-decode: follows the gyrochar nodes on a CAN bus (live SocketCAN interface, candump log
+// or stdin), shows their statistics and link health, records them as CSV / JSON lines and plots
+// ADEV and MDEV with the IEEE-952 model. Columns and exit codes: host_tools/decode/README.md.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "decode_session.hpp"
+#include "hal/linux/socketcan.hpp"
+#include "plot.hpp"
+
+namespace {
+
+using namespace gyrochar;
+using namespace gyrochar::decoding;
+
+constexpr int exit_ok = 0;
+constexpr int exit_failure = 1;                   // an output could not be written
+constexpr int exit_bad_input = 2;                 // usage, unreadable input, input without any candump line
+constexpr int exit_no_interface = 3;              // the CAN interface cannot be opened
+constexpr std::uint64_t malformed_reported = 10;  // malformed lines reported one by one, then counted
+
+[[noreturn]] void fail(int code, const std::string& what, const std::string& why) {
+  std::fprintf(stderr, "gyrochar-decode: %s: %s\n", what.c_str(), why.c_str());
+  std::exit(code);
+}
+
+volatile std::sig_atomic_t stop_requested = 0;
+extern "C" void request_stop(int) { stop_requested = 1; }
+
+void install_stop_handler() {
+  struct sigaction action {};
+  action.sa_handler = request_stop;  // no SA_RESTART: a blocked read()/poll() returns EINTR
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+double wall_s() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
+double steady_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+enum class View { live, final, none };
+
+struct Options {
+  std::string log;        // candump log path or "-"
+  std::string interface;  // live SocketCAN interface
+  std::string csv, jsonl, plot;
+  double plot_every_s = 0.0;
+  std::string view;
+  std::string rate_unit = "deg/h";
+  double confidence = 0.683;
+  double duration_s = 0.0;
+  std::vector<std::string> nodes;
+  double refresh_s = 1.0;
+};
+
+std::FILE* open_output(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) fail(exit_bad_input, path, std::strerror(errno));
+  return f;
+}
+
+NodeFilter parse_nodes(const std::vector<std::string>& texts) {
+  NodeFilter shown;
+  if (texts.empty()) return shown.set();
+  for (const std::string& t : texts) {
+    std::size_t used = 0;
+    unsigned long address = 0;
+    try {
+      address = std::stoul(t, &used, 0);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != t.size() || used == 0 || address > protocol::max_node_address)
+      fail(exit_bad_input, "--node", "'" + t + "' is not a node address 0..253 (0x00..0xFD)");
+    shown.set(address);
+  }
+  return shown;
+}
+
+// Everything the main loop does besides decoding: the live view, the periodic plot, the end.
+class Presenter {
+ public:
+  Presenter(const Options& o, View view, RateUnit rate_unit, Session& session)
+      : options_(o), view_(view), rate_unit_(rate_unit), session_(session), tty_(isatty(STDOUT_FILENO) == 1) {}
+
+  void malformed(const std::string& where, std::uint64_t line, const std::string& why) {
+    const std::uint64_t count = session_.input().malformed_lines;
+    if (count <= malformed_reported)
+      std::fprintf(stderr, "gyrochar-decode: %s:%llu: malformed line: %s\n", where.c_str(),
+                   static_cast<unsigned long long>(line), why.c_str());
+    if (count == malformed_reported)
+      std::fprintf(stderr, "gyrochar-decode: %s: further malformed lines are only counted\n", where.c_str());
+  }
+
+  /// Called often: refreshes the view and the plot when due.
+  void housekeeping() {
+    const double now = steady_s();
+    if (view_ == View::live && now - last_view_s_ >= options_.refresh_s) {
+      show();
+      last_view_s_ = now;
+    }
+    const InputCounters& in = session_.input();
+    if (!options_.plot.empty() && options_.plot_every_s > 0 && in.started &&
+        in.now_s - last_plot_s_ >= options_.plot_every_s) {
+      plot();
+      last_plot_s_ = in.now_s;
+    }
+  }
+
+  /// True once --duration has passed: decoder time since `start_s` (a live interface's clock runs
+  /// without frames too).
+  bool done(double start_s) const {
+    return options_.duration_s > 0 && session_.input().now_s - start_s >= options_.duration_s;
+  }
+
+  int finish() {
+    session_.finish();
+    int code = exit_ok;
+    if (!options_.plot.empty() && !plot()) code = exit_failure;
+    if (view_ != View::none) show();
+    std::fputs(format_summary(session_.decoder(), session_.input(), session_.options().shown).c_str(), stderr);
+    return code;
+  }
+
+ private:
+  void show() {
+    const std::string text =
+        format_view(session_.decoder(), session_.input(), session_.options().shown, rate_unit_, session_.intervals());
+    if (view_ == View::live && tty_) std::fputs("\033[H\033[J", stdout);  // home, clear screen
+    std::fputs(text.c_str(), stdout);
+    std::fflush(stdout);
+  }
+
+  bool plot() {
+    std::vector<NodePlot> panels;
+    for (const auto& [address, node] : session_.decoder().nodes())
+      if (session_.options().shown[address]) panels.push_back(plot_data(node, rate_unit_, session_.intervals()));
+    if (panels.empty()) {
+      std::fprintf(stderr, "gyrochar-decode: %s: no node to plot\n", options_.plot.c_str());
+      return true;
+    }
+    std::string why;
+    if (write_plot(options_.plot, panels, options_.confidence, why)) return true;
+    std::fprintf(stderr, "gyrochar-decode: plot: %s\n", why.c_str());
+    return false;
+  }
+
+  const Options& options_;
+  View view_;
+  RateUnit rate_unit_;
+  Session& session_;
+  bool tty_;
+  double last_view_s_ = -1e300;
+  double last_plot_s_ = 0.0;
+};
+
+int decode_log(const Options& o, Session& session, Presenter& presenter) {
+  const bool from_stdin = o.log == "-";
+  const std::string where = from_stdin ? "stdin" : o.log;
+  const int fd = from_stdin ? STDIN_FILENO : ::open(o.log.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail(exit_bad_input, o.log, std::strerror(errno));
+  session.input().source = where;
+  LineReader reader(fd);
+  std::string_view line;
+  std::string why;
+  std::uint64_t line_number = 0;
+  for (;;) {
+    const LineReader::Result r = reader.next(line);
+    if (r == LineReader::Result::line) {
+      ++line_number;
+      if (line.empty()) continue;
+      if (!session.feed_line(line, why)) presenter.malformed(where, line_number, why);
+      if ((line_number & 0xFFF) == 0) presenter.housekeeping();
+      if (presenter.done(session.input().first_s) || stop_requested) break;
+    } else if (r == LineReader::Result::again) {
+      if (stop_requested) break;
+      pollfd p{fd, POLLIN, 0};
+      ::poll(&p, 1, 200);  // wait for more input, wake up for the view
+      presenter.housekeeping();
+    } else if (r == LineReader::Result::end) {
+      break;
+    } else {
+      fail(exit_bad_input, where, std::strerror(errno));
+    }
+  }
+  if (!from_stdin) ::close(fd);
+  const InputCounters& in = session.input();
+  if (in.lines > 0 && in.malformed_lines == in.lines)
+    fail(exit_bad_input, where, fmt::format("none of its {} lines is a candump log line", in.lines));
+  return presenter.finish();
+}
+
+std::string bus_text(const std::string& interface, const hal::CanBus& bus) {
+  static constexpr const char* states[] = {"error active", "error warning", "error passive", "bus-off", "down"};
+  const hal::CanCounters& c = bus.counters();
+  return fmt::format("{}: {}; received {}, dropped in the socket queue {}, error frames {}, bus-off events {}",
+                     interface, states[static_cast<int>(bus.state())], c.received, c.rx_dropped, c.error_frames,
+                     c.bus_off_events);
+}
+
+int decode_live(const Options& o, Session& session, Presenter& presenter) {
+  std::unique_ptr<hal::SocketCan> bus;
+  try {
+    bus = std::make_unique<hal::SocketCan>(o.interface);
+  } catch (const std::exception& e) {
+    fail(exit_no_interface, o.interface, e.what());
+  }
+  session.input().source = o.interface;
+  const double start_s = wall_s();
+  session.tick(start_s);
+  while (!stop_requested && !presenter.done(start_s)) {
+    pollfd p{bus->fd(), POLLIN, 0};
+    ::poll(&p, 1, 100);
+    for (int k = 0; k < 10000; ++k) {  // bounded: the view stays alive under a flood
+      const auto frame = bus->receive();
+      if (!frame) break;
+      session.feed(*frame, wall_s());
+    }
+    session.tick(wall_s());
+    session.input().bus = bus_text(o.interface, *bus);
+    presenter.housekeeping();
+  }
+  return presenter.finish();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "gyrochar-decode: follows the gyrochar nodes on a CAN bus; shows, records and plots their "
+      "ADEV, MDEV, IEEE-952 terms and link health.",
+      "gyrochar-decode"};
+  app.footer(
+      "Input: exactly one of LOG (a `candump -l` log; '-' reads stdin, e.g. `candump -L can0 | gyrochar-decode -`)\n"
+      "and --interface. A log is decoded at its own timestamps; a live interface at the system clock.\n"
+      "Rates are shown in --rate-unit, IEEE-952 terms as Q arcsec, N deg/sqrt(h), B deg/h, K deg/h/sqrt(h),\n"
+      "R deg/h/h; a node that reports pulses is shown in pulse units, never converted.\n"
+      "CSV and JSON lines columns: host_tools/decode/README.md.\n\n"
+      "Examples:\n"
+      "  gyrochar-decode --interface can0\n"
+      "  gyrochar-decode --interface can0 --csv run.csv --jsonl run.jsonl --plot run --plot-every 60\n"
+      "  gyrochar-decode capture.log --view none --csv capture.csv --plot capture\n"
+      "  gyrochar-decode capture.log --node 0x10 --rate-unit deg/s --view final\n"
+      "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
+      "Exit codes: 0 success (malformed lines and rejected frames are counted and reported, not fatal);\n"
+      "1 an output (CSV, JSON lines, plot) could not be written; 2 bad options or bad input (missing or\n"
+      "unreadable file, no candump line at all); 3 the CAN interface is not available.");
+  Options o;
+  app.add_option("log", o.log, "candump log file, or '-' for stdin")->option_text("LOG");
+  app.add_option("-i,--interface", o.interface, "live SocketCAN interface, e.g. can0, vcan0")->option_text("IF");
+  app.add_option("--csv", o.csv, "write one row per node, closed report and tau to this CSV file")->option_text("FILE");
+  app.add_option("--jsonl", o.jsonl, "write the same rows, per-report status and events as JSON lines")
+      ->option_text("FILE");
+  app.add_option("--plot", o.plot, "write PREFIX.svg and PREFIX.png at the end")->option_text("PREFIX");
+  app.add_option("--plot-every", o.plot_every_s, "also rewrite the plot every S seconds (decoder time)")
+      ->option_text("S");
+  app.add_option("--view", o.view,
+                 "live: refreshing table; final: the table once at the end; none. "
+                 "Default: live when stdout is a terminal, else none")
+      ->option_text("MODE");
+  app.add_option("--refresh", o.refresh_s, "seconds between refreshes of the live view")->capture_default_str();
+  app.add_option("--rate-unit", o.rate_unit, "deg/h, deg/s, rad/s or native (the node's angle unit per s)")
+      ->capture_default_str();
+  app.add_option("--confidence", o.confidence, "level of the confidence intervals, in (0, 1)")->capture_default_str();
+  app.add_option("--duration", o.duration_s, "stop after S seconds of decoder time (log time for a log)")
+      ->option_text("S");
+  app.add_option("--node", o.nodes, "show and record only this node address (repeatable; 16 or 0x10)")
+      ->option_text("ADDRESS");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    fail(exit_bad_input, "options", std::string(e.what()) + " (see --help)");
+  }
+  if (o.log.empty() == o.interface.empty())
+    fail(exit_bad_input, "options", "give either a LOG or --interface (see --help)");
+  const auto rate_unit = parse_rate_unit(o.rate_unit);
+  if (!rate_unit) fail(exit_bad_input, "--rate-unit", "'" + o.rate_unit + "' is not deg/h, deg/s, rad/s or native");
+  if (!(o.confidence > 0 && o.confidence < 1)) fail(exit_bad_input, "--confidence", "must be in (0, 1)");
+  if (!(o.duration_s >= 0)) fail(exit_bad_input, "--duration", "must be >= 0");
+  if (!(o.plot_every_s >= 0)) fail(exit_bad_input, "--plot-every", "must be >= 0");
+  if (o.plot_every_s > 0 && o.plot.empty()) fail(exit_bad_input, "--plot-every", "needs --plot PREFIX");
+  if (!(o.refresh_s > 0)) fail(exit_bad_input, "--refresh", "must be > 0");
+  View view = isatty(STDOUT_FILENO) ? View::live : View::none;
+  if (o.view == "live")
+    view = View::live;
+  else if (o.view == "final")
+    view = View::final;
+  else if (o.view == "none")
+    view = View::none;
+  else if (!o.view.empty())
+    fail(exit_bad_input, "--view", "'" + o.view + "' is not live, final or none");
+  if (!o.plot.empty()) {
+    if (const std::string missing = plot_devices_missing(); !missing.empty()) fail(exit_bad_input, "--plot", missing);
+    std::fclose(open_output(o.plot + ".svg.part"));  // fail now, not after hours of decoding
+    std::remove((o.plot + ".svg.part").c_str());
+  }
+
+  SessionOptions s;
+  s.rate_unit = *rate_unit;
+  s.confidence = o.confidence;
+  s.shown = parse_nodes(o.nodes);
+  s.csv = o.csv.empty() ? nullptr : open_output(o.csv);
+  s.jsonl = o.jsonl.empty() ? nullptr : open_output(o.jsonl);
+  install_stop_handler();
+  int code = exit_ok;
+  {
+    Session session(s);
+    Presenter presenter(o, view, *rate_unit, session);
+    code = o.interface.empty() ? decode_log(o, session, presenter) : decode_live(o, session, presenter);
+  }
+  for (const auto& [file, path] : {std::pair{s.csv, o.csv}, std::pair{s.jsonl, o.jsonl}}) {
+    if (file == nullptr) continue;
+    const bool failed = std::ferror(file) != 0;
+    if (std::fclose(file) != 0 || failed) {
+      std::fprintf(stderr, "gyrochar-decode: %s: write failed: %s\n", path.c_str(), std::strerror(errno));
+      code = exit_failure;
+    }
+  }
+  return code;
+}

@@ -1,0 +1,236 @@
+#include "plot.hpp"
+
+#include <fmt/format.h>
+#include <plplot/plstream.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+// LeakSanitizer reads this hook in the sanitizer build (unused otherwise): PLplot's cairo driver
+// leaves fontconfig's font caches and libltdl's loaded driver for the life of the process, by design
+// of those libraries; neither is ours to free.
+extern "C" const char* __lsan_default_suppressions() { return "leak:libfontconfig.so\nleak:libltdl.so\n"; }
+
+namespace gyrochar::decoding {
+namespace {
+
+// Colour map 0 (index 0 is the background) and what each colour draws.
+enum Colour : PLINT {
+  background,
+  ink,
+  adev_colour,
+  mdev_colour,
+  q_colour,
+  n_colour,
+  b_colour,
+  k_colour,
+  r_colour,
+  sum_colour,
+  grid_colour
+};
+constexpr std::array<std::array<PLINT, 3>, 11> palette{{
+    {255, 255, 255},  // background: white
+    {0, 0, 0},        // axes, text, read-off points: black
+    {31, 119, 180},   // ADEV: blue
+    {214, 39, 40},    // MDEV: red
+    {148, 103, 189},  // Q: purple
+    {44, 160, 44},    // N: green
+    {255, 127, 14},   // B: orange
+    {140, 86, 75},    // K: brown
+    {23, 190, 207},   // R: cyan
+    {90, 90, 90},     // the model's sum: dark grey
+    {215, 215, 215},  // grid: light grey
+}};
+
+// Character heights relative to PLplot's default.
+constexpr PLFLT text_scale = 0.55, glyph_scale = 0.4, label_scale = 0.45;
+
+// Glyphs (UTF-8, drawn by cairo with the system fonts).
+constexpr const char* adev_glyph = "●";
+constexpr const char* mdev_glyph = "■";
+constexpr const char* read_off_glyph = "◆";
+
+constexpr std::array<PLINT, 5> term_colours{q_colour, n_colour, b_colour, k_colour, r_colour};
+
+struct Range {
+  double lo = INFINITY, hi = -INFINITY;
+  void add(double v) {
+    if (v > 0 && std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+  }
+};
+
+void draw_series(plstream& pls, const std::vector<PlotPoint>& points, PLINT colour, const char* glyph) {
+  std::vector<PLFLT> x, y, ex, low, high;
+  for (const PlotPoint& p : points) {
+    if (!(p.dev > 0)) continue;  // no place on a log axis
+    x.push_back(std::log10(p.tau_s));
+    y.push_back(std::log10(p.dev));
+    if (p.ci.valid && p.ci.low > 0) {
+      ex.push_back(x.back());
+      low.push_back(std::log10(p.ci.low));
+      high.push_back(std::log10(p.ci.high));
+    }
+  }
+  pls.col0(colour);
+  pls.width(1.2);
+  pls.erry(static_cast<PLINT>(ex.size()), ex.data(), low.data(), high.data());
+  pls.schr(0, glyph_scale);
+  pls.string(static_cast<PLINT>(x.size()), x.data(), y.data(), glyph);
+  pls.schr(0, text_scale);
+}
+
+void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
+  pls.adv(0);
+  pls.col0(ink);
+  Range y;
+  for (const auto* series : {&p.adev, &p.mdev}) {
+    for (const PlotPoint& q : *series) {
+      y.add(q.dev);
+      if (q.ci.valid) y.add(q.ci.low), y.add(q.ci.high);
+    }
+  }
+  if (!(y.hi > 0)) {
+    pls.vpor(0.1, 0.9, 0.1, 0.9);
+    pls.wind(0, 1, 0, 1);
+    pls.box("bc", 0, 0, "bc", 0, 0);
+    pls.ptex(0.5, 0.5, 1, 0, 0.5, "no positive deviation with a known tau yet");
+    pls.lab("", "", p.title.c_str());
+    return;
+  }
+  const double y_lo = std::floor(std::log10(y.lo) - 0.05), y_hi = std::ceil(std::log10(y.hi) + 0.05);
+  const double x_lo = std::log10(p.tau_min_s), x_hi = std::log10(p.tau_max_s);
+  pls.vpor(0.08, 0.64, 0.10, 0.92);
+  pls.wind(x_lo, x_hi, y_lo, y_hi);
+  pls.col0(grid_colour);
+  pls.width(0.5);
+  pls.box("ghl", 0, 0, "ghl", 0, 0);
+  pls.col0(ink);
+  pls.width(1.0);
+  pls.box("bcnlst", 0, 0, "bcnlstv", 0, 0);
+  pls.lab("averaging time #gt [s]",
+          fmt::format("ADEV, MDEV [{}], error bars: {:.1f}% confidence", p.rate_name, 100.0 * confidence).c_str(),
+          p.title.c_str());
+
+  // Legend entries in drawing order.
+  std::vector<std::string> text{"ADEV (overlapping)", "MDEV"};
+  std::vector<PLINT> opts{PL_LEGEND_SYMBOL, PL_LEGEND_SYMBOL}, colours{adev_colour, mdev_colour}, styles{1, 1};
+  std::vector<const char*> glyphs{adev_glyph, mdev_glyph};
+
+  for (const PlotLine& line : p.terms) {
+    std::vector<PLFLT> x, v;
+    for (std::size_t k = 0; k < line.tau_s.size(); ++k) {
+      if (!(line.dev[k] > 0)) continue;
+      x.push_back(std::log10(line.tau_s[k]));
+      v.push_back(std::log10(line.dev[k]));
+    }
+    const bool sum = !line.term;
+    const PLINT colour = sum ? sum_colour : term_colours[static_cast<std::size_t>(*line.term)];
+    pls.col0(colour);
+    pls.lsty(sum ? 1 : 2);
+    pls.width(sum ? 2.0 : 1.5);
+    pls.line(static_cast<PLINT>(x.size()), x.data(), v.data());
+    text.push_back(line.label);
+    opts.push_back(PL_LEGEND_LINE);
+    colours.push_back(colour);
+    styles.push_back(sum ? 1 : 2);
+    glyphs.push_back("");
+  }
+  pls.lsty(1);
+  draw_series(pls, p.adev, adev_colour, adev_glyph);
+  draw_series(pls, p.mdev, mdev_colour, mdev_glyph);
+  if (!p.read_offs.empty()) {
+    pls.col0(ink);
+    for (const ReadOffPoint& r : p.read_offs) {
+      const PLFLT x = std::log10(r.tau_s), v = std::log10(r.dev);
+      pls.schr(0, glyph_scale);
+      pls.string(1, &x, &v, read_off_glyph);
+      pls.schr(0, label_scale);
+      const bool right = x < x_hi - 0.2 * (x_hi - x_lo);  // beside the marker, inside the frame
+      pls.ptex(x + (right ? 0.015 : -0.015) * (x_hi - x_lo), v, 1, 0, right ? 0.0 : 1.0, r.label.c_str());
+    }
+    pls.schr(0, text_scale);
+    text.push_back("read-off points");
+    opts.push_back(PL_LEGEND_SYMBOL);
+    colours.push_back(ink);
+    styles.push_back(1);
+    glyphs.push_back(read_off_glyph);
+  }
+
+  const auto n = static_cast<PLINT>(text.size());
+  std::vector<const char*> labels;
+  for (const std::string& t : text) labels.push_back(t.c_str());
+  const std::vector<PLFLT> widths(text.size(), 1.5), scales(text.size(), 0.6 * glyph_scale / text_scale);
+  const std::vector<PLINT> numbers(text.size(), 1), text_colours(text.size(), ink);
+  PLFLT legend_width = 0, legend_height = 0;
+  pls.legend(&legend_width, &legend_height, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+             PL_POSITION_RIGHT | PL_POSITION_OUTSIDE, 0.02, 0.0, 0.06, background, ink, 1, 0, 0, n, opts.data(), 0.8,
+             text_scale, 2.0, 0.0, text_colours.data(), labels.data(), nullptr, nullptr, nullptr, nullptr,
+             colours.data(), styles.data(), widths.data(), colours.data(), scales.data(), numbers.data(),
+             glyphs.data());
+}
+
+bool draw(const char* device, const std::string& file, const std::vector<NodePlot>& panels, double confidence,
+          std::string& why) {
+  // PLplot would end the process on a file it cannot open: check first.
+  if (std::FILE* f = std::fopen(file.c_str(), "w")) {
+    std::fclose(f);
+  } else {
+    why = fmt::format("{}: {}", file, std::strerror(errno));
+    return false;
+  }
+  const auto columns = static_cast<PLINT>(std::ceil(std::sqrt(static_cast<double>(panels.size()))));
+  const auto rows = static_cast<PLINT>((static_cast<PLINT>(panels.size()) + columns - 1) / columns);
+  {
+    plstream pls;
+    pls.sdev(device);
+    pls.sfnam(file.c_str());
+    pls.spage(0, 0, 1500 * columns, 900 * rows, 0, 0);
+    std::array<PLINT, palette.size()> red{}, green{}, blue{};
+    for (std::size_t c = 0; c < palette.size(); ++c) {
+      red[c] = palette[c][0];
+      green[c] = palette[c][1];
+      blue[c] = palette[c][2];
+    }
+    pls.scmap0(red.data(), green.data(), blue.data(), static_cast<PLINT>(palette.size()));
+    pls.ssub(columns, rows);
+    pls.init();
+    pls.schr(0, text_scale);
+    for (const NodePlot& p : panels) draw_panel(pls, p, confidence);
+  }  // plend1: the file is complete
+  return true;
+}
+
+}  // namespace
+
+std::string plot_devices_missing() {
+  std::array<const char*, 128> menu_storage{}, name_storage{};  // plgDevs fills arrays of the caller's
+  const char** menus = menu_storage.data();
+  const char** names = name_storage.data();
+  int count = static_cast<int>(name_storage.size());
+  plgDevs(&menus, &names, &count);
+  std::string missing;
+  for (const char* wanted : {"svgcairo", "pngcairo"}) {
+    if (std::none_of(names, names + count, [&](const char* n) { return std::strcmp(n, wanted) == 0; }))
+      missing += std::string(missing.empty() ? "" : ", ") + wanted;
+  }
+  return missing.empty() ? "" : "PLplot has no " + missing + " device (Debian package plplot-driver-cairo)";
+}
+
+bool write_plot(const std::string& prefix, const std::vector<NodePlot>& panels, double confidence, std::string& why) {
+  for (const auto& [device, extension] : {std::pair{"svgcairo", ".svg"}, std::pair{"pngcairo", ".png"}}) {
+    const std::string file = prefix + extension, part = file + ".part";
+    if (!draw(device, part, panels, confidence, why)) return false;
+    if (std::rename(part.c_str(), file.c_str()) != 0) {
+      why = fmt::format("{}: {}", file, std::strerror(errno));
+      std::remove(part.c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace gyrochar::decoding

@@ -1,0 +1,23 @@
+#pragma once
+// The ADEV/MDEV plot of gyrochar-decode, drawn with PLplot's cairo drivers (Debian
+// plplot-driver-cairo): one log-log panel per node with both deviations and their confidence
+// intervals as error bars, each resolved IEEE-952 term as its own line, the model's sum and the
+// read-off points (decode_output.hpp, plot_data()).
+#include <string>
+#include <vector>
+
+#include "decode_output.hpp"
+
+namespace gyrochar::decoding {
+
+/// Empty when PLplot has the svgcairo and pngcairo devices; otherwise why not. Call before
+/// plotting: PLplot ends the process on a missing device instead of returning an error.
+std::string plot_devices_missing();
+
+/// Writes `prefix`.svg and `prefix`.png, one panel per element of `panels` (at least one), replacing
+/// the files atomically (drawn to `prefix`.*.part, then renamed). `confidence` is the level of
+/// the error bars, for the caption. Returns false and sets `why` when a file cannot be written.
+/// Allocates; O(points) per panel.
+bool write_plot(const std::string& prefix, const std::vector<NodePlot>& panels, double confidence, std::string& why);
+
+}  // namespace gyrochar::decoding

@@ -1,0 +1,111 @@
+#pragma once
+// The offline analysis engine behind gyrochar-analyze. Values stream into the core pyramid (exact
+// integer arithmetic for counts; for phase and frequency, floating phase kept small relative to a
+// reference line); beside it run Stable32's non-overlapped ADEV/HDEV and the decimated series for
+// noise identification. Per tau the engine gives the deviation, its number of terms, the noise
+// exponent, the Greenhall EDF of the estimator actually used and the chi-squared interval.
+//
+// Memory depends on the tau list and the stride factor S, never on the number of values: the
+// history holds at most 3S (1 + levels/2) points (levels: octaves of the largest tau above S; the
+// pages of a level are touched only once the data reaches it), each tau a few hundred bytes.
+//
+// Units: deviations come out in "phase unit per second", where the phase unit is the unit of the
+// values (phase data: the value's unit, e.g. s or deg; counts: one pulse; frequency data: the
+// value's unit times s, so deviations are in the value's unit). TDEV is in the phase unit.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "confidence.hpp"
+
+namespace gyrochar {
+
+enum class DataType {
+  phase,   // phase (angle, time) samples x_k
+  freq,    // frequency (rate) samples y_k, averages over tau0: N values give N + 1 phase points
+  counts,  // integer pulse counts per tau0 (exact): N counts give N + 1 phase points
+};
+enum class DevStat { adev, oadev, mdev, tdev, hdev, ohdev };
+
+/// "phase", "freq", "counts" / "adev", "oadev", ... Static strings, never null.
+const char* name(DataType t);
+const char* name(DevStat s);
+/// The statistic called `text`, or nothing.
+std::optional<DevStat> parse_dev_stat(const std::string& text);
+
+/// Largest stride factor "full" uses: with S = 2^16 the history takes a few MB whatever the run
+/// length; taus above it are strided (terms every m/S points) and their EDF says so.
+inline constexpr std::uint32_t full_stride_cap = 1u << 16;
+
+/// The stride factor used for a request: `requested` (a power of two >= 2) as is; 0 means "full":
+/// the smallest power of two >= m_max (so every tau is fully overlapped), at least 2 and at most
+/// full_stride_cap. O(1).
+std::uint32_t resolve_stride_factor(std::uint32_t requested, std::uint64_t m_max);
+
+/// True when the pyramid with stride factor S can form averaging factor m >= 1: m <= S, or m a
+/// multiple of its stride 2^L, the smallest power of two with S 2^L >= m. O(1).
+bool tau_representable(std::uint64_t m, std::uint32_t stride_factor);
+
+/// Octave averaging factors 1, 2, 4, ... up to n_phase / 2 (up to 2^39 when n_phase is 0, unknown).
+std::vector<std::uint64_t> octave_taus(std::uint64_t n_phase);
+/// Decade averaging factors as Stable32: 1, 2, 4, 10, 20, 40, 100, ... up to n_phase / 2.
+std::vector<std::uint64_t> decade_taus(std::uint64_t n_phase);
+/// Every averaging factor up to n_phase / 2 that stride factor S can form (every m when
+/// n_phase / 2 <= S). The list has O(min(n_phase, S log n_phase)) entries.
+std::vector<std::uint64_t> all_taus(std::uint64_t n_phase, std::uint32_t stride_factor);
+
+struct AnalysisOptions {
+  DataType type = DataType::phase;
+  double tau0_s = 1.0;                  // sample interval
+  std::vector<std::uint64_t> m_list;    // averaging factors, strictly increasing
+  std::vector<DevStat> stats{DevStat::oadev, DevStat::mdev};  // rows come out in this order
+  std::uint32_t stride_factor = 0;      // S, a power of two >= 2; 0: full (resolve_stride_factor)
+  double confidence = 0.682689492137086;
+  std::optional<int> alpha;             // noise exponent for the EDF; empty: identified per tau
+};
+
+struct AnalysisRow {
+  DevStat stat = DevStat::oadev;
+  std::uint64_t m = 0;
+  double tau_s = 0.0;
+  std::uint64_t n = 0;          // terms in the estimate (Stable32's "#")
+  double dev = 0.0;             // deviation: phase unit per second (TDEV: phase unit)
+  std::optional<int> alpha;     // noise exponent used for the EDF (fixed or identified)
+  std::uint64_t stride = 1;     // terms every `stride` phase points (m for adev and hdev)
+  double edf = 0.0;             // Greenhall EDF of this estimator; 0: not available
+  Interval ci;                  // same unit as dev
+};
+
+struct Analysis {
+  std::uint64_t n_values = 0;       // values read
+  std::uint64_t n_phase = 0;        // phase points (values + 1 for freq and counts)
+  std::uint32_t stride_factor = 0;  // S used
+  std::vector<AnalysisRow> rows;    // by stat (in the order asked), then by m; no row when n = 0
+};
+
+class Analyzer {
+ public:
+  /// Allocates the history and per-tau state (O(S log m_max + taus)). Throws std::invalid_argument
+  /// with a reason for inconsistent options: tau0 <= 0, no taus, taus not increasing, a tau the
+  /// stride factor cannot form, a stride factor that is not a power of two in [2, 2^24], a
+  /// confidence outside (0, 1), no statistics.
+  explicit Analyzer(const AnalysisOptions& options);
+  ~Analyzer();
+  Analyzer(const Analyzer&) = delete;
+  Analyzer& operator=(const Analyzer&) = delete;
+
+  /// The next value: a phase, a frequency, or a pulse count (an integer below 2^31 in magnitude).
+  /// O(taus) amortized, no allocation. Throws std::invalid_argument for a value that is not
+  /// finite or not a valid count, std::range_error when the accumulated count passes 2^63 pulses.
+  void add(double value);
+  /// Results so far; may be called at any time. O(taus x stats) plus the EDF, allocates the rows.
+  Analysis result() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace gyrochar

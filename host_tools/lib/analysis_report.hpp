@@ -1,0 +1,81 @@
+#pragma once
+// What gyrochar-analyze shows of an Analysis: units (gyro data in rate units, time data as
+// fractional frequency), the IEEE-952 fits on the Allan and modified Allan curves, and the table,
+// CSV and JSON formats.
+//
+// Units. The engine gives deviations in "phase unit per second" (see analysis.hpp). ReportUnits
+// says what one phase unit is: an angle in rad for gyro data (counts times the pulse weight,
+// angle samples, rate samples times 1 s) or a time in s for clock data (phase in s, fractional
+// frequency times 1 s). Gyro deviations are shown in a rate unit (TDEV in the angle unit equal to
+// that rate times 1 s: deg/h -> arcsec, deg/s -> deg, rad/s -> rad); clock deviations as
+// fractional frequency (TDEV in s).
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis.hpp"
+#include "gyrochar/ieee952.hpp"
+
+namespace gyrochar {
+
+// TODO(units.hpp): take these factors from host_tools/lib/units.hpp once it lands.
+/// Size in rad of an angle unit: rad, mrad, urad, deg, arcsec; empty for anything else. O(1).
+std::optional<double> angle_unit_rad(std::string_view unit);
+
+struct RateUnit {
+  const char* name = "rad/s";
+  double rad_per_s = 1.0;     // size of the unit
+  const char* angle = "rad";  // the unit times 1 s, for TDEV
+};
+/// A rate unit: deg/h, deg/s, rad/s; empty for anything else. O(1).
+std::optional<RateUnit> rate_unit(std::string_view unit);
+
+struct ReportUnits {
+  bool gyro = false;           // angle/rate data (else clock data)
+  double phase_unit_si = 1.0;  // one engine phase unit in rad (gyro) or s (clock)
+  RateUnit rate;               // output unit of gyro deviations
+  std::string input;           // what the values were, e.g. "counts of 1.5 arcsec", "phase in s"
+
+  /// Factor from engine deviations (and TDEV) to the output units. O(1).
+  double factor() const { return gyro ? phase_unit_si / rate.rad_per_s : phase_unit_si; }
+  /// Unit of a row of statistic s in the output: e.g. "deg/h", "arcsec", "1" (fractional), "s".
+  std::string unit(DevStat s) const;
+};
+
+/// An IEEE-952 fit on one curve: oadev rows give the AVAR curve, mdev rows the MVAR curve.
+struct CurveFit {
+  Ieee952Curve curve = Ieee952Curve::avar;
+  Ieee952Fit fit;  // parameters in SI: Q rad (s), N rad/s^0.5, B rad/s, K rad/s^1.5, R rad/s^2
+};
+
+/// Fits the AVAR curve (oadev rows) and the MVAR curve (mdev rows) that the analysis has, with the
+/// points in SI units, weighted by their EDF (rows without an EDF are left out). O(rows),
+/// allocates the result; empty when the analysis has neither curve. A fit that fails has ok false.
+std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s);
+
+/// Everything a report shows. Refers to (does not own) the analysis.
+struct Report {
+  const Analysis& analysis;
+  DataType type = DataType::phase;
+  double tau0_s = 1.0;
+  double confidence = 0.683;
+  ReportUnits units;
+  std::vector<CurveFit> fits;
+};
+
+/// Aligned table for people: a header line (data, units, stride factor, confidence), one line per
+/// row with its unit, then the fits (parameters in gyro units: Q arcsec, N deg/sqrt(h), B deg/h,
+/// K deg/h/sqrt(h), R deg/h/h; clock data: s-based units). O(rows), allocates the text.
+std::string format_table(const Report& r);
+/// CSV: header "stat,m,tau,n,dev,unit,alpha,edf,ci_low,ci_high,stride", numbers shortest
+/// round-trip, empty fields where not available. Fits are not in the CSV. O(rows).
+std::string format_csv(const Report& r);
+/// JSON: {"tau0", "n_samples", "type", "results": [{"stat", "m", "tau", "n", "dev", "alpha", "edf",
+/// "ci_low", "ci_high", "unit", "stride"}], "units", "stride_factor", "confidence", "fit" (only
+/// with fits)}; null where not available. O(rows).
+nlohmann::json to_json(const Report& r);
+
+}  // namespace gyrochar

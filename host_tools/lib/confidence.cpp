@@ -1,0 +1,23 @@
+#include "confidence.hpp"
+
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+
+namespace gyrochar {
+
+Interval confidence_interval(double dev, double edf, double confidence) {
+  Interval out;
+  if (!(edf > 0) || !std::isfinite(edf) || !(confidence > 0 && confidence < 1) || !(dev >= 0)) return out;
+  try {
+    const boost::math::chi_squared chi2(edf);
+    const double p = (1.0 - confidence) / 2.0;
+    out.low = dev * std::sqrt(edf / boost::math::quantile(chi2, 1.0 - p));
+    out.high = dev * std::sqrt(edf / boost::math::quantile(chi2, p));
+    out.valid = std::isfinite(out.low) && std::isfinite(out.high);
+  } catch (const std::exception&) {
+    out = Interval{};
+  }
+  return out;
+}
+
+}  // namespace gyrochar

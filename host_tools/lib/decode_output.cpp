@@ -1,0 +1,552 @@
+#include "decode_output.hpp"
+
+#include <fmt/compile.h>
+#include <fmt/format.h>
+
+#include <cmath>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <type_traits>
+
+#include "gyrochar/ieee952.hpp"
+
+namespace gyrochar::decoding {
+
+using namespace protocol;
+using Json = nlohmann::ordered_json;
+
+namespace {
+
+constexpr std::array<const char*, 5> term_letters{"Q", "N", "B", "K", "R"};
+
+double degrees_per(AngleUnit u) {
+  switch (u) {
+    case AngleUnit::rad:
+      return 180.0 / std::numbers::pi;
+    case AngleUnit::urad:
+      return 180.0e-6 / std::numbers::pi;
+    case AngleUnit::deg:
+      return 1.0;
+    case AngleUnit::arcsec:
+      return 1.0 / 3600.0;
+    case AngleUnit::pulse:
+      break;
+  }
+  return 0.0;  // pulses have no angle: never converted
+}
+
+// Value or nothing: CSV leaves the field empty, JSON writes null.
+template <class T>
+Json json_or_null(bool known, T value) {
+  return known ? Json(value) : Json(nullptr);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Units
+
+std::optional<RateUnit> parse_rate_unit(std::string_view text) {
+  if (text == "deg/h") return RateUnit::deg_per_h;
+  if (text == "deg/s") return RateUnit::deg_per_s;
+  if (text == "rad/s") return RateUnit::rad_per_s;
+  if (text == "native") return RateUnit::native;
+  return std::nullopt;
+}
+
+Units units_for(const NodeView& node, RateUnit choice) {
+  Units u;
+  if (!node.scale) {
+    u.rate_name = "unknown";
+    u.ieee_name.fill("unknown");
+    return u;
+  }
+  u.known = true;
+  const AngleUnit angle = node.scale->angle_unit;
+  u.pulses = angle == AngleUnit::pulse;
+  if (u.pulses || choice == RateUnit::native) {
+    const std::string a = name(angle);
+    u.rate_name = a + "/s";
+    u.ieee_name = {a, a + "/sqrt(s)", a + "/s", a + "/s/sqrt(s)", a + "/s/s"};
+    return u;
+  }
+  const double deg = degrees_per(angle);
+  const bool per_h = choice == RateUnit::deg_per_h, in_rad = choice == RateUnit::rad_per_s;
+  u.rate_name = per_h ? "deg/h" : in_rad ? "rad/s" : "deg/s";
+  u.rate = per_h ? deg * 3600.0 : in_rad ? deg * std::numbers::pi / 180.0 : deg;
+  // Q [arcsec], N [deg/sqrt(h)] = 60 N [deg/sqrt(s)], B [deg/h], K [deg/h/sqrt(h)] = 3600^1.5 K [deg/s^1.5],
+  // R [deg/h/h] = 3600^2 R [deg/s^2].
+  u.ieee_name = {"arcsec", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h/h"};
+  u.ieee = {deg * 3600.0, deg * 60.0, deg * 3600.0, deg * 3600.0 * 60.0, deg * 3600.0 * 3600.0};
+  return u;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Confidence intervals
+
+Interval ConfidenceIntervals::operator()(double dev, double edf) {
+  if (!(edf > 0) || !std::isfinite(edf)) return {};
+  auto it = unit_intervals_.find(edf);
+  if (it == unit_intervals_.end()) it = unit_intervals_.emplace(edf, confidence_interval(1.0, edf, confidence_)).first;
+  const Interval& unit = it->second;
+  return unit.valid ? Interval{dev * unit.low, dev * unit.high, true} : Interval{};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Report tracker
+
+void ReportTracker::note(const CanFrame& frame, double t_s) {
+  const Decoded d = decode(frame);
+  if (d.error != ProtocolError::none) return;
+  std::visit(
+      [&](const auto& msg) {
+        using M = std::decay_t<decltype(msg)>;
+        if constexpr (!std::is_same_v<M, CounterInputMsg>) {
+          Report& r = reports_[d.node];
+          if (!r.open || r.seq != msg.seq) r = Report{true, msg.seq, t_s, {}, {}};
+          if constexpr (std::is_same_v<M, TauDevMsg>)
+            (msg.kind == DevKind::adev ? r.adev : r.mdev)[msg.tau_index] = true;
+        }
+      },
+      d.message);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rows
+
+const char* name(DevCell::Status s) {
+  switch (s) {
+    case DevCell::Status::ok:
+      return "ok";
+    case DevCell::Status::invalid:
+      return "invalid";
+    case DevCell::Status::missing:
+      return "missing";
+  }
+  return "invalid";
+}
+
+namespace {
+
+DevCell dev_cell(const TauView::Dev& d, bool received, double rate, ConfidenceIntervals& intervals) {
+  DevCell c;
+  if (!received) return c;  // missing: nothing from this report
+  c.edf = d.edf;
+  c.noise = d.noise;
+  if (!d.valid) {
+    c.status = DevCell::Status::invalid;
+    return c;
+  }
+  c.status = DevCell::Status::ok;
+  c.value = static_cast<double>(d.dev) * rate;
+  c.ci = intervals(c.value, d.edf);
+  return c;
+}
+
+}  // namespace
+
+void tau_rows(const NodeView& node, const ReportTracker::Report& report, const Units& units,
+              ConfidenceIntervals& intervals, std::vector<TauRow>& out) {
+  for (std::uint8_t i = 0; i < node.status.tau_count && i < max_taus; ++i) {
+    const TauView& t = node.taus[i];
+    TauRow r;
+    r.time_s = report.start_s;
+    r.node = node.address;
+    r.session = node.session;
+    r.seq = report.seq;
+    r.tau_index = i;
+    r.m = t.m;
+    r.tau_s = node.tau_s(i);
+    r.n = t.n;
+    r.adev = dev_cell(t.adev, report.adev[i], units.rate, intervals);
+    r.mdev = dev_cell(t.mdev, report.mdev[i], units.rate, intervals);
+    out.push_back(r);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// CSV
+
+CsvWriter::CsvWriter(std::FILE* out, double confidence) : out_(out), confidence_(confidence) {
+  std::fputs(
+      "time_s,node,seq,tau_index,m,tau_s,n,"
+      "adev,adev_low,adev_high,adev_edf,adev_noise,adev_status,"
+      "mdev,mdev_low,mdev_high,mdev_edf,mdev_noise,mdev_status,"
+      "rate_unit,ci_level,session\n",
+      out_);
+}
+
+void CsvWriter::row(const TauRow& r, const Units& units) {
+  line_.clear();
+  const auto out = fmt::appender(line_);
+  const auto field = [&](bool known, auto value) {
+    if (known) fmt::format_to(out, FMT_COMPILE("{}"), value);
+    line_.push_back(',');
+  };
+  fmt::format_to(out, FMT_COMPILE("{:.6f},{},{},{},"), r.time_s, r.node, r.seq, r.tau_index);
+  field(r.m != 0, r.m);
+  field(r.tau_s > 0, static_cast<float>(r.tau_s));  // tau0 is a float32 on the wire
+  field(r.n != 0, r.n);
+  for (const DevCell* c : {&r.adev, &r.mdev}) {
+    field(c->status == DevCell::Status::ok, c->value);
+    field(c->ci.valid, c->ci.low);
+    field(c->ci.valid, c->ci.high);
+    field(c->edf > 0, c->edf);
+    field(c->status != DevCell::Status::missing, name(c->noise));
+    field(true, name(c->status));
+  }
+  fmt::format_to(out, FMT_COMPILE("{},{},{}\n"), units.rate_name, confidence_, r.session);
+  std::fwrite(line_.data(), 1, line_.size(), out_);
+}
+
+// ---------------------------------------------------------------------------------------------
+// JSON lines
+
+void JsonlWriter::line(const std::string& text) {
+  std::fwrite(text.data(), 1, text.size(), out_);
+  std::fputc('\n', out_);
+}
+
+namespace {
+
+Json health_json(const LinkHealth& h) {
+  Json rejected = Json::object();
+  for (const auto& [reason, count] : h.rejected) rejected[name(reason)] = count;
+  return Json{{"frames", h.frames},
+              {"reports_complete", h.reports_complete},
+              {"reports_incomplete", h.reports_incomplete},
+              {"reports_lost", h.reports_lost},
+              {"frames_missing", h.frames_missing},
+              {"restarts", h.restarts},
+              {"offline_events", h.offline_events},
+              {"duplicates", h.duplicates},
+              {"rejected", rejected}};
+}
+
+const char* name(DecoderEvent e) {
+  switch (e) {
+    case DecoderEvent::report_closed:
+      return "report_closed";
+    case DecoderEvent::restart:
+      return "restart";
+    case DecoderEvent::offline:
+      return "offline";
+    case DecoderEvent::online:
+      return "online";
+    case DecoderEvent::rejected_frame:
+      return "rejected_frame";
+    case DecoderEvent::duplicate:
+      return "duplicate";
+  }
+  return "invalid";
+}
+
+}  // namespace
+
+// The tau rows are the bulk of a recording: written with fmt, not built as JSON objects (5x faster).
+// Every string in them is an enumeration or unit name (plain ASCII, nothing to escape) and every
+// number is finite; fmt's shortest round-trip form of a double is a valid JSON number.
+void JsonlWriter::row(const TauRow& r, const Units& units) {
+  line_.clear();
+  const auto out = fmt::appender(line_);
+  const auto member = [&](const char* key, bool known, auto value) {
+    if (known)
+      fmt::format_to(out, FMT_COMPILE(",\"{}\":{}"), key, value);
+    else
+      fmt::format_to(out, FMT_COMPILE(",\"{}\":null"), key);
+  };
+  fmt::format_to(
+      out, FMT_COMPILE("{{\"type\":\"tau\",\"time_s\":{:.6f},\"node\":{},\"session\":{},\"seq\":{},\"tau_index\":{}"),
+      r.time_s, r.node, r.session, r.seq, r.tau_index);
+  member("m", r.m != 0, r.m);
+  member("tau_s", r.tau_s > 0, static_cast<float>(r.tau_s));  // as in the CSV
+  member("n", r.n != 0, r.n);
+  fmt::format_to(out, FMT_COMPILE(",\"rate_unit\":\"{}\",\"ci_level\":{}"), units.rate_name, confidence_);
+  for (const auto& [key, c] : {std::pair{"adev", &r.adev}, std::pair{"mdev", &r.mdev}}) {
+    fmt::format_to(out, FMT_COMPILE(",\"{}\":{{\"status\":\"{}\""), key, name(c->status));
+    member("value", c->status == DevCell::Status::ok, c->value);
+    member("low", c->ci.valid, c->ci.low);
+    member("high", c->ci.valid, c->ci.high);
+    member("edf", c->edf > 0, c->edf);
+    if (c->status != DevCell::Status::missing)
+      fmt::format_to(out, FMT_COMPILE(",\"noise\":\"{}\"}}"), name(c->noise));
+    else
+      fmt::format_to(out, FMT_COMPILE(",\"noise\":null}}"));
+  }
+  fmt::format_to(out, FMT_COMPILE("}}\n"));
+  std::fwrite(line_.data(), 1, line_.size(), out_);
+}
+
+void JsonlWriter::report(double time_s, const NodeView& node, std::uint8_t seq, const Units& units) {
+  const StatusFaultsMsg& f = node.faults;
+  // A metadata field, null until its page has arrived.
+  const auto meta_field = [](const auto& page, auto field) { return page ? Json(field(*page)) : Json(nullptr); };
+  const Json meta{{"tau0_s", meta_field(node.sampling, [](const auto& m) { return m.tau0_s; })},
+                  {"stride_factor", meta_field(node.sampling, [](const auto& m) { return m.stride_factor; })},
+                  {"uptime_ms", meta_field(node.clock, [](const auto& m) { return m.uptime_ms; })},
+                  {"protocol_version", meta_field(node.clock, [](const auto& m) { return m.protocol_version; })},
+                  {"angle_unit", meta_field(node.scale, [](const auto& m) { return name(m.angle_unit); })},
+                  {"angle_per_pulse", meta_field(node.scale, [](const auto& m) { return m.angle_per_pulse; })},
+                  {"input_source", meta_field(node.scale, [](const auto& m) { return name(m.input_source); })},
+                  {"config_hash", meta_field(node.config, [](const auto& m) { return m.config_hash; })},
+                  {"report_period_ms", meta_field(node.config, [](const auto& m) { return m.report_period_ms; })}};
+  Json ieee = Json::object();
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Ieee952View& p = node.ieee952[k];
+    ieee[term_letters[k]] = !p.received ? Json(nullptr)
+                                        : Json{{"resolved", p.resolved},
+                                               {"value", json_or_null(p.resolved, p.value * units.ieee[k])},
+                                               {"unit", units.ieee_name[k]},
+                                               {"rel_uncertainty", json_or_null(p.resolved, p.rel_uncertainty)}};
+  }
+  const Json j{{"type", "report"},
+               {"time_s", time_s},
+               {"node", node.address},
+               {"session", node.session},
+               {"seq", seq},
+               {"online", node.online},
+               {"state", json_or_null(node.have_status, name(node.status.state))},
+               {"tau_count", node.status.tau_count},
+               {"sample_count", node.status.sample_count},
+               {"faults",
+                {{"lost_edges", f.lost_edges},
+                 {"sample_gaps", f.sample_gaps},
+                 {"tx_dropped_frames", f.tx_dropped_frames},
+                 {"bus_off_events", f.bus_off_events}}},
+               {"health", health_json(node.health)},
+               {"metadata", meta},
+               {"rate_unit", units.rate_name},
+               {"ieee952", ieee}};
+  line(j.dump());
+}
+
+void JsonlWriter::event(double time_s, DecoderEvent e, const NodeView& node) {
+  line(
+      Json{{"type", "event"}, {"time_s", time_s}, {"node", node.address}, {"event", name(e)}, {"session", node.session}}
+          .dump());
+}
+
+void JsonlWriter::summary(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown) {
+  Json nodes = Json::array();
+  for (const auto& [address, v] : decoder.nodes()) {
+    if (!shown[address]) continue;
+    nodes.push_back(
+        Json{{"node", address}, {"online", v.online}, {"session", v.session}, {"health", health_json(v.health)}});
+  }
+  line(Json{{"type", "summary"},
+            {"source", input.source},
+            {"lines", input.lines},
+            {"malformed_lines", input.malformed_lines},
+            {"frames", input.frames},
+            {"other_frames", decoder.other_frames()},
+            {"rejected_frames", decoder.rejected_frames()},
+            {"time_backwards", input.time_backwards},
+            {"first_s", json_or_null(input.started, input.first_s)},
+            {"last_s", json_or_null(input.started, input.now_s)},
+            {"nodes", nodes}}
+           .dump());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Terminal view and summary
+
+namespace {
+
+std::string rejected_text(const LinkHealth& h) {
+  std::uint64_t total = 0;
+  std::string reasons;
+  for (const auto& [reason, count] : h.rejected) {
+    total += count;
+    reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", name(reason), count);
+  }
+  return total == 0 ? "0" : fmt::format("{} ({})", total, reasons);
+}
+
+std::string health_text(const LinkHealth& h) {
+  return fmt::format(
+      "frames {}; reports {} complete, {} incomplete, {} lost; frames missing {}; restarts {}; "
+      "offline {}; duplicates {}; rejected {}",
+      h.frames, h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing, h.restarts,
+      h.offline_events, h.duplicates, rejected_text(h));
+}
+
+std::string input_text(const Decoder& decoder, const InputCounters& in) {
+  std::string s = fmt::format("{}: ", in.source);
+  if (in.lines > 0) s += fmt::format("{} lines, {} malformed line(s); ", in.lines, in.malformed_lines);
+  s += fmt::format("{} frames: {} other traffic, {} rejected frames", in.frames, decoder.other_frames(),
+                   decoder.rejected_frames());
+  if (in.time_backwards > 0) s += fmt::format(", {} timestamps backwards", in.time_backwards);
+  if (in.started) s += fmt::format(", {:.1f} s", in.now_s - in.first_s);
+  return s;
+}
+
+std::string dev_text(const TauView::Dev& d, double rate, ConfidenceIntervals& intervals) {
+  if (!d.received || !d.valid) return fmt::format("{:>11}  {:24}", "-", "");
+  const double value = static_cast<double>(d.dev) * rate;
+  const Interval ci = intervals(value, d.edf);
+  return ci.valid ? fmt::format("{:>11.4e}  [{:.3e}, {:.3e}]", value, ci.low, ci.high)
+                  : fmt::format("{:>11.4e}  {:24}", value, "(no EDF)");
+}
+
+void node_view(std::string& s, const NodeView& v, RateUnit rate_unit, ConfidenceIntervals& intervals) {
+  const Units u = units_for(v, rate_unit);
+  auto out = std::back_inserter(s);
+  fmt::format_to(out, "\nnode 0x{:02X}  {}  {}  session {}", v.address, v.online ? "online" : "OFFLINE",
+                 v.have_status ? name(v.status.state) : "no status yet", v.session);
+  if (v.have_status) fmt::format_to(out, "  samples {}", v.status.sample_count);
+  if (v.clock)
+    fmt::format_to(out, "  uptime {:.1f} s  protocol {}", static_cast<double>(v.clock->uptime_ms) / 1000.0,
+                   v.clock->protocol_version);
+  if (v.config)
+    fmt::format_to(out, "  config 0x{:08X}  report {} ms", v.config->config_hash, v.config->report_period_ms);
+  s += "\n ";
+  if (v.sampling) fmt::format_to(out, " tau0 {} s  S {} ", v.sampling->tau0_s, v.sampling->stride_factor);
+  if (v.scale) {
+    fmt::format_to(out, " angle unit {} ({} {}/pulse)  input {}", name(v.scale->angle_unit), v.scale->angle_per_pulse,
+                   name(v.scale->angle_unit), name(v.scale->input_source));
+  } else {
+    s += " angle unit not received yet: values as sent";
+  }
+  fmt::format_to(out, "  rates [{}]", u.rate_name);
+  if (u.pulses) s += " (pulses: not converted)";
+  fmt::format_to(out, "\n  link: {}\n", health_text(v.health));
+  fmt::format_to(out, "  node faults: lost edges {}, sample gaps {}, tx dropped frames {}, bus-off events {}\n",
+                 v.faults.lost_edges, v.faults.sample_gaps, v.faults.tx_dropped_frames, v.faults.bus_off_events);
+  const std::string level = fmt::format("({:.1f}% CI)", 100.0 * intervals.confidence());
+  fmt::format_to(out, "  {:>11} {:>13}  {:>11}  {:24}  {:>11}  {:24}  {:>9}  {}\n", "tau [s]", "n", "ADEV", level,
+                 "MDEV", level, "EDF MDEV", "noise");
+  for (std::size_t i = 0; i < v.status.tau_count && i < max_taus; ++i) {
+    const TauView& t = v.taus[i];
+    const std::string tau = t.m && v.sampling ? fmt::format("{:.4g}", v.tau_s(i)) : fmt::format("#{}", i);
+    const std::string n = t.n ? fmt::format("{}", t.n) : "-";
+    const std::string edf = t.mdev.received && t.mdev.edf > 0 ? fmt::format("{:.4g}", t.mdev.edf) : "-";
+    std::string noise = t.adev.received ? name(t.adev.noise) : "-";
+    if (t.mdev.received && t.mdev.noise != t.adev.noise) noise += fmt::format(" / {} (MDEV)", name(t.mdev.noise));
+    fmt::format_to(out, "  {:>11} {:>13}  {}  {}  {:>9}  {}\n", tau, n, dev_text(t.adev, u.rate, intervals),
+                   dev_text(t.mdev, u.rate, intervals), edf, noise);
+  }
+  s += "  IEEE-952 (node's fit):";
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Ieee952View& p = v.ieee952[k];
+    if (!p.received)
+      fmt::format_to(out, "  {} -", term_letters[k]);
+    else if (!p.resolved)
+      fmt::format_to(out, "  {} not resolved", term_letters[k]);
+    else
+      fmt::format_to(out, "  {} {:.4g} {} (+-{:.1f}%)", term_letters[k], p.value * u.ieee[k], u.ieee_name[k],
+                     100.0 * p.rel_uncertainty);
+  }
+  s += '\n';
+}
+
+}  // namespace
+
+std::string format_view(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown, RateUnit rate_unit,
+                        ConfidenceIntervals& intervals) {
+  std::string s = "gyrochar-decode: " + input_text(decoder, input) + "\n";
+  if (!input.bus.empty()) s += "  " + input.bus + "\n";
+  std::size_t count = 0;
+  for (const auto& [address, v] : decoder.nodes()) {
+    if (!shown[address]) continue;
+    node_view(s, v, rate_unit, intervals);
+    ++count;
+  }
+  if (count == 0) s += "\nno gyrochar node seen yet\n";
+  return s;
+}
+
+std::string format_summary(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown) {
+  std::string s = "gyrochar-decode: " + input_text(decoder, input) + "\n";
+  if (!input.bus.empty()) s += "gyrochar-decode: " + input.bus + "\n";
+  for (const auto& [address, v] : decoder.nodes()) {
+    if (!shown[address]) continue;
+    s += fmt::format("gyrochar-decode: node 0x{:02X}{}: {}\n", address, v.online ? "" : " (offline)",
+                     health_text(v.health));
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Plot series
+
+namespace {
+
+constexpr std::size_t line_points = 97;
+
+std::vector<double> log_grid(double lo, double hi) {
+  std::vector<double> tau(line_points);
+  for (std::size_t k = 0; k < line_points; ++k)
+    tau[k] = lo * std::pow(hi / lo, static_cast<double>(k) / static_cast<double>(line_points - 1));
+  return tau;
+}
+
+// ADEV of the AVAR model with the given terms (wire units: A, s), in display units.
+double model_adev(const std::array<double, 5>& qnbkr, double tau_s, double rate) {
+  return std::sqrt(ieee952_variance(qnbkr, tau_s, Ieee952Curve::avar)) * rate;
+}
+
+}  // namespace
+
+NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals& intervals) {
+  const Units u = units_for(node, rate_unit);
+  NodePlot p;
+  p.title = fmt::format("node 0x{:02X}, session {}", node.address, node.session);
+  p.rate_name = u.rate_name;
+  double lo = INFINITY, hi = 0.0;
+  for (std::size_t i = 0; i < node.status.tau_count && i < max_taus; ++i) {
+    const double tau = node.tau_s(i);
+    if (!(tau > 0)) continue;
+    for (auto [dev, series] : {std::pair{&node.taus[i].adev, &p.adev}, std::pair{&node.taus[i].mdev, &p.mdev}}) {
+      if (!dev->received || !dev->valid) continue;
+      const double value = static_cast<double>(dev->dev) * u.rate;
+      series->push_back({tau, value, intervals(value, dev->edf)});
+      lo = std::min(lo, tau);
+      hi = std::max(hi, tau);
+    }
+  }
+  if (hi == 0.0) return p;
+  p.tau_min_s = lo / 2.0;
+  p.tau_max_s = hi * 2.0;
+  const std::vector<double> grid = log_grid(p.tau_min_s, p.tau_max_s);
+  const auto inside = [&](double tau) { return tau >= p.tau_min_s && tau <= p.tau_max_s; };
+  // Where each term's ADEV equals its parameter (s); B has its own rule below.
+  static constexpr std::array<double, 5> read_tau_s{std::numbers::sqrt3, 1.0, 0.0, 3.0, std::numbers::sqrt2};
+  static constexpr std::array<const char*, 5> read_label{"Q at sqrt(3) s", "N at 1 s", "0.664 B", "K at 3 s",
+                                                         "R at sqrt(2) s"};
+  constexpr auto b_index = static_cast<std::size_t>(Ieee952Term::bias_instability);
+  std::array<double, 5> all{};
+  std::size_t resolved = 0;
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Ieee952View& t = node.ieee952[k];
+    if (!t.received || !t.resolved) continue;
+    ++resolved;
+    std::array<double, 5> one{};
+    one[k] = all[k] = t.value;
+    PlotLine line{static_cast<Ieee952Term>(k),
+                  fmt::format("{} {:.3g} {} (±{:.2g}%)", term_letters[k], t.value * u.ieee[k], u.ieee_name[k],
+                              100.0 * t.rel_uncertainty),
+                  grid,
+                  {}};
+    for (const double tau : grid) line.dev.push_back(model_adev(one, tau, u.rate));
+    p.terms.push_back(std::move(line));
+    if (k != b_index && inside(read_tau_s[k]))
+      p.read_offs.push_back({read_tau_s[k], model_adev(one, read_tau_s[k], u.rate), read_label[k]});
+  }
+  if (resolved == 0) return p;
+  PlotLine sum{std::nullopt, "IEEE-952 model (sum)", grid, {}};
+  for (const double tau : grid) sum.dev.push_back(model_adev(all, tau, u.rate));
+  if (all[b_index] > 0) {  // B: the floor, at the sum's minimum within the points
+    std::optional<std::size_t> floor;
+    for (std::size_t k = 0; k < grid.size(); ++k) {
+      if (grid[k] >= lo && grid[k] <= hi && (!floor || sum.dev[k] < sum.dev[*floor])) floor = k;
+    }
+    std::array<double, 5> b{};
+    b[b_index] = all[b_index];
+    if (floor) p.read_offs.push_back({grid[*floor], model_adev(b, grid[*floor], u.rate), read_label[b_index]});
+  }
+  p.terms.push_back(std::move(sum));
+  return p;
+}
+
+}  // namespace gyrochar::decoding

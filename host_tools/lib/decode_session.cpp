@@ -1,0 +1,112 @@
+#include "decode_session.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace gyrochar::decoding {
+
+// ---------------------------------------------------------------------------------------------
+// LineReader
+
+LineReader::LineReader(int fd, std::size_t buffer_bytes) : fd_(fd), buffer_(buffer_bytes) {}
+
+LineReader::Result LineReader::next(std::string_view& line) {
+  for (bool have_read = false;; have_read = true) {
+    const char* begin = buffer_.data() + begin_;
+    const std::size_t available = end_ - begin_;
+    const auto* newline = static_cast<const char*>(std::memchr(begin, '\n', available));
+    const bool full = begin_ == 0 && end_ == buffer_.size();
+    if (newline != nullptr || full || (eof_ && available > 0)) {
+      const std::size_t length = newline != nullptr ? static_cast<std::size_t>(newline - begin) : available;
+      line = std::string_view(begin, length);
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      begin_ += newline != nullptr ? length + 1 : length;
+      return Result::line;
+    }
+    if (eof_) return Result::end;
+    if (have_read) return Result::again;  // one read() per call: the caller may poll() in between
+    std::memmove(buffer_.data(), begin, available);
+    begin_ = 0;
+    end_ = available;
+    const ssize_t n = ::read(fd_, buffer_.data() + end_, buffer_.size() - end_);
+    if (n > 0) {
+      end_ += static_cast<std::size_t>(n);
+    } else if (n == 0) {
+      eof_ = true;
+    } else if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) {
+      return Result::again;
+    } else {
+      return Result::error;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Session
+
+Session::Session(const SessionOptions& options)
+    : options_(options),
+      intervals_(options.confidence),
+      csv_(options.csv ? std::make_unique<CsvWriter>(options.csv, options.confidence) : nullptr),
+      jsonl_(options.jsonl ? std::make_unique<JsonlWriter>(options.jsonl, options.confidence) : nullptr),
+      decoder_([this](DecoderEvent e, const NodeView& node, std::uint8_t seq) { on_event(e, node, seq); }) {}
+
+bool Session::feed_line(std::string_view line, std::string& why) {
+  ++input_.lines;
+  if (!parse_candump_line(line, parsed_, why)) {
+    ++input_.malformed_lines;
+    return false;
+  }
+  feed(parsed_.frame, parsed_.time_s);
+  return true;
+}
+
+void Session::feed(const CanFrame& frame, double t_s) {
+  if (!input_.started) {
+    input_.started = true;
+    input_.first_s = input_.now_s = t_s;
+  }
+  if (t_s < input_.now_s) {
+    ++input_.time_backwards;
+  } else {
+    input_.now_s = t_s;
+  }
+  ++input_.frames;
+  decoder_.feed(frame, input_.now_s);
+  tracker_.note(frame, input_.now_s);
+}
+
+void Session::tick(double t_s) {
+  if (t_s <= input_.now_s) return;
+  input_.now_s = t_s;
+  decoder_.tick(t_s);
+}
+
+void Session::finish() {
+  decoder_.flush();
+  if (jsonl_) jsonl_->summary(decoder_, input_, options_.shown);
+}
+
+void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
+  const bool record = options_.shown[node.address];
+  if (e == DecoderEvent::report_closed && record && (csv_ || jsonl_)) {
+    ReportTracker::Report report = tracker_.report(node.address);
+    if (!report.open || report.seq != seq) report = {true, seq, input_.now_s, {}, {}};  // none of its values arrived
+    const Units units = units_for(node, options_.rate_unit);
+    rows_.clear();
+    tau_rows(node, report, units, intervals_, rows_);
+    for (const TauRow& row : rows_) {
+      if (csv_) csv_->row(row, units);
+      if (jsonl_) jsonl_->row(row, units);
+    }
+    if (jsonl_) jsonl_->report(report.start_s, node, seq, units);
+  }
+  if (e == DecoderEvent::report_closed || e == DecoderEvent::restart) tracker_.close(node.address);
+  const bool noteworthy = e == DecoderEvent::restart || e == DecoderEvent::offline || e == DecoderEvent::online ||
+                          e == DecoderEvent::duplicate;
+  if (noteworthy && record && jsonl_) jsonl_->event(input_.now_s, e, node);
+}
+
+}  // namespace gyrochar::decoding

@@ -1,0 +1,86 @@
+#pragma once
+// The pipeline of gyrochar-decode without its I/O: candump log lines or frames go in with their
+// times, the Decoder follows the nodes, and every closed report becomes CSV / JSON lines rows.
+// The program (host_tools/decode/main.cpp) adds the sources, the terminal view and the plot.
+#include <cstddef>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "candump.hpp"
+#include "decode_output.hpp"
+#include "decoder.hpp"
+
+namespace gyrochar::decoding {
+
+/// Reads lines from a file descriptor it does not own, in large blocks (no per-line system call).
+class LineReader {
+ public:
+  /// `fd` open for reading; `buffer_bytes` is the longest line kept whole (longer lines come out
+  /// cut in pieces, which the candump parser rejects). Allocates the buffer once.
+  explicit LineReader(int fd, std::size_t buffer_bytes = std::size_t{1} << 20);
+  enum class Result { line, again, end, error };
+  /// The next line, without its '\n' (and '\r'). `line` stays valid until the next call. Calls
+  /// read() at most once, so that the caller can poll() or check a stop flag in between:
+  /// again: no complete line yet (after one read(), on EAGAIN or on EINTR); end: end of input (a
+  /// last line without '\n' is returned first); error: read() failed, errno says why.
+  /// O(line length) amortized.
+  Result next(std::string_view& line);
+
+ private:
+  int fd_;
+  std::vector<char> buffer_;
+  std::size_t begin_ = 0, end_ = 0;
+  bool eof_ = false;
+};
+
+struct SessionOptions {
+  RateUnit rate_unit = RateUnit::deg_per_h;
+  double confidence = 0.683;
+  NodeFilter shown = NodeFilter{}.set();  // nodes recorded (the decoder follows all of them)
+  std::FILE* csv = nullptr;               // not owned; null: no CSV
+  std::FILE* jsonl = nullptr;             // not owned; null: no JSON lines
+};
+
+/// Decodes one bus. Not copyable or movable (the decoder's listener points at it).
+class Session {
+ public:
+  explicit Session(const SessionOptions& options);
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  /// One candump log line, decoded at its own timestamp. A malformed line is counted and skipped:
+  /// returns false and says why. Allocates nothing per line once warmed up (rows are reused).
+  bool feed_line(std::string_view line, std::string& why);
+  /// One frame at t_s (seconds). A time earlier than the latest is counted and decoded at the
+  /// latest (the decoder's time never goes backwards). Amortized O(1) per frame plus O(taus) per
+  /// closed report.
+  void feed(const CanFrame& frame, double t_s);
+  /// Advances time without a frame (live input): silent nodes go offline.
+  void tick(double t_s);
+  /// End of input: closes every open report and writes the JSON lines summary.
+  void finish();
+
+  const Decoder& decoder() const { return decoder_; }
+  const InputCounters& input() const { return input_; }
+  InputCounters& input() { return input_; }
+  ConfidenceIntervals& intervals() { return intervals_; }
+  const SessionOptions& options() const { return options_; }
+
+ private:
+  void on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq);
+
+  SessionOptions options_;
+  ConfidenceIntervals intervals_;
+  ReportTracker tracker_;
+  std::unique_ptr<CsvWriter> csv_;
+  std::unique_ptr<JsonlWriter> jsonl_;
+  InputCounters input_;
+  CandumpLine parsed_;
+  std::vector<TauRow> rows_;
+  Decoder decoder_;  // last: its listener uses the members above
+};
+
+}  // namespace gyrochar::decoding

@@ -1,0 +1,180 @@
+#include "decoder.hpp"
+
+#include <type_traits>
+
+namespace gyrochar {
+
+using namespace protocol;
+
+void Decoder::feed(const CanFrame& frame, double t_s) {
+  tick(t_s);
+  const Decoded d = decode(frame);
+  if (d.error == ProtocolError::unknown_id || d.error == ProtocolError::not_extended ||
+      d.error == ProtocolError::error_frame || std::holds_alternative<CounterInputMsg>(d.message)) {
+    ++other_frames_;  // not a report frame of this protocol: other traffic on the bus
+    return;
+  }
+  NodeView& v = nodes_[d.node];
+  v.address = d.node;
+  Assembly& a = assembly_[d.node];
+  if (d.error != ProtocolError::none) {
+    ++rejected_;
+    ++v.health.rejected[d.error];
+    emit(DecoderEvent::rejected_frame, v, a.seq);
+    return;
+  }
+  if (!v.online) {
+    v.online = true;
+    emit(DecoderEvent::online, v, a.seq);
+  }
+  v.last_frame_s = t_s;
+  ++v.health.frames;
+  accept(v, a, d.message);
+}
+
+void Decoder::tick(double t_s) {
+  for (auto& [address, v] : nodes_) {
+    if (v.online && t_s - v.last_frame_s >= offline_after_s_) {
+      close_report(v, assembly_[address]);
+      v.online = false;
+      ++v.health.offline_events;
+      emit(DecoderEvent::offline, v, assembly_[address].seq);
+    }
+  }
+}
+
+void Decoder::flush() {
+  for (auto& [address, v] : nodes_) close_report(v, assembly_[address]);
+}
+
+void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
+  std::visit(
+      [&](const auto& msg) {
+        using M = std::decay_t<decltype(msg)>;
+        if constexpr (!std::is_same_v<M, CounterInputMsg>) {
+          if (!a.open || msg.seq != a.seq) open_report(v, a, msg.seq);
+        }
+        if constexpr (std::is_same_v<M, StatusMsg>) {
+          const bool went_back = v.have_status && msg.sample_count < v.status.sample_count;
+          const bool tau_count_changed = v.have_status && msg.tau_count != v.status.tau_count;
+          if (went_back || tau_count_changed) {
+            restart(v, a);
+            open_report(v, a, msg.seq);
+          }
+          v.status = msg;
+          v.have_status = true;
+          if (a.tau_count != msg.tau_count) {
+            a.tau_count = msg.tau_count;
+            layout(a);
+          }
+          mark_slot(v, a, Slot::status, 0);
+        } else if constexpr (std::is_same_v<M, StatusFaultsMsg>) {
+          v.faults = msg;
+          mark_slot(v, a, Slot::faults, 0);
+        } else if constexpr (std::is_same_v<M, TauDevMsg>) {
+          TauView::Dev& dev = msg.kind == DevKind::adev ? v.taus[msg.tau_index].adev : v.taus[msg.tau_index].mdev;
+          dev = {true, msg.dev_angle_per_s, msg.edf, msg.noise, msg.valid};
+          mark_slot(v, a, msg.kind == DevKind::adev ? Slot::adev : Slot::mdev, msg.tau_index);
+        } else if constexpr (std::is_same_v<M, TauTermsMsg>) {
+          v.taus[msg.tau_index].n = msg.n;
+          mark_slot(v, a, Slot::terms, msg.tau_index);
+        } else if constexpr (std::is_same_v<M, TauInfoMsg>) {
+          v.taus[msg.tau_index].m = msg.m;
+          v.taus[msg.tau_index].stride_log2 = msg.stride_log2;
+          mark_slot(v, a, Slot::tau_info, msg.tau_index);
+        } else if constexpr (std::is_same_v<M, MetaSamplingMsg>) {
+          v.sampling = msg;
+          mark_slot(v, a, Slot::sampling, 0);
+        } else if constexpr (std::is_same_v<M, MetaClockMsg>) {
+          if (v.clock && msg.uptime_ms < v.clock->uptime_ms) {
+            restart(v, a);
+            open_report(v, a, msg.seq);
+          }
+          v.clock = msg;
+          mark_slot(v, a, Slot::clock, 0);
+        } else if constexpr (std::is_same_v<M, MetaScaleMsg>) {
+          v.scale = msg;
+          mark_slot(v, a, Slot::scale, 0);
+        } else if constexpr (std::is_same_v<M, MetaConfigMsg>) {
+          if (v.config && msg.config_hash != v.config->config_hash) {
+            restart(v, a);
+            open_report(v, a, msg.seq);
+          }
+          v.config = msg;
+          mark_slot(v, a, Slot::config, 0);
+        } else if constexpr (std::is_same_v<M, Ieee952Msg>) {
+          v.ieee952[static_cast<std::size_t>(msg.term)] = {true, msg.resolved, msg.value, msg.rel_uncertainty};
+          mark_slot(v, a, Slot::ieee952, static_cast<std::uint8_t>(msg.term));
+        }
+      },
+      message);
+}
+
+void Decoder::open_report(NodeView& v, Assembly& a, std::uint8_t seq) {
+  if (a.open) {
+    const auto d = static_cast<std::uint8_t>(seq - a.seq);
+    close_report(v, a);
+    if (d >= 128) {
+      restart(v, a);  // Seq went backwards
+    } else if (d > 1) {
+      v.health.reports_lost += d - 1u;
+    }
+  }
+  a.open = true;
+  a.seq = seq;
+  a.tau_count = v.have_status ? v.status.tau_count : 0;
+  a.received.fill(false);
+  layout(a);
+}
+
+void Decoder::layout(Assembly& a) {
+  a.position.fill(-1);
+  const std::size_t frames = report_frame_count(a.seq, a.tau_count);
+  for (std::size_t k = 0; k < frames && k < a.received.size(); ++k) {
+    const ReportSlot s = report_slot(a.seq, a.tau_count, k);
+    a.position[static_cast<std::size_t>(s.slot) * max_taus + s.index] = static_cast<std::int16_t>(k);
+  }
+}
+
+void Decoder::close_report(NodeView& v, Assembly& a) {
+  if (!a.open) return;
+  a.open = false;
+  const std::size_t frames = report_frame_count(a.seq, a.tau_count);
+  std::uint64_t missing = 0;
+  for (std::size_t k = 0; k < frames && k < a.received.size(); ++k) missing += a.received[k] ? 0 : 1;
+  v.health.frames_missing += missing;
+  if (missing == 0) {
+    ++v.health.reports_complete;
+  } else {
+    ++v.health.reports_incomplete;
+  }
+  emit(DecoderEvent::report_closed, v, a.seq);
+}
+
+void Decoder::restart(NodeView& v, Assembly& a) {
+  const std::uint8_t address = v.address;
+  LinkHealth health = v.health;
+  const std::uint32_t session = v.session;
+  const double last_frame_s = v.last_frame_s;
+  v = NodeView{};
+  v.address = address;
+  v.online = true;
+  v.last_frame_s = last_frame_s;  // the node is heard now: not offline at the next tick
+  v.health = health;
+  ++v.health.restarts;
+  v.session = session + 1;
+  a = Assembly{};
+  emit(DecoderEvent::restart, v, a.seq);
+}
+
+void Decoder::mark_slot(NodeView& v, Assembly& a, Slot slot, std::uint8_t index) {
+  const std::int16_t k = a.position[static_cast<std::size_t>(slot) * max_taus + index];
+  if (k < 0) return;  // not expected in this report (e.g. a tau beyond TauCount)
+  if (a.received[static_cast<std::size_t>(k)]) {
+    ++v.health.duplicates;
+    emit(DecoderEvent::duplicate, v, a.seq);
+  }
+  a.received[static_cast<std::size_t>(k)] = true;
+}
+
+}  // namespace gyrochar

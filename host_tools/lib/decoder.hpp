@@ -1,0 +1,127 @@
+#pragma once
+// The host side of the gyrochar CAN protocol: follows every node on a bus, assembles their reports
+// and applies the loss, restart and offline rules of docs/protocol.md section 5. Frames come from
+// anywhere (a live socket, a candump log, a test); time is passed in, never read from a clock.
+// Nothing is papered over: every lost frame, lost report, restart, silent node, duplicate and
+// rejected frame is counted and, where it happens, reported as an event.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "gyrochar/can_frame.hpp"
+#include "gyrochar/protocol.hpp"
+
+namespace gyrochar {
+
+/// The latest values of one tau of one node.
+struct TauView {
+  std::uint64_t m = 0;          // averaging factor, 0 while unknown (tau info not yet received)
+  std::uint8_t stride_log2 = 0;
+  std::uint64_t n = 0;          // overlapping Allan terms (slow cycle), 0 while unknown
+  struct Dev {
+    bool received = false;      // a value arrived in this session
+    float dev = 0.0f;           // angle unit / s
+    double edf = 0.0;           // 0: not available
+    protocol::NoiseType noise = protocol::NoiseType::not_identified;
+    bool valid = false;
+  };
+  Dev adev, mdev;
+};
+
+struct Ieee952View {
+  bool received = false;
+  bool resolved = false;
+  float value = 0.0f;          // in the term's unit (protocol::Ieee952Term)
+  double rel_uncertainty = 0.0;
+};
+
+/// Link health of one node: what went missing and what went wrong, since the decoder started.
+struct LinkHealth {
+  std::uint64_t frames = 0;             // frames accepted from this node
+  std::uint64_t reports_complete = 0;   // reports with every expected frame
+  std::uint64_t reports_incomplete = 0; // reports closed with missing frames
+  std::uint64_t reports_lost = 0;       // whole reports never seen (Seq gaps)
+  std::uint64_t frames_missing = 0;     // expected slots not received in closed reports
+  std::uint64_t restarts = 0;           // Seq/SampleCount/Uptime backwards, config or tau count change
+  std::uint64_t offline_events = 0;     // silences of 3 s or more
+  std::uint64_t duplicates = 0;         // a slot received twice in one report: address conflict
+  std::map<protocol::ProtocolError, std::uint64_t> rejected;  // frames decode() refused
+};
+
+struct NodeView {
+  std::uint8_t address = 0;
+  bool online = false;
+  double last_frame_s = 0.0;
+  std::uint32_t session = 0;            // +1 at every restart detected
+  // Latest status (fast cycle)
+  bool have_status = false;
+  protocol::StatusMsg status;
+  protocol::StatusFaultsMsg faults;
+  // Metadata (slow cycle)
+  std::optional<protocol::MetaSamplingMsg> sampling;
+  std::optional<protocol::MetaClockMsg> clock;
+  std::optional<protocol::MetaScaleMsg> scale;
+  std::optional<protocol::MetaConfigMsg> config;
+  std::array<TauView, protocol::max_taus> taus{};
+  std::array<Ieee952View, 5> ieee952{};
+  LinkHealth health;
+
+  /// tau in seconds of tau index i, 0 while tau0 or m is unknown.
+  double tau_s(std::size_t i) const {
+    return sampling && taus[i].m ? static_cast<double>(sampling->tau0_s) * static_cast<double>(taus[i].m) : 0.0;
+  }
+};
+
+enum class DecoderEvent { report_closed, restart, offline, online, rejected_frame, duplicate };
+
+class Decoder {
+ public:
+  /// Called for every event; `node` is the view after the event (for report_closed: with the
+  /// closed report's values). May be empty.
+  using Listener = std::function<void(DecoderEvent, const NodeView& node, std::uint8_t seq)>;
+  explicit Decoder(Listener listener = {}, double offline_after_s = 3.0)
+      : listener_(std::move(listener)), offline_after_s_(offline_after_s) {}
+
+  /// Feeds one frame received at time t_s (seconds, any epoch, non-decreasing). Frames that are not
+  /// gyrochar report frames (counter input, other traffic) are ignored and counted in other_frames().
+  void feed(const CanFrame& frame, double t_s);
+  /// Advances time without a frame: nodes silent for offline_after_s become offline.
+  void tick(double t_s);
+  /// Closes every open report (end of a log).
+  void flush();
+
+  const std::map<std::uint8_t, NodeView>& nodes() const { return nodes_; }
+  std::uint64_t other_frames() const { return other_frames_; }
+  std::uint64_t rejected_frames() const { return rejected_; }
+
+ private:
+  struct Assembly {
+    bool open = false;
+    std::uint8_t seq = 0;
+    std::uint8_t tau_count = 0;
+    std::array<bool, 512> received{};  // by slot position in the report
+    std::array<std::int16_t, 11 * protocol::max_taus> position{};  // (slot, index) -> position, -1: not in this report
+  };
+  static void layout(Assembly& a);
+
+  void accept(NodeView& v, Assembly& a, const protocol::Message& message);
+  void open_report(NodeView& v, Assembly& a, std::uint8_t seq);
+  void close_report(NodeView& v, Assembly& a);
+  void restart(NodeView& v, Assembly& a);
+  void mark_slot(NodeView& v, Assembly& a, protocol::Slot slot, std::uint8_t index);
+  void emit(DecoderEvent e, const NodeView& v, std::uint8_t seq) {
+    if (listener_) listener_(e, v, seq);
+  }
+
+  Listener listener_;
+  double offline_after_s_;
+  std::map<std::uint8_t, NodeView> nodes_;
+  std::map<std::uint8_t, Assembly> assembly_;  // the report being received, per node
+  std::uint64_t other_frames_ = 0;
+  std::uint64_t rejected_ = 0;
+};
+
+}  // namespace gyrochar

@@ -1,0 +1,535 @@
+// The CAN codec (core/include/gyrochar/protocol.hpp, docs/protocol.md): round trips of every frame
+// kind, every field at its range limits, saturation and quantization, rejection of malformed frames
+// with the right reason, a fuzz run, the report schedule and the bus load.
+//
+// Oracles: the byte layouts of docs/protocol.md (written out by hand below), closed forms for
+// saturation (min(v, 2^bits - 1)) and quantization (half a step), the worst-case CAN frame length of
+// Davis, Burns, Bril and Lukkien, "Controller Area Network (CAN) schedulability analysis: refuted,
+// revisited and revised", Real-Time Systems 35 (2007), section 3 (29-bit identifiers:
+// 8 s + 67 + floor((54 + 8 s - 1) / 4) bits), and brute-force counts over the schedule.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gyrochar/protocol.hpp"
+
+namespace gyrochar::protocol {
+namespace {
+
+constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
+constexpr float inf_f = std::numeric_limits<float>::infinity();
+constexpr std::uint64_t max40 = (std::uint64_t{1} << 40) - 1;
+constexpr std::uint64_t max48 = (std::uint64_t{1} << 48) - 1;
+
+CanFrame encoded(const Message& m, std::uint8_t node) {
+  CanFrame f;
+  const ProtocolError e = encode(m, node, f);
+  EXPECT_EQ(e, ProtocolError::none) << name(e);
+  return f;
+}
+
+/// Encodes, checks the frame envelope, decodes and returns the decoded message.
+Message round_trip(const Message& m, std::uint8_t node = 0x2A) {
+  const CanFrame f = encoded(m, node);
+  EXPECT_TRUE(f.extended);
+  EXPECT_FALSE(f.fd);
+  EXPECT_FALSE(f.error);
+  const Decoded d = decode(f);
+  EXPECT_EQ(d.error, ProtocolError::none) << name(d.error);
+  EXPECT_EQ(d.node, node);
+  return d.message;
+}
+
+std::array<std::uint8_t, 8> bytes(const CanFrame& f) {
+  std::array<std::uint8_t, 8> b{};
+  for (std::size_t i = 0; i < 8; ++i) b[i] = f.data[i];
+  return b;
+}
+
+// --- layouts -------------------------------------------------------------------------------
+
+TEST(ProtocolLayout, FramesMatchTheSpecificationByteForByte) {
+  // Hand-written from the tables in docs/protocol.md.
+  const CanFrame status = encoded(StatusMsg{0x12, NodeState::running, 32, 0x0102030405}, 0x01);
+  EXPECT_EQ(status.id, 0x14FF4001u);
+  EXPECT_EQ(status.len, 8);
+  EXPECT_EQ(bytes(status), (std::array<std::uint8_t, 8>{0x04, 0x12, 0x20, 0x05, 0x04, 0x03, 0x02, 0x01}));
+
+  const CanFrame faults = encoded(StatusFaultsMsg{0x12, 0x0102, 0x0304, 0x0506, 5}, 0x01);
+  EXPECT_EQ(bytes(faults), (std::array<std::uint8_t, 8>{0x15, 0x12, 0x02, 0x01, 0x04, 0x03, 0x06, 0x05}));
+
+  // 1.0f = 0x3F800000; edf 2^37 -> code 64 * (37 + 4) = 2624 = 0xA40; white PM (1); valid.
+  const CanFrame mdev = encoded(TauDevMsg{7, 1, DevKind::mdev, 1.0f, std::exp2(37.0), NoiseType::white_pm, true}, 0x2A);
+  EXPECT_EQ(mdev.id, 0x18FF412Au);
+  EXPECT_EQ(bytes(mdev), (std::array<std::uint8_t, 8>{0x05, 0x07, 0x00, 0x00, 0x80, 0x3F, 0x40, 0x9A}));
+
+  const CanFrame terms = encoded(TauTermsMsg{9, 63, 0x010203040506}, 0x2A);
+  EXPECT_EQ(bytes(terms), (std::array<std::uint8_t, 8>{0xFE, 0x09, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01}));
+
+  const CanFrame info = encoded(TauInfoMsg{9, 2, 256, 5}, 0x2A);
+  EXPECT_EQ(bytes(info), (std::array<std::uint8_t, 8>{0x0B, 0x09, 0x00, 0x01, 0x00, 0x00, 0x00, 0x05}));
+
+  // 0.001f = 0x3A83126F
+  const CanFrame sampling = encoded(MetaSamplingMsg{3, 0.001f, 8}, 0x2A);
+  EXPECT_EQ(sampling.id, 0x18FF422Au);
+  EXPECT_EQ(bytes(sampling), (std::array<std::uint8_t, 8>{0x00, 0x03, 0x6F, 0x12, 0x83, 0x3A, 0x08, 0x00}));
+
+  const CanFrame clock = encoded(MetaClockMsg{3, 0x0102030405, 1}, 0x2A);
+  EXPECT_EQ(bytes(clock), (std::array<std::uint8_t, 8>{0x01, 0x03, 0x05, 0x04, 0x03, 0x02, 0x01, 0x01}));
+
+  // 1.5f = 0x3FC00000
+  const CanFrame scale = encoded(MetaScaleMsg{3, 1.5f, AngleUnit::arcsec, InputSource::strobe_counter}, 0x2A);
+  EXPECT_EQ(bytes(scale), (std::array<std::uint8_t, 8>{0x02, 0x03, 0x00, 0x00, 0xC0, 0x3F, 0x04, 0x02}));
+
+  const CanFrame config = encoded(MetaConfigMsg{3, 0xC0FFEE01, 1000}, 0x2A);
+  EXPECT_EQ(bytes(config), (std::array<std::uint8_t, 8>{0x03, 0x03, 0x01, 0xEE, 0xFF, 0xC0, 0xE8, 0x03}));
+
+  // 2.0f = 0x40000000; 12.34 % -> 1234 = 0x04D2
+  const CanFrame ieee = encoded(Ieee952Msg{4, Ieee952Term::bias_instability, true, 2.0f, 0.1234}, 0x2A);
+  EXPECT_EQ(ieee.id, 0x18FF432Au);
+  EXPECT_EQ(bytes(ieee), (std::array<std::uint8_t, 8>{0x0A, 0x04, 0x00, 0x00, 0x00, 0x40, 0xD2, 0x04}));
+
+  const CanFrame counter = encoded(CounterInputMsg{0xA1B2C3D4, 0x55, true, false}, 0x10);
+  EXPECT_EQ(counter.id, 0x0CFF5010u);
+  EXPECT_EQ(counter.len, 6);
+  EXPECT_EQ(bytes(counter), (std::array<std::uint8_t, 8>{0xD4, 0xC3, 0xB2, 0xA1, 0x55, 0x01, 0x00, 0x00}));
+}
+
+// --- round trips ---------------------------------------------------------------------------
+
+/// One message of every kind with values on the wire's grid, so the round trip is exact.
+std::vector<Message> typical_messages() {
+  return {
+      StatusMsg{17, NodeState::running, 32, 123456789},
+      StatusFaultsMsg{17, 3, 2, 1, 1},
+      TauDevMsg{17, 5, DevKind::adev, 1.25e-3f, std::exp2(10.5), NoiseType::white_fm, true},
+      TauDevMsg{17, 5, DevKind::mdev, 9.5e-4f, std::exp2(9.25), NoiseType::flicker_fm, false},
+      TauTermsMsg{17, 5, 987654321},
+      TauInfoMsg{17, 5, 96, 2},
+      MetaSamplingMsg{17, 2.5e-3f, 16},
+      MetaClockMsg{17, 3600000, version},
+      MetaScaleMsg{17, 1.5f, AngleUnit::arcsec, InputSource::gpio_quadrature},
+      MetaConfigMsg{17, 0xDEADBEEF, 500},
+      Ieee952Msg{17, Ieee952Term::angle_random_walk, true, 3.0e-5f, 0.0125},
+      CounterInputMsg{4000000000u, 200, false, true},
+  };
+}
+
+TEST(ProtocolRoundTrip, EveryMessageKind) {
+  for (const Message& m : typical_messages()) {
+    EXPECT_EQ(round_trip(m), m) << "variant index " << m.index();
+  }
+}
+
+TEST(ProtocolRoundTrip, EveryFieldAtItsLimits) {
+  const std::vector<Message> limits{
+      StatusMsg{0, NodeState::starting, 0, 0},
+      StatusMsg{255, NodeState::input_lost, max_taus, max40},
+      StatusFaultsMsg{0, 0, 0, 0, 0},
+      StatusFaultsMsg{255, 65535, 65535, 65535, 63},
+      TauDevMsg{0, 0, DevKind::adev, 0.0f, 0.0, NoiseType::not_identified, false},
+      TauDevMsg{255, 63, DevKind::mdev, FLT_MAX, std::exp2(4095 / 64.0 - 4), NoiseType::random_run_fm, true},
+      TauDevMsg{1, 1, DevKind::adev, FLT_TRUE_MIN, std::exp2(1 / 64.0 - 4), NoiseType::white_pm, true},
+      TauTermsMsg{0, 0, 0},
+      TauTermsMsg{255, 63, max48},
+      TauInfoMsg{0, 0, 1, 0},
+      TauInfoMsg{255, 63, max40, 0},
+      TauInfoMsg{1, 2, std::uint64_t{1} << 39, 39},
+      MetaSamplingMsg{0, FLT_TRUE_MIN, 1},
+      MetaSamplingMsg{255, FLT_MAX, 32768},
+      MetaClockMsg{0, 0, 1},
+      MetaClockMsg{255, max40, 255},
+      MetaScaleMsg{0, FLT_TRUE_MIN, AngleUnit::pulse, InputSource::unknown},
+      MetaScaleMsg{255, FLT_MAX, AngleUnit::arcsec, InputSource::simulated},
+      MetaConfigMsg{0, 0, 100},
+      MetaConfigMsg{255, 0xFFFFFFFF, 2000},
+      Ieee952Msg{0, Ieee952Term::quantization, false, 0.0f, 0.0},
+      Ieee952Msg{255, Ieee952Term::rate_ramp, true, FLT_MAX, 6.5535},
+      CounterInputMsg{0, 0, false, false},
+      CounterInputMsg{0xFFFFFFFF, 255, true, true},
+  };
+  for (std::uint8_t node : {std::uint8_t{0}, max_node_address}) {
+    for (const Message& m : limits) {
+      const Message back = round_trip(m, node);
+      if (const auto* ieee = std::get_if<Ieee952Msg>(&m)) {  // 0.01 % steps: 65535 * 1e-4 is not exact
+        const auto& b = std::get<Ieee952Msg>(back);
+        EXPECT_NEAR(b.rel_uncertainty, ieee->rel_uncertainty, 1e-12);
+        EXPECT_EQ(b.value, ieee->value);
+      } else {
+        EXPECT_EQ(back, m) << "variant index " << m.index();
+      }
+    }
+  }
+}
+
+TEST(ProtocolRoundTrip, EveryEnumerationValue) {
+  for (int k = 0; k < 8; ++k) {
+    const auto noise = static_cast<NoiseType>(k);
+    EXPECT_EQ(std::get<TauDevMsg>(round_trip(TauDevMsg{1, 1, DevKind::mdev, 1.0f, 2.0, noise, true})).noise, noise);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const auto state = static_cast<NodeState>(k);
+    EXPECT_EQ(std::get<StatusMsg>(round_trip(StatusMsg{1, state, 1, 1})).state, state);
+  }
+  for (int k = 0; k < 5; ++k) {
+    const auto unit = static_cast<AngleUnit>(k);
+    const auto source = static_cast<InputSource>(k);
+    const auto back = std::get<MetaScaleMsg>(round_trip(MetaScaleMsg{1, 1.0f, unit, source}));
+    EXPECT_EQ(back.angle_unit, unit);
+    EXPECT_EQ(back.input_source, source);
+    const auto term = static_cast<Ieee952Term>(k);
+    EXPECT_EQ(std::get<Ieee952Msg>(round_trip(Ieee952Msg{1, term, true, 1.0f, 0.5})).term, term);
+  }
+}
+
+// --- saturation and quantization -----------------------------------------------------------
+
+TEST(ProtocolQuantization, CountsSaturateAtTheirFieldWidth) {
+  // Oracle: min(v, 2^bits - 1) for each field's width in docs/protocol.md.
+  const auto status = std::get<StatusMsg>(round_trip(StatusMsg{1, NodeState::running, 1, max40 + 5}));
+  EXPECT_EQ(status.sample_count, max40);
+  const auto faults = std::get<StatusFaultsMsg>(round_trip(StatusFaultsMsg{1, 65536, 1u << 31, 70000, 64}));
+  EXPECT_EQ(faults.lost_edges, 65535u);
+  EXPECT_EQ(faults.sample_gaps, 65535u);
+  EXPECT_EQ(faults.tx_dropped_frames, 65535u);
+  EXPECT_EQ(faults.bus_off_events, 63u);
+  EXPECT_EQ(std::get<TauTermsMsg>(round_trip(TauTermsMsg{1, 1, ~std::uint64_t{0}})).n, max48);
+  EXPECT_EQ(std::get<MetaClockMsg>(round_trip(MetaClockMsg{1, max40 + 1, 1})).uptime_ms, max40);
+}
+
+TEST(ProtocolQuantization, EdfIsWithinHalfAStepOfLog2) {
+  // Step 1/64 in log2(edf): the decoded EDF is within a factor 2^(1/128) of the sent one.
+  const double half_step = std::exp2(1.0 / 128) * (1 + 1e-12);
+  for (double log2_edf = -3.9; log2_edf < 59.9; log2_edf += 0.0137) {
+    const double edf = std::exp2(log2_edf);
+    const double back = std::get<TauDevMsg>(round_trip(TauDevMsg{1, 1, DevKind::adev, 1.0f, edf, NoiseType::white_fm, true})).edf;
+    EXPECT_LE(back / edf, half_step) << edf;
+    EXPECT_GE(back / edf, 1 / half_step) << edf;
+  }
+  // Outside the range the code clamps; 0 means "not available" and stays 0.
+  const auto sent = [](double edf) {
+    return std::get<TauDevMsg>(round_trip(TauDevMsg{1, 1, DevKind::adev, 1.0f, edf, NoiseType::white_fm, true})).edf;
+  };
+  EXPECT_EQ(sent(1e-12), std::exp2(1 / 64.0 - 4));
+  EXPECT_EQ(sent(1e30), std::exp2(4095 / 64.0 - 4));
+  EXPECT_EQ(sent(0.0), 0.0);
+}
+
+TEST(ProtocolQuantization, EveryEdfNoiseAndValidCodeIsCanonical) {
+  // Exhaustive over the 16-bit tail of the ADEV page: every code decodes and re-encodes unchanged.
+  CanFrame f = encoded(TauDevMsg{3, 4, DevKind::adev, 0.5f, 1.0, NoiseType::white_fm, true}, 0x07);
+  for (unsigned tail = 0; tail < 65536; ++tail) {
+    f.data[6] = static_cast<std::uint8_t>(tail);
+    f.data[7] = static_cast<std::uint8_t>(tail >> 8);
+    const Decoded d = decode(f);
+    ASSERT_EQ(d.error, ProtocolError::none) << tail;
+    EXPECT_EQ(bytes(encoded(d.message, d.node)), bytes(f)) << tail;
+  }
+}
+
+TEST(ProtocolQuantization, RelativeUncertaintyInHundredthsOfAPercent) {
+  const auto sent = [](double rel) {
+    return std::get<Ieee952Msg>(round_trip(Ieee952Msg{1, Ieee952Term::rate_random_walk, true, 1.0f, rel})).rel_uncertainty;
+  };
+  EXPECT_NEAR(sent(0.123456), 0.1235, 1e-12);  // nearest 1e-4
+  EXPECT_NEAR(sent(6.6), 6.5535, 1e-12);       // saturates at 655.35 %
+  EXPECT_NEAR(sent(std::numeric_limits<double>::infinity()), 6.5535, 1e-12);
+  EXPECT_EQ(sent(0.0), 0.0);
+}
+
+// --- rejections ----------------------------------------------------------------------------
+
+TEST(ProtocolEncode, RejectsWhatTheWireCannotCarryAndLeavesTheFrameAlone) {
+  const auto rejects = [](const Message& m, std::uint8_t node = 1) {
+    CanFrame f;
+    f.id = 0x123;
+    const ProtocolError e = encode(m, node, f);
+    EXPECT_EQ(f.id, 0x123u) << "frame modified";
+    return e;
+  };
+  constexpr auto range = ProtocolError::out_of_range;
+  EXPECT_EQ(rejects(StatusMsg{}, 0xFE), ProtocolError::bad_address);
+  EXPECT_EQ(rejects(CounterInputMsg{}, 0xFF), ProtocolError::bad_address);
+  EXPECT_EQ(rejects(StatusMsg{1, static_cast<NodeState>(3), 1, 1}), range);
+  EXPECT_EQ(rejects(StatusMsg{1, NodeState::running, max_taus + 1, 1}), range);
+  const TauDevMsg dev{1, 1, DevKind::adev, 1.0f, 10.0, NoiseType::white_fm, true};
+  for (float bad : {nan_f, inf_f, -1.0f, -FLT_TRUE_MIN}) {
+    TauDevMsg m = dev;
+    m.dev_angle_per_s = bad;
+    EXPECT_EQ(rejects(m), range) << bad;
+  }
+  for (double bad : {double(nan_f), double(inf_f), -1.0}) {
+    TauDevMsg m = dev;
+    m.edf = bad;
+    EXPECT_EQ(rejects(m), range) << bad;
+  }
+  TauDevMsg m = dev;
+  m.tau_index = max_taus;
+  EXPECT_EQ(rejects(m), range);
+  m = dev;
+  m.kind = static_cast<DevKind>(2);
+  EXPECT_EQ(rejects(m), range);
+  m = dev;
+  m.noise = static_cast<NoiseType>(8);
+  EXPECT_EQ(rejects(m), range);
+  EXPECT_EQ(rejects(TauTermsMsg{1, max_taus, 1}), range);
+  EXPECT_EQ(rejects(TauInfoMsg{1, 1, 0, 0}), range);                 // m = 0
+  EXPECT_EQ(rejects(TauInfoMsg{1, 1, max40 + 1, 0}), range);         // m >= 2^40
+  EXPECT_EQ(rejects(TauInfoMsg{1, 1, 96, 6}), range);                // 64 does not divide 96
+  EXPECT_EQ(rejects(TauInfoMsg{1, 1, 1, 40}), range);
+  EXPECT_EQ(rejects(TauInfoMsg{1, max_taus, 1, 0}), range);
+  EXPECT_EQ(rejects(MetaSamplingMsg{1, 0.0f, 8}), range);
+  EXPECT_EQ(rejects(MetaSamplingMsg{1, -1e-3f, 8}), range);
+  EXPECT_EQ(rejects(MetaSamplingMsg{1, nan_f, 8}), range);
+  EXPECT_EQ(rejects(MetaSamplingMsg{1, 1e-3f, 0}), range);
+  EXPECT_EQ(rejects(MetaSamplingMsg{1, 1e-3f, 12}), range);
+  EXPECT_EQ(rejects(MetaClockMsg{1, 1, 0}), range);
+  EXPECT_EQ(rejects(MetaScaleMsg{1, 0.0f, AngleUnit::deg, InputSource::unknown}), range);
+  EXPECT_EQ(rejects(MetaScaleMsg{1, inf_f, AngleUnit::deg, InputSource::unknown}), range);
+  EXPECT_EQ(rejects(MetaScaleMsg{1, 1.0f, static_cast<AngleUnit>(5), InputSource::unknown}), range);
+  EXPECT_EQ(rejects(MetaScaleMsg{1, 1.0f, AngleUnit::deg, static_cast<InputSource>(5)}), range);
+  EXPECT_EQ(rejects(MetaConfigMsg{1, 1, 99}), range);
+  EXPECT_EQ(rejects(MetaConfigMsg{1, 1, 2001}), range);
+  EXPECT_EQ(rejects(Ieee952Msg{1, static_cast<Ieee952Term>(5), true, 1.0f, 0.1}), range);
+  EXPECT_EQ(rejects(Ieee952Msg{1, Ieee952Term::quantization, true, -1.0f, 0.1}), range);
+  EXPECT_EQ(rejects(Ieee952Msg{1, Ieee952Term::quantization, true, nan_f, 0.1}), range);
+  EXPECT_EQ(rejects(Ieee952Msg{1, Ieee952Term::quantization, true, 1.0f, -0.1}), range);
+  EXPECT_EQ(rejects(Ieee952Msg{1, Ieee952Term::quantization, true, 1.0f, double(nan_f)}), range);
+}
+
+/// decode() of a valid frame of `m` after `mutate` changed it.
+template <class Mutate>
+ProtocolError decode_mutated(const Message& m, Mutate mutate) {
+  CanFrame f = encoded(m, 0x11);
+  mutate(f);
+  const Decoded d = decode(f);
+  return d.error;
+}
+void put_float(CanFrame& f, float v) {
+  std::uint32_t u = 0;
+  static_assert(sizeof u == sizeof v);
+  std::memcpy(&u, &v, sizeof u);
+  for (int i = 0; i < 4; ++i) f.data[2 + i] = static_cast<std::uint8_t>(u >> (8 * i));
+}
+
+TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
+  const Message status = StatusMsg{1, NodeState::running, 4, 1000};
+  const Message adev = TauDevMsg{1, 2, DevKind::adev, 1.0f, 10.0, NoiseType::white_fm, true};
+  const Message info = TauInfoMsg{1, 2, 96, 2};
+  const Message sampling = MetaSamplingMsg{1, 1e-3f, 8};
+  const Message clock = MetaClockMsg{1, 1000, 1};
+  const Message scale = MetaScaleMsg{1, 1.0f, AngleUnit::deg, InputSource::unknown};
+  const Message config = MetaConfigMsg{1, 7, 1000};
+  const Message ieee = Ieee952Msg{1, Ieee952Term::bias_instability, true, 1.0f, 0.1};
+  const Message counter = CounterInputMsg{1, 1, false, false};
+
+  // Envelope, in the order decode() checks it.
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.error = true; }), ProtocolError::error_frame);
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.extended = false; }), ProtocolError::not_extended);
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.fd = true; }), ProtocolError::fd_frame);
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x14FF4411; }), ProtocolError::unknown_id);  // PGN
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x18FF4011; }), ProtocolError::unknown_id);  // priority
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id |= 0x20000000; }), ProtocolError::unknown_id); // > 29 bits
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x14FF40FE; }), ProtocolError::bad_address);
+  EXPECT_EQ(decode_mutated(counter, [](CanFrame& f) { f.id = 0x0CFF50FF; }), ProtocolError::bad_address);
+  for (std::uint8_t len : {0, 6, 7, 9, 64}) {
+    EXPECT_EQ(decode_mutated(adev, [&](CanFrame& f) { f.len = len; }), ProtocolError::wrong_length) << int(len);
+  }
+  EXPECT_EQ(decode_mutated(counter, [](CanFrame& f) { f.len = 8; }), ProtocolError::wrong_length);
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.len = 7, f.data[0] = 2; }), ProtocolError::wrong_length);
+
+  // Multiplexor values without a layout.
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[0] = 2; }), ProtocolError::unknown_page);
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[0] = 3; }), ProtocolError::unknown_page);
+  for (std::uint8_t term : {5, 6, 7}) {
+    EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { f.data[0] = term; }), ProtocolError::unknown_page);
+  }
+
+  // Reserved bits.
+  for (std::uint8_t bit = 4; bit < 8; ++bit) {
+    EXPECT_EQ(decode_mutated(status, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+  }
+  for (std::uint8_t bit = 2; bit < 8; ++bit) {
+    for (const Message& meta : {sampling, clock, scale, config}) {
+      EXPECT_EQ(decode_mutated(meta, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    }
+    EXPECT_EQ(decode_mutated(counter, [&](CanFrame& f) { f.data[5] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+  }
+
+  // Values out of range.
+  constexpr auto range = ProtocolError::out_of_range;
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[0] = 0x0C; }), range);  // state 3
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[2] = max_taus + 1; }), range);
+  for (float bad : {nan_f, inf_f, -inf_f, -1.0f}) {
+    EXPECT_EQ(decode_mutated(adev, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
+  }
+  EXPECT_EQ(decode_mutated(info, [](CanFrame& f) { f.data[2] = f.data[3] = 0; }), range);  // m = 0
+  EXPECT_EQ(decode_mutated(info, [](CanFrame& f) { f.data[7] = 6; }), range);  // 2^6 does not divide 96
+  EXPECT_EQ(decode_mutated(info, [](CanFrame& f) { f.data[7] = 200; }), range);
+  for (float bad : {0.0f, -1e-3f, nan_f, inf_f}) {
+    EXPECT_EQ(decode_mutated(sampling, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
+    EXPECT_EQ(decode_mutated(scale, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
+  }
+  EXPECT_EQ(decode_mutated(sampling, [](CanFrame& f) { f.data[6] = 3; }), range);  // S = 3
+  EXPECT_EQ(decode_mutated(sampling, [](CanFrame& f) { f.data[6] = 0; }), range);  // S = 0
+  EXPECT_EQ(decode_mutated(clock, [](CanFrame& f) { f.data[7] = 0; }), range);     // version 0
+  EXPECT_EQ(decode_mutated(scale, [](CanFrame& f) { f.data[6] = 5; }), range);
+  EXPECT_EQ(decode_mutated(scale, [](CanFrame& f) { f.data[7] = 255; }), range);
+  EXPECT_EQ(decode_mutated(config, [](CanFrame& f) { f.data[6] = 99, f.data[7] = 0; }), range);
+  EXPECT_EQ(decode_mutated(config, [](CanFrame& f) { f.data[6] = 0xD1, f.data[7] = 0x07; }), range);  // 2001 ms
+  for (float bad : {nan_f, -1.0f, inf_f}) {
+    EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
+  }
+}
+
+TEST(ProtocolDecode, RandomFramesNeverCrashAndAcceptedOnesAreCanonical) {
+  // Half the frames are random, half are valid frames with 1 to 3 random bits flipped (in the data,
+  // the identifier, the length or the flags). Oracle: any frame decode() accepts must come back bit
+  // for bit from encode() of its message.
+  std::mt19937_64 rng(20240611);
+  const std::vector<Message> valid = typical_messages();
+  std::map<std::size_t, int> accepted;  // by variant index
+  std::map<ProtocolError, int> reasons;
+  for (int i = 0; i < 200000; ++i) {
+    CanFrame f;
+    if (i % 2 == 0) {
+      f.id = static_cast<std::uint32_t>(rng()) & 0x3FFFFFFF;
+      f.extended = rng() % 8 != 0;
+      f.fd = rng() % 8 == 0;
+      f.error = rng() % 8 == 0;
+      f.len = static_cast<std::uint8_t>(rng() % 65);
+      for (auto& b : f.data) b = static_cast<std::uint8_t>(rng());
+    } else {
+      f = encoded(valid[rng() % valid.size()], static_cast<std::uint8_t>(rng() % (max_node_address + 1)));
+      for (int flips = 1 + static_cast<int>(rng() % 3); flips > 0; --flips) {
+        const unsigned where = static_cast<unsigned>(rng() % 100);
+        const unsigned bit = static_cast<unsigned>(rng() % 64);
+        if (where < 90) f.data[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
+        else if (where < 96) f.id ^= 1u << (bit % 30);
+        else if (where < 98) f.len = static_cast<std::uint8_t>(bit % 10);
+        else f.extended = !f.extended;
+      }
+    }
+    const Decoded d = decode(f);
+    ++reasons[d.error];
+    if (d.error != ProtocolError::none) continue;
+    ++accepted[d.message.index()];
+    CanFrame again;
+    ASSERT_EQ(encode(d.message, d.node, again), ProtocolError::none);
+    EXPECT_EQ(again.id, f.id);
+    EXPECT_EQ(again.len, f.len);
+    for (std::size_t k = 0; k < f.len; ++k) ASSERT_EQ(again.data[k], f.data[k]) << "frame " << i << " byte " << k;
+  }
+  EXPECT_EQ(accepted.size(), std::variant_size_v<Message>) << "some frame kind was never accepted";
+  for (const auto& [kind, count] : accepted) EXPECT_GT(count, 100) << "variant index " << kind;
+  for (int e = 1; e <= static_cast<int>(ProtocolError::out_of_range); ++e)
+    EXPECT_GT(reasons[static_cast<ProtocolError>(e)], 0) << name(static_cast<ProtocolError>(e));
+}
+
+// --- names and noise types -----------------------------------------------------------------
+
+TEST(ProtocolNames, AlphaAndNoiseTypeAreInverse) {
+  for (int a = -4; a <= 2; ++a) {
+    EXPECT_NE(noise_type(a), NoiseType::not_identified);
+    EXPECT_EQ(alpha(noise_type(a)), a);
+  }
+  EXPECT_EQ(noise_type(3), NoiseType::not_identified);
+  EXPECT_EQ(noise_type(-5), NoiseType::not_identified);
+  EXPECT_EQ(alpha(NoiseType::white_fm), 0);       // angle random walk
+  EXPECT_EQ(alpha(NoiseType::flicker_fm), -1);    // bias instability
+  EXPECT_EQ(alpha(NoiseType::white_pm), 2);       // quantization
+}
+
+TEST(ProtocolNames, EveryValueHasItsOwnName) {
+  std::vector<std::string> seen;
+  for (int k = 0; k < 8; ++k) seen.push_back(name(static_cast<NoiseType>(k)));
+  for (int k = 0; k < 3; ++k) seen.push_back(name(static_cast<NodeState>(k)));
+  for (int k = 0; k < 5; ++k) seen.push_back(name(static_cast<AngleUnit>(k)));
+  for (int k = 0; k < 5; ++k) seen.push_back(name(static_cast<InputSource>(k)));
+  for (int k = 0; k < 5; ++k) seen.push_back(name(static_cast<Ieee952Term>(k)));
+  for (int k = 0; k <= static_cast<int>(ProtocolError::out_of_range); ++k)
+    seen.push_back(name(static_cast<ProtocolError>(k)));
+  for (const std::string& s : seen) EXPECT_NE(s, "invalid");
+  EXPECT_STREQ(name(static_cast<NoiseType>(9)), "invalid");
+  EXPECT_STREQ(name(static_cast<AngleUnit>(9)), "invalid");
+}
+
+// --- schedule and bus load -----------------------------------------------------------------
+
+TEST(ProtocolSchedule, FastFramesEveryReportSlowListOncePerCycle) {
+  for (std::size_t taus : {0u, 1u, 3u, 32u, 40u, 64u}) {
+    // Brute force: count every slot over the four reports of a cycle.
+    std::map<std::pair<Slot, int>, int> count;
+    std::size_t longest = 0;
+    for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) {
+      const std::size_t n = report_frame_count(seq, taus);
+      longest = std::max(longest, n);
+      ASSERT_GE(n, 2 + 2 * taus);
+      EXPECT_EQ(report_slot(seq, taus, 0).slot, Slot::status);  // the heartbeat opens every report
+      EXPECT_EQ(report_slot(seq, taus, 1).slot, Slot::faults);
+      for (std::size_t i = 0; i < taus; ++i) {
+        const ReportSlot a = report_slot(seq, taus, 2 + 2 * i), m = report_slot(seq, taus, 3 + 2 * i);
+        EXPECT_EQ(a.slot, Slot::adev);
+        EXPECT_EQ(m.slot, Slot::mdev);
+        EXPECT_EQ(a.index, i);
+        EXPECT_EQ(m.index, i);
+      }
+      for (std::size_t p = 2 + 2 * taus; p < n; ++p) {
+        const ReportSlot s = report_slot(seq, taus, p);
+        ++count[{s.slot, s.index}];
+      }
+    }
+    // Every slow item exactly once per cycle: 4 metadata pages, tau info and terms per tau, 5 terms.
+    std::size_t slow = 0;
+    for (Slot s : {Slot::sampling, Slot::clock, Slot::scale, Slot::config}) {
+      EXPECT_EQ((count[{s, 0}]), 1);
+      ++slow;
+    }
+    for (std::size_t i = 0; i < taus; ++i) {
+      EXPECT_EQ((count[{Slot::tau_info, static_cast<int>(i)}]), 1) << i;
+      EXPECT_EQ((count[{Slot::terms, static_cast<int>(i)}]), 1) << i;
+      slow += 2;
+    }
+    for (int t = 0; t < 5; ++t) {
+      EXPECT_EQ((count[{Slot::ieee952, t}]), 1) << t;
+      ++slow;
+    }
+    EXPECT_EQ(count.size(), slow);
+    EXPECT_EQ(longest, 2 + 2 * taus + (slow + 3) / 4) << taus;
+    // The cycle follows seq modulo 4, so it survives the wrap 255 -> 0.
+    for (unsigned seq = 0; seq < 256; ++seq) {
+      const auto s = static_cast<std::uint8_t>(seq);
+      ASSERT_EQ(report_frame_count(s, taus), report_frame_count(s % 4, taus));
+      const std::size_t last = report_frame_count(s, taus) - 1;
+      EXPECT_EQ(report_slot(s, taus, last).slot, report_slot(s % 4, taus, last).slot);
+      EXPECT_EQ(report_slot(s, taus, last).index, report_slot(s % 4, taus, last).index);
+    }
+  }
+}
+
+TEST(ProtocolBusLoad, WorstCaseFrameLengthsAndLoadPerNode) {
+  // Davis et al. 2007: 8 s + 67 + floor((54 + 8 s - 1) / 4) bits for a 29-bit identifier.
+  EXPECT_EQ(worst_case_frame_bits(0), 80u);
+  EXPECT_EQ(worst_case_frame_bits(6), 140u);
+  EXPECT_EQ(worst_case_frame_bits(8), 160u);
+  // 32 taus, one report per second: longest report 2 + 64 + ceil(73 / 4) = 85 frames of 160 bits.
+  const double load32 = worst_case_bus_load(32, 1.0, 500000.0);
+  EXPECT_DOUBLE_EQ(load32, 85 * 160 / 500000.0);
+  EXPECT_LE(load32, 0.03);
+  // 40 taus (the design brief's example): 2 + 80 + ceil(89 / 4) = 105 frames.
+  EXPECT_DOUBLE_EQ(worst_case_bus_load(40, 1.0, 500000.0), 105 * 160 / 500000.0);
+}
+
+}  // namespace
+}  // namespace gyrochar::protocol

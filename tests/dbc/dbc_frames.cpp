@@ -1,0 +1,198 @@
+// Frames from the gyrochar codec for the DBC check (tests/dbc/test_dbc.py).
+//
+//   gyrochar_dbc_frames              candump log of the frames on stdout (canplayer replays it)
+//   gyrochar_dbc_frames --expected   the same frames as JSON: for each, the candump line, the value
+//                                    of every DBC signal as the codec decodes the frame, and the
+//                                    VAL_ name of every enumeration
+//
+// The frames are four paced reports of a 3-tau node (every slot of the schedule, sequence wrapping
+// 254 -> 1) and a set of messages at their range limits, covering every enumeration value.
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "candump.hpp"
+#include "gyrochar/protocol.hpp"
+
+namespace {
+
+using namespace gyrochar::protocol;
+using gyrochar::CanFrame;
+using nlohmann::json;
+
+struct Entry {
+  std::uint64_t t_us = 0;  // candump timestamp
+  std::uint8_t node = 0;
+  Message message;
+};
+
+// --- what the DBC must say about a decoded message ------------------------------------------
+
+struct Expected {
+  json signals = json::object();
+  json names = json::object();
+};
+
+double physical(float v) { return static_cast<double>(v); }
+
+Expected expected(const StatusMsg& m) {
+  return {{{"Page", 0}, {"State", static_cast<int>(m.state)}, {"Seq", m.seq}, {"TauCount", m.tau_count},
+           {"SampleCount", m.sample_count}},
+          {{"State", name(m.state)}}};
+}
+Expected expected(const StatusFaultsMsg& m) {
+  return {{{"Page", 1}, {"BusOffEvents", m.bus_off_events}, {"Seq", m.seq}, {"LostEdges", m.lost_edges},
+           {"SampleGaps", m.sample_gaps}, {"TxDroppedFrames", m.tx_dropped_frames}}};
+}
+Expected expected(const TauDevMsg& m) {
+  const std::string p = m.kind == DevKind::adev ? "ADEV" : "MDEV";
+  // Log2Edf: raw 0 (EDF not available) is the signal's offset, -4.
+  return {{{"Page", static_cast<int>(m.kind)}, {"TauIndex", m.tau_index}, {"Seq", m.seq},
+           {p, physical(m.dev_angle_per_s)}, {p + "_Log2Edf", m.edf == 0.0 ? -4.0 : std::log2(m.edf)},
+           {p + "_Noise", static_cast<int>(m.noise)}, {p + "_Valid", m.valid ? 1 : 0}},
+          {{p + "_Noise", name(m.noise)}}};
+}
+Expected expected(const TauTermsMsg& m) {
+  return {{{"Page", 2}, {"TauIndex", m.tau_index}, {"Seq", m.seq}, {"Terms", m.n}}};
+}
+Expected expected(const TauInfoMsg& m) {
+  return {{{"Page", 3}, {"TauIndex", m.tau_index}, {"Seq", m.seq}, {"TauM", m.m}, {"StrideLog2", m.stride_log2}}};
+}
+Expected expected(const MetaSamplingMsg& m) {
+  return {{{"Page", 0}, {"Seq", m.seq}, {"Tau0", physical(m.tau0_s)}, {"StrideFactor", m.stride_factor}}};
+}
+Expected expected(const MetaClockMsg& m) {
+  return {{{"Page", 1}, {"Seq", m.seq}, {"Uptime", static_cast<double>(m.uptime_ms) / 1000.0},
+           {"ProtocolVersion", m.protocol_version}}};
+}
+Expected expected(const MetaScaleMsg& m) {
+  return {{{"Page", 2}, {"Seq", m.seq}, {"PulseWeight", physical(m.angle_per_pulse)},
+           {"AngleUnit", static_cast<int>(m.angle_unit)}, {"InputSource", static_cast<int>(m.input_source)}},
+          {{"AngleUnit", name(m.angle_unit)}, {"InputSource", name(m.input_source)}}};
+}
+Expected expected(const MetaConfigMsg& m) {
+  return {{{"Page", 3}, {"Seq", m.seq}, {"ConfigHash", m.config_hash},
+           {"ReportPeriod", static_cast<double>(m.report_period_ms) / 1000.0}}};
+}
+Expected expected(const Ieee952Msg& m) {
+  static const char* const value_signal[] = {"Q", "N", "B", "K", "R"};
+  return {{{"Term", static_cast<int>(m.term)}, {"Resolved", m.resolved ? 1 : 0}, {"Seq", m.seq},
+           {value_signal[static_cast<int>(m.term)], physical(m.value)}, {"RelUncertainty", m.rel_uncertainty * 100.0}},
+          {{"Term", name(m.term)}}};
+}
+Expected expected(const CounterInputMsg& m) {
+  return {{{"Count", m.count}, {"Seq", m.seq}, {"CountError", m.count_error ? 1 : 0},
+           {"SensorNotReady", m.sensor_not_ready ? 1 : 0}}};
+}
+
+// --- the frames ------------------------------------------------------------------------------
+
+/// A message of a plausible node for one slot of the schedule.
+Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
+  const std::uint8_t i = slot.index;
+  const float tau_s = 0.001f * static_cast<float>(1u << (4 * i));  // m = 1, 16, 256 at tau0 = 1 ms
+  switch (slot.slot) {
+    case Slot::status: return StatusMsg{seq, NodeState::running, 3, 1000 * (report + 1)};
+    case Slot::faults: return StatusFaultsMsg{seq, 2, 1, 0, 0};
+    case Slot::adev: return TauDevMsg{seq, i, DevKind::adev, 0.02f / std::sqrt(tau_s), 1000.0 / (1 + i), NoiseType::white_fm, true};
+    case Slot::mdev: return TauDevMsg{seq, i, DevKind::mdev, 0.015f / std::sqrt(tau_s), 800.0 / (1 + i), NoiseType::white_fm, true};
+    case Slot::terms: return TauTermsMsg{seq, i, 1000 * (report + 1) - 2 * (std::uint64_t{1} << (4 * i))};
+    case Slot::tau_info: return TauInfoMsg{seq, i, std::uint64_t{1} << (4 * i), static_cast<std::uint8_t>(i == 0 ? 0 : 4 * i - 3)};  // S = 8
+    case Slot::sampling: return MetaSamplingMsg{seq, 0.001f, 8};
+    case Slot::clock: return MetaClockMsg{seq, 1000 * (report + 1) + 250, version};
+    case Slot::scale: return MetaScaleMsg{seq, 1.5f, AngleUnit::arcsec, InputSource::strobe_counter};
+    case Slot::config: return MetaConfigMsg{seq, 0xC0FFEE01u, 1000};
+    case Slot::ieee952:
+      return Ieee952Msg{seq, static_cast<Ieee952Term>(i), i != 4, 0.001f * static_cast<float>(i + 1), 0.05 * (i + 1)};
+  }
+  return StatusMsg{};
+}
+
+std::vector<Entry> frames() {
+  std::vector<Entry> out;
+  constexpr std::uint64_t t0_us = 1'700'000'000'000'000;
+  constexpr std::size_t taus = 3;
+  for (std::uint64_t report = 0; report < slow_cycle_reports; ++report) {
+    const auto seq = static_cast<std::uint8_t>(254 + report);
+    const std::size_t count = report_frame_count(seq, taus);
+    for (std::size_t p = 0; p < count; ++p) {
+      const std::uint64_t t_us = t0_us + report * 1'000'000 + p * 1'000'000 / count;
+      out.push_back({t_us, 0x2A, for_slot(report_slot(seq, taus, p), seq, report)});
+    }
+  }
+
+  std::vector<Message> limits{
+      StatusMsg{0, NodeState::starting, 0, 0},
+      StatusMsg{255, NodeState::input_lost, max_taus, (std::uint64_t{1} << 40) - 1},
+      StatusFaultsMsg{255, 65535, 65535, 65535, 63},
+      TauDevMsg{0, 0, DevKind::adev, 0.0f, 0.0, NoiseType::not_identified, false},
+      TauDevMsg{255, 63, DevKind::mdev, FLT_MAX, std::exp2(59.984375), NoiseType::random_run_fm, true},
+      TauDevMsg{1, 62, DevKind::adev, FLT_TRUE_MIN, std::exp2(-4.0 + 1.0 / 64), NoiseType::flicker_walk_fm, true},
+      TauTermsMsg{255, 63, (std::uint64_t{1} << 48) - 1},
+      TauTermsMsg{0, 0, 0},
+      TauInfoMsg{255, 63, (std::uint64_t{1} << 40) - 1, 0},
+      TauInfoMsg{0, 0, std::uint64_t{1} << 39, 39},
+      MetaSamplingMsg{255, FLT_MAX, 32768},
+      MetaSamplingMsg{0, FLT_TRUE_MIN, 1},
+      MetaClockMsg{255, (std::uint64_t{1} << 40) - 1, 255},
+      MetaScaleMsg{0, 1.0f, AngleUnit::pulse, InputSource::unknown},
+      MetaScaleMsg{1, 0.5f, AngleUnit::rad, InputSource::gpio_quadrature},
+      MetaScaleMsg{2, 2.0e-6f, AngleUnit::urad, InputSource::can_counter},
+      MetaScaleMsg{3, 4.2e-4f, AngleUnit::deg, InputSource::simulated},
+      MetaConfigMsg{255, 0xFFFFFFFFu, 2000},
+      MetaConfigMsg{0, 0, 100},
+      Ieee952Msg{255, Ieee952Term::rate_ramp, true, FLT_MAX, 6.5535},
+      Ieee952Msg{0, Ieee952Term::quantization, false, 0.0f, 0.0},
+      CounterInputMsg{0xFFFFFFFFu, 255, true, true},
+      CounterInputMsg{0, 0, false, false},
+      CounterInputMsg{123456789, 17, false, true},
+  };
+  for (int k = 0; k < 16; ++k)  // every noise type on both pages
+    limits.push_back(TauDevMsg{static_cast<std::uint8_t>(k), static_cast<std::uint8_t>(k), static_cast<DevKind>(k / 8),
+                               1.0f / static_cast<float>(k + 1), 10.0 * (k + 1), static_cast<NoiseType>(k % 8), k % 3 != 0});
+  std::uint64_t t_us = t0_us + 10'000'000;
+  const std::uint8_t nodes[] = {0x00, 0x01, max_node_address};
+  for (std::size_t k = 0; k < limits.size(); ++k) out.push_back({t_us += 1000, nodes[k % 3], limits[k]});
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool want_json = argc == 2 && std::strcmp(argv[1], "--expected") == 0;
+  if (argc > 2 || (argc == 2 && !want_json)) {
+    std::fprintf(stderr, "usage: gyrochar_dbc_frames [--expected]\n"
+                         "  prints codec frames as a candump log, or with --expected as JSON with the\n"
+                         "  value of every DBC signal\n");
+    return 2;
+  }
+  json all = json::array();
+  for (const Entry& e : frames()) {
+    CanFrame f;
+    if (const ProtocolError err = encode(e.message, e.node, f); err != ProtocolError::none) {
+      std::fprintf(stderr, "gyrochar_dbc_frames: encode: %s\n", name(err));
+      return 1;
+    }
+    // Expected values come from what the codec decodes, so they carry the wire's quantization.
+    const Decoded d = decode(f);
+    if (d.error != ProtocolError::none) {
+      std::fprintf(stderr, "gyrochar_dbc_frames: decode: %s\n", name(d.error));
+      return 1;
+    }
+    const std::string line = gyrochar::format_candump_line(static_cast<double>(e.t_us) * 1e-6, "can0", f);
+    if (!want_json) {
+      std::puts(line.c_str());
+      continue;
+    }
+    const Expected x = std::visit([](const auto& m) { return expected(m); }, d.message);
+    all.push_back({{"candump", line}, {"signals", x.signals}, {"names", x.names}});
+  }
+  if (want_json) std::puts(all.dump(1).c_str());
+  return 0;
+}

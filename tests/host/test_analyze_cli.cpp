@@ -1,0 +1,236 @@
+// gyrochar-analyze as a user meets it: every kind of bad input gets one line
+// 'gyrochar-analyze: what: why' on stderr, nothing on stdout and exit code 2; good input gives the
+// documented formats and units. Oracles: the CLI contract in --help; unit identities; the
+// closed-form angle random walk of white rate noise (values themselves: test_analyze_reference).
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <regex>
+#include <string>
+
+namespace {
+
+const std::string tool = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-analyze";
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+// Per-process names: CTest runs the tests of this file in parallel processes.
+std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_" + name; }
+
+Outcome run(const std::string& args) {
+  const std::string err_file = temp("analyze_err.txt");
+  Outcome r;
+  FILE* p = popen((tool + " " + args + " 2>" + err_file).c_str(), "r");
+  char buf[4096];
+  while (const std::size_t n = fread(buf, 1, sizeof buf, p)) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(err_file);
+  r.err.assign(std::istreambuf_iterator<char>(e), {});
+  return r;
+}
+
+std::string file_with(const std::string& name, const std::string& content) {
+  const std::string path = temp(name);
+  std::ofstream(path) << content;
+  return path;
+}
+
+void expect_bad_input(const std::string& args, const std::string& what) {
+  const Outcome r = run(args);
+  EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+  static const std::regex one_line("gyrochar-analyze: [^\n]+: [^\n]+\n");
+  EXPECT_TRUE(std::regex_match(r.err, one_line)) << "not 'gyrochar-analyze: what: why': " << r.err;
+  EXPECT_NE(r.err.find(what), std::string::npos) << "expected '" << what << "' in: " << r.err;
+  EXPECT_TRUE(r.out.empty()) << "no data on stdout after an error";
+}
+
+std::string good_phase() {
+  std::string s = "# phase\n";
+  for (int i = 0; i < 200; ++i) s += std::to_string((i * 7919 % 101) * 1e-9) + "\n";
+  return file_with("good.txt", s);
+}
+
+// 20000 counts of white rate noise: 1000 + U{-3..3} pulses per 1 ms (variance 4 pulses^2).
+std::vector<int> white_rate_counts() {
+  std::mt19937_64 rng(42);
+  std::uniform_int_distribution<int> jitter(-3, 3);
+  std::vector<int> c(20000);
+  for (int& v : c) v = 1000 + jitter(rng);
+  return c;
+}
+
+TEST(AnalyzeCli, BadInputsGetExitCodeTwoAndAReason) {
+  const std::string good = good_phase();
+  expect_bad_input("--type phase --tau0 1 " + file_with("nan.txt", "1\n2\nabc\n"), "line 3");
+  expect_bad_input("--type phase --tau0 1 " + file_with("nan2.txt", "1\nnan\n"), "not a finite number");
+  expect_bad_input("--type phase --tau0 1 " + file_with("empty.txt", ""), "no data");
+  expect_bad_input("--type phase --tau0 1 " + file_with("comments.txt", "# only\n\n"), "no data");
+  expect_bad_input("--type phase --tau0 1 - < " + file_with("empty2.txt", ""), "no data");
+  expect_bad_input("--type phase --tau0 1 --column 3 " + file_with("cols.txt", "1 2\n3 4\n"), "column 3");
+  expect_bad_input("--type phase --tau0 0 " + good, "--tau0");
+  expect_bad_input("--type phase --tau0 -1 " + good, "--tau0");
+  expect_bad_input("--type phase --tau0 1 --frobnicate " + good, "options");
+  expect_bad_input("--tau0 1 " + good, "--type");  // required: no silent default
+  expect_bad_input("--type phase " + good, "--tau0");
+  expect_bad_input("--type velocity --tau0 1 " + good, "--type");
+  expect_bad_input("--type phase --tau0 1 /nonexistent/file.txt", "No such file");
+  expect_bad_input("--type phase --tau0 1 --stats adev,foo " + good, "foo");
+  expect_bad_input("--type phase --tau0 1 --stride-factor 6 " + good, "--stride-factor");
+  expect_bad_input("--type phase --tau0 1 --alpha 5 " + good, "--alpha");
+  expect_bad_input("--type phase --tau0 1 --confidence 1.5 " + good, "--confidence");
+  expect_bad_input("--type phase --tau0 1 --taus 4,2 " + good, "--taus");
+  expect_bad_input("--type phase --tau0 1 --taus 1,11 --stride-factor 8 " + good, "cannot be formed");
+  expect_bad_input("--type phase --tau0 1 --taus 500,600 " + good, "too few");
+  expect_bad_input("--type phase --tau0 1 --taus all - < " + good, "--taus");  // stdin: no count
+  expect_bad_input("--type phase --tau0 1 --format xml " + good, "--format");
+  expect_bad_input("--type phase --tau0 1 --fit ieee952 --stats adev " + good, "--fit");
+  expect_bad_input("--type phase --tau0 1 --unit furlong " + good, "--unit");
+  expect_bad_input("--type phase --tau0 1 --rate-unit deg/h " + good, "--rate-unit");  // clock data
+  expect_bad_input("--type phase --tau0 1 --nominal-hz 1e7 " + good, "--nominal-hz");
+  expect_bad_input("--type freq --tau0 1 --unit Hz " + good, "--nominal-hz");
+  expect_bad_input("--type counts --tau0 1 " + good, "--pulse-weight");
+  expect_bad_input("--type counts --tau0 1 --pulse-weight 1parsec " + good, "unknown angle unit");
+  expect_bad_input("--type counts --tau0 1 --pulse-weight 1arcsec --rate-unit mph " + good, "--rate-unit");
+  expect_bad_input("--type counts --tau0 1 --pulse-weight 1arcsec " + file_with("frac.txt", "1\n2.5\n"), "integer");
+  expect_bad_input("--type counts --tau0 1 --pulse-weight 1arcsec " + file_with("huge.txt", "1\n1e12\n"), "2^31");
+  std::string many;
+  for (int i = 0; i < 20000; ++i) many += std::to_string(i * 0.001) + "\n";
+  const std::string whole = file_with("many.txt", many);
+  ASSERT_EQ(std::system(("gzip -kf " + whole + " && head -c 20000 " + whole + ".gz > " + whole + ".cut.gz").c_str()), 0);
+  expect_bad_input("--type phase --tau0 1 " + whole + ".cut.gz", "unexpected end of file");  // not a short run
+  const std::string dir = temp("a_directory");
+  mkdir(dir.c_str(), 0700);
+  expect_bad_input("--type phase --tau0 1 " + dir, "directory");
+}
+
+TEST(AnalyzeCli, HelpHasExamplesAndExitCodes) {
+  const Outcome r = run("--help");
+  EXPECT_EQ(r.code, 0);
+  for (const char* part : {"Examples:", "Exit codes:", "--type", "--pulse-weight", "--stride-factor", "2^16"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part;
+}
+
+TEST(AnalyzeCli, UnwritableOutputIsExitCodeThree) {
+  const Outcome r = run("--type phase --tau0 1 " + good_phase() + " > /dev/full");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_EQ(r.err.rfind("gyrochar-analyze: output: ", 0), 0u) << r.err;
+}
+
+TEST(AnalyzeCli, JsonHasTheDocumentedShape) {
+  const Outcome r = run("--type phase --tau0 1 --stats oadev,mdev --format json " + good_phase());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["tau0"], 1.0);
+  EXPECT_EQ(j["n_samples"], 200);
+  EXPECT_EQ(j["type"], "phase");
+  EXPECT_FALSE(j.contains("fit"));  // only when asked
+  ASSERT_FALSE(j["results"].empty());
+  for (const auto& row : j["results"]) {
+    for (const char* key : {"stat", "m", "tau", "n", "dev", "alpha", "edf", "ci_low", "ci_high"})
+      EXPECT_TRUE(row.contains(key)) << key;
+  }
+  EXPECT_EQ(j["results"][0]["stat"], "oadev");
+  EXPECT_EQ(j["results"][0]["n"], 198);  // N - 2m for m = 1 (Stable32's count)
+}
+
+TEST(AnalyzeCli, CountsInGyroUnitsFromGzipAndStdin) {
+  // Constant 1000 pulses of 1 arcsec per 0.01 s: every deviation is exactly 0 (oracle: a constant
+  // rate has no second differences); gzip and standard input give the same rows.
+  std::string s;
+  for (int i = 0; i < 500; ++i) s += "1000\n";
+  const std::string path = file_with("counts.txt", s);
+  ASSERT_EQ(std::system(("gzip -kf " + path).c_str()), 0);
+  const Outcome a = run("--type counts --tau0 0.01 --pulse-weight 1arcsec --format csv " + path + ".gz");
+  ASSERT_EQ(a.code, 0) << a.err;
+  EXPECT_EQ(a.out.rfind("stat,m,tau,n,dev,unit,alpha,edf,ci_low,ci_high,stride\n", 0), 0u) << a.out;
+  EXPECT_NE(a.out.find("\noadev,1,0.01,499,0,deg/h,"), std::string::npos) << a.out;
+  const Outcome b = run("--type counts --tau0 0.01 --pulse-weight 1 --pulse-unit arcsec --format csv - < " + path);
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_EQ(a.out, b.out);
+}
+
+TEST(AnalyzeCli, CountsAngleAndRateGiveTheSameGyroDeviations) {
+  // One gyro run three ways (oracle: unit identities): counts of 1 arcsec per 1 ms; the angle in
+  // arcsec, x_0 = 0, x_k = sum of the first k counts; the rate c * 1 arcsec / 1 ms = 1000 c deg/h
+  // (1 arcsec/s = 1 deg/h). All in deg/s here, TDEV in deg.
+  std::string counts, angle = "0\n", rate;
+  long long x = 0;
+  for (const int c : white_rate_counts()) {
+    counts += std::to_string(c) + "\n";
+    angle += std::to_string(x += c) + "\n";
+    rate += std::to_string(1000 * c) + "\n";
+  }
+  const std::string common = " --tau0 0.001 --rate-unit deg/s --stats adev,oadev,mdev,tdev,ohdev --format json ";
+  const Outcome a = run("--type counts --pulse-weight '1 arcsec'" + common + file_with("c.txt", counts));
+  const Outcome b = run("--type phase --unit arcsec" + common + file_with("a.txt", angle));
+  const Outcome c = run("--type freq --unit deg/h" + common + file_with("r.txt", rate));
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  ASSERT_EQ(c.code, 0) << c.err;
+  const auto ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out), jc = nlohmann::json::parse(c.out);
+  ASSERT_EQ(ja["results"].size(), jb["results"].size());
+  ASSERT_EQ(ja["results"].size(), jc["results"].size());
+  ASSERT_GT(ja["results"].size(), 50u);
+  for (std::size_t i = 0; i < ja["results"].size(); ++i) {
+    const auto &ra = ja["results"][i], &rb = jb["results"][i], &rc = jc["results"][i];
+    EXPECT_EQ(ra["unit"], ra["stat"] == "tdev" ? "deg" : "deg/s");
+    for (const auto* r : {&rb, &rc}) {
+      EXPECT_EQ((*r)["unit"], ra["unit"]);
+      EXPECT_EQ((*r)["n"], ra["n"]);
+      EXPECT_NEAR((*r)["dev"].get<double>() / ra["dev"].get<double>(), 1.0, 1e-9) << ra["stat"] << " m=" << ra["m"];
+    }
+  }
+}
+
+TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
+  // White rate noise of variance 4 pulses^2 per tau0 = 1 ms, 1 arcsec per pulse: AVAR = N^2 / tau
+  // with N = 2 arcsec / sqrt(1 ms) = 2/3600 deg * sqrt(3600 / 0.001) / sqrt(h) = 1.05409 deg/sqrt(h)
+  // (closed form, IEEE Std 952); the fit must find it within 3 of its standard uncertainties. The
+  // EDF weights use the generating process's alpha = 0 (white FM), not the identified one.
+  std::string counts;
+  for (const int c : white_rate_counts()) counts += std::to_string(c) + "\n";
+  const Outcome r = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 --format json " +
+                        file_with("white.txt", counts));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["fit"].size(), 2u);  // avar and mvar curves
+  const double n_true = 2.0 / 3600.0 * std::sqrt(3600.0 / 0.001);
+  for (const auto& fit : j["fit"]) {
+    EXPECT_EQ(fit["N"]["unit"], "deg/sqrt(h)");
+    ASSERT_TRUE(fit["N"]["resolved"].get<bool>()) << fit["curve"];
+    EXPECT_NEAR(fit["N"]["value"].get<double>(), n_true, 3 * fit["N"]["uncertainty"].get<double>()) << fit["curve"];
+  }
+  const Outcome table = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 " + temp("white.txt"));
+  EXPECT_NE(table.out.find("IEEE-952 fit on the avar curve"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("deg/sqrt(h)"), std::string::npos) << table.out;
+}
+
+TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
+  // Progress appears every 2^20 values: a file of 2^20 + 1 values shows it, with --progress, in
+  // both passes (counting, analyzing); stdout still carries only the table.
+  std::string s;
+  s.reserve(2u << 21);
+  for (int i = 0; i <= (1 << 20); ++i) s += "1\n";
+  const std::string path = file_with("long.txt", s);
+  const Outcome r = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 --progress " + path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("counting"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("analyzing"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("gyrochar-analyze"), std::string::npos);
+  const Outcome quiet = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 " + path);
+  EXPECT_TRUE(quiet.err.empty()) << quiet.err;  // stderr is a file here, not a terminal
+}
+
+}  // namespace

@@ -1,0 +1,189 @@
+// The analysis engine's own contract, beside the reference sets: the tau lists and the stride
+// factor, what it refuses, strided taus above the "full" cap against a brute-force strided
+// estimator, and the floating phase reference (a line added to phase changes nothing).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include "analysis.hpp"
+#include "datafile.hpp"
+#include "gyrochar/edf.hpp"
+
+namespace gyrochar {
+namespace {
+
+TEST(AnalyzeEngine, StrideFactorAndRepresentableTaus) {
+  // "full": the smallest power of two >= m_max, within [2, 2^16] (the documented rule).
+  EXPECT_EQ(resolve_stride_factor(0, 1), 2u);
+  EXPECT_EQ(resolve_stride_factor(0, 500), 512u);
+  EXPECT_EQ(resolve_stride_factor(0, 1u << 16), 1u << 16);
+  EXPECT_EQ(resolve_stride_factor(0, 1u << 30), full_stride_cap);
+  EXPECT_EQ(resolve_stride_factor(8, 1u << 30), 8u);
+  // S = 8: every m <= 8, then multiples of 2 up to 16, of 4 up to 32, ...
+  EXPECT_TRUE(tau_representable(7, 8));
+  EXPECT_TRUE(tau_representable(10, 8));
+  EXPECT_FALSE(tau_representable(11, 8));
+  EXPECT_TRUE(tau_representable(20, 8));
+  EXPECT_FALSE(tau_representable(18, 8));
+  EXPECT_FALSE(tau_representable(0, 8));
+}
+
+TEST(AnalyzeEngine, AllTausAreEveryRepresentableFactor) {
+  // Oracle: the brute-force filter of 1..N/2 by tau_representable.
+  for (const std::uint32_t s : {2u, 8u, 64u}) {
+    for (const std::uint64_t n_phase : {2ull, 3ull, 17ull, 1000ull, 5000ull}) {
+      std::vector<std::uint64_t> want;
+      for (std::uint64_t m = 1; m <= n_phase / 2; ++m)
+        if (tau_representable(m, s)) want.push_back(m);
+      EXPECT_EQ(all_taus(n_phase, s), want) << "S=" << s << " N=" << n_phase;
+    }
+  }
+  EXPECT_EQ(octave_taus(1001), (std::vector<std::uint64_t>{1, 2, 4, 8, 16, 32, 64, 128, 256}));
+  EXPECT_EQ(octave_taus(0).back(), std::uint64_t{1} << 39);  // unknown length
+  EXPECT_EQ(decade_taus(1001), (std::vector<std::uint64_t>{1, 2, 4, 10, 20, 40, 100, 200, 400}));  // Stable32's decade
+}
+
+TEST(AnalyzeEngine, RefusesInconsistentOptionsAndValues) {
+  AnalysisOptions o;
+  o.m_list = {1, 2};
+  auto refused = [](AnalysisOptions bad) {
+    try {
+      Analyzer a(bad);
+    } catch (const std::invalid_argument&) {
+      return true;
+    }
+    return false;
+  };
+  EXPECT_FALSE(refused(o));
+  AnalysisOptions b = o;
+  b.tau0_s = 0;
+  EXPECT_TRUE(refused(b));
+  b = o;
+  b.m_list = {2, 1};
+  EXPECT_TRUE(refused(b));
+  b = o;
+  b.m_list = {};
+  EXPECT_TRUE(refused(b));
+  b = o;
+  b.stride_factor = 6;
+  EXPECT_TRUE(refused(b));
+  b = o;
+  b.stride_factor = 8;
+  b.m_list = {1, 11};  // above S = 8 only even m
+  EXPECT_TRUE(refused(b));
+  b.m_list = {1, 12};
+  EXPECT_FALSE(refused(b));
+  b = o;
+  b.stats = {};
+  EXPECT_TRUE(refused(b));
+  b = o;
+  b.confidence = 1.0;
+  EXPECT_TRUE(refused(b));
+
+  Analyzer phase(o);
+  EXPECT_THROW(phase.add(std::nan("")), std::invalid_argument);
+  EXPECT_THROW(phase.add(INFINITY), std::invalid_argument);
+  o.type = DataType::counts;
+  Analyzer counts(o);
+  EXPECT_THROW(counts.add(2.5), std::invalid_argument);
+  EXPECT_THROW(counts.add(2147483648.0), std::invalid_argument);
+  EXPECT_NO_THROW(counts.add(-2147483647.0));
+}
+
+TEST(AnalyzeEngine, TausAboveTheFullCapAreStridedAndTheirEdfSaysSo) {
+  // 2^18 + 3000 points of white phase noise, taus 2^15 and 2^17 with S "full": the cap 2^16 makes
+  // 2^17 strided by 2. Oracle: the overlapping AVAR formula summed by brute force over every 2nd
+  // start j (every start for 2^15); EDF: Greenhall's for stride 2 (and 1).
+  const std::uint64_t n = (1u << 18) + 3000;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal;
+  std::vector<double> x(n);
+  for (double& v : x) v = normal(rng);
+  AnalysisOptions o;
+  o.m_list = {1u << 15, 1u << 17};
+  o.stats = {DevStat::oadev};
+  o.alpha = 2;
+  Analyzer analyzer(o);
+  for (const double v : x) analyzer.add(v);
+  const Analysis a = analyzer.result();
+  EXPECT_EQ(a.stride_factor, full_stride_cap);
+  ASSERT_EQ(a.rows.size(), 2u);
+  for (const AnalysisRow& row : a.rows) {
+    const std::uint64_t m = row.m, stride = m > full_stride_cap ? m / full_stride_cap : 1;
+    EXPECT_EQ(row.stride, stride);
+    double sum = 0;
+    std::uint64_t terms = 0;
+    for (std::uint64_t j = 0; j + 2 * m < n; j += stride, ++terms) {
+      const double d = x[j + 2 * m] - 2 * x[j + m] + x[j];
+      sum += d * d;
+    }
+    EXPECT_EQ(row.n, terms) << "m=" << m;
+    const double tau = static_cast<double>(m);
+    EXPECT_NEAR(row.dev / std::sqrt(sum / (2.0 * static_cast<double>(terms) * tau * tau)), 1.0, 1e-9) << "m=" << m;
+    EXPECT_DOUBLE_EQ(row.edf, edf_for(EdfStat::avar, 2, m, stride, n)) << "m=" << m;
+  }
+  // For white PM, striding by 2 halves the EDF of the unmodified AVAR (Greenhall: 1500 vs 3000).
+  EXPECT_NEAR(a.rows[1].edf / edf_for(EdfStat::avar, 2, 1u << 17, 1, n), 0.5, 1e-9);
+}
+
+TEST(AnalyzeEngine, PhaseOffsetAndTrendChangeNothing) {
+  // Oracle: differences of order >= 2 (all six statistics) do not see a line added to phase. The
+  // added line is large (up to 10^6 s, 10^9 times the noise), so this exercises the reference line
+  // the engine subtracts; 1e-9 covers the rounding of the shifted input values themselves.
+  const std::vector<std::string> stats{"adev", "oadev", "mdev", "tdev", "hdev", "ohdev"};
+  DataFile file(std::string(GYROCHAR_REFDATA) + "/phasedat/PHASE.DAT");
+  std::vector<double> x;
+  for (double v = 0; file.next(v);) x.push_back(v);
+  AnalysisOptions o;
+  o.m_list = octave_taus(x.size());
+  for (const auto& s : stats) o.stats.push_back(*parse_dev_stat(s));
+  o.alpha = 0;
+  Analyzer plain(o), shifted(o);
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    plain.add(x[k]);
+    shifted.add(x[k] + 12345.678 + 987.654321 * static_cast<double>(k));
+  }
+  const Analysis a = plain.result(), b = shifted.result();
+  ASSERT_EQ(a.rows.size(), b.rows.size());
+  ASSERT_GT(a.rows.size(), 40u);
+  for (std::size_t i = 0; i < a.rows.size(); ++i) {
+    EXPECT_EQ(a.rows[i].n, b.rows[i].n);
+    EXPECT_NEAR(b.rows[i].dev / a.rows[i].dev, 1.0, 1e-9) << name(a.rows[i].stat) << " m=" << a.rows[i].m;
+  }
+}
+
+TEST(AnalyzeEngine, CountsEqualTheirPhaseExactly) {
+  // Counts c_k and the phase x_k = sum_{i<k} c_i (with x_0 = 0) are the same data: equal n and
+  // deviations (oracle: the definitions; integer phase below 2^53 is exact in double as well).
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<int> count(-1000, 1000);
+  AnalysisOptions o;
+  o.m_list = {1, 3, 16, 100};
+  o.stats = {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::hdev, DevStat::ohdev};
+  o.alpha = 0;
+  AnalysisOptions p = o;
+  o.type = DataType::counts;
+  Analyzer counts(o), phase(p);
+  double x = 0;
+  phase.add(x);
+  for (int k = 0; k < 3000; ++k) {
+    const int c = count(rng) + 5000;
+    counts.add(c);
+    x += c;
+    phase.add(x);
+  }
+  const Analysis a = counts.result(), b = phase.result();
+  ASSERT_EQ(a.rows.size(), b.rows.size());
+  for (std::size_t i = 0; i < a.rows.size(); ++i) {
+    EXPECT_EQ(a.rows[i].n, b.rows[i].n);
+    EXPECT_NEAR(a.rows[i].dev / b.rows[i].dev, 1.0, 1e-12) << name(a.rows[i].stat) << " m=" << a.rows[i].m;
+  }
+  EXPECT_EQ(a.n_phase, 3001u);
+  EXPECT_EQ(a.n_values, 3000u);
+}
+
+}  // namespace
+}  // namespace gyrochar

@@ -1,0 +1,239 @@
+// The offline analysis engine against Stable32 and NIST SP 1065 on the reference sets in
+// ../shared/refdata (README there): n exact; deviation within 1e-4 relative (Stable32 prints 5
+// digits), 5e-5 for the OCXO all-tau files, 2e-3 for the OCXO octave files (Stable32 lost
+// precision normalising them); CI bounds within 1e-3 relative (2e-3 OCXO octave) when computed
+// with Stable32's alpha; the automatic noise identification equal to Stable32's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "analysis.hpp"
+#include "datafile.hpp"
+
+namespace gyrochar {
+namespace {
+
+const std::string ref = GYROCHAR_REFDATA;
+const std::vector<std::string> stat_names{"adev", "oadev", "mdev", "tdev", "hdev", "ohdev"};
+
+// One data row of a Stable32 result file: AF Tau # Alpha MinSigma Sigma MaxSigma.
+struct Stable32Row {
+  std::uint64_t m = 0, n = 0;
+  int alpha = 0;
+  double min = 0, sigma = 0, max = 0;
+};
+
+std::vector<Stable32Row> read_stable32(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << path;
+  std::vector<Stable32Row> rows;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ss(line);
+    Stable32Row r;
+    double tau = 0;
+    if (ss >> r.m >> tau >> r.n >> r.alpha >> r.min >> r.sigma >> r.max) rows.push_back(r);
+  }
+  return rows;
+}
+
+std::vector<double> read_values(const std::string& path) {
+  DataFile file(path);
+  std::vector<double> v;
+  for (double x = 0; file.next(x);) v.push_back(x);
+  return v;
+}
+
+Analysis run(const std::vector<double>& values, DataType type, DevStat stat, std::vector<std::uint64_t> m_list,
+             std::optional<int> alpha = std::nullopt) {
+  AnalysisOptions o;
+  o.type = type;
+  o.tau0_s = 1.0;
+  o.m_list = std::move(m_list);
+  o.stats = {stat};
+  o.alpha = alpha;
+  Analyzer analyzer(o);
+  for (const double v : values) analyzer.add(v);
+  return analyzer.result();
+}
+
+const AnalysisRow* find(const Analysis& a, std::uint64_t m) {
+  for (const auto& r : a.rows)
+    if (r.m == m) return &r;
+  return nullptr;
+}
+
+struct Tolerance {
+  double dev = 1e-4;
+  double ci = 1e-3;
+};
+
+// Every row of a Stable32 file: n, deviation and (where the file has them) the CI bounds computed
+// with the file's alpha. Returns the engine's automatic analysis of the same taus.
+Analysis compare(const std::vector<double>& values, DataType type, DevStat stat, const std::string& file, Tolerance tol) {
+  const auto rows = read_stable32(file);
+  EXPECT_FALSE(rows.empty()) << file;
+  std::vector<std::uint64_t> m_list;
+  for (const auto& r : rows) m_list.push_back(r.m);
+  std::map<int, Analysis> with_alpha;  // one run per alpha Stable32 used
+  for (const auto& r : rows)
+    if (!with_alpha.count(r.alpha)) with_alpha[r.alpha] = run(values, type, stat, m_list, r.alpha);
+  for (const auto& r : rows) {
+    const AnalysisRow* got = find(with_alpha[r.alpha], r.m);
+    if (got == nullptr) {
+      ADD_FAILURE() << file << " m=" << r.m << " missing";
+      continue;
+    }
+    EXPECT_EQ(got->n, r.n) << file << " m=" << r.m;
+    EXPECT_NEAR(got->dev / r.sigma, 1.0, tol.dev) << file << " m=" << r.m;
+    if (r.min > 0) {
+      EXPECT_TRUE(got->ci.valid) << file << " m=" << r.m;
+      EXPECT_NEAR(got->ci.low / r.min, 1.0, tol.ci) << file << " m=" << r.m << " low";
+      EXPECT_NEAR(got->ci.high / r.max, 1.0, tol.ci) << file << " m=" << r.m << " high";
+    }
+  }
+  return run(values, type, stat, m_list);
+}
+
+// The automatic alpha equals Stable32's on the rows `where` selects; returns the rows compared.
+int expect_same_alpha(const Analysis& automatic, const std::string& file, const std::function<bool(const Stable32Row&)>& where) {
+  int compared = 0;
+  for (const auto& r : read_stable32(file)) {
+    if (!where(r)) continue;
+    const AnalysisRow* got = find(automatic, r.m);
+    ++compared;
+    if (got == nullptr || !got->alpha) {
+      ADD_FAILURE() << file << " m=" << r.m << ": no alpha";
+      continue;
+    }
+    EXPECT_EQ(*got->alpha, r.alpha) << file << " m=" << r.m << " (noise identification)";
+  }
+  return compared;
+}
+
+std::vector<double> ocxo_fractional_frequency() {
+  auto f = read_values(ref + "/ocxo/ocxo_frequency.txt");
+  for (double& v : f) v = (v - 1e7) / 1e7;  // frequency in Hz of a 10 MHz oscillator
+  return f;
+}
+
+TEST(Stable32, PhaseDatEveryAveragingFactor) {
+  const auto x = read_values(ref + "/phasedat/PHASE.DAT");
+  ASSERT_EQ(x.size(), 1001u);
+  for (const auto& s : stat_names)
+    compare(x, DataType::phase, *parse_dev_stat(s), ref + "/phasedat/phase_dat_" + s + ".txt", {});
+}
+
+TEST(Stable32, PhaseDatOctavesWithConfidenceIntervals) {
+  const auto x = read_values(ref + "/phasedat/PHASE.DAT");
+  for (const auto& s : stat_names)
+    compare(x, DataType::phase, *parse_dev_stat(s), ref + "/phasedat/phase_dat_" + s + "_octave.txt", {});
+}
+
+TEST(Stable32, OcxoFrequencyAllTaus) {
+  const auto y = ocxo_fractional_frequency();
+  ASSERT_EQ(y.size(), 19982u);
+  for (const auto& s : stat_names)
+    compare(y, DataType::freq, *parse_dev_stat(s), ref + "/ocxo/stable32_" + s + "_alltau.txt", {5e-5, 0});
+}
+
+TEST(Stable32, OcxoFrequencyOctavesWithConfidenceIntervalsAndNoiseIdentification) {
+  const auto y = ocxo_fractional_frequency();
+  for (const auto& s : stat_names) {
+    const std::string file = ref + "/ocxo/" + s + "_octave.txt";
+    const Analysis automatic = compare(y, DataType::freq, *parse_dev_stat(s), file, {2e-3, 2e-3});
+    // The lag-1 autocorrelation rule (>= 30 averages) reproduces Stable32 on every such row. With
+    // fewer (m >= 1024 here) both fall back to the B1 ratio, where Stable32 picks differently on
+    // some rows (e.g. alpha 0 where the engine picks -2 at m = 2048): not required, not checked.
+    EXPECT_GE(expect_same_alpha(automatic, file, [&](const Stable32Row& r) { return (y.size() + 1) / r.m >= 30; }), 10)
+        << file;
+  }
+}
+
+TEST(Stable32, KeysightTimeIntervalNoiseFloorWithNoiseIdentification) {
+  const auto x = read_values(ref + "/Keysight53230A_ti_noise_floor/tic_phase.txt");
+  ASSERT_EQ(x.size(), 55688u);
+  for (const auto& s : stat_names) {
+    const std::string file = ref + "/Keysight53230A_ti_noise_floor/tic_" + s + ".txt";
+    const Analysis automatic = compare(x, DataType::phase, *parse_dev_stat(s), file, {});
+    // Octave rows (1..8192; 1..64 in the log-spaced adev file), alpha 2 then 1: the case only
+    // R(n) = MVAR/AVAR separates.
+    EXPECT_GE(expect_same_alpha(automatic, file, [](const Stable32Row& r) { return (r.m & (r.m - 1)) == 0; }), 7)
+        << file;
+  }
+}
+
+TEST(Stable32, KeysightNoiseIdentificationAtEveryAveragingFactor) {
+  // tic_adev.txt has 260 averaging factors. Stable32's choices there are not all reproducible from
+  // its published rules (lag-1 ACF with >= 30 points, B1 and R(n) below): at some non-octave m it
+  // reports alpha 0 where both the lag-1 ACF and B1/R(n) give 1 or 2. We require the agreement
+  // measured (222 of 260 = 85 %; every octave row agrees, see above) not to drop.
+  const auto x = read_values(ref + "/Keysight53230A_ti_noise_floor/tic_phase.txt");
+  const auto rows = read_stable32(ref + "/Keysight53230A_ti_noise_floor/tic_adev.txt");
+  ASSERT_EQ(rows.size(), 260u);
+  std::vector<std::uint64_t> m_list;
+  for (const auto& r : rows) m_list.push_back(r.m);
+  const Analysis a = run(x, DataType::phase, DevStat::adev, m_list);
+  int agree = 0;
+  for (const auto& r : rows) {
+    const AnalysisRow* got = find(a, r.m);
+    if (got && got->alpha && *got->alpha == r.alpha) ++agree;
+  }
+  std::printf("noise identification agrees with Stable32 on %d of %zu averaging factors\n", agree, rows.size());
+  EXPECT_GE(agree, 222);
+}
+
+// NIST SP 1065 values from a *_expected.csv: {stat -> deviations at the file's m}.
+std::map<DevStat, std::vector<double>> read_expected(const std::string& path, std::size_t columns) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << path;
+  std::map<DevStat, std::vector<double>> out;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ss(line);
+    std::string field;
+    std::getline(ss, field, ',');
+    const auto stat = parse_dev_stat(field);
+    if (!stat) continue;  // header, totdev and the other statistics the engine does not have
+    for (std::size_t k = 0; k < columns && std::getline(ss, field, ','); ++k) out[*stat].push_back(std::stod(field));
+  }
+  return out;
+}
+
+void expect_nist(const std::vector<double>& values, DataType type, const std::string& expected_csv,
+                 const std::vector<std::uint64_t>& m_list) {
+  const auto expected = read_expected(expected_csv, m_list.size());
+  EXPECT_EQ(expected.size(), 6u) << expected_csv;  // all six statistics are in the table
+  for (const auto& [stat, devs] : expected) {
+    ASSERT_EQ(devs.size(), m_list.size());
+    const Analysis a = run(values, type, stat, m_list, 0);
+    for (std::size_t k = 0; k < m_list.size(); ++k) {
+      const AnalysisRow* got = find(a, m_list[k]);
+      ASSERT_NE(got, nullptr) << name(stat) << " m=" << m_list[k];
+      EXPECT_NEAR(got->dev / devs[k], 1.0, 1e-4) << name(stat) << " m=" << m_list[k];
+    }
+  }
+}
+
+TEST(NistSp1065, Nbs14TenPointPhaseAndNinePointFrequency) {
+  // The 9 frequency values are the differences of the 10 phase values plus a constant, which no
+  // statistic sees: both reproduce the same table (NIST SP 1065 NBS14, m = 1 and 2).
+  const std::string expected = ref + "/nbs14/nbs14_10point_expected.csv";
+  expect_nist(read_values(ref + "/nbs14/nbs14_10point_phase.txt"), DataType::phase, expected, {1, 2});
+  expect_nist(read_values(ref + "/nbs14/nbs14_10point_freq.txt"), DataType::freq, expected, {1, 2});
+}
+
+TEST(NistSp1065, Nbs14ThousandPointFrequency) {
+  expect_nist(read_values(ref + "/nbs14/nbs14_1000point_freq.txt"), DataType::freq,
+              ref + "/nbs14/nbs14_1000point_expected.csv", {1, 10, 100});
+}
+
+}  // namespace
+}  // namespace gyrochar

@@ -1,0 +1,600 @@
+// gyrochar-decode as a user meets it, on candump logs this test writes with the codec
+// (protocol::encode + format_candump_line). Oracle: the values the test encoded (exact in the node's
+// own unit; unit conversions are closed forms: 1 rad = 180/pi deg, 1 h = 3600 s), the confidence
+// intervals of confidence.hpp (Boost.Math chi-squared, NIST SP 1065 eq. 45), and the frames the
+// test removed, reordered or mangled on purpose; exit codes and messages: the CLI contract in --help.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "candump.hpp"
+#include "confidence.hpp"
+#include "gyrochar/protocol.hpp"
+
+namespace gyrochar {
+namespace {
+
+using namespace protocol;
+using Json = nlohmann::json;
+
+const std::string tool = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-decode";
+constexpr double rad_to_deg = 180.0 / std::numbers::pi;
+
+// ---------------------------------------------------------------------------------------------
+// Running the program
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+// Per-process names: CTest runs the tests of this file in parallel processes.
+std::string temp(const std::string& name) {
+  return ::testing::TempDir() + std::to_string(getpid()) + "_decode_" + name;
+}
+
+Outcome run(const std::string& args) {
+  const std::string err_file = temp("stderr.txt");
+  Outcome r;
+  FILE* p = popen((tool + " " + args + " 2>" + err_file).c_str(), "r");
+  char buf[4096];
+  while (std::size_t n = fread(buf, 1, sizeof buf, p)) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(err_file);
+  r.err.assign(std::istreambuf_iterator<char>(e), {});
+  return r;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// ---------------------------------------------------------------------------------------------
+// The nodes' values: simple functions of (node, report, tau), so every row has a known answer
+
+struct NodeSpec {
+  std::uint8_t address = 0x10;
+  std::uint8_t taus = 6;
+  AngleUnit unit = AngleUnit::arcsec;
+  float tau0_s = 0.01f;
+};
+
+float adev_of(const NodeSpec& n, std::uint8_t seq, std::size_t i) {
+  return 0.25f * static_cast<float>(n.address) / static_cast<float>(1 + i) + 0.001f * static_cast<float>(seq);
+}
+float mdev_of(const NodeSpec& n, std::uint8_t seq, std::size_t i) { return 0.75f * adev_of(n, seq, i); }
+double edf_of(std::size_t i) { return std::ldexp(1.0, static_cast<int>(i) + 1); }  // 2^k: exact on the wire
+NoiseType noise_of(std::size_t i) { return static_cast<NoiseType>(1 + i % 7); }
+std::uint64_t n_of(std::uint8_t seq, std::size_t i) { return 1000u * (seq + 1u) + i; }
+std::uint64_t m_of(std::size_t i) { return std::uint64_t{1} << i; }
+float ieee_of(std::size_t k) { return 0.001f * static_cast<float>(k + 1); }
+bool ieee_resolved(std::size_t k) { return k != 4; }  // R not resolved
+
+Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t samples) {
+  switch (s.slot) {
+    case Slot::status:
+      return StatusMsg{seq, NodeState::running, n.taus, samples};
+    case Slot::faults:
+      return StatusFaultsMsg{seq, 1, 2, 3, 0};
+    case Slot::adev:
+      return TauDevMsg{seq, s.index, DevKind::adev, adev_of(n, seq, s.index), edf_of(s.index), noise_of(s.index), true};
+    case Slot::mdev:
+      return TauDevMsg{seq, s.index, DevKind::mdev, mdev_of(n, seq, s.index), edf_of(s.index), noise_of(s.index), true};
+    case Slot::terms:
+      return TauTermsMsg{seq, s.index, n_of(seq, s.index)};
+    case Slot::tau_info:
+      return TauInfoMsg{seq, s.index, m_of(s.index), 0};
+    case Slot::sampling:
+      return MetaSamplingMsg{seq, n.tau0_s, 8};
+    case Slot::clock:
+      return MetaClockMsg{seq, samples * 10, version};
+    case Slot::scale:
+      return MetaScaleMsg{seq, 1.0f, n.unit, InputSource::simulated};
+    case Slot::config:
+      return MetaConfigMsg{seq, 0xC0FFEEu, 1000};
+    case Slot::ieee952:
+      return Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), ieee_resolved(s.index), ieee_of(s.index), 0.125};
+  }
+  return {};
+}
+
+// What a closed report must produce: the oracle of its rows.
+struct Expected {
+  std::uint8_t node = 0, seq = 0;
+  std::uint32_t session = 0;
+  std::vector<std::uint64_t> m, n;  // latest received, 0 = unknown
+  std::vector<bool> adev, mdev;     // received in this report
+};
+
+// Writes a candump log: frames of several nodes, each report paced over one second, lines sorted
+// by time; keeps the oracle of every report it wrote.
+class LogWriter {
+ public:
+  using Drop = std::function<bool(const ReportSlot&)>;
+
+  /// Report `seq` of node `n` starting at t_s; frames for which `drop` is true are left out.
+  void report(const NodeSpec& n, std::uint8_t seq, double t_s, std::uint64_t samples, const Drop& drop = {}) {
+    State& st = state_[n.address];
+    st.m.resize(n.taus);
+    st.n.resize(n.taus);
+    Expected e{n.address, seq, st.session, {}, {}, std::vector<bool>(n.taus), std::vector<bool>(n.taus)};
+    const std::size_t frames = report_frame_count(seq, n.taus);
+    for (std::size_t k = 0; k < frames; ++k) {
+      const ReportSlot s = report_slot(seq, n.taus, k);
+      if (drop && drop(s)) continue;
+      CanFrame f;
+      EXPECT_EQ(encode(message(n, seq, s, samples), n.address, f), ProtocolError::none);
+      lines_.emplace_back(t_s + static_cast<double>(k) / static_cast<double>(frames),
+                          format_candump_line(0, "can0", f));
+      if (s.slot == Slot::adev) e.adev[s.index] = true;
+      if (s.slot == Slot::mdev) e.mdev[s.index] = true;
+      if (s.slot == Slot::terms) st.n[s.index] = n_of(seq, s.index);
+      if (s.slot == Slot::tau_info) st.m[s.index] = m_of(s.index);
+    }
+    e.m = st.m;
+    e.n = st.n;
+    expected_.push_back(e);
+  }
+  /// The node restarted: the decoder forgets its tau table and counts a new session.
+  void restart(std::uint8_t node) {
+    State& st = state_[node];
+    ++st.session;
+    std::fill(st.m.begin(), st.m.end(), 0);
+    std::fill(st.n.begin(), st.n.end(), 0);
+  }
+  void raw(double t_s, const std::string& line) { lines_.emplace_back(t_s, line); }
+
+  /// The log text: lines by time, timestamps put in (raw lines as given).
+  std::string text() const {
+    std::vector<std::pair<double, std::string>> sorted = lines_;
+    std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::string s;
+    for (const auto& [t, line] : sorted) {
+      // format_candump_line() was called with time 0: replace its "(0.000000)" by the real time.
+      s += line.rfind("(0.000000) ", 0) == 0 ? fmt_time(t) + line.substr(10) : line;
+      s += '\n';
+    }
+    return s;
+  }
+  std::string write(const std::string& name) const {
+    const std::string path = temp(name);
+    std::ofstream(path, std::ios::binary) << text();
+    return path;
+  }
+  const std::vector<Expected>& expected() const { return expected_; }
+
+ private:
+  static std::string fmt_time(double t) {
+    char b[64];
+    std::snprintf(b, sizeof b, "(%.6f)", t);
+    return b;
+  }
+  struct State {
+    std::uint32_t session = 0;
+    std::vector<std::uint64_t> m, n;
+  };
+  std::map<std::uint8_t, State> state_;
+  std::vector<Expected> expected_;
+  std::vector<std::pair<double, std::string>> lines_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Reading the CSV
+
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  std::size_t col(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<std::size_t>(it - header.begin());
+  }
+  const std::string& get(const std::vector<std::string>& row, const std::string& name) const {
+    return row.at(col(name));
+  }
+};
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream ss(line);
+  std::string f;
+  while (std::getline(ss, f, ',')) fields.push_back(f);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+Csv read_csv(const std::string& path) {
+  Csv csv;
+  std::ifstream in(path);
+  std::string line;
+  if (std::getline(in, line)) csv.header = split(line);
+  while (std::getline(in, line)) {
+    csv.rows.push_back(split(line));
+    EXPECT_EQ(csv.rows.back().size(), csv.header.size()) << line;
+  }
+  return csv;
+}
+
+std::vector<Json> read_jsonl(const std::string& path) {
+  std::vector<Json> records;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) records.push_back(Json::parse(line));
+  return records;
+}
+
+const Expected* find_expected(const LogWriter& log, std::uint8_t node, std::uint8_t seq, std::uint32_t session) {
+  for (const Expected& e : log.expected())
+    if (e.node == node && e.seq == seq && e.session == session) return &e;
+  return nullptr;
+}
+
+// Checks one CSV row against the oracle; `rate` converts the node's unit/s into the shown unit.
+void expect_row(const Csv& csv, const std::vector<std::string>& row, const LogWriter& log,
+                const std::map<std::uint8_t, NodeSpec>& nodes, double rate) {
+  const auto node = static_cast<std::uint8_t>(std::stoi(csv.get(row, "node")));
+  const auto seq = static_cast<std::uint8_t>(std::stoi(csv.get(row, "seq")));
+  const auto session = static_cast<std::uint32_t>(std::stoul(csv.get(row, "session")));
+  const std::size_t i = std::stoul(csv.get(row, "tau_index"));
+  const Expected* e = find_expected(log, node, seq, session);
+  ASSERT_NE(e, nullptr) << "row of a report the log does not hold: node " << int(node) << " seq " << int(seq);
+  ASSERT_LT(i, e->m.size());
+  const NodeSpec& n = nodes.at(node);
+  SCOPED_TRACE(testing::Message() << "node " << int(node) << " seq " << int(seq) << " tau " << i);
+  EXPECT_EQ(csv.get(row, "m"), e->m[i] ? std::to_string(e->m[i]) : "");
+  EXPECT_EQ(csv.get(row, "n"), e->n[i] ? std::to_string(e->n[i]) : "");
+  if (e->m[i])
+    EXPECT_FLOAT_EQ(std::stof(csv.get(row, "tau_s")), n.tau0_s * static_cast<float>(e->m[i]));
+  else
+    EXPECT_EQ(csv.get(row, "tau_s"), "");
+  for (const auto& [kind, received, value] : {std::tuple{std::string("adev"), bool(e->adev[i]), adev_of(n, seq, i)},
+                                              std::tuple{std::string("mdev"), bool(e->mdev[i]), mdev_of(n, seq, i)}}) {
+    if (!received) {
+      EXPECT_EQ(csv.get(row, kind + "_status"), "missing");
+      EXPECT_EQ(csv.get(row, kind), "");
+      EXPECT_EQ(csv.get(row, kind + "_low"), "");
+      continue;
+    }
+    const double want = static_cast<double>(value) * rate;
+    EXPECT_EQ(csv.get(row, kind + "_status"), "ok");
+    EXPECT_NEAR(std::stod(csv.get(row, kind)), want, 1e-14 * want);
+    const Interval ci = confidence_interval(want, edf_of(i), 0.683);
+    ASSERT_TRUE(ci.valid);
+    EXPECT_NEAR(std::stod(csv.get(row, kind + "_low")), ci.low, 1e-12 * ci.low);
+    EXPECT_NEAR(std::stod(csv.get(row, kind + "_high")), ci.high, 1e-12 * ci.high);
+    EXPECT_EQ(std::stod(csv.get(row, kind + "_edf")), edf_of(i));
+    EXPECT_EQ(csv.get(row, kind + "_noise"), name(noise_of(i)));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(DecodeCli, CsvAndJsonLinesCarryTheEncodedValuesOfEveryNode) {
+  const std::map<std::uint8_t, NodeSpec> nodes{{0x10, {0x10, 6, AngleUnit::arcsec, 0.01f}},
+                                               {0x2A, {0x2A, 4, AngleUnit::rad, 0.5f}}};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 9; ++seq)
+    for (const auto& [address, n] : nodes) log.report(n, seq, 1000.0 + seq + 0.3 * (address == 0x2A), 100u * (seq + 1));
+  const std::string csv_path = temp("values.csv"), jsonl_path = temp("values.jsonl");
+  const Outcome r =
+      run(log.write("values.log") + " --view none --rate-unit native --csv " + csv_path + " --jsonl " + jsonl_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << "--view none writes nothing on stdout";
+
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 9u * 6 + 9u * 4);  // one row per node, report and tau
+  for (const auto& row : csv.rows) {
+    expect_row(csv, row, log, nodes, 1.0);  // native: exactly the float on the wire
+    const bool arcsec = csv.get(row, "node") == "16";
+    EXPECT_EQ(csv.get(row, "rate_unit"), arcsec ? "arcsec/s" : "rad/s");
+    EXPECT_EQ(csv.get(row, "ci_level"), "0.683");
+  }
+
+  std::size_t taus = 0, reports = 0, summaries = 0;
+  for (const Json& j : read_jsonl(jsonl_path)) {
+    const std::string type = j.at("type");
+    if (type == "tau") {
+      ++taus;
+      const NodeSpec& n = nodes.at(j.at("node").get<std::uint8_t>());
+      const auto seq = j.at("seq").get<std::uint8_t>();
+      const std::size_t i = j.at("tau_index");
+      EXPECT_EQ(j.at("adev").at("value").get<double>(), static_cast<double>(adev_of(n, seq, i)));
+      EXPECT_EQ(j.at("mdev").at("value").get<double>(), static_cast<double>(mdev_of(n, seq, i)));
+      EXPECT_EQ(j.at("mdev").at("edf").get<double>(), edf_of(i));
+      EXPECT_EQ(j.at("adev").at("noise"), name(noise_of(i)));
+    } else if (type == "report") {
+      ++reports;
+      EXPECT_EQ(j.at("faults").at("lost_edges"), 1);
+      EXPECT_EQ(j.at("faults").at("sample_gaps"), 2);
+      EXPECT_EQ(j.at("faults").at("tx_dropped_frames"), 3);
+      EXPECT_EQ(j.at("sample_count"), 100 * (j.at("seq").get<int>() + 1));
+    } else if (type == "summary") {
+      ++summaries;
+      EXPECT_EQ(j.at("malformed_lines"), 0);
+      EXPECT_EQ(j.at("rejected_frames"), 0);
+      ASSERT_EQ(j.at("nodes").size(), 2u);
+      for (const Json& node : j.at("nodes")) {
+        EXPECT_EQ(node.at("health").at("reports_complete"), 9);
+        EXPECT_EQ(node.at("health").at("frames_missing"), 0);
+      }
+    }
+  }
+  EXPECT_EQ(taus, csv.rows.size());
+  EXPECT_EQ(reports, 18u);
+  EXPECT_EQ(summaries, 1u);
+}
+
+TEST(DecodeCli, RatesInDegreesPerHourAndPulsesNeverConverted) {
+  const std::map<std::uint8_t, NodeSpec> nodes{{0x21, {0x21, 4, AngleUnit::rad, 0.01f}},
+                                               {0x22, {0x22, 4, AngleUnit::pulse, 0.01f}}};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 5; ++seq)
+    for (const auto& [address, n] : nodes) log.report(n, seq, 50.0 + seq + 0.5 * (address == 0x22), 100u * (seq + 1));
+  const std::string csv_path = temp("units.csv"), jsonl_path = temp("units.jsonl");
+  const Outcome r = run(log.write("units.log") + " --view final --csv " + csv_path + " --jsonl " + jsonl_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 2u * 5 * 4);
+  for (const auto& row : csv.rows) {
+    const bool pulses = csv.get(row, "node") == "34";
+    EXPECT_EQ(csv.get(row, "rate_unit"), pulses ? "pulse/s" : "deg/h");
+    expect_row(csv, row, log, nodes, pulses ? 1.0 : rad_to_deg * 3600.0);  // rad/s -> deg/h
+  }
+  // IEEE-952 terms of the last report in gyro units; the pulse node's in pulse units.
+  Json last_rad, last_pulse;
+  for (const Json& j : read_jsonl(jsonl_path))
+    if (j.at("type") == "report") (j.at("node") == 0x21 ? last_rad : last_pulse) = j;
+  const std::array<double, 5> to_gyro{rad_to_deg * 3600.0, rad_to_deg * 60.0, rad_to_deg * 3600.0,
+                                      rad_to_deg * std::pow(3600.0, 1.5), rad_to_deg * 3600.0 * 3600.0};
+  const std::array<const char*, 5> letters{"Q", "N", "B", "K", "R"},
+      gyro_units{"arcsec", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h/h"},
+      pulse_units{"pulse", "pulse/sqrt(s)", "pulse/s", "pulse/s/sqrt(s)", "pulse/s/s"};
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Json& q = last_rad.at("ieee952").at(letters[k]);
+    const Json& p = last_pulse.at("ieee952").at(letters[k]);
+    EXPECT_EQ(q.at("unit"), gyro_units[k]);
+    EXPECT_EQ(p.at("unit"), pulse_units[k]);
+    EXPECT_EQ(q.at("resolved"), ieee_resolved(k));
+    if (!ieee_resolved(k)) {
+      EXPECT_TRUE(q.at("value").is_null());
+      continue;
+    }
+    const double want = static_cast<double>(ieee_of(k)) * to_gyro[k];
+    EXPECT_NEAR(q.at("value").get<double>(), want, 1e-14 * want) << letters[k];
+    EXPECT_EQ(p.at("value").get<double>(), static_cast<double>(ieee_of(k))) << letters[k];
+    EXPECT_DOUBLE_EQ(q.at("rel_uncertainty").get<double>(), 0.125);  // 12.5 % = 1250 steps of 0.01 %
+  }
+  EXPECT_TRUE(contains(r.out, "node 0x22")) << r.out;
+  EXPECT_TRUE(contains(r.out, "rates [pulse/s] (pulses: not converted)")) << r.out;
+  EXPECT_TRUE(contains(r.out, "rates [deg/h]")) << r.out;
+  EXPECT_TRUE(contains(r.out, "N 0.002 pulse/sqrt(s)")) << r.out;  // as sent: no conversion
+}
+
+TEST(DecodeCli, LostFramesAndReportsAreShownNeverPaperedOver) {
+  const NodeSpec n{0x31, 5, AngleUnit::deg, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 8; ++seq) {
+    if (seq == 5) continue;  // report 5 lost entirely
+    log.report(n, seq, 10.0 + seq, 100u * (seq + 1), [&](const ReportSlot& s) {
+      return seq == 3 && s.slot == Slot::adev && s.index == 1;  // one ADEV frame lost
+    });
+  }
+  const std::string csv_path = temp("loss.csv"), jsonl_path = temp("loss.jsonl");
+  const Outcome r =
+      run(log.write("loss.log") + " --view final --rate-unit deg/s --csv " + csv_path + " --jsonl " + jsonl_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 7u * 5);
+  std::size_t missing = 0;
+  for (const auto& row : csv.rows) {
+    expect_row(csv, row, log, {{n.address, n}}, 1.0);  // deg/s from deg/s
+    EXPECT_NE(csv.get(row, "seq"), "5");
+    missing += csv.get(row, "adev_status") == "missing";
+  }
+  EXPECT_EQ(missing, 1u);
+  EXPECT_TRUE(contains(r.err, "gyrochar-decode: node 0x31: frames")) << r.err;
+  EXPECT_TRUE(contains(r.err, "reports 6 complete, 1 incomplete, 1 lost; frames missing 1;")) << r.err;
+  EXPECT_TRUE(contains(r.out, "reports 6 complete, 1 incomplete, 1 lost; frames missing 1;")) << r.out;
+  const std::vector<Json> records = read_jsonl(jsonl_path);
+  ASSERT_FALSE(records.empty());
+  const Json& health = records.back().at("nodes").at(0).at("health");
+  EXPECT_EQ(health.at("reports_lost"), 1);
+  EXPECT_EQ(health.at("frames_missing"), 1);
+}
+
+TEST(DecodeCli, MalformedLinesAndRejectedFramesAreCountedAndReportedWithExitZero) {
+  const NodeSpec n{0x40, 3, AngleUnit::arcsec, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 4; ++seq) log.report(n, seq, 20.0 + seq, 100u * (seq + 1));
+  std::string text = log.text();
+  // Line 1: garbage; after the first report's lines: a bad timestamp and a bad identifier; at the
+  // end a frame of the right identifier with 2 data bytes (rejected: wrong_length) and a line cut
+  // in the middle of its data (no newline).
+  const std::size_t first_report_lines = report_frame_count(0, n.taus);
+  std::vector<std::string> lines;
+  std::stringstream ss(text);
+  for (std::string l; std::getline(ss, l);) lines.push_back(l);
+  lines.insert(lines.begin() + static_cast<std::ptrdiff_t>(first_report_lines),
+               {"(abc) can0 18FF4140#00", "(24.5) can0 18FZ4140#0000000000000000"});
+  lines.insert(lines.begin(), "this is not a candump line");
+  lines.push_back("(24.900000) can0 18FF4140#0102");
+  std::string body;
+  for (const std::string& l : lines) body += l + "\n";
+  body += "(24.950000) can0 18FF4140#0102030";
+  const std::string path = temp("malformed.log"), csv_path = temp("malformed.csv");
+  std::ofstream(path, std::ios::binary) << body;
+
+  const Outcome r = run(path + " --view final --rate-unit native --csv " + csv_path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "gyrochar-decode: " + path + ":1: malformed line: does not start with a '(timestamp)'\n"))
+      << r.err;
+  EXPECT_TRUE(contains(r.err, path + ":" + std::to_string(first_report_lines + 2) + ": malformed line: bad timestamp"))
+      << r.err;
+  EXPECT_TRUE(contains(
+      r.err, path + ":" + std::to_string(first_report_lines + 3) + ": malformed line: identifier is not hexadecimal"))
+      << r.err;
+  EXPECT_TRUE(contains(
+      r.err, path + ":" + std::to_string(lines.size() + 1) + ": malformed line: odd number of data hex digits"))
+      << r.err;
+  EXPECT_TRUE(contains(r.err, "4 malformed line(s)")) << r.err;
+  EXPECT_TRUE(contains(r.err, "1 rejected frames")) << r.err;
+  EXPECT_TRUE(contains(r.err, "rejected 1 (wrong_length 1)")) << r.err;
+  EXPECT_TRUE(contains(r.out, "4 malformed line(s)")) << "the view shows them too:\n" << r.out;
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 4u * 3);  // every report decoded despite the bad lines
+  for (const auto& row : csv.rows) expect_row(csv, row, log, {{n.address, n}}, 1.0);
+}
+
+TEST(DecodeCli, TruncatedLogClosesItsLastReportWithTheMissingFramesShown) {
+  const NodeSpec n{0x41, 4, AngleUnit::arcsec, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 3; ++seq) log.report(n, seq, 30.0 + seq, 100u * (seq + 1));
+  const std::string text = log.text();
+  // Cut inside the ADEV frame of tau 2 of the last report: its status, faults and the ADEV and MDEV
+  // of taus 0 and 1 survive as whole lines; the cut line (an odd number of hex digits) is malformed.
+  const std::size_t frames_before = 2 * report_frame_count(0, n.taus);
+  std::size_t pos = 0;
+  for (std::size_t k = 0; k < frames_before + 6; ++k) pos = text.find('\n', pos) + 1;  // 6 whole lines of report 2
+  const std::string path = temp("truncated.log"), csv_path = temp("truncated.csv");
+  std::ofstream(path, std::ios::binary) << text.substr(0, pos + 31);  // "(32.400000) can0 18FF4141#" + 5 digits
+  const Outcome r = run(path + " --view none --rate-unit native --csv " + csv_path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "1 malformed line(s)")) << r.err;
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 3u * 4);  // the cut report is closed at the end of the log
+  // Report 2 kept status, faults, ADEV/MDEV of tau 0 and 1: taus 2, 3 are missing.
+  const std::vector<bool> want_adev{true, true, false, false};
+  for (const auto& row : csv.rows) {
+    if (csv.get(row, "seq") != "2") continue;
+    const std::size_t i = std::stoul(csv.get(row, "tau_index"));
+    EXPECT_EQ(csv.get(row, "adev_status"), want_adev[i] ? "ok" : "missing") << i;
+    EXPECT_EQ(csv.get(row, "mdev_status"), want_adev[i] ? "ok" : "missing") << i;
+  }
+}
+
+TEST(DecodeCli, BadInvocationsExitTwoWithWhatAndWhy) {
+  const auto expect_bad = [](const std::string& args, const std::string& first_line) {
+    const Outcome r = run(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind(first_line, 0), 0u) << "expected '" << first_line << "' first in: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << "no data on stdout after an error";
+  };
+  expect_bad("/nonexistent/capture.log --view none",
+             "gyrochar-decode: /nonexistent/capture.log: No such file or directory\n");
+  expect_bad("--view none", "gyrochar-decode: options: give either a LOG or --interface");
+  expect_bad("x.log --interface can0 --view none", "gyrochar-decode: options: give either a LOG or --interface");
+  expect_bad("x.log --frobnicate", "gyrochar-decode: options: ");
+  expect_bad("x.log --rate-unit furlong/s", "gyrochar-decode: --rate-unit: 'furlong/s' is not");
+  expect_bad("x.log --node 254", "gyrochar-decode: --node: '254' is not a node address");
+  expect_bad("x.log --node 0x1G", "gyrochar-decode: --node: '0x1G' is not a node address");
+  expect_bad("x.log --confidence 1.5", "gyrochar-decode: --confidence: must be in (0, 1)");
+  expect_bad("x.log --view sometimes", "gyrochar-decode: --view: 'sometimes' is not live, final or none");
+  expect_bad("x.log --plot-every 10", "gyrochar-decode: --plot-every: needs --plot PREFIX");
+  expect_bad("x.log --csv /nonexistent/dir/out.csv",
+             "gyrochar-decode: /nonexistent/dir/out.csv: No such file or directory");
+  expect_bad("x.log --plot /nonexistent/dir/plot",
+             "gyrochar-decode: /nonexistent/dir/plot.svg.part: No such file or directory");
+  const std::string garbage = temp("garbage.log");
+  std::ofstream(garbage) << "hello\nworld\n";
+  const Outcome all_bad = run(garbage + " --view none");
+  EXPECT_EQ(all_bad.code, 2);
+  EXPECT_TRUE(contains(all_bad.err, "gyrochar-decode: " + garbage + ": none of its 2 lines is a candump log line\n"))
+      << all_bad.err;
+  const Outcome help = run("--help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_TRUE(contains(help.out, "Examples:"));
+  EXPECT_TRUE(contains(help.out, "Exit codes: 0"));
+}
+
+TEST(DecodeCli, MissingInterfaceExitsThree) {
+  const Outcome r = run("--interface nosuchcan7 --view none --duration 0.1");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_EQ(r.err.rfind("gyrochar-decode: nosuchcan7: ", 0), 0u) << r.err;
+}
+
+TEST(DecodeCli, PlotFilesAreWrittenForEveryNode) {
+  LogWriter log;
+  const NodeSpec a{0x50, 6, AngleUnit::arcsec, 0.01f}, b{0x51, 6, AngleUnit::rad, 0.01f};
+  for (std::uint8_t seq = 0; seq < 5; ++seq) {
+    log.report(a, seq, 100.0 + seq, 100u * (seq + 1));
+    log.report(b, seq, 100.4 + seq, 100u * (seq + 1));
+  }
+  const std::string prefix = temp("plot");
+  std::remove((prefix + ".svg").c_str());
+  std::remove((prefix + ".png").c_str());
+  const Outcome r = run(log.write("plot.log") + " --view none --plot " + prefix + " --plot-every 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string svg = read_file(prefix + ".svg"), png = read_file(prefix + ".png");
+  EXPECT_GT(svg.size(), 1000u);
+  EXPECT_TRUE(contains(svg, "<svg"));
+  EXPECT_GT(png.size(), 1000u);
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));  // PNG signature
+  EXPECT_FALSE(std::ifstream(prefix + ".png.part").good()) << "the temporary file was renamed";
+}
+
+TEST(DecodeCli, RestartsAndSilentNodesAreDetected) {
+  const NodeSpec a{0x60, 3, AngleUnit::arcsec, 0.01f}, b{0x61, 3, AngleUnit::arcsec, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 12; ++seq) log.report(b, seq, 200.0 + seq, 100u * (seq + 1));
+  for (std::uint8_t seq = 0; seq < 3; ++seq) log.report(a, seq, 200.5 + seq, 100u * (seq + 1));
+  log.restart(a.address);  // silent for 6 s, then starts again from report 0
+  for (std::uint8_t seq = 0; seq < 3; ++seq) log.report(a, seq, 209.5 + seq, 100u * (seq + 1));
+  const std::string csv_path = temp("restart.csv"), jsonl_path = temp("restart.jsonl");
+  const Outcome r =
+      run(log.write("restart.log") + " --view none --rate-unit native --csv " + csv_path + " --jsonl " + jsonl_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "node 0x60: frames")) << r.err;
+  EXPECT_TRUE(contains(r.err, "restarts 1; offline 1;")) << r.err;
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 12u * 3 + 6u * 3);
+  for (const auto& row : csv.rows) expect_row(csv, row, log, {{a.address, a}, {b.address, b}}, 1.0);
+  std::vector<std::string> events;
+  for (const Json& j : read_jsonl(jsonl_path))
+    if (j.at("type") == "event" && j.at("node") == 0x60) events.push_back(j.at("event"));
+  EXPECT_EQ(events, (std::vector<std::string>{"online", "offline", "online", "restart"}));
+}
+
+TEST(DecodeCli, StdinNodeFilterDurationAndTimeGoingBackwards) {
+  const NodeSpec a{0x70, 3, AngleUnit::arcsec, 0.01f}, b{0x71, 3, AngleUnit::arcsec, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 8; ++seq) {
+    log.report(a, seq, 300.0 + seq, 100u * (seq + 1));
+    log.report(b, seq, 300.5 + seq, 100u * (seq + 1));
+  }
+  log.raw(301.2, "(299.000000) can1 123#00");  // out of order: counted, decoded at the latest time
+  const std::string path = log.write("stdin.log"), csv_path = temp("stdin.csv");
+  // --duration 3.45: decoding stops at the first frame at 303.45 s or later, 303.5 s (frame 6 of
+  // report 3 of node 0x70, written before the first frame of report 3 of node 0x71 at the same time).
+  const Outcome r =
+      run("--view none --node 0x71 --duration 3.45 --rate-unit native --csv " + csv_path + " - < " + path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "gyrochar-decode: stdin: ")) << r.err;
+  EXPECT_TRUE(contains(r.err, "1 timestamps backwards")) << r.err;
+  EXPECT_FALSE(contains(r.err, "node 0x70")) << "filtered out:\n" << r.err;
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 3u * 3);  // node 0x71, reports 0..2 (its report 3 starts at 303.5)
+  for (const auto& row : csv.rows) {
+    EXPECT_EQ(csv.get(row, "node"), "113");
+    expect_row(csv, row, log, {{b.address, b}}, 1.0);
+  }
+}
+
+}  // namespace
+}  // namespace gyrochar

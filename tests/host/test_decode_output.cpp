@@ -1,0 +1,239 @@
+// The pieces behind gyrochar-decode's outputs (decode_output.hpp, decode_session.hpp): units,
+// memoized confidence intervals, which values a closed report really carried, the plot's IEEE-952
+// lines and read-off points, and the line reader. Oracles: closed forms (1 rad = 180/pi deg,
+// 1 h = 3600 s; the IEEE Std 952 AVAR terms of the design brief section 3), confidence.hpp
+// (Boost.Math chi-squared, NIST SP 1065 eq. 45) and values the test encodes with the codec.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "decode_output.hpp"
+#include "decode_session.hpp"
+
+namespace gyrochar::decoding {
+namespace {
+
+using namespace protocol;
+
+constexpr double rad_to_deg = 180.0 / std::numbers::pi;
+
+NodeView node_in(AngleUnit unit) {
+  NodeView v;
+  v.address = 0x12;
+  v.scale = MetaScaleMsg{0, 1.0f, unit, InputSource::simulated};
+  return v;
+}
+
+void expect_rel(double got, double want, double rel = 1e-15) { EXPECT_NEAR(got, want, rel * std::abs(want)); }
+
+TEST(DecodeOutput, UnitsConvertAnglesButNeverPulses) {
+  // 1 arcsec/s = (1/3600) deg/s = 3600/3600 deg/h.
+  Units u = units_for(node_in(AngleUnit::arcsec), RateUnit::deg_per_h);
+  EXPECT_EQ(u.rate_name, "deg/h");
+  expect_rel(u.rate, 1.0);
+  u = units_for(node_in(AngleUnit::rad), RateUnit::deg_per_h);
+  expect_rel(u.rate, rad_to_deg * 3600.0);
+  // IEEE-952 terms from rad and s: Q arcsec, N deg/sqrt(h) = 60 deg/sqrt(s), B deg/h,
+  // K deg/h/sqrt(h) = 3600^1.5 deg/s^1.5, R deg/h/h = 3600^2 deg/s^2.
+  const std::array<double, 5> gyro{rad_to_deg * 3600.0, rad_to_deg * 60.0, rad_to_deg * 3600.0,
+                                   rad_to_deg * std::pow(3600.0, 1.5), rad_to_deg * 3600.0 * 3600.0};
+  const std::array<const char*, 5> names{"arcsec", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h/h"};
+  for (std::size_t k = 0; k < 5; ++k) {
+    expect_rel(u.ieee[k], gyro[k]);
+    EXPECT_EQ(u.ieee_name[k], names[k]);
+  }
+  u = units_for(node_in(AngleUnit::rad), RateUnit::deg_per_s);
+  EXPECT_EQ(u.rate_name, "deg/s");
+  expect_rel(u.rate, rad_to_deg);
+  u = units_for(node_in(AngleUnit::urad), RateUnit::rad_per_s);
+  EXPECT_EQ(u.rate_name, "rad/s");
+  expect_rel(u.rate, 1e-6);
+  u = units_for(node_in(AngleUnit::deg), RateUnit::native);
+  EXPECT_EQ(u.rate_name, "deg/s");
+  EXPECT_EQ(u.rate, 1.0);
+  EXPECT_EQ(u.ieee_name[1], "deg/sqrt(s)");
+
+  u = units_for(node_in(AngleUnit::pulse), RateUnit::deg_per_h);
+  EXPECT_TRUE(u.pulses);
+  EXPECT_EQ(u.rate_name, "pulse/s");
+  EXPECT_EQ(u.rate, 1.0);
+  for (std::size_t k = 0; k < 5; ++k) EXPECT_EQ(u.ieee[k], 1.0);
+  EXPECT_EQ(u.ieee_name[3], "pulse/s/sqrt(s)");
+
+  u = units_for(NodeView{}, RateUnit::deg_per_h);  // no metadata yet: shown as sent, unit unknown
+  EXPECT_FALSE(u.known);
+  EXPECT_EQ(u.rate_name, "unknown");
+  EXPECT_EQ(u.rate, 1.0);
+}
+
+TEST(DecodeOutput, MemoizedConfidenceIntervalsEqualTheDirectOnes) {
+  for (const double confidence : {0.683, 0.95}) {
+    ConfidenceIntervals intervals(confidence);
+    for (const double edf : {0.5, 3.0, 17.4, 1e6}) {
+      for (const double dev : {1e-6, 2.5, 3e4}) {
+        for (int pass = 0; pass < 2; ++pass) {  // computed, then looked up
+          const Interval got = intervals(dev, edf), want = confidence_interval(dev, edf, confidence);
+          ASSERT_TRUE(got.valid);
+          expect_rel(got.low, want.low, 1e-14);
+          expect_rel(got.high, want.high, 1e-14);
+          EXPECT_LT(got.low, dev);
+          EXPECT_GT(got.high, dev);
+        }
+      }
+    }
+    EXPECT_FALSE(intervals(1.0, 0.0).valid);  // EDF not available
+    EXPECT_FALSE(intervals(1.0, std::nan("")).valid);
+  }
+}
+
+CanFrame frame_of(const Message& m, std::uint8_t node) {
+  CanFrame f;
+  EXPECT_EQ(encode(m, node, f), ProtocolError::none);
+  return f;
+}
+
+TEST(DecodeOutput, TrackerAndRowsTellMissingFromInvalidFromOk) {
+  ReportTracker tracker;
+  tracker.note(frame_of(StatusMsg{5, NodeState::running, 3, 500}, 0x12), 10.0);
+  tracker.note(frame_of(TauDevMsg{5, 0, DevKind::adev, 2.0f, 16.0, NoiseType::white_fm, true}, 0x12), 10.1);
+  tracker.note(frame_of(TauDevMsg{5, 0, DevKind::mdev, 1.0f, 8.0, NoiseType::white_fm, true}, 0x12), 10.2);
+  tracker.note(frame_of(TauDevMsg{5, 1, DevKind::adev, 0.0f, 0.0, NoiseType::not_identified, false}, 0x12), 10.3);
+  tracker.note(frame_of(TauDevMsg{9, 2, DevKind::adev, 1.0f, 4.0, NoiseType::white_fm, true}, 0x13),
+               10.4);  // other node
+  const ReportTracker::Report& r = tracker.report(0x12);
+  EXPECT_TRUE(r.open);
+  EXPECT_EQ(r.seq, 5);
+  EXPECT_EQ(r.start_s, 10.0);
+  EXPECT_TRUE(r.adev[0] && r.mdev[0] && r.adev[1]);
+  EXPECT_FALSE(r.mdev[1] || r.adev[2] || r.mdev[2]);
+
+  // The view holds stale values for tau 2 (from an earlier report): the row must not show them.
+  NodeView v = node_in(AngleUnit::arcsec);
+  v.status = {5, NodeState::running, 3, 500};
+  v.sampling = MetaSamplingMsg{5, 0.5f, 8};
+  v.session = 2;
+  v.taus[0] = {1, 0, 77, {true, 2.0f, 16.0, NoiseType::white_fm, true}, {true, 1.0f, 8.0, NoiseType::white_fm, true}};
+  v.taus[1] = {2, 0, 0, {true, 0.0f, 0.0, NoiseType::not_identified, false}, {}};
+  v.taus[2] = {4, 0, 99, {true, 9.0f, 4.0, NoiseType::white_fm, true}, {true, 9.0f, 4.0, NoiseType::white_fm, true}};
+  ConfidenceIntervals intervals(0.683);
+  std::vector<TauRow> rows;
+  tau_rows(v, r, units_for(v, RateUnit::native), intervals, rows);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].adev.status, DevCell::Status::ok);
+  EXPECT_EQ(rows[0].adev.value, 2.0);
+  EXPECT_EQ(rows[0].m, 1u);
+  EXPECT_EQ(rows[0].n, 77u);
+  EXPECT_EQ(rows[0].tau_s, 0.5);
+  EXPECT_EQ(rows[0].session, 2u);
+  EXPECT_EQ(rows[0].seq, 5);
+  expect_rel(rows[0].mdev.ci.low, confidence_interval(1.0, 8.0, 0.683).low, 1e-14);
+  EXPECT_EQ(rows[1].adev.status, DevCell::Status::invalid);
+  EXPECT_EQ(rows[1].mdev.status, DevCell::Status::missing);
+  EXPECT_EQ(rows[2].adev.status, DevCell::Status::missing);
+  EXPECT_EQ(rows[2].mdev.status, DevCell::Status::missing);
+  EXPECT_FALSE(rows[2].adev.ci.valid);
+
+  tracker.close(0x12);
+  tracker.note(frame_of(StatusFaultsMsg{5, 0, 0, 0, 0}, 0x12), 11.0);  // same seq after a close: a new report
+  EXPECT_EQ(tracker.report(0x12).start_s, 11.0);
+  EXPECT_FALSE(tracker.report(0x12).adev[0]);
+}
+
+TEST(DecodeOutput, PlotDrawsEachIeeeTermAsItsOwnLineAndReadsItOff) {
+  // Parameters in arcsec and s; the rate unit deg/h is numerically arcsec/s, so every closed form
+  // below is in the wire's numbers.
+  const std::array<float, 5> qnbkr{2.0f, 0.1f, 0.01f, 0.001f, 1e-5f};
+  NodeView v = node_in(AngleUnit::arcsec);
+  v.status.tau_count = 10;
+  v.sampling = MetaSamplingMsg{0, 0.125f, 8};
+  for (std::size_t i = 0; i < 10; ++i) {
+    v.taus[i].m = std::uint64_t{1} << i;  // tau 0.125 .. 64 s
+    v.taus[i].adev = {true, 1.0f / static_cast<float>(i + 1), 50.0, NoiseType::white_fm, i != 4};
+    v.taus[i].mdev = {true, 0.5f / static_cast<float>(i + 1), 0.0, NoiseType::white_fm, true};
+  }
+  for (std::size_t k = 0; k < 5; ++k) v.ieee952[k] = {true, true, qnbkr[k], 0.1};
+  ConfidenceIntervals intervals(0.683);
+  const NodePlot p = plot_data(v, RateUnit::deg_per_h, intervals);
+
+  EXPECT_EQ(p.rate_name, "deg/h");
+  ASSERT_EQ(p.adev.size(), 9u);  // tau 4 is not valid
+  ASSERT_EQ(p.mdev.size(), 10u);
+  EXPECT_TRUE(p.adev[0].ci.valid);
+  EXPECT_FALSE(p.mdev[0].ci.valid);  // no EDF, no error bar
+  EXPECT_DOUBLE_EQ(p.tau_min_s, 0.125 / 2);
+  EXPECT_DOUBLE_EQ(p.tau_max_s, 64.0 * 2);
+
+  const double q = qnbkr[0], n = qnbkr[1], b = qnbkr[2], k = qnbkr[3], r = qnbkr[4];
+  const double b_floor = std::sqrt(2.0 * std::log(2.0) / std::numbers::pi);  // 0.6643
+  ASSERT_EQ(p.terms.size(), 6u);                                             // Q N B K R and their sum
+  for (std::size_t j = 0; j < p.terms[0].tau_s.size(); ++j) {
+    const double t = p.terms[0].tau_s[j];
+    const std::array<double, 5> want{std::sqrt(3.0) * q / t, n / std::sqrt(t), b_floor * b, k * std::sqrt(t / 3.0),
+                                     r * t / std::sqrt(2.0)};
+    double sum2 = 0;
+    for (std::size_t term = 0; term < 5; ++term) {
+      expect_rel(p.terms[term].dev[j], want[term], 1e-12);
+      sum2 += want[term] * want[term];
+    }
+    expect_rel(p.terms[5].dev[j], std::sqrt(sum2), 1e-12);
+  }
+  EXPECT_EQ(p.terms[1].label, "N 0.00167 deg/sqrt(h) (±10%)");  // 0.1 arcsec/sqrt(s) = 0.1 x 60 / 3600 deg/sqrt(h)
+  EXPECT_EQ(p.terms[5].label, "IEEE-952 model (sum)");
+
+  ASSERT_EQ(p.read_offs.size(), 5u);
+  const auto read = [&](const std::string& label) {
+    for (const ReadOffPoint& x : p.read_offs)
+      if (x.label == label) return x;
+    ADD_FAILURE() << "no read-off " << label;
+    return ReadOffPoint{};
+  };
+  // Where each term's ADEV equals its parameter.
+  EXPECT_DOUBLE_EQ(read("Q at sqrt(3) s").tau_s, std::sqrt(3.0));
+  expect_rel(read("Q at sqrt(3) s").dev, q, 1e-12);
+  EXPECT_EQ(read("N at 1 s").tau_s, 1.0);
+  expect_rel(read("N at 1 s").dev, n, 1e-12);
+  EXPECT_EQ(read("K at 3 s").tau_s, 3.0);
+  expect_rel(read("K at 3 s").dev, k, 1e-12);
+  EXPECT_DOUBLE_EQ(read("R at sqrt(2) s").tau_s, std::sqrt(2.0));
+  expect_rel(read("R at sqrt(2) s").dev, r, 1e-12);
+  const ReadOffPoint floor = read("0.664 B");
+  expect_rel(floor.dev, b_floor * b, 1e-12);
+  const double model_at_floor = p.terms[5].dev[static_cast<std::size_t>(
+      std::find(p.terms[5].tau_s.begin(), p.terms[5].tau_s.end(), floor.tau_s) - p.terms[5].tau_s.begin())];
+  for (std::size_t j = 0; j < p.terms[5].tau_s.size(); ++j) {  // at the model's minimum within the points
+    if (p.terms[5].tau_s[j] >= 0.125 && p.terms[5].tau_s[j] <= 64.0) {
+      EXPECT_GE(p.terms[5].dev[j], model_at_floor);
+    }
+  }
+
+  v.ieee952[1].resolved = false;  // N not resolved: no line, no read-off
+  v.ieee952[3].received = false;  // K never received
+  const NodePlot fewer = plot_data(v, RateUnit::deg_per_h, intervals);
+  EXPECT_EQ(fewer.terms.size(), 4u);  // Q B R and the sum
+  EXPECT_EQ(fewer.read_offs.size(), 3u);
+}
+
+TEST(DecodeOutput, LineReaderGivesWholeLinesWhateverTheReads) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const std::string text = "a\r\nbb\n\n0123456789abcdefXY\nlast";
+  ASSERT_EQ(write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  close(fds[1]);
+  LineReader reader(fds[0], 8);  // lines longer than 8 bytes come in pieces
+  std::vector<std::string> lines;
+  std::string_view line;
+  for (LineReader::Result r; (r = reader.next(line)) != LineReader::Result::end;) {
+    ASSERT_NE(r, LineReader::Result::error);
+    if (r == LineReader::Result::line) lines.emplace_back(line);
+  }
+  close(fds[0]);
+  const std::vector<std::string> want{"a", "bb", "", "01234567", "89abcdef", "XY", "last"};
+  EXPECT_EQ(lines, want);
+}
+
+}  // namespace
+}  // namespace gyrochar::decoding

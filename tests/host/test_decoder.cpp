@@ -1,0 +1,160 @@
+// The decoder against the loss, restart and offline rules of docs/protocol.md section 5.
+// Oracle: frames made by the codec from known values, then dropped, reordered or repeated on
+// purpose; the expected counts follow from what the test removed.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "decoder.hpp"
+
+namespace gyrochar {
+namespace {
+
+using namespace protocol;
+
+// The frames of report `seq` of a node with `taus` taus, values derived from (seq, tau).
+std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t taus, std::uint64_t samples,
+                             std::uint64_t uptime_ms = 0, std::uint32_t hash = 7) {
+  std::vector<CanFrame> frames;
+  for (std::size_t k = 0; k < report_frame_count(seq, taus); ++k) {
+    const ReportSlot s = report_slot(seq, taus, k);
+    Message m;
+    switch (s.slot) {
+      case Slot::status: m = StatusMsg{seq, NodeState::running, taus, samples}; break;
+      case Slot::faults: m = StatusFaultsMsg{seq, 1, 2, 3, 0}; break;
+      case Slot::adev: m = TauDevMsg{seq, s.index, DevKind::adev, 1.0f / (1 + s.index), 100.0, NoiseType::white_fm, true}; break;
+      case Slot::mdev: m = TauDevMsg{seq, s.index, DevKind::mdev, 0.5f / (1 + s.index), 90.0, NoiseType::white_fm, true}; break;
+      case Slot::terms: m = TauTermsMsg{seq, s.index, samples - 2}; break;
+      case Slot::tau_info: m = TauInfoMsg{seq, s.index, std::uint64_t{1} << s.index, 0}; break;
+      case Slot::sampling: m = MetaSamplingMsg{seq, 0.01f, 8}; break;
+      case Slot::clock: m = MetaClockMsg{seq, uptime_ms ? uptime_ms : samples * 10, version}; break;
+      case Slot::scale: m = MetaScaleMsg{seq, 1.5f, AngleUnit::arcsec, InputSource::simulated}; break;
+      case Slot::config: m = MetaConfigMsg{seq, hash, 1000}; break;
+      case Slot::ieee952: m = Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.25f, 0.1}; break;
+    }
+    CanFrame f;
+    EXPECT_EQ(encode(m, node, f), ProtocolError::none);
+    frames.push_back(f);
+  }
+  return frames;
+}
+
+struct Feed {
+  Decoder decoder;
+  double t = 0;
+  void frames(const std::vector<CanFrame>& fs) {
+    for (const auto& f : fs) decoder.feed(f, t += 0.01);
+  }
+  const NodeView& node(std::uint8_t a) { return decoder.nodes().at(a); }
+};
+
+TEST(Decoder, CompleteReportsCarryEveryValue) {
+  Feed feed;
+  for (std::uint8_t s = 0; s < 6; ++s) feed.frames(report(5, s, 8, 1000 + s * 100));
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.reports_complete, 6u);
+  EXPECT_EQ(v.health.frames_missing, 0u);
+  EXPECT_EQ(v.health.reports_lost, 0u);
+  ASSERT_TRUE(v.sampling.has_value());
+  EXPECT_FLOAT_EQ(v.sampling->tau0_s, 0.01f);
+  EXPECT_EQ(v.taus[3].m, 8u);
+  EXPECT_DOUBLE_EQ(v.tau_s(3), static_cast<double>(0.01f) * 8);
+  EXPECT_FLOAT_EQ(v.taus[3].adev.dev, 0.25f);
+  EXPECT_TRUE(v.ieee952[2].resolved);
+}
+
+TEST(Decoder, MissingFramesAndLostReportsAreCounted) {
+  Feed feed;
+  auto r0 = report(5, 0, 8, 1000);
+  r0.erase(r0.begin() + 4);  // one ADEV/MDEV frame lost
+  r0.erase(r0.begin() + 9);
+  feed.frames(r0);
+  feed.frames(report(5, 1, 8, 1100));
+  feed.frames(report(5, 4, 8, 1400));  // reports 2 and 3 never seen
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.frames_missing, 2u);
+  EXPECT_EQ(v.health.reports_incomplete, 1u);
+  EXPECT_EQ(v.health.reports_complete, 2u);
+  EXPECT_EQ(v.health.reports_lost, 2u);
+  EXPECT_EQ(v.health.restarts, 0u);
+}
+
+TEST(Decoder, RestartWhenSeqOrSampleCountGoesBack) {
+  Feed feed;
+  feed.frames(report(9, 40, 4, 5000));
+  feed.frames(report(9, 41, 4, 5100));
+  feed.frames(report(9, 0, 4, 10));  // Seq backwards and SampleCount backwards
+  feed.decoder.flush();
+  const NodeView& v = feed.node(9);
+  EXPECT_EQ(v.health.restarts, 1u);
+  EXPECT_EQ(v.session, 1u);
+  EXPECT_EQ(v.status.sample_count, 10u);
+  EXPECT_EQ(v.health.reports_lost, 0u);  // a restart is not a loss
+}
+
+TEST(Decoder, SeqWrapIsNotARestart) {
+  Feed feed;
+  feed.frames(report(9, 254, 4, 5000));
+  feed.frames(report(9, 255, 4, 5100));
+  feed.frames(report(9, 0, 4, 5200));
+  feed.decoder.flush();
+  EXPECT_EQ(feed.node(9).health.restarts, 0u);
+  EXPECT_EQ(feed.node(9).health.reports_complete, 3u);
+}
+
+TEST(Decoder, SilenceMakesANodeOfflineThenOnline) {
+  std::vector<DecoderEvent> events;
+  Decoder decoder([&](DecoderEvent e, const NodeView&, std::uint8_t) { events.push_back(e); });
+  for (const auto& f : report(3, 0, 2, 100)) decoder.feed(f, 1.0);
+  decoder.tick(3.9);
+  EXPECT_TRUE(decoder.nodes().at(3).online);
+  decoder.tick(4.1);  // 3 s after the last frame
+  EXPECT_FALSE(decoder.nodes().at(3).online);
+  EXPECT_EQ(decoder.nodes().at(3).health.offline_events, 1u);
+  for (const auto& f : report(3, 1, 2, 200)) decoder.feed(f, 10.0);
+  EXPECT_TRUE(decoder.nodes().at(3).online);
+  EXPECT_NE(std::find(events.begin(), events.end(), DecoderEvent::offline), events.end());
+}
+
+TEST(Decoder, SeveralNodesAreKeptApart) {
+  Feed feed;
+  auto a = report(1, 0, 4, 100), b = report(2, 7, 6, 900);
+  std::vector<CanFrame> mixed;
+  for (std::size_t i = 0; i < std::max(a.size(), b.size()); ++i) {
+    if (i < a.size()) mixed.push_back(a[i]);
+    if (i < b.size()) mixed.push_back(b[i]);
+  }
+  feed.frames(mixed);
+  feed.decoder.flush();
+  EXPECT_EQ(feed.node(1).health.reports_complete, 1u);
+  EXPECT_EQ(feed.node(2).health.reports_complete, 1u);
+  EXPECT_EQ(feed.node(1).status.tau_count, 4);
+  EXPECT_EQ(feed.node(2).status.tau_count, 6);
+}
+
+TEST(Decoder, BadFramesAreCountedNeverFatal) {
+  Feed feed;
+  auto r = report(5, 0, 4, 100);
+  CanFrame bad = r[2];
+  bad.len = 5;  // wrong length
+  CanFrame reserved = r[0];
+  reserved.data[0] |= 0xF0;  // reserved bits of the heartbeat
+  CanFrame other;
+  other.id = 0x123;  // unrelated 11-bit traffic
+  other.len = 2;
+  feed.frames({bad, reserved, other});
+  feed.frames(r);
+  feed.frames({r[3]});  // a duplicate slot
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(feed.decoder.rejected_frames(), 2u);
+  EXPECT_EQ(v.health.rejected.at(ProtocolError::wrong_length), 1u);
+  EXPECT_EQ(v.health.rejected.at(ProtocolError::reserved_bits), 1u);
+  EXPECT_EQ(feed.decoder.other_frames(), 1u);
+  EXPECT_EQ(v.health.duplicates, 1u);
+}
+
+}  // namespace
+}  // namespace gyrochar

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# One entry point for people and CI: installs what is missing (Debian packages, only when
+# missing), configures, builds, then runs the chosen job.
+#   toolchain/build.sh demo   build and run the main job on embedded defaults
+#   toolchain/build.sh test   build and run the whole test suite (what CI runs)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+job=${1:-}
+case "$job" in
+  demo|test) ;;
+  *) echo "usage: toolchain/build.sh demo|test" >&2; exit 2 ;;
+esac
+
+# Debian packages: the host build, then what only the tests need (cross compilers for the
+# microcontroller build of the core).
+packages=(
+  g++ cmake ninja-build pkg-config
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libboost-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libplplot-dev plplot-driver-cairo
+)
+if [ "$job" = test ]; then
+  # The board (aarch64, tests under qemu-aarch64-static) needs Debian's arm64 multiarch packages.
+  if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+    sudo_cmd=(); [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+    "${sudo_cmd[@]}" dpkg --add-architecture arm64
+  fi
+  packages+=(g++-aarch64-linux-gnu qemu-user-static libgtest-dev:arm64)
+  packages+=(gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi
+             python3-canmatrix python3-can clang libclang-rt-14-dev)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "build.sh: installing missing Debian packages: ${missing[*]}" >&2
+  sudo_cmd=(); [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+cmake --preset host >/dev/null
+cmake --build --preset host -j "$(nproc)"
+
+case "$job" in
+  demo)
+    # The main job: the live system as a host simulation on a virtual clock. Two simulated ring
+    # laser gyros (1 arcsec pulses at 100 Hz) feed the board's estimator, their reports cross an
+    # in-process CAN bus that loses 1 frame in 2000, and the decoder shows what arrives.
+    mkdir -p build/demo
+    build/host/host_tools/gyrochar-demo --hours 6 --nodes 2 --loss 0.0005 --view-every 60 \
+      --csv build/demo/decoded.csv
+    ;;
+  test)
+    # Every configuration is built once; the host suite runs last so that its summary closes the log.
+    for mcu in cortex-m4 cortex-m7; do
+      echo "build.sh: freestanding core for $mcu (text/data/bss of the MCU example):" >&2
+      cmake --preset "$mcu" >/dev/null
+      cmake --build --preset "$mcu" >/dev/null
+      arm-none-eabi-size "build/$mcu/firmware/mcu/gyrochar-mcu-example" >&2
+    done
+    echo "build.sh: fuzz targets, smoke run" >&2
+    cmake --preset fuzz >/dev/null
+    cmake --build --preset fuzz -j "$(nproc)"
+    tests/fuzz/run.sh 10
+    echo "build.sh: the board build (aarch64): tests under qemu-aarch64-static, install into a staging root" >&2
+    cmake --preset aarch64 >/dev/null
+    cmake --build --preset aarch64 -j "$(nproc)"
+    ctest --preset aarch64 -j "$(nproc)"
+    DESTDIR="$PWD/build/aarch64/staging" cmake --install build/aarch64 >/dev/null
+    find build/aarch64/staging -type f | sed 's|^build/aarch64/staging|build.sh: staged |' >&2
+    echo "build.sh: the test suite under AddressSanitizer and UndefinedBehaviorSanitizer" >&2
+    cmake --preset sanitize >/dev/null
+    cmake --build --preset sanitize -j "$(nproc)"
+    ctest --preset sanitize -j "$(nproc)"
+    echo "build.sh: the host test suite" >&2
+    ctest --preset host -j "$(nproc)"
+    ;;
+esac
