@@ -24,12 +24,11 @@ ParseResult parse_config(int argc, const char* const* argv) {
   app.set_version_flag("--version", "gyrochard 0.1.0");
   std::map<std::string, SourceKind> sources{{"quadrature", SourceKind::quadrature},
                                             {"strobe", SourceKind::strobe},
-                                            {"can-counter", SourceKind::can_counter},
-                                            {"sim", SourceKind::sim}};
+                                            {"can-counter", SourceKind::can_counter}};
   unsigned node = c.node;
   app.add_option("--node", node, "node address, 0..253 (low byte of the CAN identifiers)")->capture_default_str();
   app.add_option("--can-interface", c.can_interface, "SocketCAN interface for reports")->capture_default_str();
-  app.add_option("--source", c.source, "count source: quadrature, strobe, can-counter, sim")
+  app.add_option("--source", c.source, "count source: quadrature, strobe, can-counter")
       ->transform(CLI::CheckedTransformer(sources, CLI::ignore_case));
   app.add_option("--gpio-chip", c.gpio_chip, "GPIO chip (quadrature, strobe)")->capture_default_str();
   app.add_option("--line-a", c.line_a, "quadrature channel A line offset")->capture_default_str();

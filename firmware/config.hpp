@@ -9,12 +9,12 @@
 
 namespace gyrochar::firmware {
 
-enum class SourceKind { quadrature, strobe, can_counter, sim };
+enum class SourceKind { quadrature, strobe, can_counter };
 
 struct Config {
   // CAN output
   std::uint8_t node = 0x01;             // node address: low byte of every 29-bit identifier
-  std::string can_interface = "can0";   // SocketCAN interface ("sim" uses the in-process bus)
+  std::string can_interface = "can0";   // SocketCAN interface
   // Count source
   SourceKind source = SourceKind::quadrature;
   std::string gpio_chip = "gpiochip0";  // quadrature and strobe sources

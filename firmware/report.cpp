@@ -1,6 +1,9 @@
 #include "report.hpp"
 
 #include <cmath>
+#include <cstring>
+
+#include "gyrochar/crc32.hpp"
 
 #include "gyrochar/edf.hpp"
 #include "gyrochar/ieee952.hpp"
@@ -19,6 +22,50 @@ bool Estimator::configure(const EstimatorSettings& s) {
   samples_ = 0;
   first_ = true;
   return true;
+}
+
+namespace {
+struct EstimatorTail {  // what the estimator adds to the pyramid's checkpoint
+  std::int64_t x = 0;
+  std::uint64_t samples = 0;
+};
+}  // namespace
+
+std::size_t Estimator::checkpoint_size() const {
+  return pyramid_.checkpoint_size() + sizeof(EstimatorTail) + sizeof decimation_ + sizeof(std::uint32_t);
+}
+
+std::size_t Estimator::save(std::span<std::byte> out) const {
+  if (out.size() < checkpoint_size()) return 0;
+  std::size_t k = pyramid_.save(out);
+  const EstimatorTail tail{x_, samples_};
+  std::memcpy(out.data() + k, &tail, sizeof tail);
+  k += sizeof tail;
+  std::memcpy(out.data() + k, &decimation_, sizeof decimation_);
+  k += sizeof decimation_;
+  const std::uint32_t crc = crc32(out.first(k));
+  std::memcpy(out.data() + k, &crc, sizeof crc);
+  return k + sizeof crc;
+}
+
+RestoreStatus Estimator::restore(std::span<const std::byte> in) {
+  const std::size_t size = checkpoint_size();
+  std::uint32_t magic = 0;
+  if (in.size() >= sizeof magic) std::memcpy(&magic, in.data(), sizeof magic);
+  if (in.size() >= sizeof magic && magic != pyramid_.checkpoint_magic) return RestoreStatus::not_a_checkpoint;
+  if (in.size() < size) return RestoreStatus::truncated;
+  std::uint32_t crc = 0;
+  std::memcpy(&crc, in.data() + size - sizeof crc, sizeof crc);
+  if (crc != crc32(in.first(size - sizeof crc))) return RestoreStatus::corrupted;
+  const RestoreStatus s = pyramid_.restore(in.first(pyramid_.checkpoint_size()));
+  if (s != RestoreStatus::ok) return s;
+  EstimatorTail tail;
+  std::memcpy(&tail, in.data() + pyramid_.checkpoint_size(), sizeof tail);
+  std::memcpy(&decimation_, in.data() + pyramid_.checkpoint_size() + sizeof tail, sizeof decimation_);
+  x_ = tail.x;
+  samples_ = tail.samples;
+  mark_gap();
+  return RestoreStatus::ok;
 }
 
 void Estimator::decimate(std::int64_t x) {

@@ -5,7 +5,9 @@
 // fixed (40 octave taus, stride factor up to 64); the firmware's event loop and the host
 // simulation share this code.
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "gyrochar/noise_id.hpp"
 #include "gyrochar/protocol.hpp"
@@ -58,6 +60,12 @@ class Estimator {
   /// Fills `out` for report `seq` from the current state. O(taus), no allocation.
   void report(std::uint8_t seq, std::uint64_t uptime_ms, const FaultCounters& faults, ReportContent& out) const;
   std::uint64_t samples() const { return samples_; }
+
+  // Checkpoints: the pyramid's (versioned, CRC-checked) followed by the estimator's own state and a
+  // second CRC. Restoring is a restart: a gap, then accumulation goes on. No allocation.
+  std::size_t checkpoint_size() const;
+  std::size_t save(std::span<std::byte> out) const;
+  RestoreStatus restore(std::span<const std::byte> in);
   const Pyramid<CountArith>& pyramid() const { return pyramid_; }
 
  private:

@@ -18,6 +18,7 @@ packages=(
   g++ cmake ninja-build pkg-config
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libplplot-dev plplot-driver-cairo
+  libgpiod-dev
 )
 if [ "$job" = test ]; then
   # The board (aarch64, tests under qemu-aarch64-static) needs Debian's arm64 multiarch packages.
@@ -25,7 +26,7 @@ if [ "$job" = test ]; then
     sudo_cmd=(); [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
     "${sudo_cmd[@]}" dpkg --add-architecture arm64
   fi
-  packages+=(g++-aarch64-linux-gnu qemu-user-static libgtest-dev:arm64)
+  packages+=(g++-aarch64-linux-gnu qemu-user-static libgtest-dev:arm64 libgpiod-dev:arm64)
   packages+=(gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi
              python3-canmatrix python3-can clang libclang-rt-14-dev)
 fi

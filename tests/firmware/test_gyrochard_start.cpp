@@ -1,5 +1,5 @@
 // gyrochard's start-up as an operator meets it: invalid configuration names the key and exits 2
-// with nothing started; a missing CAN interface exits 3. Oracle: the exit codes in --help.
+// with nothing started; a missing CAN interface or GPIO chip exits 3 and names it. Oracle: the exit codes in --help.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -46,9 +46,10 @@ TEST(GyrochardStart, InvalidConfigurationNamesTheKey) {
   expect("--config " + conf, 2, "tau0");
 }
 
-TEST(GyrochardStart, MissingInterfaceAndUnbuiltSources) {
+TEST(GyrochardStart, MissingHardwareIsNamed) {
   expect("--source can-counter --can-interface nosuchcan9", 3, "can-interface");
-  expect("--source quadrature", 2, "source");
+  expect("--source quadrature --gpio-chip nosuchchip9", 3, "source");
+  expect("--source strobe --gpio-chip nosuchchip9 --counter-path /nonexistent", 3, "source");
   EXPECT_EQ(run("--help").code, 0);
 }
 

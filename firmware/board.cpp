@@ -1,0 +1,218 @@
+#include "board.hpp"
+
+#include <sys/epoll.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#include "gyrochar/crc32.hpp"
+
+namespace gyrochar::firmware {
+namespace {
+
+// Logs for journald: a priority prefix (<3> error, <4> warning, <6> info, <7> debug). printf-style
+// so that logging in the loop allocates nothing.
+#define BOARD_LOG(level, ...)                  \
+  do {                                         \
+    std::fprintf(stderr, "<" level ">gyrochard: " __VA_ARGS__); \
+    std::fputc('\n', stderr);                  \
+  } while (0)
+
+protocol::InputSource input_source(SourceKind s) {
+  switch (s) {
+    case SourceKind::quadrature: return protocol::InputSource::gpio_quadrature;
+    case SourceKind::strobe: return protocol::InputSource::strobe_counter;
+    case SourceKind::can_counter: return protocol::InputSource::can_counter;
+  }
+  return protocol::InputSource::unknown;
+}
+
+// What a checkpoint must match: everything that shapes the accumulator's state.
+std::uint32_t hash_settings(const EstimatorSettings& s) {
+  char text[160];
+  const int n = std::snprintf(text, sizeof text, "tau0=%.17g pulse=%.17g S=%u octaves=%u source=%u", s.tau0_s,
+                              s.pulse_weight_arcsec, s.stride_factor, s.octaves, static_cast<unsigned>(s.source));
+  return crc32(std::as_bytes(std::span(text, static_cast<std::size_t>(n))));
+}
+
+// The checkpoint file: this header, then the estimator's checkpoint.
+struct FileHeader {
+  std::uint32_t magic = 0x44525947;  // "GYRD"
+  std::uint16_t version = 1;
+  std::uint16_t reserved = 0;
+  std::uint32_t config_hash = 0;
+  std::uint32_t payload_bytes = 0;
+};
+
+const char* restore_reason(RestoreStatus s) {
+  switch (s) {
+    case RestoreStatus::ok: return "ok";
+    case RestoreStatus::truncated: return "truncated";
+    case RestoreStatus::not_a_checkpoint: return "not a gyrochar checkpoint";
+    case RestoreStatus::wrong_version: return "written by another checkpoint format version";
+    case RestoreStatus::corrupted: return "CRC mismatch (corrupted)";
+    case RestoreStatus::config_mismatch: return "written under another estimator configuration";
+  }
+  return "invalid";
+}
+
+}  // namespace
+
+Board::Board(const Config& config, BoardIo io)
+    : config_(config), io_(io), can_counter_(static_cast<std::uint8_t>(config.counter_node)),
+      checkpoint_file_(config.checkpoint_path) {
+  settings_.tau0_s = config.tau0_s;
+  settings_.pulse_weight_arcsec = config.pulse_weight_arcsec;
+  settings_.stride_factor = config.stride_factor;
+  settings_.octaves = config.octaves;
+  settings_.source = input_source(config.source);
+  settings_.report_period_ms = static_cast<std::uint16_t>(config.report_period_s * 1000.0);
+  settings_.config_hash = hash_settings(settings_);
+  if (!estimator_.configure(settings_)) throw std::invalid_argument("estimator settings out of range");
+  checkpoint_buffer_.resize(sizeof(FileHeader) + estimator_.checkpoint_size());
+  checkpoint_period_ns_ = static_cast<std::uint64_t>(config.checkpoint_period_s * 1e9);
+  start_ns_ = io.clock.now_ns();
+  next_checkpoint_ns_ = start_ns_ + checkpoint_period_ns_;
+  frames_ = protocol::report_frame_count(0, config.octaves);
+
+  epoll_ = epoll_create1(EPOLL_CLOEXEC);
+  for (const int fd : {io.can.fd(), io.timer.fd(), io.source ? io.source->fd() : -1, io.stop_fd}) {
+    if (fd < 0) continue;
+    epoll_event ev{};
+    ev.events = EPOLLIN;
+    ev.data.fd = fd;
+    epoll_ctl(epoll_, EPOLL_CTL_ADD, fd, &ev);
+  }
+  // Pacing: one tick per frame, the frames of a report spread over the report period.
+  io.timer.start(static_cast<std::uint64_t>(config.report_period_s * 1e9 / static_cast<double>(frames_)));
+}
+
+Board::~Board() { close(epoll_); }
+
+std::string Board::resume() {
+  if (config_.checkpoint_path.empty()) return "no checkpoint file configured";
+  const long n = checkpoint_file_.read(checkpoint_buffer_);
+  if (n == -ENOENT) return "no checkpoint at " + checkpoint_file_.path() + ": starting fresh";
+  std::string why;
+  FileHeader h;
+  if (n < 0) {
+    why = n == -EFBIG ? "larger than any checkpoint of this configuration" : std::strerror(static_cast<int>(-n));
+  } else if (static_cast<std::size_t>(n) < sizeof h) {
+    why = "truncated";
+  } else {
+    std::memcpy(&h, checkpoint_buffer_.data(), sizeof h);
+    const auto payload = std::span<const std::byte>(checkpoint_buffer_).subspan(sizeof h, static_cast<std::size_t>(n) - sizeof h);
+    if (h.magic != FileHeader{}.magic) {
+      why = "not a gyrochard checkpoint";
+    } else if (h.version != FileHeader{}.version) {
+      why = "written by checkpoint format version " + std::to_string(h.version);
+    } else if (h.config_hash != settings_.config_hash) {
+      why = "written under another configuration (tau0, pulse weight, stride factor, octaves or source changed)";
+    } else if (payload.size() != h.payload_bytes) {
+      why = "truncated";
+    } else if (const RestoreStatus s = estimator_.restore(payload); s != RestoreStatus::ok) {
+      why = restore_reason(s);
+    } else {
+      ++faults_.sample_gaps;  // the restart is a gap
+      return "resumed from " + checkpoint_file_.path() + ": " + std::to_string(estimator_.samples()) + " samples";
+    }
+  }
+  const int e = checkpoint_file_.set_aside();
+  return "checkpoint " + checkpoint_file_.path() + " not used: " + why + "; starting fresh" +
+         (e == 0 ? ", the file is kept as " + checkpoint_file_.aside_path()
+                 : std::string(", and it could not be kept aside: ") + std::strerror(e));
+}
+
+int Board::checkpoint() {
+  if (config_.checkpoint_path.empty()) return 0;
+  FileHeader h;
+  h.config_hash = settings_.config_hash;
+  const std::size_t n = estimator_.save(std::span(checkpoint_buffer_).subspan(sizeof h));
+  h.payload_bytes = static_cast<std::uint32_t>(n);
+  std::memcpy(checkpoint_buffer_.data(), &h, sizeof h);
+  const int e = checkpoint_file_.write(std::span(checkpoint_buffer_).first(sizeof h + n));
+  if (e != 0) BOARD_LOG("3", "checkpoint %s: %s", config_.checkpoint_path.c_str(), std::strerror(e));
+  return e;
+}
+
+void Board::on_sample(const hal::CountSample& s) {
+  faults_.lost_edges += s.lost_edges;
+  if (s.gap) {
+    ++faults_.sample_gaps;  // a new segment, never bridged
+    estimator_.mark_gap();
+    return;
+  }
+  estimator_.add_count(static_cast<std::int32_t>(s.count));
+}
+
+void Board::on_frames() {
+  for (int k = 0; k < 256; ++k) {  // bounded work per wake-up: an input storm cannot starve the rest
+    const auto f = io_.can.receive();
+    if (!f) break;
+    if (io_.source == nullptr) can_counter_.on_frame(*f, io_.clock.now_ns(), *this);
+  }
+}
+
+void Board::watch_bus() {
+  const hal::BusState state = io_.can.state();
+  if (state == last_state_) return;
+  static constexpr const char* names[] = {"error-active", "error-warning", "error-passive", "bus-off", "down"};
+  if (state == hal::BusState::active)
+    BOARD_LOG("6", "CAN bus %s again (was %s): reports resume", names[0], names[static_cast<int>(last_state_)]);
+  else
+    BOARD_LOG("4", "CAN bus %s: accumulation goes on, reports are dropped until it recovers",
+              names[static_cast<int>(state)]);
+  last_state_ = state;
+}
+
+void Board::on_tick() {
+  if (frame_ == 0) {
+    faults_.tx_dropped_frames = static_cast<std::uint32_t>(io_.can.counters().tx_dropped);
+    faults_.bus_off_events = static_cast<std::uint32_t>(io_.can.counters().bus_off_events);
+    estimator_.report(seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, content_);
+    frames_ = protocol::report_frame_count(seq_, config_.octaves);
+    if (config_.verbose)
+      BOARD_LOG("7", "report %u: %llu samples", static_cast<unsigned>(seq_),
+                static_cast<unsigned long long>(estimator_.samples()));
+  }
+  CanFrame f;
+  if (protocol::encode(report_message(content_, frame_), config_.node, f) == protocol::ProtocolError::none)
+    io_.can.send(f);  // a full queue or a downed bus is counted by the backend, never waited for
+  if (++frame_ >= frames_) {
+    frame_ = 0;
+    ++seq_;
+  }
+}
+
+bool Board::run_once(int timeout_ms) {
+  epoll_event events[8];
+  const int n = epoll_wait(epoll_, events, 8, timeout_ms);
+  if (n < 0 && errno != EINTR) {
+    BOARD_LOG("3", "epoll: %s", std::strerror(errno));
+    return false;
+  }
+  bool ticked = false;
+  for (int i = 0; i < n; ++i) {
+    const int fd = events[i].data.fd;
+    if (fd == io_.stop_fd) return false;
+    if (fd == io_.can.fd()) on_frames();
+    if (fd == io_.timer.fd()) ticked = true;
+  }
+  // The source is polled on every pass: input closes intervals, and so does time passing.
+  if (io_.source != nullptr) io_.source->poll(io_.clock.now_ns(), *this);
+  if (ticked) {
+    const std::uint64_t expirations = io_.timer.take_expirations();
+    for (std::uint64_t k = 0; k < expirations && k < 64; ++k) on_tick();  // bounded catch-up
+    watch_bus();
+  }
+  if (checkpoint_period_ns_ != 0 && !config_.checkpoint_path.empty() && io_.clock.now_ns() >= next_checkpoint_ns_) {
+    checkpoint();
+    next_checkpoint_ns_ = io_.clock.now_ns() + checkpoint_period_ns_;
+  }
+  return true;
+}
+
+}  // namespace gyrochar::firmware

@@ -1,0 +1,70 @@
+#pragma once
+// The board: counts from a count source (or CounterInput frames on the bus) into the estimator,
+// reports paced over each report period onto the CAN bus, checkpoints to a file. It runs on any
+// HAL backends: the Linux ones in gyrochard (main.cpp), the fakes in the host tests. Everything
+// is allocated in the constructor; run_once() and checkpoint() allocate nothing.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "checkpoint.hpp"
+#include "config.hpp"
+#include "hal/can_bus.hpp"
+#include "hal/can_counter.hpp"
+#include "hal/clock.hpp"
+#include "hal/count_source.hpp"
+#include "report.hpp"
+
+namespace gyrochar::firmware {
+
+struct BoardIo {
+  hal::CanBus& can;
+  hal::CountSource* source = nullptr;  // nullptr: counts come as CounterInput frames on `can`
+  const hal::Clock& clock;
+  hal::PeriodicTimer& timer;
+  int stop_fd = -1;                    // readable: stop (gyrochard's signalfd)
+};
+
+class Board final : public hal::CountSink {
+ public:
+  /// Throws std::invalid_argument for settings the estimator cannot hold.
+  Board(const Config& config, BoardIo io);
+  ~Board();
+  Board(const Board&) = delete;
+  Board& operator=(const Board&) = delete;
+
+  /// Resumes from the checkpoint file when there is one for this configuration; returns what
+  /// happened, for the log (a bad file is kept aside and the run starts fresh).
+  std::string resume();
+  /// One pass of the event loop: waits up to timeout_ms for input, a pacing tick or stop.
+  /// Returns false once stop_fd is readable.
+  bool run_once(int timeout_ms);
+  /// Writes a checkpoint now (run_once also does, every checkpoint period). Returns 0 or errno.
+  int checkpoint();
+
+  void on_sample(const hal::CountSample& sample) override;
+  const Estimator& estimator() const { return estimator_; }
+  const FaultCounters& faults() const { return faults_; }
+  std::uint32_t config_hash() const { return settings_.config_hash; }
+
+ private:
+  void on_tick();
+  void on_frames();
+  void watch_bus();
+  Config config_;
+  BoardIo io_;
+  EstimatorSettings settings_;
+  Estimator estimator_;
+  ReportContent content_;
+  FaultCounters faults_;
+  hal::CanCounterDecoder can_counter_;
+  CheckpointFile checkpoint_file_;
+  std::vector<std::byte> checkpoint_buffer_;
+  std::uint64_t start_ns_ = 0, next_checkpoint_ns_ = 0, checkpoint_period_ns_ = 0;
+  std::uint8_t seq_ = 0;
+  std::size_t frame_ = 0, frames_ = 1;
+  hal::BusState last_state_ = hal::BusState::active;
+  int epoll_ = -1;
+};
+
+}  // namespace gyrochar::firmware
