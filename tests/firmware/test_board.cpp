@@ -1,0 +1,243 @@
+// The board program's loop on the HAL fakes (in-process CAN bus, scripted count source, virtual
+// clock): no heap allocation after start-up, quadrature edges end up as the exact counts, a downed
+// bus costs reports but no samples, and checkpoints resume or are refused with the reason.
+// Oracles: an Estimator fed the same counts directly (same exact integer sums), the fake bus's own
+// counters, and the checkpoint format's checks.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <fstream>
+#include <new>
+#include <random>
+#include <vector>
+
+#include "board.hpp"
+#include "hal/fake/fake_can_bus.hpp"
+#include "hal/fake/fake_clock.hpp"
+#include "hal/fake/fake_count_source.hpp"
+
+// Counts every heap allocation of this test program while armed. The replacement pairs malloc
+// with free on purpose; GCC cannot see that both are replaced.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+namespace {
+std::atomic<bool> armed{false};
+std::atomic<std::uint64_t> allocations{0};
+}  // namespace
+void* operator new(std::size_t n) {
+  if (armed) ++allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace gyrochar::firmware {
+namespace {
+
+constexpr std::uint64_t ms = 1000000;
+
+Config test_config() {
+  Config c;
+  c.node = 7;
+  c.source = SourceKind::quadrature;  // any GPIO kind: the fake source stands in for it
+  c.tau0_s = 0.001;
+  c.stride_factor = 8;
+  c.octaves = 20;
+  c.report_period_s = 0.1;
+  return c;
+}
+
+std::vector<std::int64_t> test_counts(std::size_t n, std::uint64_t seed = 3) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 3.0);
+  std::vector<std::int64_t> c(n);
+  for (auto& v : c) v = 5 + static_cast<std::int64_t>(std::lround(noise(rng)));
+  return c;
+}
+
+// The board, its fakes, and a loop that advances the virtual clock one millisecond at a time.
+struct Rig {
+  hal::FakeCanBus bus;
+  std::unique_ptr<hal::FakeCanNode> board_node = bus.attach();
+  hal::FakeClock clock;
+  hal::FakeTimer timer{clock};
+  hal::FakeCountSource source;
+  std::unique_ptr<Board> board;
+  explicit Rig(const Config& c) { board = std::make_unique<Board>(c, BoardIo{*board_node, &source, clock, timer}); }
+  void run_for(std::uint64_t ns) {
+    for (std::uint64_t t = 0; t < ns; t += ms) {
+      clock.advance(ms);
+      timer.update();
+      ASSERT_TRUE(board->run_once(0));
+    }
+  }
+};
+
+void expect_same_sums(const Estimator& a, const Estimator& b) {
+  ASSERT_EQ(a.pyramid().tau_count(), b.pyramid().tau_count());
+  for (std::size_t i = 0; i < a.pyramid().tau_count(); ++i) {
+    const auto ra = a.pyramid().result(i), rb = b.pyramid().result(i);
+    for (std::size_t k = 0; k < stat_count; ++k) {
+      EXPECT_EQ(ra.n[k], rb.n[k]) << "tau " << i << " stat " << k;
+      EXPECT_TRUE(ra.sum[k] == rb.sum[k]) << "tau " << i << " stat " << k;
+    }
+  }
+}
+
+// The oracle: an estimator fed the counts directly.
+std::unique_ptr<Estimator> direct(const Config& c, const std::vector<std::int64_t>& counts) {
+  EstimatorSettings s;
+  s.tau0_s = c.tau0_s;
+  s.stride_factor = c.stride_factor;
+  s.octaves = c.octaves;
+  auto e = std::make_unique<Estimator>();
+  EXPECT_TRUE(e->configure(s));
+  for (const auto v : counts) e->add_count(static_cast<std::int32_t>(v));
+  return e;
+}
+
+TEST(Board, NoHeapAllocationAfterStartUp) {
+  Config c = test_config();
+  c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_alloc.ckpt";
+  c.checkpoint_period_s = 0.5;
+  Rig rig(c);
+  const auto counts = test_counts(5000);
+  rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+  rig.board->resume();
+  armed = true;
+  rig.run_for(5000 * ms);  // 5000 samples, 50 reports, 10 checkpoints
+  armed = false;
+  EXPECT_EQ(allocations.load(), 0u);
+  EXPECT_EQ(rig.board->estimator().samples(), counts.size());
+  EXPECT_GT(rig.bus.frames_on_bus(), 50u * 40u);
+  std::remove(c.checkpoint_path.c_str());
+}
+
+TEST(Board, QuadratureEdgesBecomeTheExactCounts) {
+  const Config c = test_config();
+  Rig rig(c);
+  hal::QuadratureSettings q;
+  q.start_ns = rig.clock.now_ns();
+  q.tau0_ns = ms;
+  rig.source.use_quadrature(q);
+  // |count| edges spread over each interval, in the count's sense (AB: 00 10 11 01 forwards).
+  const auto counts = test_counts(3000);
+  const bool cycle[4][2] = {{false, false}, {true, false}, {true, true}, {false, true}};
+  int state = 0;
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    const std::int64_t n = std::llabs(counts[k]);
+    for (std::int64_t e = 0; e < n; ++e) {
+      const int next = (state + (counts[k] > 0 ? 1 : 3)) % 4;
+      const bool a_changes = cycle[state][0] != cycle[next][0];
+      const std::uint64_t t = q.start_ns + k * ms + static_cast<std::uint64_t>((e + 1) * ms / (n + 1));
+      rig.source.push_edge(t, a_changes ? hal::QuadratureLine::a : hal::QuadratureLine::b,
+                           a_changes ? cycle[next][0] : cycle[next][1]);
+      state = next;
+    }
+  }
+  rig.run_for(3000 * ms);
+  EXPECT_EQ(rig.board->estimator().samples(), counts.size());
+  expect_same_sums(rig.board->estimator(), *direct(c, counts));
+  EXPECT_EQ(rig.board->faults().lost_edges, 0u);
+}
+
+TEST(Board, ADownedBusCostsReportsButNoSamples) {
+  const Config c = test_config();
+  Rig rig(c);
+  auto listener = rig.bus.attach();
+  const auto counts = test_counts(3000);
+  rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+  rig.run_for(1000 * ms);
+  std::size_t received = 0;
+  while (listener->receive()) ++received;
+  EXPECT_GT(received, 0u);
+  rig.bus.set_down(true);
+  rig.run_for(1000 * ms);
+  EXPECT_EQ(listener->receive(), std::nullopt) << "nothing crosses a downed bus";
+  EXPECT_GT(rig.board_node->counters().tx_dropped, 0u);
+  rig.bus.set_down(false);
+  rig.run_for(1000 * ms);
+  received = 0;
+  while (listener->receive()) ++received;
+  EXPECT_GT(received, 0u) << "reports resume";
+  EXPECT_EQ(rig.board->estimator().samples(), counts.size());
+  expect_same_sums(rig.board->estimator(), *direct(c, counts));
+}
+
+class BoardCheckpoint : public ::testing::Test {
+ protected:
+  Config c = test_config();
+  std::vector<std::int64_t> counts = test_counts(2000);
+  void SetUp() override {
+    c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_board.ckpt";
+    std::remove(c.checkpoint_path.c_str());
+    std::remove((c.checkpoint_path + ".bad").c_str());
+    Rig rig(c);
+    rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+    rig.run_for(2000 * ms);
+    ASSERT_EQ(rig.board->checkpoint(), 0);
+  }
+  void TearDown() override {
+    std::remove(c.checkpoint_path.c_str());
+    std::remove((c.checkpoint_path + ".bad").c_str());
+  }
+  std::string bytes() {
+    std::ifstream f(c.checkpoint_path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(f), {}};
+  }
+  void rewrite(const std::string& b) { std::ofstream(c.checkpoint_path, std::ios::binary) << b; }
+  bool exists(const std::string& p) { return access(p.c_str(), F_OK) == 0; }
+};
+
+TEST_F(BoardCheckpoint, ResumesWithTheSameSums) {
+  Rig rig(c);
+  const std::string said = rig.board->resume();
+  EXPECT_NE(said.find("resumed"), std::string::npos) << said;
+  EXPECT_EQ(rig.board->estimator().samples(), counts.size());
+  expect_same_sums(rig.board->estimator(), *direct(c, counts));
+}
+
+TEST_F(BoardCheckpoint, ACorruptedFileIsReportedAndKeptAside) {
+  std::string b = bytes();
+  b[b.size() / 2] = static_cast<char>(b[b.size() / 2] ^ 0x10);
+  rewrite(b);
+  Rig rig(c);
+  const std::string said = rig.board->resume();
+  EXPECT_NE(said.find("CRC"), std::string::npos) << said;
+  EXPECT_NE(said.find("starting fresh"), std::string::npos) << said;
+  EXPECT_EQ(rig.board->estimator().samples(), 0u);
+  EXPECT_TRUE(exists(c.checkpoint_path + ".bad"));
+  EXPECT_FALSE(exists(c.checkpoint_path));
+}
+
+TEST_F(BoardCheckpoint, ATruncatedFileIsReportedAndKeptAside) {
+  for (const std::size_t keep : {std::size_t{3}, bytes().size() - 1}) {
+    const std::string b = bytes();
+    rewrite(b.substr(0, keep));
+    Rig rig(c);
+    const std::string said = rig.board->resume();
+    EXPECT_NE(said.find("truncated"), std::string::npos) << keep << ": " << said;
+    EXPECT_EQ(rig.board->estimator().samples(), 0u);
+    EXPECT_TRUE(exists(c.checkpoint_path + ".bad"));
+    std::rename((c.checkpoint_path + ".bad").c_str(), c.checkpoint_path.c_str());
+    rewrite(b);
+  }
+}
+
+TEST_F(BoardCheckpoint, AnotherConfigurationIsNotResumed) {
+  Config other = c;
+  other.tau0_s = 0.002;
+  Rig rig(other);
+  const std::string said = rig.board->resume();
+  EXPECT_NE(said.find("another configuration"), std::string::npos) << said;
+  EXPECT_EQ(rig.board->estimator().samples(), 0u);
+  // Garbage is not a checkpoint.
+  rewrite(std::string(4096, 'x'));
+  Rig rig2(c);
+  EXPECT_NE(rig2.board->resume().find("not a gyrochard checkpoint"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace gyrochar::firmware
