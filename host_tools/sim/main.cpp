@@ -1,12 +1,98 @@
 // gyrochar-sim: a simulated ring laser gyro with known IEEE-952 parameters, faster than real time:
 // writes pulse counts per tau0 (one per line) for gyrochar-analyze, the firmware's fakes or a test.
+// With --can it is also the gyro's readout electronics: it sends the same counts as CounterInput
+// frames (docs/protocol.md, section 8) on a SocketCAN interface, paced at tau0 (or --speed times
+// faster), for gyrochard's can-counter source.
 #include <CLI/CLI.hpp>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
+#include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "gyro_sim.hpp"
+#include "gyrochar/protocol.hpp"
+#include "hal/linux/socketcan.hpp"
+
+namespace {
+
+using namespace gyrochar;
+
+constexpr int exit_no_interface = 4;
+
+// The readout electronics: frame k carries the pulses accumulated over the first k intervals
+// (modulo 2^32) and Seq = k mod 256, sent at start + k tau0 / speed on CLOCK_MONOTONIC. Frame 0
+// (Count 0) marks the start, so a board that receives every frame derives exactly the simulated
+// counts. A full TX queue is waited out (1 ms steps, up to 1 s); a frame the interface refuses
+// because it is down is lost, as on a real bus, and counted.
+class CounterInputSender {
+ public:
+  CounterInputSender(const std::string& interface, std::uint8_t node, double interval_s)
+      : bus_(interface), node_(node), interval_ns_(static_cast<long long>(std::llround(interval_s * 1e9))) {
+    clock_gettime(CLOCK_MONOTONIC, &start_);
+  }
+
+  void send_next(std::int64_t count) {
+    accumulated_ += static_cast<std::uint32_t>(count);  // two's complement: wraps like the electronics
+    wait_until_due();
+    protocol::CounterInputMsg msg;
+    msg.count = accumulated_;
+    msg.seq = static_cast<std::uint8_t>(frames_);
+    CanFrame frame;
+    if (protocol::encode(msg, node_, frame) != protocol::ProtocolError::none)
+      throw std::logic_error("CounterInput frame refused by the codec");
+    ++frames_;
+    for (int attempt = 0; attempt < 1000; ++attempt) {
+      switch (bus_.send(frame)) {
+        case hal::SendResult::sent:
+          return;
+        case hal::SendResult::bus_down:
+          ++lost_down_;
+          return;
+        case hal::SendResult::queue_full:
+          ++queue_full_waits_;
+          sleep_ns(1000000);
+          break;
+      }
+    }
+    ++lost_queue_full_;
+  }
+
+  std::string summary() const {
+    return std::to_string(frames_) + " CounterInput frames from node " + std::to_string(node_) + ", " +
+           std::to_string(late_) + " sent late, " + std::to_string(queue_full_waits_) + " waits for a full TX queue, " +
+           std::to_string(lost_down_) + " lost (interface down), " + std::to_string(lost_queue_full_) +
+           " lost (TX queue full for 1 s)";
+  }
+
+ private:
+  static void sleep_ns(long long ns) {
+    const timespec t{static_cast<time_t>(ns / 1000000000LL), static_cast<long>(ns % 1000000000LL)};
+    nanosleep(&t, nullptr);
+  }
+
+  void wait_until_due() {
+    const long long due_ns = static_cast<long long>(frames_) * interval_ns_ + start_.tv_nsec;
+    timespec due{start_.tv_sec + static_cast<time_t>(due_ns / 1000000000LL), static_cast<long>(due_ns % 1000000000LL)};
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (now.tv_sec > due.tv_sec || (now.tv_sec == due.tv_sec && now.tv_nsec > due.tv_nsec + 1000000)) ++late_;
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr) == EINTR) {
+    }
+  }
+
+  hal::SocketCan bus_;
+  std::uint8_t node_;
+  long long interval_ns_;
+  timespec start_{};
+  std::uint32_t accumulated_ = 0;
+  std::uint64_t frames_ = 0, late_ = 0, queue_full_waits_ = 0, lost_down_ = 0, lost_queue_full_ = 0;
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace gyrochar;
@@ -16,11 +102,18 @@ int main(int argc, char** argv) {
 weight (Q = pulse weight / sqrt(12)). Bias instability is flicker rate noise over the band from
 1e5 s down to 2 tau0.
 
+With --can the counts also go out as CounterInput frames (0x0CFF50xx, docs/protocol.md section 8)
+from node --can-node, one per tau0 interval, paced on the monotonic clock at tau0 / --speed; the
+first frame carries Count 0 and marks the start, so a board receiving every frame derives exactly
+the counts written to --out. With --can, --out writes nothing unless given. A summary of what was
+sent goes to stderr at the end.
+
 Examples:
   gyrochar-sim --duration 7200 --tau0 0.01 --arw 0.002 --rrw 0.01 > counts.txt
   gyrochar-sim --duration 3600 --arw 0.002 | gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1 -
+  gyrochar-sim --duration 60 --tau0 0.01 --arw 0.003 --can vcan0 --can-node 128 --speed 4 --out counts.txt
 
-Exit codes: 0 success, 2 bad options, 3 cannot write.)");
+Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not available.)");
   GyroParameters p;
   double duration_s = 3600, pulse_arcsec = 1.0, rate_dph = 15.041, q_arcsec = 0, arw = 0, rrw = 0, ramp = 0, bias = 0;
   double dither_arcsec = 0, dither_hz = 0;
@@ -38,6 +131,14 @@ Exit codes: 0 success, 2 bad options, 3 cannot write.)");
   app.add_option("--dither-hz", dither_hz, "dither frequency in Hz")->capture_default_str();
   app.add_option("--seed", p.seed, "random seed (runs are reproducible)")->capture_default_str();
   app.add_option("--out", out, "output file, '-' for standard output")->capture_default_str();
+  std::string can_interface;
+  unsigned can_node = 0x80;
+  double speed = 1.0;
+  app.add_option("--can", can_interface, "also send the counts as CounterInput frames on this SocketCAN interface")
+      ->option_text("IF");
+  app.add_option("--can-node", can_node, "with --can: address of the simulated electronics, 0..253")
+      ->capture_default_str();
+  app.add_option("--speed", speed, "with --can: frames every tau0 / SPEED seconds (1: real time)")->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -55,6 +156,11 @@ Exit codes: 0 success, 2 bad options, 3 cannot write.)");
   if (!(pulse_arcsec > 0)) return bad("--pulse-weight", "must be positive");
   for (double v : {q_arcsec, arw, rrw, ramp, bias, dither_arcsec, dither_hz})
     if (!(v >= 0) || !std::isfinite(v)) return bad("noise parameters", "must be finite and >= 0");
+  if (can_node > protocol::max_node_address) return bad("--can-node", "must be an address 0..253");
+  if (!(speed > 0) || !std::isfinite(speed)) return bad("--speed", "must be positive");
+  if (can_interface.empty() && (app.count("--can-node") || app.count("--speed")))
+    return bad("--can-node, --speed", "only apply with --can");
+  if (!can_interface.empty() && !app.count("--out")) out.clear();  // frames only
   p.pulse_weight_rad = pulse_arcsec * units::arcsec;
   p.rate_rad_s = rate_dph * units::deg_per_h;
   p.q_rad = q_arcsec * units::arcsec;
@@ -64,17 +170,36 @@ Exit codes: 0 success, 2 bad options, 3 cannot write.)");
   p.b_rad_s = bias * units::deg_per_h;
   p.dither_amplitude_rad = dither_arcsec * units::arcsec;
   p.dither_frequency_hz = dither_hz;
-  FILE* f = out == "-" ? stdout : std::fopen(out.c_str(), "w");
-  if (f == nullptr) {
+  std::unique_ptr<CounterInputSender> sender;
+  if (!can_interface.empty()) {
+    try {
+      sender = std::make_unique<CounterInputSender>(can_interface, static_cast<std::uint8_t>(can_node), p.tau0_s / speed);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "gyrochar-sim: --can: %s\n", e.what());
+      return exit_no_interface;
+    }
+  }
+  FILE* f = out.empty() ? nullptr : out == "-" ? stdout : std::fopen(out.c_str(), "w");
+  if (!out.empty() && f == nullptr) {
     std::fprintf(stderr, "gyrochar-sim: %s: cannot write\n", out.c_str());
     return 3;
   }
-  std::fprintf(f, "# gyrochar-sim counts: tau0 %g s, pulse weight %g arcsec, rate %g deg/h, ARW %g deg/sqrt(h), "
+  if (f != nullptr)
+    std::fprintf(f, "# gyrochar-sim counts: tau0 %g s, pulse weight %g arcsec, rate %g deg/h, ARW %g deg/sqrt(h), "
                "RRW %g deg/h/sqrt(h), ramp %g deg/h/h, seed %llu\n", p.tau0_s, pulse_arcsec, rate_dph, arw, rrw, ramp,
                static_cast<unsigned long long>(p.seed));
   GyroSimulator sim(p);
   const auto n = static_cast<std::uint64_t>(std::llround(duration_s / p.tau0_s));
-  for (std::uint64_t k = 0; k < n; ++k) std::fprintf(f, "%lld\n", static_cast<long long>(sim.next_count()));
-  if (f != stdout) std::fclose(f);
+  if (sender) sender->send_next(0);  // the start: Count 0
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const std::int64_t count = sim.next_count();
+    if (f != nullptr) std::fprintf(f, "%lld\n", static_cast<long long>(count));
+    if (sender) sender->send_next(count);
+  }
+  if (sender) std::fprintf(stderr, "gyrochar-sim: %s: %s\n", can_interface.c_str(), sender->summary().c_str());
+  if (f != nullptr && f != stdout && std::fclose(f) != 0) {
+    std::fprintf(stderr, "gyrochar-sim: %s: cannot write\n", out.c_str());
+    return 3;
+  }
   return 0;
 }
