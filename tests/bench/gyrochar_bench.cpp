@@ -191,9 +191,10 @@ int check_link(const std::string& jsonl, const std::vector<unsigned>& wanted, bo
     }
     std::size_t after = 0;
     for (std::size_t k = gap; k + 1 < reports.size(); ++k) after += reports[k].complete ? 1 : 0;
-    std::printf("node %u: gap at report %zu of %zu (t = %.3f s): %llu reports lost, %llu offline events; "
+    std::printf("node %u: gap at report %zu of %zu (%.3f s after the first): %llu reports lost, %llu offline events; "
                 "%zu complete reports after it\n",
-                node, gap + 1, reports.size(), reports[gap].line["time_s"].get<double>(),
+                node, gap + 1, reports.size(),
+                reports[gap].line["time_s"].get<double>() - reports[0].line["time_s"].get<double>(),
                 static_cast<unsigned long long>(health(last, "reports_lost")),
                 static_cast<unsigned long long>(health(last, "offline_events")), after);
     if (after < min_reports) problem(node, "did not resume: " + std::to_string(after) + " complete reports after the gap");

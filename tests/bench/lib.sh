@@ -66,3 +66,64 @@ can_up() {
   ip link set "$1" type can bitrate "$2"
   ip link set "$1" up
 }
+
+# --- Counter-input nodes: gyrochard nodes fed by simulated gyro electronics over CAN -------------
+# Node A's electronics have address A + 112; tau0 0.01 s, 16 octave taus.
+bench_tau0=0.01
+
+# start_nodes REPORT_IF DECODE_IF NODE...: the decoder on DECODE_IF (CSV and JSON lines in /tmp,
+# native units), then the gyrochard nodes on REPORT_IF; waits until they are up.
+start_nodes() {
+  local report_if=$1 decode_if=$2 node
+  shift 2
+  start decode gyrochar-decode --interface "$decode_if" --rate-unit native --csv /tmp/decoded.csv \
+    --jsonl /tmp/decoded.jsonl --view none
+  for node in "$@"; do
+    start "gyrochard-$node" gyrochard --source can-counter --can-interface "$report_if" --node "$node" \
+      --counter-node $((node + 112)) --tau0 "$bench_tau0" --octaves 16
+  done
+  sleep 2
+  for node in "$@"; do running "gyrochard-$node" || fail "gyrochard node $node stopped at start"; done
+}
+
+# feed_nodes INPUT_IF DURATION_S SPEED NODE...: one gyrochar-sim per node sends DURATION_S of
+# counts (seed = node, written to /tmp/counts-NODE.txt) at SPEED times real time; waits for them.
+feed_nodes() {
+  local input_if=$1 duration_s=$2 speed=$3 node
+  shift 3
+  for node in "$@"; do
+    start "sim-$node" gyrochar-sim --duration "$duration_s" --tau0 "$bench_tau0" --white-angle 2 --arw 0.003 \
+      --seed "$node" --can "$input_if" --can-node $((node + 112)) --speed "$speed" --out "/tmp/counts-$node.txt"
+  done
+  for node in "$@"; do
+    finish "sim-$node"
+    [ "$status" -eq 0 ] || fail "gyrochar-sim for node $node exited with $status"
+    cat "/tmp/sim-$node.log"
+  done
+}
+
+# stop_nodes NODE...: the decoder first (the report in flight is its last, cut short), then the
+# nodes, which must stop cleanly.
+stop_nodes() {
+  local node
+  stop decode
+  [ "$status" -eq 0 ] || fail "gyrochar-decode exited with $status"
+  for node in "$@"; do
+    stop "gyrochard-$node"
+    [ "$status" -eq 0 ] || fail "gyrochard node $node exited with $status on SIGTERM"
+  done
+  tail -n $(($# + 1)) /tmp/decode.log
+}
+
+# check_estimates SAMPLES NODE...: each node's last complete report with SAMPLES samples holds
+# ADEV and MDEV equal to gyrochar-analyze's on /tmp/counts-NODE.txt.
+check_estimates() {
+  local samples=$1 node
+  shift
+  for node in "$@"; do
+    gyrochar-analyze --type counts --tau0 "$bench_tau0" --pulse-weight 1arcsec --rate-unit deg/s --stride-factor 8 \
+      --format csv "/tmp/counts-$node.txt" > "/tmp/analyzed-$node.csv"
+    gyrochar-bench estimates --jsonl /tmp/decoded.jsonl --csv /tmp/decoded.csv --node "$node" --samples "$samples" \
+      --analyzed "/tmp/analyzed-$node.csv" || fail "node $node: decoded estimates differ from gyrochar-analyze (above)"
+  done
+}
