@@ -29,6 +29,8 @@ if [ "$job" = test ]; then
   packages+=(g++-aarch64-linux-gnu qemu-user-static libgtest-dev:arm64 libgpiod-dev:arm64)
   packages+=(gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi
              python3-canmatrix python3-can clang libclang-rt-14-dev)
+  # The QEMU bench (toolchain/bench/build.sh adds the kernel headers of the kernel it boots).
+  packages+=(qemu-system-x86 busybox-static cpio can-utils)
 fi
 
 missing=()
@@ -48,11 +50,12 @@ cmake --build --preset host -j "$(nproc)"
 case "$job" in
   demo)
     # The main job: the live system as a host simulation on a virtual clock. Two simulated ring
-    # laser gyros (1 arcsec pulses at 100 Hz) feed the board's estimator, their reports cross an
-    # in-process CAN bus that loses 1 frame in 2000, and the decoder shows what arrives.
+    # laser gyros (1 arcsec pulses at 100 Hz) feed the board program's own loop through the HAL
+    # fakes, their reports cross an in-process CAN bus that loses 1 frame in 2000, and the decoder
+    # shows what arrives and leaves a CSV and the ADEV/MDEV plot behind.
     mkdir -p build/demo
     build/host/host_tools/gyrochar-demo --hours 6 --nodes 2 --loss 0.0005 --view-every 60 \
-      --csv build/demo/decoded.csv
+      --csv build/demo/decoded.csv --plot build/demo/adev
     ;;
   test)
     # Every configuration is built once; the host suite runs last so that its summary closes the log.
@@ -76,7 +79,10 @@ case "$job" in
     cmake --preset sanitize >/dev/null
     cmake --build --preset sanitize -j "$(nproc)"
     ctest --preset sanitize -j "$(nproc)"
+    echo "build.sh: the QEMU bench: a real kernel's CAN and GPIO drivers under emulation (docs/bench.md)" >&2
+    toolchain/bench/build.sh
+    ctest --preset host -L bench -j "$(nproc)"
     echo "build.sh: the host test suite" >&2
-    ctest --preset host -j "$(nproc)"
+    ctest --preset host -j "$(nproc)" -LE bench
     ;;
 esac

@@ -18,7 +18,7 @@
 
 #include "decode_session.hpp"
 #include "hal/linux/socketcan.hpp"
-#include "plot.hpp"
+#include "decode_plot.hpp"
 
 namespace {
 

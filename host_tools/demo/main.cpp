@@ -1,7 +1,9 @@
 // gyrochar-demo: the live system as a host simulation on a virtual clock. Simulated ring laser
-// gyros feed the board's estimator (firmware/report.hpp) on several nodes; their reports cross an
-// in-process CAN bus (hal/fake) with optional frame loss; the host decoder follows every node,
-// shows a refreshing table, and writes a CSV. Hours of gyro time pass in seconds.
+// gyros feed the board program's own code (firmware/board.hpp: the event loop, the estimator, the
+// report pacing) through the HAL fakes: a scripted count source, a virtual clock and timer, and an
+// in-process CAN bus with optional frame loss. The host decoder (the pipeline of gyrochar-decode)
+// follows every node, shows its table as the run goes, and leaves a CSV and an ADEV/MDEV plot.
+// Hours of gyro time pass in seconds.
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
@@ -10,115 +12,165 @@
 #include <memory>
 #include <vector>
 
-#include "decoder.hpp"
-#include "live_view.hpp"
+#include "board.hpp"
+#include "decode_plot.hpp"
+#include "decode_session.hpp"
 #include "gyro_sim.hpp"
 #include "hal/fake/fake_can_bus.hpp"
-#include "report.hpp"
+#include "hal/fake/fake_clock.hpp"
+#include "hal/fake/fake_count_source.hpp"
 
 namespace {
 
 using namespace gyrochar;
 
+constexpr int exit_ok = 0, exit_failure = 1, exit_usage = 2;
+
+// One simulated gyro board on the bus.
 struct Node {
-  Node(std::uint8_t a, const GyroParameters& g, std::unique_ptr<hal::FakeCanNode> c)
-      : address(a), gyro(g), can(std::move(c)) {}
-  std::uint8_t address;
+  Node(const firmware::Config& c, const GyroParameters& g, hal::FakeCanBus& bus, const hal::FakeClock& clock)
+      : gyro(g), can(bus.attach()), timer(clock),
+        board(c, firmware::BoardIo{*can, &source, clock, timer}) {}
   GyroSimulator gyro;
-  firmware::Estimator estimator;
   std::unique_ptr<hal::FakeCanNode> can;
-  std::uint8_t seq = 0;
+  hal::FakeTimer timer;
+  hal::FakeCountSource source;
+  firmware::Board board;
 };
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"gyrochar-demo: simulated gyros -> board estimator -> virtual CAN bus -> decoder, on a virtual clock.",
+  CLI::App app{"gyrochar-demo: simulated gyros -> the board program (on HAL fakes) -> virtual CAN bus -> decoder,\n"
+               "on a virtual clock.",
                "gyrochar-demo"};
-  app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv\n"
-             "Exit codes: 0 success, 2 bad options.");
+  app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n"
+             "Exit codes: 0 success, 1 an output could not be written, 2 bad options.");
   double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30;
   unsigned nodes = 2, octaves = 20;
-  std::string csv_path = "gyrochar-demo.csv";
+  std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo";
   app.add_option("--hours", hours, "gyro hours to simulate")->capture_default_str();
-  app.add_option("--nodes", nodes, "gyro nodes on the bus (1..8)")->capture_default_str();
+  app.add_option("--nodes", nodes, "gyro boards on the bus (1..8)")->capture_default_str();
   app.add_option("--tau0", tau0, "sample interval in seconds")->capture_default_str();
-  app.add_option("--octaves", octaves, "octave taus per node")->capture_default_str();
+  app.add_option("--octaves", octaves, "octave taus per node (1..40)")->capture_default_str();
   app.add_option("--loss", loss, "probability that a frame is lost on the bus")->capture_default_str();
-  app.add_option("--view-every", view_every_min, "refresh the view every N gyro minutes")->capture_default_str();
+  app.add_option("--view-every", view_every_min, "show the table every N gyro minutes (0: only at the end)")
+      ->capture_default_str();
   app.add_option("--csv", csv_path, "decoded reports as CSV (one row per node, report and tau)")->capture_default_str();
+  app.add_option("--plot", plot_prefix, "ADEV/MDEV plot written to PREFIX.svg and PREFIX.png (empty: none)")
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "gyrochar-demo: options: %s (see --help)\n", e.what());
-    return 2;
+    return exit_usage;
   }
-  if (!(hours > 0) || !(tau0 > 0) || nodes < 1 || nodes > 8 || !(loss >= 0 && loss < 1) || octaves < 1 || octaves > 40) {
+  if (!(hours > 0) || !(tau0 > 0) || nodes < 1 || nodes > 8 || !(loss >= 0 && loss < 1) || octaves < 1 ||
+      octaves > 40 || !(view_every_min >= 0)) {
     std::fprintf(stderr, "gyrochar-demo: options: hours, tau0 > 0; nodes 1..8; loss in [0, 1); octaves 1..40\n");
-    return 2;
+    return exit_usage;
+  }
+  if (!plot_prefix.empty()) {
+    if (const std::string why = decoding::plot_devices_missing(); !why.empty()) {
+      std::fprintf(stderr, "gyrochar-demo: plot: %s\n", why.c_str());
+      return exit_failure;
+    }
   }
   FILE* csv = std::fopen(csv_path.c_str(), "w");
   if (csv == nullptr) {
     std::fprintf(stderr, "gyrochar-demo: %s: cannot write\n", csv_path.c_str());
-    return 2;
+    return exit_failure;
   }
-  write_csv_header(csv);
 
+  hal::FakeClock clock;
   hal::FakeCanBus bus(7);
   bus.set_loss(loss);
+  auto host = bus.attach(1 << 16);
   std::vector<std::unique_ptr<Node>> gyros;
   for (unsigned i = 0; i < nodes; ++i) {
+    firmware::Config c;
+    c.node = static_cast<std::uint8_t>(0x10 + i);
+    c.source = firmware::SourceKind::quadrature;  // what a real board would use; the fake stands in
+    c.tau0_s = tau0;
+    c.octaves = octaves;
+    c.report_period_s = 1.0;
     GyroParameters g;
     g.tau0_s = tau0;
     g.q_rad = 2 * units::arcsec;
     g.n_rad_sqrt_s = (0.002 + 0.001 * i) * units::deg_per_sqrt_h;
+    g.b_rad_s = 0.01 * units::deg_per_h;
     g.k_rad_s_sqrt_s = 0.03 * units::deg_per_h_sqrt_h;
     g.seed = 100 + i;
-    auto n = std::make_unique<Node>(static_cast<std::uint8_t>(0x10 + i), g, bus.attach());
-    firmware::EstimatorSettings s;
-    s.tau0_s = tau0;
-    s.octaves = octaves;
-    s.source = protocol::InputSource::simulated;
-    if (!n->estimator.configure(s)) {
-      std::fprintf(stderr, "gyrochar-demo: cannot configure the estimator\n");
-      return 2;
+    try {
+      gyros.push_back(std::make_unique<Node>(c, g, bus, clock));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "gyrochar-demo: node %u: %s\n", i, e.what());
+      return exit_usage;
     }
-    gyros.push_back(std::move(n));
   }
-  auto host = bus.attach(1 << 16);
-  double t = 0;
-  Decoder decoder([&](DecoderEvent e, const NodeView& v, std::uint8_t seq) {
-    if (e == DecoderEvent::report_closed) write_csv_rows(csv, v, seq, t);
-  });
+  decoding::SessionOptions so;
+  so.csv = csv;
+  decoding::Session session(so);
+  session.input().source = "in-process CAN bus";
 
-  const bool tty = isatty(STDOUT_FILENO);
-  const auto samples_per_report = static_cast<std::uint64_t>(std::llround(1.0 / tau0));  // 1 s reports
-  const auto reports = static_cast<std::uint64_t>(hours * 3600.0);
-  const auto view_every = static_cast<std::uint64_t>(view_every_min * 60.0);
-  firmware::ReportContent content;
-  for (std::uint64_t r = 0; r < reports; ++r) {
-    for (auto& n : gyros) {
-      for (std::uint64_t k = 0; k < samples_per_report; ++k)
-        n->estimator.add_count(static_cast<std::int32_t>(n->gyro.next_count()));
-      n->estimator.report(n->seq, (r + 1) * 1000, {}, content);
-      const std::size_t frames = protocol::report_frame_count(n->seq, octaves);
-      for (std::size_t k = 0; k < frames; ++k) {  // paced over the report period
-        CanFrame f;
-        protocol::encode(firmware::report_message(content, k), n->address, f);
-        n->can->send(f);
-        while (auto in = host->receive()) decoder.feed(*in, t + static_cast<double>(k) / static_cast<double>(frames));
-      }
-      ++n->seq;
+  // The virtual clock moves in steps of a quarter second: each step scripts the counts of that
+  // step into every node's source, runs each board's loop once (samples, paced report frames),
+  // and hands what crossed the bus to the decoder.
+  const bool tty = isatty(STDOUT_FILENO) == 1;
+  const auto tau0_ns = static_cast<std::uint64_t>(std::llround(tau0 * 1e9));
+  const std::uint64_t step_ns = 250000000;
+  const std::uint64_t start_ns = clock.now_ns();
+  const auto end_ns = start_ns + static_cast<std::uint64_t>(hours * 3600e9);
+  const auto view_every_ns = static_cast<std::uint64_t>(view_every_min * 60e9);
+  std::uint64_t scripted_ns = start_ns, next_view_ns = start_ns + view_every_ns;
+  std::vector<std::int64_t> counts;
+  auto show = [&] {
+    if (tty) std::fputs("\033[H\033[J", stdout);
+    std::fputs(decoding::format_view(session.decoder(), session.input(), so.shown, so.rate_unit, session.intervals())
+                   .c_str(),
+               stdout);
+    std::fflush(stdout);
+  };
+  while (clock.now_ns() < end_ns) {
+    clock.advance(step_ns);
+    const std::uint64_t n = (clock.now_ns() - scripted_ns) / tau0_ns;
+    for (auto& node : gyros) {
+      counts.resize(n);
+      for (auto& c : counts) c = node->gyro.next_count();
+      node->source.script_counts(scripted_ns, tau0_ns, counts.data(), counts.size());
+      node->timer.update();
+      node->board.run_once(0);
     }
-    t += 1.0;
-    if (view_every && (r + 1) % view_every == 0) print_view(stdout, decoder, t, tty);
+    scripted_ns += n * tau0_ns;
+    const double t_s = static_cast<double>(clock.now_ns() - start_ns) * 1e-9;
+    while (auto frame = host->receive()) session.feed(*frame, t_s);
+    if (view_every_ns != 0 && clock.now_ns() >= next_view_ns) {
+      show();
+      next_view_ns += view_every_ns;
+    }
   }
-  decoder.flush();
-  print_view(stdout, decoder, t, tty);
-  std::fclose(csv);
-  std::fprintf(stderr, "gyrochar-demo: %.1f gyro hours, %u nodes, %llu frames on the bus; decoded reports in %s\n",
-               hours, nodes, static_cast<unsigned long long>(bus.frames_on_bus()), csv_path.c_str());
-  return 0;
+  session.finish();
+  show();
+  int code = exit_ok;
+  if (std::fclose(csv) != 0) {
+    std::fprintf(stderr, "gyrochar-demo: %s: write failed\n", csv_path.c_str());
+    code = exit_failure;
+  }
+  if (!plot_prefix.empty()) {
+    std::vector<decoding::NodePlot> panels;
+    for (const auto& [address, node] : session.decoder().nodes())
+      panels.push_back(decoding::plot_data(node, so.rate_unit, session.intervals()));
+    std::string why;
+    if (!decoding::write_plot(plot_prefix, panels, so.confidence, why)) {
+      std::fprintf(stderr, "gyrochar-demo: plot: %s\n", why.c_str());
+      code = exit_failure;
+    }
+  }
+  std::fputs(decoding::format_summary(session.decoder(), session.input(), so.shown).c_str(), stderr);
+  std::fprintf(stderr, "gyrochar-demo: %.1f gyro hours, %u nodes, %llu frames on the bus; CSV %s%s%s\n", hours, nodes,
+               static_cast<unsigned long long>(bus.frames_on_bus()), csv_path.c_str(),
+               plot_prefix.empty() ? "" : ", plot ", plot_prefix.empty() ? "" : (plot_prefix + ".svg/.png").c_str());
+  return code;
 }

@@ -1,4 +1,4 @@
-#include "plot.hpp"
+#include "decode_plot.hpp"
 
 #include <fmt/format.h>
 #include <plplot/plstream.h>
