@@ -46,6 +46,15 @@ start() {
   bench_pid[$name]=$!
 }
 running() { kill -0 "${bench_pid[$1]}" 2> /dev/null; }
+# wait_socket NAME: waits (up to 20 s) until NAME has opened a socket (a CAN program is listening).
+wait_socket() {
+  local tries=0
+  until ls -l "/proc/${bench_pid[$1]}/fd" 2> /dev/null | grep -q 'socket:'; do
+    running "$1" || fail "$1 stopped at start"
+    ((++tries <= 200)) || fail "$1 opened no socket within 20 s"
+    sleep 0.1
+  done
+}
 # finish NAME: waits for NAME to end by itself; sets `status` to its exit code.
 finish() {
   status=0
@@ -78,6 +87,7 @@ start_nodes() {
   shift 2
   start decode gyrochar-decode --interface "$decode_if" --rate-unit native --csv /tmp/decoded.csv \
     --jsonl /tmp/decoded.jsonl --view none
+  wait_socket decode  # listening before the first report goes out
   for node in "$@"; do
     start "gyrochard-$node" gyrochard --source can-counter --can-interface "$report_if" --node "$node" \
       --counter-node $((node + 112)) --tau0 "$bench_tau0" --octaves 16

@@ -112,7 +112,8 @@ else
   mkdir -p "$kernel_dir/modules"
   declare -A module_file=() visited=()
   while IFS= read -r f; do
-    n=$(basename "$f" .ko)
+    n=${f##*/}
+    n=${n%.ko}
     module_file[${n//-/_}]=$f
   done < <(find "$unpack/lib/modules/$abi" -name '*.ko')
   load_order=()
