@@ -166,6 +166,29 @@ TEST(Board, ADownedBusCostsReportsButNoSamples) {
   expect_same_sums(rig.board->estimator(), *direct(c, counts));
 }
 
+TEST(Board, MeasuredBusLoadOfOneNodeIsUnderThreePercentOf500kbits) {
+  // 32 taus, one report per second, for 60 s of virtual time: every frame that crossed the bus is
+  // counted at its worst-case length on the wire (maximum stuffing). Oracle: the 3 % budget of the
+  // protocol specification (docs/protocol.md) and the codec's own worst-case figure.
+  Config c = test_config();
+  c.octaves = 32;
+  c.report_period_s = 1.0;
+  Rig rig(c);
+  auto listener = rig.bus.attach(1 << 16);
+  const auto counts = test_counts(60000);
+  rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+  double bits = 0;
+  for (int s = 0; s < 60; ++s) {
+    rig.run_for(1000 * ms);
+    while (auto f = listener->receive()) bits += protocol::worst_case_frame_bits(f->len);
+  }
+  const double load = bits / 60.0 / 500000.0;
+  std::printf("measured bus load, 32 taus at 1 report/s: %.3f %% of 500 kbit/s\n", 100 * load);
+  EXPECT_LE(load, 0.03);
+  EXPECT_LE(load, protocol::worst_case_bus_load(32, 1.0, 500000.0) * (1 + 1e-9));
+  EXPECT_GT(load, 0.5 * protocol::worst_case_bus_load(32, 1.0, 500000.0)) << "reports were sent";
+}
+
 class BoardCheckpoint : public ::testing::Test {
  protected:
   Config c = test_config();
