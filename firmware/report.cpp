@@ -119,8 +119,8 @@ void Estimator::report(std::uint8_t seq, std::uint64_t uptime_ms, const FaultCou
     const NoiseId id = identify_noise(decimation_[i].noise, in);
     const bool known = id.method != NoiseIdMethod::none;
     const std::uint64_t stride = pyramid_.stride(i);
-    const double edf_a = known ? edf_for(EdfStat::avar, id.alpha, r.m, stride, n_phase) : 0.0;
-    const double edf_m = known ? edf_for(EdfStat::mvar, id.alpha, r.m, stride, n_phase) : 0.0;
+    const double edf_a = known ? edf_for_terms(EdfStat::avar, id.alpha, r.m, stride, n_phase, r.n[0]) : 0.0;
+    const double edf_m = known ? edf_for_terms(EdfStat::mvar, id.alpha, r.m, stride, n_phase, r.n[1]) : 0.0;
     const NoiseType noise = known ? noise_type(id.alpha) : NoiseType::not_identified;
     const bool clean = r.out_of_range == 0 && !r.sum_overflow;
     const auto idx = static_cast<std::uint8_t>(i);

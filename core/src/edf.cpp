@@ -169,4 +169,18 @@ double edf_for(EdfStat stat, int alpha, std::uint64_t m, std::uint64_t stride, s
   return edf_greenhall(q);
 }
 
+std::uint64_t unbroken_terms(EdfStat stat, std::uint64_t m, std::uint64_t stride, std::uint64_t n) {
+  if (m == 0 || stride == 0) return 0;
+  const std::uint64_t first = stat == EdfStat::avar ? 2 * m : stat == EdfStat::mvar ? 3 * m - 1 : 3 * m;
+  if (n == 0 || first > n - 1) return 0;
+  return (n - 1) / stride - (first + stride - 1) / stride + 1;  // multiples of stride in [first, n-1]
+}
+
+double edf_for_terms(EdfStat stat, int alpha, std::uint64_t m, std::uint64_t stride, std::uint64_t n, std::uint64_t terms) {
+  const std::uint64_t whole = unbroken_terms(stat, m, stride, n);
+  if (whole == 0 || terms == 0) return 0.0;
+  const double edf = edf_for(stat, alpha, m, stride, n);
+  return terms >= whole ? edf : edf * static_cast<double>(terms) / static_cast<double>(whole);
+}
+
 }  // namespace gyrochar

@@ -96,3 +96,36 @@ TEST(Edf, NotAvailableOutsideTheDomain) {
 
 }  // namespace
 }  // namespace gyrochar
+
+namespace gyrochar {
+namespace {
+
+TEST(Edf, SegmentedRunsScaleByTheTermsFormed) {
+  // Without gaps the scaled EDF is edf_for() itself (oracle: the definition).
+  for (std::uint64_t stride : {1u, 8u, 64u})
+    EXPECT_EQ(edf_for_terms(EdfStat::mvar, 0, 64, stride, 100000, unbroken_terms(EdfStat::mvar, 64, stride, 100000)),
+              edf_for(EdfStat::mvar, 0, 64, stride, 100000));
+  // Term counts of an unbroken run (oracle: counting the grid points by hand): N = 20, m = 2,
+  // stride 1: AVAR e = 4..19 (16), MVAR e = 5..19 (15), HVAR e = 6..19 (14); stride 4: 4, 8, 12, 16.
+  EXPECT_EQ(unbroken_terms(EdfStat::avar, 2, 1, 20), 16u);
+  EXPECT_EQ(unbroken_terms(EdfStat::mvar, 2, 1, 20), 15u);
+  EXPECT_EQ(unbroken_terms(EdfStat::hvar, 2, 1, 20), 14u);
+  EXPECT_EQ(unbroken_terms(EdfStat::avar, 2, 4, 20), 4u);
+  EXPECT_EQ(unbroken_terms(EdfStat::avar, 8, 1, 16), 0u);
+  // k equal independent segments pool to an EDF of k EDF(N/k) (oracle: chi-squared variances add
+  // for independent segments of equal weight). The term-share scaling is at most 4 % below it
+  // (measured: 0.996..1.000 for segments of 625 m and more, 0.971..0.981 for segments of 25 m)
+  // and never above it: the confidence intervals it gives are, if anything, wider.
+  for (int alpha : {2, 1, 0, -1, -2})
+    for (std::uint64_t k : {2u, 4u, 16u, 100u}) {
+      const std::uint64_t n = 160000, m = 64, seg = n / k;
+      const double pooled = static_cast<double>(k) * edf_for(EdfStat::mvar, alpha, m, 1, seg);
+      const std::uint64_t terms = k * unbroken_terms(EdfStat::mvar, m, 1, seg);
+      const double scaled = edf_for_terms(EdfStat::mvar, alpha, m, 1, n, terms);
+      EXPECT_GT(scaled / pooled, 0.96) << "alpha " << alpha << ", " << k << " segments";
+      EXPECT_LE(scaled / pooled, 1.0 + 1e-9) << "alpha " << alpha << ", " << k << " segments";
+    }
+}
+
+}  // namespace
+}  // namespace gyrochar
