@@ -35,10 +35,23 @@ FakeCanNode::~FakeCanNode() {
   if (event_fd_ >= 0) close(event_fd_);
 }
 
+BusState FakeCanNode::state() const {
+  return bus_.down() ? BusState::down : bus_off_ ? BusState::bus_off : BusState::active;
+}
+
+void FakeCanNode::set_bus_off(bool off) {
+  if (off && !bus_off_) ++counters_.bus_off_events;
+  bus_off_ = off;
+}
+
 SendResult FakeCanNode::send(const CanFrame& frame) {
-  if (bus_.down()) {
+  if (bus_.down() || bus_off_) {
     ++counters_.tx_dropped;
     return SendResult::bus_down;
+  }
+  if (tx_full_) {
+    ++counters_.tx_dropped;
+    return SendResult::queue_full;
   }
   ++counters_.sent;
   bus_.deliver(this, frame);

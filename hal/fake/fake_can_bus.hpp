@@ -1,7 +1,8 @@
 #pragma once
 // An in-process CAN bus for host simulation and tests: any number of nodes attach to one bus and
 // each sees the others' frames (not its own, like a CAN controller without loopback). Loss and
-// bus-down are injected deterministically (seeded); each node has a bounded receive queue whose
+// bus-down are injected deterministically (seeded), and per node a full TX queue or bus-off (the
+// controller's own state, as after too many errors); each node has a bounded receive queue whose
 // overflows are counted, and an eventfd that is readable while frames wait, so the same epoll
 // loop runs on it as on SocketCAN.
 #include <cstdint>
@@ -45,7 +46,11 @@ class FakeCanNode final : public CanBus {
   SendResult send(const CanFrame& frame) override;
   std::optional<CanFrame> receive() override;
   int fd() const override { return event_fd_; }
-  BusState state() const override { return bus_.down() ? BusState::down : BusState::active; }
+  BusState state() const override;
+  /// This node's TX queue refuses frames (queue_full, counted) while `full`.
+  void set_tx_full(bool full) { tx_full_ = full; }
+  /// This node's controller goes bus-off (sends fail, one bus-off event counted) or recovers.
+  void set_bus_off(bool off);
   const CanCounters& counters() const override { return counters_; }
 
  private:
@@ -57,6 +62,7 @@ class FakeCanNode final : public CanBus {
   std::deque<CanFrame> rx_;
   CanCounters counters_;
   int event_fd_ = -1;
+  bool tx_full_ = false, bus_off_ = false;
 };
 
 }  // namespace gyrochar::hal

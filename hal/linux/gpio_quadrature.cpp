@@ -109,7 +109,11 @@ void GpioQuadratureSource::poll(std::uint64_t now_ns, CountSink& sink) {
     const Event e = next->events[next->head++];
     decoder_.on_edge(e.t_ns, line == 0 ? QuadratureLine::a : QuadratureLine::b, e.level, sink);
   }
-  decoder_.close_until(now_ns, sink);
+  // With a backlog left in the kernel (an edge storm), time must not close intervals its edges
+  // belong to: the edges themselves move the intervals on.
+  bool backlog = false;
+  for (const Queue& q : queues_) backlog = backlog || q.size == batch;
+  if (!backlog) decoder_.close_until(now_ns, sink);
 }
 
 }  // namespace gyrochar::hal

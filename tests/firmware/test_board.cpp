@@ -189,6 +189,74 @@ TEST(Board, MeasuredBusLoadOfOneNodeIsUnderThreePercentOf500kbits) {
   EXPECT_GT(load, 0.5 * protocol::worst_case_bus_load(32, 1.0, 500000.0)) << "reports were sent";
 }
 
+TEST(Board, FullTxQueueAndBusOffAreCountedReportedAndSurvived) {
+  // Oracles: the fake node's own counters, and the board's status frames as decoded by the codec.
+  const Config c = test_config();
+  Rig rig(c);
+  auto listener = rig.bus.attach(1 << 16);
+  const auto counts = test_counts(4000);
+  rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+  rig.run_for(1000 * ms);
+  rig.board_node->set_tx_full(true);
+  rig.run_for(500 * ms);
+  rig.board_node->set_tx_full(false);
+  rig.board_node->set_bus_off(true);
+  rig.run_for(500 * ms);
+  rig.board_node->set_bus_off(false);
+  while (listener->receive()) {
+  }
+  rig.run_for(2000 * ms);
+  EXPECT_EQ(rig.board->estimator().samples(), counts.size()) << "accumulation never stopped";
+  expect_same_sums(rig.board->estimator(), *direct(c, counts));
+  std::optional<protocol::StatusFaultsMsg> faults;
+  while (auto f = listener->receive()) {
+    const protocol::Decoded d = protocol::decode(*f);
+    if (const auto* m = std::get_if<protocol::StatusFaultsMsg>(&d.message)) faults = *m;
+  }
+  ASSERT_TRUE(faults.has_value()) << "reports resumed after the faults";
+  EXPECT_EQ(faults->tx_dropped_frames, rig.board_node->counters().tx_dropped);
+  EXPECT_GT(faults->tx_dropped_frames, 0u);
+  EXPECT_EQ(faults->bus_off_events, 1u);
+}
+
+TEST(Board, EdgeStormsAreWorkedOffInBoundedPassesAndClockJumpsAreOneGap) {
+  // Oracles: the fake source's batch bound (256 edges per pass) and the quadrature decoder's stall
+  // rule (a silence over max_silent_intervals is one gap sample).
+  const Config c = test_config();
+  Rig rig(c);
+  hal::QuadratureSettings q;
+  q.start_ns = rig.clock.now_ns();
+  q.tau0_ns = ms;
+  q.max_silent_intervals = 1000;
+  rig.source.use_quadrature(q);
+  // 100000 edges inside the first millisecond: 25000 forward cycles.
+  const bool cycle[4][2] = {{false, false}, {true, false}, {true, true}, {false, true}};
+  for (int e = 0; e < 100000; ++e) {
+    const int from = e % 4, to = (e + 1) % 4;
+    const bool a_changes = cycle[from][0] != cycle[to][0];
+    rig.source.push_edge(q.start_ns + static_cast<std::uint64_t>(e) * 5, a_changes ? hal::QuadratureLine::a : hal::QuadratureLine::b,
+                         a_changes ? cycle[to][0] : cycle[to][1]);
+  }
+  rig.clock.advance(2 * ms);
+  rig.timer.update();
+  ASSERT_TRUE(rig.board->run_once(0));
+  EXPECT_EQ(rig.source.counters().edges, hal::FakeCountSource::batch) << "one pass, one batch";
+  int passes = 1;
+  while (rig.source.counters().edges < 100000 && passes < 10000) {
+    ASSERT_TRUE(rig.board->run_once(0));
+    ++passes;
+  }
+  EXPECT_EQ(passes, (100000 + 255) / 256);
+  EXPECT_EQ(rig.board->estimator().samples(), 1u) << "the storm's interval, closed once its backlog is read";
+  EXPECT_EQ(rig.source.counters().late_edges, 0u);
+  // The clock jumps a day ahead: one pass, one gap, nothing bridged.
+  rig.clock.advance(86400ull * 1000 * ms);
+  rig.timer.update();
+  ASSERT_TRUE(rig.board->run_once(0));
+  EXPECT_EQ(rig.board->faults().sample_gaps, 1u);
+  EXPECT_EQ(rig.board->estimator().samples(), 1u);
+}
+
 class BoardCheckpoint : public ::testing::Test {
  protected:
   Config c = test_config();
