@@ -42,7 +42,6 @@ ParseResult parse_config(int argc, const char* const* argv) {
   app.add_option("--stride-factor", c.stride_factor, "stride factor S, power of two 2..64")->capture_default_str();
   app.add_option("--octaves", c.octaves, "number of octave taus, 1..40")->capture_default_str();
   app.add_option("--report-period", c.report_period_s, "seconds between reports")->capture_default_str();
-  app.add_option("--metadata-period", c.metadata_period_s, "seconds between metadata frames")->capture_default_str();
   app.add_option("--checkpoint", c.checkpoint_path, "checkpoint file (empty: none)");
   app.add_option("--checkpoint-period", c.checkpoint_period_s, "seconds between checkpoints")->capture_default_str();
   app.add_flag("--verbose", c.verbose, "log every report");
@@ -84,7 +83,6 @@ std::optional<ConfigError> validate(const Config& c) {
   if (c.octaves < 1 || c.octaves > 40) return ConfigError{"octaves", "must be 1..40"};
   if (!positive(c.report_period_s) || c.report_period_s < c.tau0_s)
     return ConfigError{"report-period", "must be at least tau0"};
-  if (!positive(c.metadata_period_s)) return ConfigError{"metadata-period", "must be positive"};
   if (!c.checkpoint_path.empty() && !positive(c.checkpoint_period_s))
     return ConfigError{"checkpoint-period", "must be positive"};
   if (c.can_interface.empty() || c.can_interface.size() > 15)
