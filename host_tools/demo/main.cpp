@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "board.hpp"
+#include "candump.hpp"
 #include "decode_plot.hpp"
 #include "decode_session.hpp"
 #include "gyro_sim.hpp"
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
              "Exit codes: 0 success, 1 an output could not be written, 2 bad options.");
   double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30;
   unsigned nodes = 2, octaves = 20;
-  std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo";
+  std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo", candump_path;
   app.add_option("--hours", hours, "gyro hours to simulate")->capture_default_str();
   app.add_option("--nodes", nodes, "gyro boards on the bus (1..8)")->capture_default_str();
   app.add_option("--tau0", tau0, "sample interval in seconds")->capture_default_str();
@@ -59,6 +60,7 @@ int main(int argc, char** argv) {
   app.add_option("--csv", csv_path, "decoded reports as CSV (one row per node, report and tau)")->capture_default_str();
   app.add_option("--plot", plot_prefix, "ADEV/MDEV plot written to PREFIX.svg and PREFIX.png (empty: none)")
       ->capture_default_str();
+  app.add_option("--candump", candump_path, "also record the bus as a candump log (canplayer replays it)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -81,6 +83,12 @@ int main(int argc, char** argv) {
   FILE* csv = std::fopen(csv_path.c_str(), "w");
   if (csv == nullptr) {
     std::fprintf(stderr, "gyrochar-demo: %s: cannot write\n", csv_path.c_str());
+    return exit_failure;
+  }
+
+  FILE* candump = nullptr;
+  if (!candump_path.empty() && (candump = std::fopen(candump_path.c_str(), "w")) == nullptr) {
+    std::fprintf(stderr, "gyrochar-demo: %s: cannot write\n", candump_path.c_str());
     return exit_failure;
   }
 
@@ -145,7 +153,10 @@ int main(int argc, char** argv) {
     }
     scripted_ns += n * tau0_ns;
     const double t_s = static_cast<double>(clock.now_ns() - start_ns) * 1e-9;
-    while (auto frame = host->receive()) session.feed(*frame, t_s);
+    while (auto frame = host->receive()) {
+      session.feed(*frame, t_s);
+      if (candump != nullptr) std::fprintf(candump, "%s\n", format_candump_line(t_s, "vcan0", *frame).c_str());
+    }
     if (view_every_ns != 0 && clock.now_ns() >= next_view_ns) {
       show();
       next_view_ns += view_every_ns;
@@ -154,6 +165,10 @@ int main(int argc, char** argv) {
   session.finish();
   show();
   int code = exit_ok;
+  if (candump != nullptr && std::fclose(candump) != 0) {
+    std::fprintf(stderr, "gyrochar-demo: %s: write failed\n", candump_path.c_str());
+    code = exit_failure;
+  }
   if (std::fclose(csv) != 0) {
     std::fprintf(stderr, "gyrochar-demo: %s: write failed\n", csv_path.c_str());
     code = exit_failure;

@@ -4,15 +4,21 @@
 //   gyrochar_dbc_frames --expected   the same frames as JSON: for each, the candump line, the value
 //                                    of every DBC signal as the codec decodes the frame, and the
 //                                    VAL_ name of every enumeration
+//   gyrochar_dbc_frames --log FILE [--expected]
+//                                    the same for the frames of a candump log captured from a run
+//                                    (gyrochar-demo --candump): lines that are not gyrochar frames
+//                                    are an error
 //
 // The frames are four paced reports of a 3-tau node (every slot of the schedule, sequence wrapping
 // 254 -> 1) and a set of messages at their range limits, covering every enumeration value.
+#include <cerrno>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -165,27 +171,60 @@ std::vector<Entry> frames() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool want_json = argc == 2 && std::strcmp(argv[1], "--expected") == 0;
-  if (argc > 2 || (argc == 2 && !want_json)) {
-    std::fprintf(stderr, "usage: gyrochar_dbc_frames [--expected]\n"
-                         "  prints codec frames as a candump log, or with --expected as JSON with the\n"
-                         "  value of every DBC signal\n");
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  bool want_json = false;
+  std::string log_path;
+  bool usage = false;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    if (args[k] == "--expected") want_json = true;
+    else if (args[k] == "--log" && k + 1 < args.size()) log_path = args[++k];
+    else usage = true;
+  }
+  if (usage) {
+    std::fprintf(stderr, "usage: gyrochar_dbc_frames [--log FILE] [--expected]\n"
+                         "  prints codec frames (or those of a candump log) as a candump log, or with\n"
+                         "  --expected as JSON with the value of every DBC signal\n");
     return 2;
   }
-  json all = json::array();
-  for (const Entry& e : frames()) {
-    CanFrame f;
-    if (const ProtocolError err = encode(e.message, e.node, f); err != ProtocolError::none) {
-      std::fprintf(stderr, "gyrochar_dbc_frames: encode: %s\n", name(err));
+  std::vector<std::tuple<double, std::string, CanFrame>> frames_out;  // time, interface, frame
+  if (log_path.empty()) {
+    for (const Entry& e : frames()) {
+      CanFrame f;
+      if (const ProtocolError err = encode(e.message, e.node, f); err != ProtocolError::none) {
+        std::fprintf(stderr, "gyrochar_dbc_frames: encode: %s\n", name(err));
+        return 1;
+      }
+      frames_out.emplace_back(static_cast<double>(e.t_us) * 1e-6, "can0", f);
+    }
+  } else {
+    std::FILE* in = std::fopen(log_path.c_str(), "r");
+    if (in == nullptr) {
+      std::fprintf(stderr, "gyrochar_dbc_frames: %s: %s\n", log_path.c_str(), std::strerror(errno));
       return 1;
     }
+    char buffer[256];
+    gyrochar::CandumpLine parsed;
+    std::string why;
+    while (std::fgets(buffer, sizeof buffer, in) != nullptr) {
+      std::string_view line(buffer);
+      while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
+      if (!gyrochar::parse_candump_line(line, parsed, why)) {
+        std::fprintf(stderr, "gyrochar_dbc_frames: %s: %s\n", log_path.c_str(), why.c_str());
+        return 1;
+      }
+      frames_out.emplace_back(parsed.time_s, parsed.interface, parsed.frame);
+    }
+    std::fclose(in);
+  }
+  json all = json::array();
+  for (const auto& [t_s, interface, f] : frames_out) {
     // Expected values come from what the codec decodes, so they carry the wire's quantization.
     const Decoded d = decode(f);
     if (d.error != ProtocolError::none) {
       std::fprintf(stderr, "gyrochar_dbc_frames: decode: %s\n", name(d.error));
       return 1;
     }
-    const std::string line = gyrochar::format_candump_line(static_cast<double>(e.t_us) * 1e-6, "can0", f);
+    const std::string line = gyrochar::format_candump_line(t_s, interface, f);
     if (!want_json) {
       std::puts(line.c_str());
       continue;
