@@ -153,6 +153,8 @@ Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not
   };
   if (!(p.tau0_s > 0)) return bad("--tau0", "must be positive");
   if (!(duration_s >= p.tau0_s)) return bad("--duration", "must be at least tau0");
+  if (!(duration_s / p.tau0_s <= 1e12)) return bad("--duration", "more than 10^12 samples of tau0");
+  if (!std::isfinite(rate_dph) || std::fabs(rate_dph) > 1e9) return bad("--rate", "must be a finite rate in deg/h");
   if (!(pulse_arcsec > 0)) return bad("--pulse-weight", "must be positive");
   for (double v : {q_arcsec, arw, rrw, ramp, bias, dither_arcsec, dither_hz})
     if (!(v >= 0) || !std::isfinite(v)) return bad("noise parameters", "must be finite and >= 0");
