@@ -78,6 +78,12 @@ Board::Board(const Config& config, BoardIo io)
   next_checkpoint_ns_ = start_ns_ + checkpoint_period_ns_;
   frames_ = protocol::report_frame_count(0, config.octaves);
 
+  // The board listens to its counter electronics only (or to nothing: a GPIO source); error
+  // frames always come through.
+  const hal::CanFilter counter_frames{protocol::counter_input_id | config.counter_node, 0x1FFFFFFF};
+  if (!io.can.set_filters(io.source ? std::span<const hal::CanFilter>{} : std::span(&counter_frames, 1)))
+    throw std::invalid_argument("the CAN interface refused the receive filters");
+
   epoll_ = epoll_create1(EPOLL_CLOEXEC);
   for (const int fd : {io.can.fd(), io.timer.fd(), io.source ? io.source->fd() : -1, io.stop_fd}) {
     if (fd < 0) continue;

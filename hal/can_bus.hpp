@@ -4,6 +4,7 @@
 // hal/linux/socketcan.hpp (raw SocketCAN) and hal/fake/fake_can_bus.hpp (in-process bus).
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include "gyrochar/can_frame.hpp"
 
@@ -18,6 +19,14 @@ struct CanCounters {
   std::uint64_t rx_dropped = 0;   // lost in the socket's receive queue (SO_RXQ_OVFL)
   std::uint64_t error_frames = 0;
   std::uint64_t bus_off_events = 0;
+  std::uint8_t tx_error_counter = 0;  // the controller's TEC and REC, as its last error frame said
+  std::uint8_t rx_error_counter = 0;
+};
+
+/// A receive filter on 29-bit identifiers: a frame passes when (frame.id & mask) == (id & mask).
+struct CanFilter {
+  std::uint32_t id = 0;
+  std::uint32_t mask = 0;
 };
 
 enum class SendResult : std::uint8_t { sent, queue_full, bus_down };
@@ -32,6 +41,9 @@ class CanBus {
   virtual std::optional<CanFrame> receive() = 0;
   /// A file descriptor that becomes readable when a frame is waiting (for epoll).
   virtual int fd() const = 0;
+  /// Receives only extended data frames that pass one of `filters` (none: no data frames at all);
+  /// error frames always come through. Returns false when the backend refused the filters.
+  virtual bool set_filters(std::span<const CanFilter> filters) = 0;
   virtual BusState state() const = 0;
   virtual const CanCounters& counters() const = 0;
 };

@@ -58,7 +58,18 @@ SendResult FakeCanNode::send(const CanFrame& frame) {
   return SendResult::sent;
 }
 
+bool FakeCanNode::set_filters(std::span<const CanFilter> filters) {
+  filters_.assign(filters.begin(), filters.end());
+  filtered_ = true;
+  return true;
+}
+
 void FakeCanNode::push(const CanFrame& frame) {
+  if (filtered_ && !frame.error) {
+    bool pass = false;
+    for (const CanFilter& f : filters_) pass = pass || (frame.extended && (frame.id & f.mask) == (f.id & f.mask));
+    if (!pass) return;
+  }
   if (rx_.size() >= capacity_) {
     ++counters_.rx_dropped;
     return;

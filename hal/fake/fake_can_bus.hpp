@@ -46,6 +46,7 @@ class FakeCanNode final : public CanBus {
   SendResult send(const CanFrame& frame) override;
   std::optional<CanFrame> receive() override;
   int fd() const override { return event_fd_; }
+  bool set_filters(std::span<const CanFilter> filters) override;
   BusState state() const override;
   /// This node's TX queue refuses frames (queue_full, counted) while `full`.
   void set_tx_full(bool full) { tx_full_ = full; }
@@ -63,6 +64,8 @@ class FakeCanNode final : public CanBus {
   CanCounters counters_;
   int event_fd_ = -1;
   bool tx_full_ = false, bus_off_ = false;
+  bool filtered_ = false;
+  std::vector<CanFilter> filters_;
 };
 
 }  // namespace gyrochar::hal

@@ -53,7 +53,8 @@ SendResult SocketCan::send(const CanFrame& f) {
   const std::size_t size = f.fd ? CANFD_MTU : CAN_MTU;
   if (write(fd_, &raw, size) == static_cast<ssize_t>(size)) {
     ++counters_.sent;
-    if (state_ == BusState::down) state_ = BusState::active;
+    // The queue takes frames again: the interface is up and the controller out of bus-off.
+    if (state_ == BusState::down || state_ == BusState::bus_off) state_ = BusState::active;
     return SendResult::sent;
   }
   ++counters_.tx_dropped;
@@ -62,6 +63,16 @@ SendResult SocketCan::send(const CanFrame& f) {
     return SendResult::bus_down;
   }
   return SendResult::queue_full;
+}
+
+bool SocketCan::set_filters(std::span<const CanFilter> filters) {
+  constexpr std::size_t max_filters = 16;
+  if (filters.size() > max_filters) return false;
+  can_filter raw[max_filters];
+  for (std::size_t k = 0; k < filters.size(); ++k)
+    raw[k] = {(filters[k].id & CAN_EFF_MASK) | CAN_EFF_FLAG, (filters[k].mask & CAN_EFF_MASK) | CAN_EFF_FLAG | CAN_RTR_FLAG};
+  return setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, filters.empty() ? nullptr : raw,
+                    static_cast<socklen_t>(filters.size() * sizeof(can_filter))) == 0;
 }
 
 std::optional<CanFrame> SocketCan::receive() {
@@ -94,6 +105,12 @@ std::optional<CanFrame> SocketCan::receive() {
   std::memcpy(f.data.data(), raw.data, f.len);
   if (f.error) {
     ++counters_.error_frames;
+#ifdef CAN_ERR_CNT
+    if ((f.id & CAN_ERR_CNT) && f.len >= 8) {
+      counters_.tx_error_counter = raw.data[6];
+      counters_.rx_error_counter = raw.data[7];
+    }
+#endif
     if (f.id & CAN_ERR_BUSOFF) {
       if (state_ != BusState::bus_off) ++counters_.bus_off_events;
       state_ = BusState::bus_off;

@@ -21,6 +21,7 @@ class SocketCan final : public CanBus {
   SendResult send(const CanFrame& frame) override;
   std::optional<CanFrame> receive() override;
   int fd() const override { return fd_; }
+  bool set_filters(std::span<const CanFilter> filters) override;
   BusState state() const override { return state_; }
   const CanCounters& counters() const override { return counters_; }
 

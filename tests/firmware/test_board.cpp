@@ -257,6 +257,38 @@ TEST(Board, EdgeStormsAreWorkedOffInBoundedPassesAndClockJumpsAreOneGap) {
   EXPECT_EQ(rig.board->estimator().samples(), 1u);
 }
 
+TEST(Board, CounterFramesFromItsElectronicsOnlyBecomeTheExactCounts) {
+  // CounterInput frames from node 0x80 carry the accumulated count; another electronics (0x81)
+  // shares the bus and must be filtered out. Oracle: an estimator fed the counts directly.
+  Config c = test_config();
+  c.source = SourceKind::can_counter;
+  c.counter_node = 0x80;
+  hal::FakeCanBus bus;
+  auto board_node = bus.attach(), electronics = bus.attach();
+  hal::FakeClock clock;
+  hal::FakeTimer timer(clock);
+  Board board(c, BoardIo{*board_node, nullptr, clock, timer});
+  const auto counts = test_counts(2000);
+  std::uint32_t accumulated = 0;
+  for (std::size_t k = 0; k <= counts.size(); ++k) {
+    if (k > 0) accumulated += static_cast<std::uint32_t>(counts[k - 1]);
+    for (const std::uint8_t node : {std::uint8_t{0x80}, std::uint8_t{0x81}}) {
+      protocol::CounterInputMsg m;
+      m.count = node == 0x80 ? accumulated : 7 * static_cast<std::uint32_t>(k);
+      m.seq = static_cast<std::uint8_t>(k);
+      CanFrame f;
+      ASSERT_EQ(protocol::encode(m, node, f), protocol::ProtocolError::none);
+      electronics->send(f);
+    }
+    clock.advance(ms);
+    timer.update();
+    ASSERT_TRUE(board.run_once(0));
+  }
+  EXPECT_EQ(board.estimator().samples(), counts.size());
+  expect_same_sums(board.estimator(), *direct(c, counts));
+  EXPECT_EQ(board_node->counters().received, counts.size() + 1) << "the other node's frames never reached the board";
+}
+
 class BoardCheckpoint : public ::testing::Test {
  protected:
   Config c = test_config();

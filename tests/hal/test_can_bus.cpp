@@ -80,3 +80,37 @@ TEST(SocketCan, MissingInterfaceGivesAClearError) {
 
 }  // namespace
 }  // namespace gyrochar::hal
+
+namespace gyrochar::hal {
+namespace {
+
+TEST(FakeCanBus, FiltersPassMatchingExtendedFramesAndErrorFrames) {
+  // Oracle: the filter rule (frame.id & mask) == (id & mask), extended data frames only.
+  FakeCanBus bus;
+  auto a = bus.attach(), b = bus.attach();
+  const CanFilter only_0x80[] = {{0x0CFF5080, 0x1FFFFFFF}};
+  ASSERT_TRUE(b->set_filters(only_0x80));
+  CanFrame pass;
+  pass.id = 0x0CFF5080;
+  pass.extended = true;
+  CanFrame other = pass;
+  other.id = 0x0CFF5081;
+  CanFrame standard = pass;
+  standard.extended = false;
+  standard.id = 0x80;
+  CanFrame error;
+  error.error = true;
+  error.id = 0x40;
+  for (const CanFrame& f : {pass, other, standard, error}) a->send(f);
+  auto first = b->receive(), second = b->receive();
+  ASSERT_TRUE(first && second);
+  EXPECT_EQ(first->id, 0x0CFF5080u);
+  EXPECT_TRUE(second->error);
+  EXPECT_FALSE(b->receive());
+  ASSERT_TRUE(b->set_filters({}));  // nothing but error frames
+  a->send(pass);
+  EXPECT_FALSE(b->receive());
+}
+
+}  // namespace
+}  // namespace gyrochar::hal
