@@ -9,10 +9,10 @@ for p in valgrind time libbenchmark-dev; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || {
     echo "benchmarks.sh: installing $p" >&2; apt-get install -y -qq "$p" >/dev/null; }
 done
-cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release -DGYROCHAR_BENCHMARKS=ON >/dev/null
-cmake --build build/bench >/dev/null
+cmake -S . -B build/perf -G Ninja -DCMAKE_BUILD_TYPE=Release -DGYROCHAR_BENCHMARKS=ON >/dev/null
+cmake --build build/perf >/dev/null
 out=BENCHMARKS.md
-data=build/bench/data
+data=build/perf/data
 mkdir -p "$data"
 
 {
@@ -29,14 +29,14 @@ echo "40 octave taus, ADEV+MDEV+HDEV per tau, counts of about 1000 pulses; batch
 echo "fully overlapped estimators, O(N) per tau, whole series in memory."
 echo
 echo '```'
-build/bench/tests/bench_pyramid --benchmark_min_time=0.5 2>/dev/null | grep -E "^(Benchmark|PerSample|Block|FullStride|Batch|-)"
+build/perf/tests/bench_pyramid --benchmark_min_time=0.5 2>/dev/null | grep -E "^(Benchmark|PerSample|Block|FullStride|Batch|-)"
 echo '```'
 echo
 echo "## Instructions per sample (callgrind)"
 echo
-base=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null build/bench/tests/bench_per_sample 0 2>&1 | awk '/refs/{gsub(",","",$4); print $4}')
-run=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null build/bench/tests/bench_per_sample 2000000 2>&1 | awk '/refs/{gsub(",","",$4); print $4}')
-echo "\`valgrind --tool=callgrind build/bench/tests/bench_per_sample 2000000\` minus the same with 0:"
+base=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null build/perf/tests/bench_per_sample 0 2>&1 | awk '/refs/{gsub(",","",$4); print $4}')
+run=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null build/perf/tests/bench_per_sample 2000000 2>&1 | awk '/refs/{gsub(",","",$4); print $4}')
+echo "\`valgrind --tool=callgrind build/perf/tests/bench_per_sample 2000000\` minus the same with 0:"
 echo "**$(( (run - base) / 2000000 )) instructions per sample** (40 octaves, S = 8, per-sample API; target 200)."
 echo
 echo "## gyrochar-analyze on counts files"
@@ -45,8 +45,8 @@ echo "| samples | file | wall time | samples/s | peak RSS |"
 echo "|---|---|---|---|---|"
 for n in 1000000 100000000; do
   f=$data/counts_$n.txt
-  [ -f "$f" ] || build/bench/host_tools/gyrochar-sim --duration $((n / 100)) --tau0 0.01 --arw 0.003 --white-angle 3 --out "$f"
-  /usr/bin/time -v build/bench/host_tools/gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1 \
+  [ -f "$f" ] || build/perf/host_tools/gyrochar-sim --duration $((n / 100)) --tau0 0.01 --arw 0.003 --white-angle 3 --out "$f"
+  /usr/bin/time -v build/perf/host_tools/gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1 \
       --stats oadev,mdev,ohdev --stride-factor 8 --format csv "$f" > /dev/null 2> "$data/time_$n.txt"
   wall=$(awk -F': ' '/Elapsed/{print $2}' "$data/time_$n.txt")
   rss=$(awk -F': ' '/Maximum resident/{print $2}' "$data/time_$n.txt")
@@ -59,7 +59,7 @@ echo "grow with the file: the analyzer streams."
 echo
 echo "## State size"
 echo
-echo "$(build/bench/tests/core_test_pyramid_alloc --gtest_filter='*StateSize*' | grep sizeof) (budget 16 KiB)."
+echo "$(build/perf/tests/core_test_pyramid_alloc --gtest_filter='*StateSize*' | grep sizeof) (budget 16 KiB)."
 echo
 echo "## Freestanding core on Cortex-M (MCU example: 40-octave S = 8 pyramid and a snapshot)"
 echo

@@ -10,18 +10,35 @@
 
 #include <cerrno>
 #include <cstring>
+#include <ctime>
 #include <stdexcept>
 
 namespace gyrochar::hal {
 
-SocketCan::SocketCan(const std::string& interface) {
+namespace {
+
+// The interface's index, or 0 when there is no such interface now.
+int interface_index(int fd, const std::string& name) {
+  ifreq ifr{};
+  std::strncpy(ifr.ifr_name, name.c_str(), IFNAMSIZ - 1);
+  return ioctl(fd, SIOCGIFINDEX, &ifr) < 0 ? 0 : ifr.ifr_ifindex;
+}
+
+std::uint64_t monotonic_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::uint64_t>(ts.tv_sec) * 1000u + static_cast<std::uint64_t>(ts.tv_nsec) / 1000000u;
+}
+
+}  // namespace
+
+SocketCan::SocketCan(const std::string& interface) : name_(interface) {
   if (interface.empty() || interface.size() >= IFNAMSIZ)
     throw std::runtime_error(interface + ": not a valid interface name");
   fd_ = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
   if (fd_ < 0) throw std::runtime_error(std::string("cannot open a CAN socket: ") + std::strerror(errno));
-  ifreq ifr{};
-  std::strncpy(ifr.ifr_name, interface.c_str(), IFNAMSIZ - 1);
-  if (ioctl(fd_, SIOCGIFINDEX, &ifr) < 0) {
+  ifindex_ = interface_index(fd_, interface);
+  if (ifindex_ == 0) {
     const int e = errno;
     close(fd_);
     throw std::runtime_error(interface + ": " + std::strerror(e));
@@ -31,9 +48,12 @@ SocketCan::SocketCan(const std::string& interface) {
   const int on = 1;
   setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on);
   setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on);  // refused on classic-only: fine
+  // Bound to every CAN interface (index 0), sending to and keeping frames of ours by index: an
+  // interface that vanishes and comes back (a USB adapter re-plugged) gets a new index, which
+  // send() finds again without a new socket, so the descriptor the caller polls stays valid.
   sockaddr_can addr{};
   addr.can_family = AF_CAN;
-  addr.can_ifindex = ifr.ifr_ifindex;
+  addr.can_ifindex = 0;
   if (bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) {
     const int e = errno;
     close(fd_);
@@ -46,18 +66,33 @@ SocketCan::~SocketCan() {
 }
 
 SendResult SocketCan::send(const CanFrame& f) {
+  if (ifindex_ == 0) {  // vanished: look for it again, at most once a second
+    const std::uint64_t now = monotonic_ms();
+    if (now - last_lookup_ms_ >= 1000) {
+      last_lookup_ms_ = now;
+      ifindex_ = interface_index(fd_, name_);
+    }
+    if (ifindex_ == 0) {
+      ++counters_.tx_dropped;
+      return SendResult::bus_down;
+    }
+  }
   canfd_frame raw{};
   raw.can_id = f.id | (f.extended ? CAN_EFF_FLAG : 0u);
   raw.len = f.len;
   std::memcpy(raw.data, f.data.data(), f.len);
   const std::size_t size = f.fd ? CANFD_MTU : CAN_MTU;
-  if (write(fd_, &raw, size) == static_cast<ssize_t>(size)) {
+  sockaddr_can to{};
+  to.can_family = AF_CAN;
+  to.can_ifindex = ifindex_;
+  if (sendto(fd_, &raw, size, 0, reinterpret_cast<const sockaddr*>(&to), sizeof to) == static_cast<ssize_t>(size)) {
     ++counters_.sent;
     // The queue takes frames again: the interface is up and the controller out of bus-off.
     if (state_ == BusState::down || state_ == BusState::bus_off) state_ = BusState::active;
     return SendResult::sent;
   }
   ++counters_.tx_dropped;
+  if (errno == ENODEV || errno == ENXIO) ifindex_ = 0;  // the interface is gone
   if (errno == ENETDOWN || errno == ENXIO || errno == ENODEV) {
     state_ = BusState::down;
     return SendResult::bus_down;
@@ -79,15 +114,30 @@ std::optional<CanFrame> SocketCan::receive() {
   canfd_frame raw{};
   iovec iov{&raw, sizeof raw};
   alignas(cmsghdr) char control[CMSG_SPACE(sizeof(std::uint32_t))];
+  sockaddr_can from{};
   msghdr msg{};
-  msg.msg_iov = &iov;
-  msg.msg_iovlen = 1;
-  msg.msg_control = control;
-  msg.msg_controllen = sizeof control;
-  const ssize_t n = recvmsg(fd_, &msg, MSG_DONTWAIT);
-  if (n < static_cast<ssize_t>(CAN_MTU)) {
-    if (n < 0 && (errno == ENETDOWN || errno == ENODEV)) state_ = BusState::down;
-    return std::nullopt;
+  ssize_t n = 0;
+  for (int skipped = 0;; ++skipped) {  // frames of other CAN interfaces are not ours: skip them
+    msg = msghdr{};
+    msg.msg_name = &from;
+    msg.msg_namelen = sizeof from;
+    msg.msg_iov = &iov;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control;
+    msg.msg_controllen = sizeof control;
+    n = recvmsg(fd_, &msg, MSG_DONTWAIT);
+    if (n < static_cast<ssize_t>(CAN_MTU)) {
+      if (n < 0 && (errno == ENETDOWN || errno == ENODEV)) state_ = BusState::down;
+      return std::nullopt;
+    }
+    if (from.can_ifindex == ifindex_) break;
+    // Ours may have come back under a new index (a receive-only user never sends to find out).
+    if (const std::uint64_t now = monotonic_ms(); now - last_lookup_ms_ >= 1000) {
+      last_lookup_ms_ = now;
+      if (const int index = interface_index(fd_, name_); index != 0) ifindex_ = index;
+      if (from.can_ifindex == ifindex_) break;
+    }
+    if (skipped == 255) return std::nullopt;  // bounded: the descriptor stays readable
   }
   for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
     if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {

@@ -2,7 +2,8 @@
 // Raw SocketCAN backend of hal::CanBus: non-blocking socket bound to one interface, error frames
 // enabled (bus state and bus-off events), SO_RXQ_OVFL for receive-queue drops, CAN FD frames
 // accepted where the interface allows. A full TX queue (ENOBUFS/EAGAIN) and a downed interface
-// (ENETDOWN) are counted, never waited for.
+// (ENETDOWN) are counted, never waited for. An interface that vanishes is looked for again (once
+// a second, by name) and used again when it is back, on the same descriptor.
 #include <string>
 
 #include "hal/can_bus.hpp"
@@ -26,7 +27,10 @@ class SocketCan final : public CanBus {
   const CanCounters& counters() const override { return counters_; }
 
  private:
+  std::string name_;
   int fd_ = -1;
+  int ifindex_ = 0;  // 0: the interface is gone
+  std::uint64_t last_lookup_ms_ = 0;
   BusState state_ = BusState::active;
   CanCounters counters_;
 };
