@@ -57,6 +57,15 @@ echo
 echo "Both runs read the file twice (first pass counts the values to choose the taus). Peak RSS does not"
 echo "grow with the file: the analyzer streams."
 echo
+echo "## Decoder (gyrochar-decode's pipeline)"
+echo
+echo "A candump log of 10^7 frames (4 nodes, 32 taus, one report per second each), read in blocks,"
+echo "parsed and decoded in one process (\`build/perf/tests/bench_decode 10000000\`):"
+echo
+echo '```'
+build/perf/tests/bench_decode 10000000
+echo '```'
+echo
 echo "## State size"
 echo
 echo "$(build/perf/tests/core_test_pyramid_alloc --gtest_filter='*StateSize*' | grep sizeof) (budget 16 KiB)."
