@@ -3,9 +3,10 @@
 // (emulated) CAN interface and what gyrochar-analyze computed offline, and says whether they agree.
 //
 //   gyrochar-bench link --jsonl decoded.jsonl --node 17 --node 18 [--expect-gap] [--min-reports 5]
+//                       [--lost-edges N]
 //     Every node was decoded; without --expect-gap no report was lost or incomplete (the last one
 //     may be cut by the end of the recording), no restart, no offline event, no rejected frame,
-//     and the nodes counted no sample gap or lost edge. With --expect-gap: the link went away
+//     and the nodes counted no sample gap and exactly N (default 0) lost edges. With --expect-gap: the link went away
 //     (lost reports or an offline event), the node did not restart, and at least --min-reports
 //     complete reports followed.
 //   gyrochar-bench estimates --jsonl decoded.jsonl --csv decoded.csv --node 17 --samples 3000
@@ -16,12 +17,41 @@
 //     deg/s, pulse weight 1 arcsec; the node reports in arcsec/s, recorded with --rate-unit
 //     native). The CSV recording must hold the same values as the JSON lines.
 //
-// Output: one line per node on stdout; problems as `gyrochar-bench: what: why` on stderr.
-// Exit codes: 0 agree, 1 disagree, 2 bad options or unreadable input.
+//   gyrochar-bench quadrature --chip /dev/gpiochip0 --sim /sys/devices/platform/gpio-sim.0/gpiochip0
+//                             --tau0 0.1 --counts counts.txt --expected expected.txt [--overflow-every K]
+//     The quadrature signal generator: plays the counts as 4x quadrature A/B edges on two gpio-sim
+//     lines, one tau0 interval per count, by writing pull-up / pull-down to the lines' sysfs
+//     `pull` attributes; it runs SCHED_FIFO, like a generator that does not wait for its DUT. The
+//     intervals are gyrochard's own: gyrochard takes its grid's origin just before it requests
+//     line A, and the kernel timestamps that request (line info watch, GPIO uAPI v2), so each
+//     interval's edges are played in the first half of that interval. --expected gets the sample
+//     stream gyrochard must count, from the times the edges were actually made (an emulator stall
+//     may push edges late): silent intervals before the first edge as zeros, then every interval
+//     up to the last edge gyrochard sees.
+//     --overflow-every K: every K-th interval also gets 17 back-and-forth edges on line A, made
+//     once gyrochard (--reader) sleeps with nothing left to read and without letting it run in
+//     between: the kernel's 16-event buffer per line (uAPI v1, what libgpiod 1.6 uses) keeps 16
+//     and drops the 17th, and the toggle that brings A back shows gyrochard a change to the level
+//     A already had: exactly one lost edge per burst, and no count changes (the 16 kept edges go
+//     back and forth, the lost one and its detection cancel).
+//
+// Output: one line per node (or the playback summary) on stdout; problems as
+// `gyrochar-bench: what: why` on stderr.
+// Exit codes: 0 agree (played), 1 disagree (an edge's interval not known), 2 bad options or input.
+#include <fcntl.h>
+#include <linux/gpio.h>
+#include <poll.h>
+#include <sched.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <ctime>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -145,7 +175,8 @@ std::string link_text(const Json& r) {
          std::to_string(fault(r, "tx_dropped_frames")) + " tx dropped frames";
 }
 
-int check_link(const std::string& jsonl, const std::vector<unsigned>& wanted, bool expect_gap, unsigned min_reports) {
+int check_link(const std::string& jsonl, const std::vector<unsigned>& wanted, bool expect_gap, unsigned min_reports,
+               std::uint64_t lost_edges) {
   const auto nodes = read_reports(jsonl);
   int result = exit_agree;
   const auto problem = [&](unsigned node, const std::string& why) {
@@ -171,8 +202,10 @@ int check_link(const std::string& jsonl, const std::vector<unsigned>& wanted, bo
       if (health(last, "offline_events") != 0) problem(node, "went offline");
       if (health(judged, "reports_incomplete") != 0 || health(judged, "frames_missing") != 0)
         problem(node, "incomplete reports before the last one");
-      if (fault(last, "sample_gaps") != 0 || fault(last, "lost_edges") != 0)
-        problem(node, "the node counted sample gaps or lost edges in its input");
+      if (fault(last, "sample_gaps") != 0) problem(node, "the node counted sample gaps in its input");
+      if (fault(last, "lost_edges") != lost_edges)
+        problem(node, "the node counted " + std::to_string(fault(last, "lost_edges")) + " lost edges, not " +
+                          std::to_string(lost_edges));
       if (health(judged, "reports_complete") < min_reports)
         problem(node, "only " + std::to_string(health(judged, "reports_complete")) + " complete reports");
       continue;
@@ -277,6 +310,227 @@ int check_estimates(const std::string& jsonl, const std::string& csv, unsigned n
   return result;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Quadrature signal generator on gpio-sim
+
+std::int64_t monotonic_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1000000000LL + t.tv_nsec;
+}
+
+void sleep_until_ns(std::int64_t t_ns) {
+  const timespec due{static_cast<time_t>(t_ns / 1000000000LL), static_cast<long>(t_ns % 1000000000LL)};
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr) == EINTR) {
+  }
+}
+
+std::vector<std::int64_t> read_counts(const std::string& path) {
+  std::vector<std::int64_t> counts;
+  std::size_t number = 0;
+  for (const std::string& line : read_lines(path)) {
+    ++number;
+    if (line[0] == '#') continue;
+    std::size_t used = 0;
+    long long v = 0;
+    try {
+      v = std::stoll(line, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != line.size()) bad_input(path, "line " + std::to_string(number) + ": not an integer count");
+    counts.push_back(v);
+  }
+  if (counts.empty()) bad_input(path, "no counts");
+  return counts;
+}
+
+// Two gpio-sim lines driven through their `pull` attributes. The levels (AB) follow the Gray code
+// 00 -> 10 -> 11 -> 01 -> 00 upwards (A leading B), so each change of one line is one quarter
+// cycle, +1 or -1 by the sense of that step.
+class QuadratureLines {
+ public:
+  QuadratureLines(const std::string& sim_dir, unsigned line_a, unsigned line_b)
+      : fd_{open_pull(sim_dir, line_a), open_pull(sim_dir, line_b)} {
+    write_level(0, false);
+    write_level(1, false);
+  }
+  ~QuadratureLines() {
+    for (const int fd : fd_) close(fd);
+  }
+  QuadratureLines(const QuadratureLines&) = delete;
+  QuadratureLines& operator=(const QuadratureLines&) = delete;
+
+  /// The line that moves one quarter cycle up (direction > 0) or down.
+  int line_for(int direction) const { return (level_[0] == level_[1]) == (direction > 0) ? 0 : 1; }
+  /// Changes `line`; returns the step that is: +1 or -1.
+  int toggle(int line) {
+    write_level(line, !level_[line]);
+    const bool up = line == 0 ? level_[0] != level_[1] : level_[1] == level_[0];
+    return up ? 1 : -1;
+  }
+
+ private:
+  static int open_pull(const std::string& sim_dir, unsigned line) {
+    const std::string path = sim_dir + "/sim_gpio" + std::to_string(line) + "/pull";
+    const int fd = open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) bad_input(path, std::strerror(errno));
+    return fd;
+  }
+  void write_level(int line, bool high) {
+    static constexpr const char up[] = "pull-up", down[] = "pull-down";
+    const char* text = high ? up : down;
+    const std::size_t size = high ? sizeof up - 1 : sizeof down - 1;
+    if (pwrite(fd_[line], text, size, 0) != static_cast<ssize_t>(size)) bad_input("pull", std::strerror(errno));
+    level_[line] = high;
+  }
+  int fd_[2];
+  bool level_[2] = {false, false};
+};
+
+// What gyrochard must count: every edge it sees, in the interval of its kernel timestamp. The
+// timestamp lies between the start and the end of the write that made the edge; the interval grid
+// starts at the request of line A less at most `origin_slack_ns` (gyrochard reads its clock, then
+// opens the chip and requests the line: microseconds on hardware, tens of milliseconds when the
+// emulator is starved). An edge whose interval these bounds do not fix is ambiguous.
+class EdgeLedger {
+ public:
+  EdgeLedger(std::int64_t origin_ns, std::int64_t tau_ns, std::int64_t origin_slack_ns)
+      : origin_ns_(origin_ns), tau_ns_(tau_ns), origin_slack_ns_(origin_slack_ns) {}
+
+  /// An edge gyrochard sees; `counted`: it changes the count by `step` (false: a lost-edge detection).
+  void seen(std::int64_t before_ns, std::int64_t after_ns, int step, bool counted) {
+    const std::int64_t first = (before_ns - origin_ns_) / tau_ns_;
+    const std::int64_t last = (after_ns + origin_slack_ns_ - origin_ns_) / tau_ns_;
+    if (first != last) ++ambiguous_;
+    const auto k = static_cast<std::size_t>(first);
+    if (k >= counts_.size()) counts_.resize(k + 1, 0);
+    if (counted) counts_[k] += step;
+    ++edges_;
+  }
+  const std::vector<std::int64_t>& counts() const { return counts_; }  // up to the last interval with an edge
+  std::uint64_t edges() const { return edges_; }
+  std::uint64_t ambiguous() const { return ambiguous_; }
+
+ private:
+  std::int64_t origin_ns_, tau_ns_, origin_slack_ns_;
+  std::vector<std::int64_t> counts_;
+  std::uint64_t edges_ = 0, ambiguous_ = 0;
+};
+
+struct PlaybackOptions {
+  std::string chip, sim_dir, counts, expected;
+  unsigned line_a = 0, line_b = 1;
+  double tau0_s = 0.1, lead_s = 1.5, wait_s = 30;
+  unsigned overflow_every = 0;
+  std::string reader = "gyrochard";
+};
+
+// Waits for the first request of line A (gyrochard starting) and returns its kernel timestamp.
+std::int64_t wait_for_request(const PlaybackOptions& o) {
+  const int fd = open(o.chip.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) bad_input(o.chip, std::strerror(errno));
+  gpio_v2_line_info info{};
+  info.offset = o.line_a;
+  if (ioctl(fd, GPIO_V2_GET_LINEINFO_WATCH_IOCTL, &info) < 0) bad_input(o.chip, std::string("line info watch: ") + std::strerror(errno));
+  std::printf("gyrochar-bench: watching line %u of %s for its request\n", o.line_a, o.chip.c_str());
+  std::fflush(stdout);
+  for (;;) {
+    pollfd p{fd, POLLIN, 0};
+    if (poll(&p, 1, static_cast<int>(o.wait_s * 1000)) <= 0) bad_input(o.chip, "line A was not requested in time");
+    gpio_v2_line_info_changed change{};
+    if (read(fd, &change, sizeof change) != static_cast<ssize_t>(sizeof change)) bad_input(o.chip, std::strerror(errno));
+    if (change.event_type == GPIO_V2_LINE_CHANGED_REQUESTED) {
+      close(fd);
+      return static_cast<std::int64_t>(change.timestamp_ns);
+    }
+  }
+}
+
+// The process named `name` (gyrochard), by /proc/PID/comm; 0 if there is none.
+pid_t find_process(const std::string& name) {
+  for (pid_t pid = 2; pid < 32768; ++pid) {
+    std::ifstream comm("/proc/" + std::to_string(pid) + "/comm");
+    std::string text;
+    if (comm && std::getline(comm, text) && text == name) return pid;
+  }
+  return 0;
+}
+
+// True while `pid` sleeps (state S: gyrochard blocks only in epoll_wait, which it enters with
+// nothing left to read).
+bool sleeping(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text;
+  std::getline(stat, text);
+  const std::size_t end = text.rfind(')');
+  return end != std::string::npos && end + 2 < text.size() && text[end + 2] == 'S';
+}
+
+int play_quadrature(const PlaybackOptions& o) {
+  const std::vector<std::int64_t> counts = read_counts(o.counts);
+  const auto tau_ns = static_cast<std::int64_t>(std::llround(o.tau0_s * 1e9));
+  QuadratureLines lines(o.sim_dir, o.line_a, o.line_b);  // both low before gyrochard starts
+  sched_param realtime{};
+  realtime.sched_priority = 10;  // above every normal task, below the kernel's interrupt threads (50)
+  if (sched_setscheduler(0, SCHED_FIFO, &realtime) != 0) bad_input("SCHED_FIFO", std::strerror(errno));
+
+  const std::int64_t origin_ns = wait_for_request(o);
+  const pid_t reader = o.overflow_every != 0 ? find_process(o.reader) : 0;
+  if (o.overflow_every != 0 && reader == 0) bad_input("--reader", "no process named " + o.reader);
+  // Every edge is played in the first 55 % of its interval, so the grid may start up to 45 % of
+  // tau0 before the request and the edges still fall where they were meant to.
+  EdgeLedger ledger(origin_ns, tau_ns, 45 * tau_ns / 100);
+  const auto edge = [&](int line, bool counted) {
+    const std::int64_t before = monotonic_ns();
+    const int step = lines.toggle(line);
+    ledger.seen(before, monotonic_ns(), step, counted);
+  };
+  const std::int64_t first = (monotonic_ns() + static_cast<std::int64_t>(o.lead_s * 1e9) - origin_ns) / tau_ns + 1;
+  std::uint64_t bursts = 0, late = 0;
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    const std::int64_t start_ns = origin_ns + (first + static_cast<std::int64_t>(k)) * tau_ns;
+    const std::int64_t c = counts[k];
+    const std::int64_t n = c < 0 ? -c : c;
+    const int direction = c > 0 ? 1 : -1;
+    for (std::int64_t i = 0; i < n; ++i) {  // the count's edges, spread over 0.02 .. 0.25 tau0
+      sleep_until_ns(start_ns + tau_ns / 50 + (2 * i + 1) * (23 * tau_ns / 100) / (2 * n));
+      edge(lines.line_for(direction), true);
+    }
+    if (o.overflow_every != 0 && (k + 1) % o.overflow_every == 0) {
+      sleep_until_ns(start_ns + 28 * tau_ns / 100);
+      while (!sleeping(reader)) sleep_until_ns(monotonic_ns() + 1000000);  // it has read every event
+      for (int i = 0; i < 16; ++i) edge(0, true);  // no sleep: gyrochard cannot read in between,
+      lines.toggle(0);                             // and the kernel's buffer drops this 17th edge
+      sleep_until_ns(std::max(start_ns + 42 * tau_ns / 100, monotonic_ns() + 2000000));
+      edge(0, false);  // A back where it was: gyrochard sees a change to the level A already had
+      ++bursts;
+    }
+    if (monotonic_ns() > start_ns + 55 * tau_ns / 100) ++late;  // a stall of the emulator
+  }
+
+  // The sample stream gyrochard delivers, up to the last interval with an edge it saw (silent
+  // intervals before the first edge are delivered as zeros, those after the last one are not).
+  std::FILE* f = std::fopen(o.expected.c_str(), "w");
+  if (f == nullptr) bad_input(o.expected, std::strerror(errno));
+  std::fprintf(f, "# counts gyrochard must deliver: the edges played from %s, by interval of its grid\n",
+               o.counts.c_str());
+  for (const std::int64_t c : ledger.counts()) std::fprintf(f, "%lld\n", static_cast<long long>(c));
+  if (std::fclose(f) != 0) bad_input(o.expected, "write failed");
+  std::printf("gyrochar-bench: played %zu intervals of %g s from interval %lld of gyrochard's grid: %llu edges seen, "
+              "%llu overflow bursts (one lost edge each), %llu intervals ended late (stalls), %llu edges ambiguous; "
+              "%zu samples expected\n",
+              counts.size(), o.tau0_s, static_cast<long long>(first), static_cast<unsigned long long>(ledger.edges()),
+              static_cast<unsigned long long>(bursts), static_cast<unsigned long long>(late),
+              static_cast<unsigned long long>(ledger.ambiguous()), ledger.counts().size());
+  if (ledger.ambiguous() != 0) {
+    std::fprintf(stderr, "gyrochar-bench: quadrature: %llu edges were played so near an interval's end that their "
+                 "interval is not known (the emulator stalled)\n", static_cast<unsigned long long>(ledger.ambiguous()));
+    return exit_disagree;
+  }
+  return exit_agree;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -294,12 +548,30 @@ int main(int argc, char** argv) {
   link->add_option("--node", nodes, "node address that must be there (repeatable)")->required();
   link->add_flag("--expect-gap", expect_gap, "the link went away and came back");
   link->add_option("--min-reports", min_reports, "complete reports required (after the gap)")->capture_default_str();
+  std::uint64_t lost_edges = 0;
+  link->add_option("--lost-edges", lost_edges, "lost edges every node must have counted (without --expect-gap)")
+      ->capture_default_str();
   CLI::App* estimates = app.add_subcommand("estimates", "decoded ADEV and MDEV against gyrochar-analyze");
   estimates->add_option("--jsonl", jsonl, "gyrochar-decode --jsonl recording (--rate-unit native)")->required();
   estimates->add_option("--csv", csv, "gyrochar-decode --csv recording of the same run")->required();
   estimates->add_option("--node", node, "node address")->required();
   estimates->add_option("--samples", samples, "samples the node must have counted")->required();
   estimates->add_option("--analyzed", analyzed, "gyrochar-analyze --format csv --rate-unit deg/s output")->required();
+  PlaybackOptions q;
+  CLI::App* quadrature = app.add_subcommand("quadrature", "play counts as quadrature edges on two gpio-sim lines");
+  quadrature->add_option("--chip", q.chip, "GPIO character device, e.g. /dev/gpiochip0")->required();
+  quadrature->add_option("--sim", q.sim_dir, "the chip's gpio-sim folder: /sys/devices/platform/DEV/CHIP")->required();
+  quadrature->add_option("--line-a", q.line_a, "line offset of channel A")->capture_default_str();
+  quadrature->add_option("--line-b", q.line_b, "line offset of channel B")->capture_default_str();
+  quadrature->add_option("--tau0", q.tau0_s, "gyrochard's sample interval, s")->capture_default_str();
+  quadrature->add_option("--counts", q.counts, "counts per interval (gyrochar-sim output)")->required();
+  quadrature->add_option("--expected", q.expected, "write the sample stream gyrochard must count here")->required();
+  quadrature->add_option("--overflow-every", q.overflow_every, "a lost-edge burst every K intervals (0: none)")
+      ->capture_default_str();
+  quadrature->add_option("--reader", q.reader, "with --overflow-every: the program reading the lines")
+      ->capture_default_str();
+  quadrature->add_option("--lead", q.lead_s, "seconds between gyrochard's request and the first edge")
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -307,6 +579,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "gyrochar-bench: options: %s (see --help)\n", e.what());
     return exit_bad_input;
   }
-  if (*link) return check_link(jsonl, nodes, expect_gap, min_reports);
+  if (*link) return check_link(jsonl, nodes, expect_gap, min_reports, lost_edges);
+  if (*quadrature) {
+    if (!(q.tau0_s >= 0.01)) bad_input("--tau0", "must be at least 0.01 s (the emulated kernel follows ~1 edge/ms)");
+    return play_quadrature(q);
+  }
   return check_estimates(jsonl, csv, node, samples, analyzed);
 }

@@ -126,7 +126,7 @@ stop_nodes() {
 }
 
 # check_estimates SAMPLES NODE...: each node's last complete report with SAMPLES samples holds
-# ADEV and MDEV equal to gyrochar-analyze's on /tmp/counts-NODE.txt.
+# ADEV and MDEV equal to gyrochar-analyze's on /tmp/counts-NODE.txt (tau0 $bench_tau0).
 check_estimates() {
   local samples=$1 node
   shift
@@ -136,4 +136,49 @@ check_estimates() {
     gyrochar-bench estimates --jsonl /tmp/decoded.jsonl --csv /tmp/decoded.csv --node "$node" --samples "$samples" \
       --analyzed "/tmp/analyzed-$node.csv" || fail "node $node: decoded estimates differ from gyrochar-analyze (above)"
   done
+}
+
+# --- GPIO quadrature: gyrochard reading two gpio-sim lines, the bench driver playing them ---------
+
+# gpio_sim_up LINES: a gpio-sim chip with LINES lines (configfs); sets gpio_chip (gpiochipN) and
+# gpio_sim_dir (its sysfs folder with sim_gpio<N>/pull).
+gpio_sim_up() {
+  local cfg=/sys/kernel/config/gpio-sim/bench
+  mkdir "$cfg" "$cfg/bank0"
+  echo "$1" > "$cfg/bank0/num_lines"
+  echo 1 > "$cfg/live"
+  gpio_chip=$(cat "$cfg/bank0/chip_name")
+  gpio_sim_dir=/sys/devices/platform/$(cat "$cfg/dev_name")/$gpio_chip
+  [ -c "/dev/$gpio_chip" ] || fail "gpio-sim made no /dev/$gpio_chip"
+}
+
+# quadrature_node NODE DURATION_S OVERFLOW_EVERY: gyrochard NODE counts quadrature edges on lines
+# 0 (A) and 1 (B) of the gpio-sim chip and reports on vcan0 to the decoder; the bench driver plays
+# DURATION_S of simulated counts (tau0 $bench_tau0) with an overflow burst every OVERFLOW_EVERY
+# intervals (0: none). Leaves the sample stream gyrochard must have counted in /tmp/counts-NODE.txt
+# and its length in `samples`.
+quadrature_node() {
+  local node=$1 duration_s=$2 overflow=$3 tries=0
+  gyrochar-sim --duration "$duration_s" --tau0 "$bench_tau0" --white-angle 3 --arw 0.003 --seed "$node" \
+    --out "/tmp/sim-counts-$node.txt"
+  start decode gyrochar-decode --interface vcan0 --rate-unit native --csv /tmp/decoded.csv \
+    --jsonl /tmp/decoded.jsonl --view none
+  wait_socket decode
+  start player gyrochar-bench quadrature --chip "/dev/$gpio_chip" --sim "$gpio_sim_dir" --line-a 0 --line-b 1 \
+    --tau0 "$bench_tau0" --counts "/tmp/sim-counts-$node.txt" --expected "/tmp/counts-$node.txt" \
+    --overflow-every "$overflow"
+  until grep -q watching /tmp/player.log; do
+    running player || fail "the quadrature driver stopped: $(cat /tmp/player.log)"
+    ((++tries <= 100)) || fail "the quadrature driver is not ready after 10 s"
+    sleep 0.1
+  done
+  start "gyrochard-$node" gyrochard --source quadrature --gpio-chip "$gpio_chip" --line-a 0 --line-b 1 \
+    --can-interface vcan0 --node "$node" --tau0 "$bench_tau0" --octaves 16
+  finish player
+  cat /tmp/player.log
+  [ "$status" -eq 0 ] || fail "the quadrature driver failed (exit $status)"
+  running "gyrochard-$node" || fail "gyrochard stopped during the playback"
+  samples=$(grep -vc '^#' "/tmp/counts-$node.txt")
+  sleep 3  # the last played interval is closed and reported
+  stop_nodes "$node"
 }
