@@ -18,19 +18,19 @@
 //     native). The CSV recording must hold the same values as the JSON lines.
 //
 //   gyrochar-bench quadrature --chip /dev/gpiochip0 --sim /sys/devices/platform/gpio-sim.0/gpiochip0
-//                             --tau0 0.1 --counts counts.txt --expected expected.txt [--overflow-every K]
+//                             --tau0 0.2 --counts counts.txt --expected expected.txt [--overflow-every K]
 //     The quadrature signal generator: plays the counts as 4x quadrature A/B edges on two gpio-sim
 //     lines, one tau0 interval per count, by writing pull-up / pull-down to the lines' sysfs
 //     `pull` attributes; it runs SCHED_FIFO, like a generator that does not wait for its DUT. The
 //     intervals are gyrochard's own: gyrochard takes its grid's origin just before it requests
 //     line A, and the kernel timestamps that request (line info watch, GPIO uAPI v2), so each
-//     interval's edges are played in the first half of that interval. --expected gets the sample
+//     interval's edges are played in the first 45 % of that interval. --expected gets the sample
 //     stream gyrochard must count, from the times the edges were actually made (an emulator stall
 //     may push edges late): silent intervals before the first edge as zeros, then every interval
 //     up to the last edge gyrochard sees.
 //     --overflow-every K: every K-th interval also gets 17 back-and-forth edges on line A, made
-//     once gyrochard (--reader) sleeps with nothing left to read and without letting it run in
-//     between: the kernel's 16-event buffer per line (uAPI v1, what libgpiod 1.6 uses) keeps 16
+//     once gyrochard (--reader) sleeps with nothing left to read (else in the next interval) and
+//     without letting it run in between: the kernel's 16-event buffer per line (uAPI v1, what libgpiod 1.6 uses) keeps 16
 //     and drops the 17th, and the toggle that brings A back shows gyrochard a change to the level
 //     A already had: exactly one lost edge per burst, and no count changes (the 16 kept edges go
 //     back and forth, the lost one and its detection cancel).
@@ -421,7 +421,7 @@ class EdgeLedger {
 struct PlaybackOptions {
   std::string chip, sim_dir, counts, expected;
   unsigned line_a = 0, line_b = 1;
-  double tau0_s = 0.1, lead_s = 1.5, wait_s = 30;
+  double tau0_s = 0.2, lead_s = 1.5, wait_s = 30;
   unsigned overflow_every = 0;
   std::string reader = "gyrochard";
 };
@@ -478,9 +478,10 @@ int play_quadrature(const PlaybackOptions& o) {
   const std::int64_t origin_ns = wait_for_request(o);
   const pid_t reader = o.overflow_every != 0 ? find_process(o.reader) : 0;
   if (o.overflow_every != 0 && reader == 0) bad_input("--reader", "no process named " + o.reader);
-  // Every edge is played in the first 55 % of its interval, so the grid may start up to 45 % of
-  // tau0 before the request and the edges still fall where they were meant to.
-  EdgeLedger ledger(origin_ns, tau_ns, 45 * tau_ns / 100);
+  // Every edge is played in the first 45 % of its interval; the grid may start up to 30 % of tau0
+  // before the request, and stalls may delay an edge by up to 25 % of tau0, without changing its
+  // interval.
+  EdgeLedger ledger(origin_ns, tau_ns, 30 * tau_ns / 100);
   const auto edge = [&](int line, bool counted) {
     const std::int64_t before = monotonic_ns();
     const int step = lines.toggle(line);
@@ -488,6 +489,8 @@ int play_quadrature(const PlaybackOptions& o) {
   };
   const std::int64_t first = (monotonic_ns() + static_cast<std::int64_t>(o.lead_s * 1e9) - origin_ns) / tau_ns + 1;
   std::uint64_t bursts = 0, late = 0;
+  std::int64_t longest_burst_ns = 0;
+  bool burst_due = false;
   for (std::size_t k = 0; k < counts.size(); ++k) {
     const std::int64_t start_ns = origin_ns + (first + static_cast<std::int64_t>(k)) * tau_ns;
     const std::int64_t c = counts[k];
@@ -497,16 +500,25 @@ int play_quadrature(const PlaybackOptions& o) {
       sleep_until_ns(start_ns + tau_ns / 50 + (2 * i + 1) * (23 * tau_ns / 100) / (2 * n));
       edge(lines.line_for(direction), true);
     }
-    if (o.overflow_every != 0 && (k + 1) % o.overflow_every == 0) {
+    burst_due = burst_due || (o.overflow_every != 0 && (k + 1) % o.overflow_every == 0);
+    if (burst_due) {
+      // Once gyrochard has read every earlier event (it sleeps); if it is still busy at 35 % of
+      // the interval, the burst waits for the next interval.
       sleep_until_ns(start_ns + 28 * tau_ns / 100);
-      while (!sleeping(reader)) sleep_until_ns(monotonic_ns() + 1000000);  // it has read every event
-      for (int i = 0; i < 16; ++i) edge(0, true);  // no sleep: gyrochard cannot read in between,
-      lines.toggle(0);                             // and the kernel's buffer drops this 17th edge
-      sleep_until_ns(std::max(start_ns + 42 * tau_ns / 100, monotonic_ns() + 2000000));
-      edge(0, false);  // A back where it was: gyrochard sees a change to the level A already had
-      ++bursts;
+      while (!sleeping(reader) && monotonic_ns() < start_ns + 35 * tau_ns / 100)
+        sleep_until_ns(monotonic_ns() + 1000000);
+      if (sleeping(reader)) {
+        const std::int64_t burst_ns = monotonic_ns();
+        for (int i = 0; i < 16; ++i) edge(0, true);  // no sleep: gyrochard cannot read in between,
+        lines.toggle(0);                             // and the kernel's buffer drops this 17th edge
+        longest_burst_ns = std::max(longest_burst_ns, monotonic_ns() - burst_ns);
+        sleep_until_ns(std::max(start_ns + 42 * tau_ns / 100, monotonic_ns() + 2000000));
+        edge(0, false);  // A back where it was: gyrochard sees a change to the level A already had
+        ++bursts;
+        burst_due = false;
+      }
     }
-    if (monotonic_ns() > start_ns + 55 * tau_ns / 100) ++late;  // a stall of the emulator
+    if (monotonic_ns() > start_ns + 45 * tau_ns / 100) ++late;  // a stall of the emulator
   }
 
   // The sample stream gyrochard delivers, up to the last interval with an edge it saw (silent
@@ -518,10 +530,11 @@ int play_quadrature(const PlaybackOptions& o) {
   for (const std::int64_t c : ledger.counts()) std::fprintf(f, "%lld\n", static_cast<long long>(c));
   if (std::fclose(f) != 0) bad_input(o.expected, "write failed");
   std::printf("gyrochar-bench: played %zu intervals of %g s from interval %lld of gyrochard's grid: %llu edges seen, "
-              "%llu overflow bursts (one lost edge each), %llu intervals ended late (stalls), %llu edges ambiguous; "
-              "%zu samples expected\n",
+              "%llu overflow bursts (one lost edge each, longest %.1f ms), %llu intervals ended late (stalls), "
+              "%llu edges ambiguous; %zu samples expected\n",
               counts.size(), o.tau0_s, static_cast<long long>(first), static_cast<unsigned long long>(ledger.edges()),
-              static_cast<unsigned long long>(bursts), static_cast<unsigned long long>(late),
+              static_cast<unsigned long long>(bursts), static_cast<double>(longest_burst_ns) / 1e6,
+              static_cast<unsigned long long>(late),
               static_cast<unsigned long long>(ledger.ambiguous()), ledger.counts().size());
   if (ledger.ambiguous() != 0) {
     std::fprintf(stderr, "gyrochar-bench: quadrature: %llu edges were played so near an interval's end that their "

@@ -155,8 +155,8 @@ gpio_sim_up() {
 # quadrature_node NODE DURATION_S OVERFLOW_EVERY: gyrochard NODE counts quadrature edges on lines
 # 0 (A) and 1 (B) of the gpio-sim chip and reports on vcan0 to the decoder; the bench driver plays
 # DURATION_S of simulated counts (tau0 $bench_tau0) with an overflow burst every OVERFLOW_EVERY
-# intervals (0: none). Leaves the sample stream gyrochard must have counted in /tmp/counts-NODE.txt
-# and its length in `samples`.
+# intervals (0: none). Leaves the sample stream gyrochard must have counted in /tmp/counts-NODE.txt,
+# its length in `samples` and the number of overflow bursts played in `bursts`.
 quadrature_node() {
   local node=$1 duration_s=$2 overflow=$3 tries=0
   gyrochar-sim --duration "$duration_s" --tau0 "$bench_tau0" --white-angle 3 --arw 0.003 --seed "$node" \
@@ -179,6 +179,7 @@ quadrature_node() {
   [ "$status" -eq 0 ] || fail "the quadrature driver failed (exit $status)"
   running "gyrochard-$node" || fail "gyrochard stopped during the playback"
   samples=$(grep -vc '^#' "/tmp/counts-$node.txt")
+  bursts=$(grep -o '[0-9]* overflow bursts' /tmp/player.log | cut -d' ' -f1)
   sleep 3  # the last played interval is closed and reported
   stop_nodes "$node"
 }

@@ -73,8 +73,8 @@ if ((${#missing[@]})); then
   [ "$install" = yes ] || missing_exit "missing Debian packages: ${missing[*]}"
   apt_update
   say "installing missing Debian packages: ${missing[*]}"
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2 \
-    || die "apt-get install failed for: ${missing[*]}"
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" \
+    > "$out/logs/apt-install.log" 2>&1 || { cat "$out/logs/apt-install.log" >&2; die "apt-get install failed for: ${missing[*]}"; }
 fi
 
 # 3. Packages used as archives, never installed: the kernel image (not this machine's kernel) and
