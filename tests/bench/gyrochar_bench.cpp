@@ -52,6 +52,7 @@
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -449,10 +450,12 @@ std::int64_t wait_for_request(const PlaybackOptions& o) {
 
 // The process named `name` (gyrochard), by /proc/PID/comm; 0 if there is none.
 pid_t find_process(const std::string& name) {
-  for (pid_t pid = 2; pid < 32768; ++pid) {
-    std::ifstream comm("/proc/" + std::to_string(pid) + "/comm");
+  for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
+    const std::string pid = entry.path().filename();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream comm(entry.path() / "comm");
     std::string text;
-    if (comm && std::getline(comm, text) && text == name) return pid;
+    if (comm && std::getline(comm, text) && text == name) return static_cast<pid_t>(std::stol(pid));
   }
   return 0;
 }
@@ -549,7 +552,16 @@ int play_quadrature(const PlaybackOptions& o) {
 int main(int argc, char** argv) {
   CLI::App app{"gyrochar-bench: checks gyrochar-decode recordings made on the bench (docs/bench.md).", "gyrochar-bench"};
   app.require_subcommand(1);
-  app.footer("Exit codes: 0 agree, 1 disagree, 2 bad options or unreadable input.");
+  app.footer(
+      "Run by the bench's scenarios inside the QEMU guest (tests/bench/lib.sh, docs/bench.md).\n\n"
+      "Examples:\n"
+      "  gyrochar-bench link --jsonl decoded.jsonl --node 17 --node 18 --min-reports 8\n"
+      "  gyrochar-bench link --jsonl decoded.jsonl --node 49 --expect-gap --min-reports 5\n"
+      "  gyrochar-bench estimates --jsonl decoded.jsonl --csv decoded.csv --node 17 --samples 3000 \\\n"
+      "                           --analyzed analyzed.csv\n"
+      "  gyrochar-bench quadrature --chip /dev/gpiochip0 --sim /sys/devices/platform/gpio-sim.0/gpiochip0 \\\n"
+      "                            --tau0 0.2 --counts counts.txt --expected expected.txt --overflow-every 10\n\n"
+      "Exit codes: 0 agree, 1 disagree, 2 bad options or unreadable input.");
 
   std::string jsonl, csv, analyzed;
   std::vector<unsigned> nodes;
