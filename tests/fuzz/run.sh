@@ -16,7 +16,7 @@ for target in candump protocol datafile config; do
     tail -n 30 build/fuzz/$target.log >&2
     status=1
   else
-    grep -E "stat::number_of_executed_units|stat::new_units_added" build/fuzz/$target.log | sed "s/^/fuzz: $target /" >&2
+    grep -aE "stat::number_of_executed_units|stat::new_units_added" build/fuzz/$target.log | sed "s/^/fuzz: $target /" >&2
   fi
 done
 exit $status
