@@ -111,17 +111,24 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
 }
 
 void Decoder::open_report(NodeView& v, Assembly& a, std::uint8_t seq) {
-  if (a.open) {
+  // Rule 2 holds across an offline period too (rule 4 closed the report, the last Seq stays): the
+  // reports a node made while none of its frames arrived (its bus down, the decoder's link cut)
+  // are lost reports, whatever the reason they did not arrive.
+  std::uint8_t lost = 0;
+  if (a.seen) {
     const auto d = static_cast<std::uint8_t>(seq - a.seq);
     close_report(v, a);
     if (d >= 128) {
       restart(v, a);  // Seq went backwards
     } else if (d > 1) {
-      v.health.reports_lost += d - 1u;
+      lost = static_cast<std::uint8_t>(d - 1u);
+      v.health.reports_lost += lost;
     }
   }
   a.open = true;
+  a.seen = true;
   a.seq = seq;
+  a.lost_at_open = lost;
   a.tau_count = v.have_status ? v.status.tau_count : 0;
   a.received.fill(false);
   layout(a);
@@ -154,6 +161,9 @@ void Decoder::close_report(NodeView& v, Assembly& a) {
 void Decoder::restart(NodeView& v, Assembly& a) {
   const std::uint8_t address = v.address;
   LinkHealth health = v.health;
+  // A restart found in the report that opened with a Seq jump (its Status, Clock or Config): the
+  // jump was the node starting again, not reports lost (rule 3 before rule 2).
+  health.reports_lost -= a.open ? a.lost_at_open : 0u;
   const std::uint32_t session = v.session;
   const double last_frame_s = v.last_frame_s;
   v = NodeView{};

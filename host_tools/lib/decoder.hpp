@@ -100,7 +100,9 @@ class Decoder {
  private:
   struct Assembly {
     bool open = false;
+    bool seen = false;  // a report of this session was opened: `seq` is the last Seq heard, also after offline
     std::uint8_t seq = 0;
+    std::uint8_t lost_at_open = 0;  // reports counted lost when the current report opened
     std::uint8_t tau_count = 0;
     std::array<bool, 512> received{};  // by slot position in the report
     std::array<std::int16_t, 11 * protocol::max_taus> position{};  // (slot, index) -> position, -1: not in this report

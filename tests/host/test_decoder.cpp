@@ -118,6 +118,38 @@ TEST(Decoder, SilenceMakesANodeOfflineThenOnline) {
   EXPECT_NE(std::find(events.begin(), events.end(), DecoderEvent::offline), events.end());
 }
 
+// The bench's observation (sja1000-bus-fault): the node's bus was down for 5 s, its Seq advanced by
+// about 5 while none of its frames arrived. Rule 4 closes the report at the offline event, but the
+// last Seq stays: the reports made meanwhile are lost reports (rule 2), besides the offline event.
+TEST(Decoder, ReportsMadeWhileOfflineAreLost) {
+  Decoder decoder;
+  for (const auto& f : report(3, 10, 2, 1000)) decoder.feed(f, 1.0);
+  for (const auto& f : report(3, 11, 2, 1100)) decoder.feed(f, 2.0);
+  decoder.tick(6.0);  // offline
+  for (const auto& f : report(3, 17, 2, 1700)) decoder.feed(f, 8.0);  // 12..16 never arrived
+  decoder.flush();
+  const NodeView& v = decoder.nodes().at(3);
+  EXPECT_EQ(v.health.offline_events, 1u);
+  EXPECT_EQ(v.health.reports_lost, 5u);
+  EXPECT_EQ(v.health.reports_complete, 3u);
+  EXPECT_EQ(v.health.restarts, 0u);
+  EXPECT_EQ(v.session, 0u);
+}
+
+// A node that restarts (SampleCount back) with a Seq that happens to be a few ahead is a restart,
+// not lost reports; the reports lost before an offline period that ends without a restart stay.
+TEST(Decoder, RestartAfterASeqJumpIsNotALoss) {
+  Decoder decoder;
+  for (const auto& f : report(4, 250, 2, 5000)) decoder.feed(f, 1.0);
+  decoder.tick(5.0);  // offline
+  for (const auto& f : report(4, 3, 2, 20)) decoder.feed(f, 9.0);  // d = 9, but SampleCount went back
+  decoder.flush();
+  const NodeView& v = decoder.nodes().at(4);
+  EXPECT_EQ(v.health.restarts, 1u);
+  EXPECT_EQ(v.health.reports_lost, 0u);
+  EXPECT_EQ(v.session, 1u);
+}
+
 TEST(Decoder, SeveralNodesAreKeptApart) {
   Feed feed;
   auto a = report(1, 0, 4, 100), b = report(2, 7, 6, 900);
