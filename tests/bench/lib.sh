@@ -79,6 +79,7 @@ can_up() {
 # --- Counter-input nodes: gyrochard nodes fed by simulated gyro electronics over CAN -------------
 # Node A's electronics have address A + 112; tau0 0.01 s, 16 octave taus.
 bench_tau0=0.01
+bench_gyrochard_args=()  # more gyrochard options for start_nodes (e.g. --report-period 0.25)
 
 # start_nodes REPORT_IF DECODE_IF NODE...: the decoder on DECODE_IF (CSV and JSON lines in /tmp,
 # native units), then the gyrochard nodes on REPORT_IF; waits until they are up.
@@ -90,7 +91,7 @@ start_nodes() {
   wait_socket decode  # listening before the first report goes out
   for node in "$@"; do
     start "gyrochard-$node" gyrochard --source can-counter --can-interface "$report_if" --node "$node" \
-      --counter-node $((node + 112)) --tau0 "$bench_tau0" --octaves 16
+      --counter-node $((node + 112)) --tau0 "$bench_tau0" --octaves 16 "${bench_gyrochard_args[@]}"
   done
   sleep 2
   for node in "$@"; do running "gyrochard-$node" || fail "gyrochard node $node stopped at start"; done
@@ -183,3 +184,16 @@ quadrature_node() {
   sleep 3  # the last played interval is closed and reported
   stop_nodes "$node"
 }
+
+# --- Process and socket figures -----------------------------------------------------------------
+
+# proc_kib PID KEY: a /proc/PID/status field in KiB (VmRSS, VmHWM, VmSize, ...).
+proc_kib() { awk -v key="$2:" '$1 == key { print $2 }' "/proc/$1/status"; }
+# cpu_ticks PID: user + system CPU time of PID so far, in clock ticks (1/100 s).
+cpu_ticks() { awk '{ sub(/^.*\) /, ""); print $12 + $13 }' "/proc/$1/stat"; }
+# minor_faults PID: pages PID has touched for the first time (or again after reclaim) so far.
+minor_faults() { awk '{ sub(/^.*\) /, ""); print $8 }' "/proc/$1/stat"; }
+# rx_packets IF: frames the interface has carried (vcan: every frame sent on it).
+rx_packets() { cat "/sys/class/net/$1/statistics/rx_packets"; }
+# socket_drops LOG: the decoder's SO_RXQ_OVFL total from the summary it printed at its end.
+socket_drops() { sed -n 's/.*dropped in the socket queue \([0-9]*\).*/\1/p' "$1" | tail -n 1; }

@@ -177,7 +177,7 @@ programs=(
 for p in "${programs[@]}"; do
   [ -x "$p" ] || die "$p is missing: build the host programs first (cmake --preset host && cmake --build --preset host)"
 done
-system_programs=(/usr/bin/bash "$(command -v ip)" /usr/bin/candump /usr/bin/cansend)
+system_programs=(/usr/bin/bash "$(command -v ip)" /usr/bin/candump /usr/bin/cansend /usr/bin/cangen)
 busybox=/bin/busybox
 for p in "${system_programs[@]}" "$busybox"; do [ -x "$p" ] || die "$p is missing (Debian packages above)"; done
 ldd "$busybox" > /dev/null 2>&1 && die "$busybox is dynamically linked: the image needs busybox-static's"
