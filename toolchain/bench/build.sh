@@ -174,7 +174,8 @@ programs=(
   "$host/host_tools/gyrochar-sim"
   "$host/tests/bench/gyrochar-bench"
 )
-for p in "${programs[@]}"; do
+preload=$host/tests/bench/malloc_count.so  # the allocation counter of the gyrochard-rss scenario
+for p in "${programs[@]}" "$preload"; do
   [ -x "$p" ] || die "$p is missing: build the host programs first (cmake --preset host && cmake --build --preset host)"
 done
 system_programs=(/usr/bin/bash "$(command -v ip)" /usr/bin/candump /usr/bin/cansend /usr/bin/cangen)
@@ -183,7 +184,7 @@ for p in "${system_programs[@]}" "$busybox"; do [ -x "$p" ] || die "$p is missin
 ldd "$busybox" > /dev/null 2>&1 && die "$busybox is dynamically linked: the image needs busybox-static's"
 
 initramfs=$out/initramfs.cpio.gz
-inputs=("${programs[@]}" "${system_programs[@]}" "$busybox" toolchain/bench/init tests/bench/lib.sh
+inputs=("${programs[@]}" "$preload" "${system_programs[@]}" "$busybox" toolchain/bench/init tests/bench/lib.sh
         tests/bench/scenarios "$kernel_dir/modules" "$gpio_ko" "$0")
 if up_to_date "$initramfs" "${inputs[@]}"; then
   say "initramfs: up to date"
@@ -209,6 +210,7 @@ else
     strip --strip-unneeded "$root/usr/bin/$(basename "$p")"
   done
   for p in "${system_programs[@]}"; do copy_with_libraries "$p" "$p"; done
+  copy_with_libraries "$preload" /usr/lib/malloc_count.so
   cp "$busybox" "$root/bin/busybox"
   # busybox for every command the programs above do not provide, except init: without a working
   # /init the kernel must panic (and QEMU stop at once), not fall back to busybox's init.

@@ -3,7 +3,8 @@
 #   toolchain/bench/run.sh SCENARIO [--can] [--timeout S]
 # SCENARIO is tests/bench/scenarios/SCENARIO.sh. --can adds two emulated SJA1000 controllers
 # (kvaser_pci, can0 and can1) on one emulated CAN bus; a scenario whose file has the line
-# `# bench: can-controllers` gets them without the option. The serial console goes to
+# `# bench: can-controllers` gets them without the option; one with `# bench: timeout S` gets S
+# seconds instead of the default 180. The serial console goes to
 # build/bench/logs/SCENARIO.log and is printed when the scenario fails.
 # Exit code: 0 PASS, 1 FAIL (or no verdict: crash, time limit), 2 usage, 77 bench not assembled.
 set -euo pipefail
@@ -16,10 +17,11 @@ say() { echo "bench/run.sh: $*" >&2; }
 scenario=""
 can=no
 limit_s=180
+limit_given=no
 while (($#)); do
   case "$1" in
     --can) can=yes ;;
-    --timeout) [ $# -ge 2 ] || usage; limit_s=$2; shift ;;
+    --timeout) [ $# -ge 2 ] || usage; limit_s=$2; limit_given=yes; shift ;;
     -*) usage ;;
     *) [ -z "$scenario" ] || usage; scenario=$1 ;;
   esac
@@ -32,6 +34,11 @@ if [ ! -f "$script" ]; then
   exit 2
 fi
 grep -qx '# bench: can-controllers' "$script" && can=yes
+# A scenario longer than the default limit says so: `# bench: timeout S` (--timeout overrides it).
+if [ "$limit_given" = no ]; then
+  own_limit=$(sed -n 's/^# bench: timeout \([0-9][0-9]*\)$/\1/p' "$script" | head -n 1)
+  [ -z "$own_limit" ] || limit_s=$own_limit
+fi
 
 kernel=$out/kernel/vmlinuz
 initramfs=$out/initramfs.cpio.gz
