@@ -16,6 +16,23 @@ std::unique_ptr<FakeCanNode> FakeCanBus::attach(std::size_t rx_capacity) {
 
 void FakeCanBus::deliver(const FakeCanNode* from, const CanFrame& frame) {
   ++frames_;
+  if (delay_ns_ != 0 && clock_ != nullptr) {
+    delayed_.push_back({clock_->now_ns() + delay_ns_, from, frame});
+    pump();
+    return;
+  }
+  distribute(from, frame);
+}
+
+void FakeCanBus::pump() {
+  while (!delayed_.empty() && clock_ != nullptr && delayed_.front().due_ns <= clock_->now_ns()) {
+    const Delayed d = delayed_.front();
+    delayed_.pop_front();
+    distribute(d.from, d.frame);
+  }
+}
+
+void FakeCanBus::distribute(const FakeCanNode* from, const CanFrame& frame) {
   for (FakeCanNode* n : nodes_) {
     if (n == from) continue;
     if (loss_ > 0 && std::uniform_real_distribution<double>(0, 1)(rng_) < loss_) continue;
@@ -23,7 +40,11 @@ void FakeCanBus::deliver(const FakeCanNode* from, const CanFrame& frame) {
   }
 }
 
-void FakeCanBus::detach(FakeCanNode* node) { nodes_.erase(std::remove(nodes_.begin(), nodes_.end(), node), nodes_.end()); }
+void FakeCanBus::detach(FakeCanNode* node) {
+  nodes_.erase(std::remove(nodes_.begin(), nodes_.end(), node), nodes_.end());
+  for (Delayed& d : delayed_)
+    if (d.from == node) d.from = nullptr;  // still delivered to everyone else
+}
 
 FakeCanNode::FakeCanNode(FakeCanBus& bus, std::size_t rx_capacity) : bus_(bus), capacity_(rx_capacity) {
   event_fd_ = eventfd(0, EFD_NONBLOCK | EFD_SEMAPHORE | EFD_CLOEXEC);
@@ -80,6 +101,7 @@ void FakeCanNode::push(const CanFrame& frame) {
 }
 
 std::optional<CanFrame> FakeCanNode::receive() {
+  bus_.pump();
   if (rx_.empty()) return std::nullopt;
   std::uint64_t value = 0;
   [[maybe_unused]] const auto n = read(event_fd_, &value, sizeof value);

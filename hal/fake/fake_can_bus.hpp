@@ -4,7 +4,7 @@
 // bus-down are injected deterministically (seeded), and per node a full TX queue or bus-off (the
 // controller's own state, as after too many errors); each node has a bounded receive queue whose
 // overflows are counted, and an eventfd that is readable while frames wait, so the same epoll
-// loop runs on it as on SocketCAN.
+// loop runs on it as on SocketCAN. A delay on a (virtual) clock can be injected too.
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "hal/can_bus.hpp"
+#include "hal/clock.hpp"
 
 namespace gyrochar::hal {
 
@@ -24,6 +25,14 @@ class FakeCanBus {
   std::unique_ptr<FakeCanNode> attach(std::size_t rx_capacity = 4096);
   /// Drops each frame with this probability (0..1).
   void set_loss(double probability) { loss_ = probability; }
+  /// Delays every frame by `delay_ns` on `clock` (0: none): it reaches the other nodes once the
+  /// clock has passed its send time + delay, when any node next sends, receives or pump() runs.
+  void set_delay(const Clock& clock, std::uint64_t delay_ns) {
+    clock_ = &clock;
+    delay_ns_ = delay_ns;
+  }
+  /// Delivers the delayed frames that are due.
+  void pump();
   /// Takes the bus down (sends fail with bus_down) or brings it back.
   void set_down(bool down) { down_ = down; }
   bool down() const { return down_; }
@@ -32,7 +41,16 @@ class FakeCanBus {
  private:
   friend class FakeCanNode;
   void deliver(const FakeCanNode* from, const CanFrame& frame);
+  void distribute(const FakeCanNode* from, const CanFrame& frame);
   void detach(FakeCanNode* node);
+  struct Delayed {
+    std::uint64_t due_ns;
+    const FakeCanNode* from;
+    CanFrame frame;
+  };
+  std::deque<Delayed> delayed_;
+  const Clock* clock_ = nullptr;
+  std::uint64_t delay_ns_ = 0;
   std::vector<FakeCanNode*> nodes_;
   std::mt19937_64 rng_;
   double loss_ = 0.0;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "hal/fake/fake_can_bus.hpp"
+#include "hal/fake/fake_clock.hpp"
 #include "hal/linux/socketcan.hpp"
 
 namespace gyrochar::hal {
@@ -110,6 +111,38 @@ TEST(FakeCanBus, FiltersPassMatchingExtendedFramesAndErrorFrames) {
   ASSERT_TRUE(b->set_filters({}));  // nothing but error frames
   a->send(pass);
   EXPECT_FALSE(b->receive());
+}
+
+}  // namespace
+}  // namespace gyrochar::hal
+
+namespace gyrochar::hal {
+namespace {
+
+TEST(FakeCanBus, DelayedFramesArriveInOrderOnceTheirTimeHasCome) {
+  // Oracle: the injected delay on the virtual clock (5 ms).
+  FakeClock clock;
+  FakeCanBus bus;
+  bus.set_delay(clock, 5000000);
+  auto a = bus.attach(), b = bus.attach();
+  CanFrame f;
+  f.extended = true;
+  for (std::uint32_t id : {1u, 2u}) {
+    f.id = id;
+    a->send(f);
+    clock.advance(1000000);
+  }
+  clock.advance(2999999);  // 4.999999 ms after the first
+  EXPECT_FALSE(b->receive().has_value());
+  clock.advance(1);
+  auto first = b->receive();
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->id, 1u);
+  EXPECT_FALSE(b->receive().has_value()) << "the second is due 1 ms later";
+  clock.advance(1000000);
+  bus.pump();
+  EXPECT_TRUE(readable(b->fd()));
+  EXPECT_EQ(b->receive()->id, 2u);
 }
 
 }  // namespace
