@@ -48,6 +48,12 @@ SocketCan::SocketCan(const std::string& interface) : name_(interface) {
   const int on = 1;
   setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on);
   setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on);  // refused on classic-only: fine
+  // A receive queue of some thousands of frames instead of the default few hundred, so that a
+  // reader that is not scheduled for a while loses nothing. FORCE passes net.core.rmem_max with
+  // CAP_NET_ADMIN; without it the plain option is capped there.
+  const int rcvbuf = 4 << 20;
+  if (setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &rcvbuf, sizeof rcvbuf) != 0)
+    setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
   // Bound to every CAN interface (index 0), sending to and keeping frames of ours by index: an
   // interface that vanishes and comes back (a USB adapter re-plugged) gets a new index, which
   // send() finds again without a new socket, so the descriptor the caller polls stays valid.
