@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <memory>
 #include <stdexcept>
@@ -183,7 +184,7 @@ Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not
   }
   FILE* f = out.empty() ? nullptr : out == "-" ? stdout : std::fopen(out.c_str(), "w");
   if (!out.empty() && f == nullptr) {
-    std::fprintf(stderr, "gyrochar-sim: %s: cannot write\n", out.c_str());
+    std::fprintf(stderr, "gyrochar-sim: %s: cannot write: %s\n", out.c_str(), std::strerror(errno));
     return 3;
   }
   if (f != nullptr)

@@ -61,4 +61,32 @@ TEST(ToolErrors, DemoNamesWhatIsWrong) {
   EXPECT_EQ(run(bin + "gyrochar-demo --help").code, 0);
 }
 
+// Runs `command` as an unprivileged user when this test runs as root (root reads and writes
+// anything), so that permissions are really checked.
+std::string unprivileged(const std::string& command) {
+  return getuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " + command : command;
+}
+
+TEST(ToolErrors, PermissionDeniedIsNamedWithItsReason) {
+  const std::string dir = ::testing::TempDir() + "gyrochar_perm_" + std::to_string(getpid());
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir + "/locked && chmod 755 " + dir).c_str());
+  std::ofstream(dir + "/secret.txt") << "5\n6\n7\n";
+  std::system(("chmod 000 " + dir + "/secret.txt && chmod 555 " + dir + "/locked").c_str());
+  const struct {
+    std::string program, args;
+    int code;
+  } cases[] = {
+      {"gyrochar-analyze", "--type counts --tau0 1 --pulse-weight 1arcsec " + dir + "/secret.txt", 2},
+      {"gyrochar-decode", dir + "/secret.txt", 2},
+      {"gyrochar-sim", "--duration 1 --out " + dir + "/locked/counts.txt", 3},
+  };
+  for (const auto& c : cases) {
+    const Outcome r = run(unprivileged(bin + c.program + " " + c.args));
+    EXPECT_EQ(r.code, c.code) << c.program << ": " << r.err;
+    EXPECT_EQ(r.err.rfind(c.program + ": " + dir, 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("Permission denied"), std::string::npos) << r.err;
+  }
+  std::system(("chmod -R 755 " + dir + " && rm -rf " + dir).c_str());
+}
+
 }  // namespace
