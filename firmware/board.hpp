@@ -45,7 +45,6 @@ class Board final : public hal::CountSink {
   void on_sample(const hal::CountSample& sample) override;
   const Estimator& estimator() const { return estimator_; }
   const FaultCounters& faults() const { return faults_; }
-  std::uint32_t config_hash() const { return settings_.config_hash; }
 
  private:
   void on_tick();

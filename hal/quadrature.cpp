@@ -9,13 +9,20 @@ std::uint64_t QuadratureDecoder::interval_of(std::uint64_t t_ns) const {
   return t_ns < s_.start_ns ? 0 : (t_ns - s_.start_ns) / s_.tau0_ns;
 }
 
-void QuadratureDecoder::emit(std::int64_t count, std::uint32_t lost, std::uint64_t end_interval, CountSink& sink) {
+void QuadratureDecoder::emit(std::int64_t count, std::uint32_t lost, std::uint64_t end_interval, CountSink& sink,
+                             std::uint64_t gap_intervals) {
   CountSample sample;
   sample.count = count;
   sample.lost_edges = lost;
   sample.end_ns = s_.start_ns + end_interval * s_.tau0_ns;
+  sample.gap = gap_intervals != 0;
+  sample.gap_intervals = gap_intervals;
   sink.on_sample(sample);
   ++counters_.samples;
+  if (sample.gap) {
+    ++counters_.gaps;
+    counters_.gap_intervals += gap_intervals;
+  }
 }
 
 void QuadratureDecoder::advance_to(std::uint64_t interval, CountSink& sink) {
@@ -33,14 +40,7 @@ void QuadratureDecoder::advance_to(std::uint64_t interval, CountSink& sink) {
   lost_ = 0;
   active_ = false;
   if (silent_ > s_.max_silent_intervals) {  // a stall: one gap sample, however long
-    CountSample gap;
-    gap.gap = true;
-    gap.gap_intervals = silent_;
-    gap.end_ns = s_.start_ns + open_ * s_.tau0_ns;
-    sink.on_sample(gap);
-    ++counters_.samples;
-    ++counters_.gaps;
-    counters_.gap_intervals += silent_;
+    emit(0, 0, open_, sink, silent_);
     silent_ = 0;
   }
 }

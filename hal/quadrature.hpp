@@ -39,7 +39,8 @@ class QuadratureDecoder {
  private:
   std::uint64_t interval_of(std::uint64_t t_ns) const;
   void advance_to(std::uint64_t interval, CountSink& sink);  // closes [open_, interval)
-  void emit(std::int64_t count, std::uint32_t lost, std::uint64_t end_interval, CountSink& sink);
+  void emit(std::int64_t count, std::uint32_t lost, std::uint64_t end_interval, CountSink& sink,
+            std::uint64_t gap_intervals = 0);  // gap_intervals > 0: a gap sample
   QuadratureSettings s_;
   bool a_, b_;
   std::uint64_t open_ = 0;   // index of the open interval

@@ -12,7 +12,6 @@ class FakeClock final : public Clock {
   explicit FakeClock(std::uint64_t start_ns = 1000000000u) : now_(start_ns) {}
   std::uint64_t now_ns() const override { return now_; }
   void advance(std::uint64_t ns) { now_ += ns; }
-  void set(std::uint64_t ns) { now_ = ns; }  // may jump backwards or far ahead (fault tests)
 
  private:
   std::uint64_t now_;

@@ -64,15 +64,9 @@ void GpioStrobeSource::poll(std::uint64_t, CountSink& sink) {
     std::uint64_t value = 0;
     const std::uint64_t t = static_cast<std::uint64_t>(events[k].ts.tv_sec) * 1000000000u +
                             static_cast<std::uint64_t>(events[k].ts.tv_nsec);
-    if (!read_counter(value)) {  // an unreadable counter: this interval is lost
-      CountSample gap;
-      gap.gap = true;
-      gap.gap_intervals = 1;
-      gap.end_ns = t;
-      sink.on_sample(gap);
-      continue;
-    }
-    decoder_.on_strobe(t, value, sink);
+    // An unreadable counter loses this strobe: the next one then spans two intervals, which the
+    // decoder's missed-strobe rule delivers as a gap.
+    if (read_counter(value)) decoder_.on_strobe(t, value, sink);
   }
 }
 

@@ -86,6 +86,18 @@ void expect_same_sums(const Estimator& a, const Estimator& b) {
   }
 }
 
+// A quadrature encoder's lines: each step is one edge, forwards (AB: 00 10 11 01 00) or back.
+struct Encoder {
+  int state = 0;
+  void step(hal::FakeCountSource& source, std::uint64_t t_ns, bool forward) {
+    static constexpr bool ab[4][2] = {{false, false}, {true, false}, {true, true}, {false, true}};
+    const int next = (state + (forward ? 1 : 3)) % 4;
+    const bool a_changes = ab[state][0] != ab[next][0];
+    source.push_edge(t_ns, a_changes ? hal::QuadratureLine::a : hal::QuadratureLine::b, ab[next][a_changes ? 0 : 1]);
+    state = next;
+  }
+};
+
 // The oracle: an estimator fed the counts directly.
 std::unique_ptr<Estimator> direct(const Config& c, const std::vector<std::int64_t>& counts) {
   EstimatorSettings s;
@@ -122,20 +134,13 @@ TEST(Board, QuadratureEdgesBecomeTheExactCounts) {
   q.start_ns = rig.clock.now_ns();
   q.tau0_ns = ms;
   rig.source.use_quadrature(q);
-  // |count| edges spread over each interval, in the count's sense (AB: 00 10 11 01 forwards).
+  // |count| edges spread over each interval, in the count's sense.
   const auto counts = test_counts(3000);
-  const bool cycle[4][2] = {{false, false}, {true, false}, {true, true}, {false, true}};
-  int state = 0;
+  Encoder encoder;
   for (std::size_t k = 0; k < counts.size(); ++k) {
     const std::int64_t n = std::llabs(counts[k]);
-    for (std::int64_t e = 0; e < n; ++e) {
-      const int next = (state + (counts[k] > 0 ? 1 : 3)) % 4;
-      const bool a_changes = cycle[state][0] != cycle[next][0];
-      const std::uint64_t t = q.start_ns + k * ms + static_cast<std::uint64_t>((e + 1) * ms / (n + 1));
-      rig.source.push_edge(t, a_changes ? hal::QuadratureLine::a : hal::QuadratureLine::b,
-                           a_changes ? cycle[next][0] : cycle[next][1]);
-      state = next;
-    }
+    for (std::int64_t e = 0; e < n; ++e)
+      encoder.step(rig.source, q.start_ns + k * ms + static_cast<std::uint64_t>((e + 1) * ms / (n + 1)), counts[k] > 0);
   }
   rig.run_for(3000 * ms);
   EXPECT_EQ(rig.board->estimator().samples(), counts.size());
@@ -230,13 +235,8 @@ TEST(Board, EdgeStormsAreWorkedOffInBoundedPassesAndClockJumpsAreOneGap) {
   q.max_silent_intervals = 1000;
   rig.source.use_quadrature(q);
   // 100000 edges inside the first millisecond: 25000 forward cycles.
-  const bool cycle[4][2] = {{false, false}, {true, false}, {true, true}, {false, true}};
-  for (int e = 0; e < 100000; ++e) {
-    const int from = e % 4, to = (e + 1) % 4;
-    const bool a_changes = cycle[from][0] != cycle[to][0];
-    rig.source.push_edge(q.start_ns + static_cast<std::uint64_t>(e) * 5, a_changes ? hal::QuadratureLine::a : hal::QuadratureLine::b,
-                         a_changes ? cycle[to][0] : cycle[to][1]);
-  }
+  Encoder encoder;
+  for (int e = 0; e < 100000; ++e) encoder.step(rig.source, q.start_ns + static_cast<std::uint64_t>(e) * 5, true);
   rig.clock.advance(2 * ms);
   rig.timer.update();
   ASSERT_TRUE(rig.board->run_once(0));
