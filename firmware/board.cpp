@@ -30,31 +30,23 @@ protocol::InputSource input_source(SourceKind s) {
   return protocol::InputSource::unknown;
 }
 
-// What a checkpoint must match: everything that shapes the accumulator's state.
-std::uint32_t hash_settings(const EstimatorSettings& s) {
+// What a checkpoint must match: everything that shapes the accumulator's state or its meaning.
+std::uint32_t hash_settings(const ReportSettings& s) {
   char text[160];
   const int n = std::snprintf(text, sizeof text, "tau0=%.17g pulse=%.17g S=%u octaves=%u source=%u", s.tau0_s,
                               s.pulse_weight_arcsec, s.stride_factor, s.octaves, static_cast<unsigned>(s.source));
   return crc32(std::as_bytes(std::span(text, static_cast<std::size_t>(n))));
 }
 
-// The checkpoint file: this header, then the estimator's checkpoint.
-struct FileHeader {
-  std::uint32_t magic = 0x44525947;  // "GYRD"
-  std::uint16_t version = 1;
-  std::uint16_t reserved = 0;
-  std::uint32_t config_hash = 0;
-  std::uint32_t payload_bytes = 0;
-};
-
 const char* restore_reason(RestoreStatus s) {
   switch (s) {
     case RestoreStatus::ok: return "ok";
     case RestoreStatus::truncated: return "truncated";
-    case RestoreStatus::not_a_checkpoint: return "not a gyrochar checkpoint";
+    case RestoreStatus::not_a_checkpoint: return "not a gyrochard checkpoint";
     case RestoreStatus::wrong_version: return "written by another checkpoint format version";
     case RestoreStatus::corrupted: return "CRC mismatch (corrupted)";
-    case RestoreStatus::config_mismatch: return "written under another estimator configuration";
+    case RestoreStatus::config_mismatch:
+      return "written under another configuration (tau0, pulse weight, stride factor, octaves or source changed)";
   }
   return "invalid";
 }
@@ -71,8 +63,8 @@ Board::Board(const Config& config, BoardIo io)
   settings_.source = input_source(config.source);
   settings_.report_period_ms = static_cast<std::uint16_t>(config.report_period_s * 1000.0);
   settings_.config_hash = hash_settings(settings_);
-  if (!estimator_.configure(settings_)) throw std::invalid_argument("estimator settings out of range");
-  checkpoint_buffer_.resize(sizeof(FileHeader) + estimator_.checkpoint_size());
+  if (!configure(characterizer_, settings_)) throw std::invalid_argument("estimator settings out of range");
+  checkpoint_buffer_.resize(characterizer_.checkpoint_size());
   checkpoint_period_ns_ = static_cast<std::uint64_t>(config.checkpoint_period_s * 1e9);
   start_ns_ = io.clock.now_ns();
   next_checkpoint_ns_ = start_ns_ + checkpoint_period_ns_;
@@ -103,28 +95,14 @@ std::string Board::resume() {
   const long n = checkpoint_file_.read(checkpoint_buffer_);
   if (n == -ENOENT) return "no checkpoint at " + checkpoint_file_.path() + ": starting fresh";
   std::string why;
-  FileHeader h;
   if (n < 0) {
     why = n == -EFBIG ? "larger than any checkpoint of this configuration" : std::strerror(static_cast<int>(-n));
-  } else if (static_cast<std::size_t>(n) < sizeof h) {
-    why = "truncated";
+  } else if (const RestoreStatus s = characterizer_.restore(std::span(checkpoint_buffer_).first(static_cast<std::size_t>(n)));
+             s != RestoreStatus::ok) {
+    why = restore_reason(s);
   } else {
-    std::memcpy(&h, checkpoint_buffer_.data(), sizeof h);
-    const auto payload = std::span<const std::byte>(checkpoint_buffer_).subspan(sizeof h, static_cast<std::size_t>(n) - sizeof h);
-    if (h.magic != FileHeader{}.magic) {
-      why = "not a gyrochard checkpoint";
-    } else if (h.version != FileHeader{}.version) {
-      why = "written by checkpoint format version " + std::to_string(h.version);
-    } else if (h.config_hash != settings_.config_hash) {
-      why = "written under another configuration (tau0, pulse weight, stride factor, octaves or source changed)";
-    } else if (payload.size() != h.payload_bytes) {
-      why = "truncated";
-    } else if (const RestoreStatus s = estimator_.restore(payload); s != RestoreStatus::ok) {
-      why = restore_reason(s);
-    } else {
-      ++faults_.sample_gaps;  // the restart is a gap
-      return "resumed from " + checkpoint_file_.path() + ": " + std::to_string(estimator_.samples()) + " samples";
-    }
+    ++faults_.sample_gaps;  // the restart is a gap
+    return "resumed from " + checkpoint_file_.path() + ": " + std::to_string(characterizer_.increments()) + " samples";
   }
   const int e = checkpoint_file_.set_aside();
   return "checkpoint " + checkpoint_file_.path() + " not used: " + why + "; starting fresh" +
@@ -134,12 +112,8 @@ std::string Board::resume() {
 
 int Board::checkpoint() {
   if (config_.checkpoint_path.empty()) return 0;
-  FileHeader h;
-  h.config_hash = settings_.config_hash;
-  const std::size_t n = estimator_.save(std::span(checkpoint_buffer_).subspan(sizeof h));
-  h.payload_bytes = static_cast<std::uint32_t>(n);
-  std::memcpy(checkpoint_buffer_.data(), &h, sizeof h);
-  const int e = checkpoint_file_.write(std::span(checkpoint_buffer_).first(sizeof h + n));
+  const std::size_t n = characterizer_.save(checkpoint_buffer_);
+  const int e = checkpoint_file_.write(std::span(checkpoint_buffer_).first(n));
   if (e != 0) BOARD_LOG("3", "checkpoint %s: %s", config_.checkpoint_path.c_str(), std::strerror(e));
   return e;
 }
@@ -148,10 +122,10 @@ void Board::on_sample(const hal::CountSample& s) {
   faults_.lost_edges += s.lost_edges;
   if (s.gap) {
     ++faults_.sample_gaps;  // a new segment, never bridged
-    estimator_.mark_gap();
+    characterizer_.mark_gap();
     return;
   }
-  estimator_.add_count(static_cast<std::int32_t>(s.count));
+  characterizer_.add_increment(static_cast<std::int32_t>(s.count));
 }
 
 void Board::on_frames() {
@@ -178,11 +152,11 @@ void Board::on_tick() {
   if (frame_ == 0) {
     faults_.tx_dropped_frames = static_cast<std::uint32_t>(io_.can.counters().tx_dropped);
     faults_.bus_off_events = static_cast<std::uint32_t>(io_.can.counters().bus_off_events);
-    estimator_.report(seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, content_);
+    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, content_);
     frames_ = protocol::report_frame_count(seq_, config_.octaves);
     if (config_.verbose)
       BOARD_LOG("7", "report %u: %llu samples", static_cast<unsigned>(seq_),
-                static_cast<unsigned long long>(estimator_.samples()));
+                static_cast<unsigned long long>(characterizer_.increments()));
   }
   CanFrame f;
   if (protocol::encode(report_message(content_, frame_), config_.node, f) == protocol::ProtocolError::none)

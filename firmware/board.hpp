@@ -43,7 +43,7 @@ class Board final : public hal::CountSink {
   int checkpoint();
 
   void on_sample(const hal::CountSample& sample) override;
-  const Estimator& estimator() const { return estimator_; }
+  const Characterizer<CountArith>& characterizer() const { return characterizer_; }
   const FaultCounters& faults() const { return faults_; }
 
  private:
@@ -52,8 +52,8 @@ class Board final : public hal::CountSink {
   void watch_bus();
   Config config_;
   BoardIo io_;
-  EstimatorSettings settings_;
-  Estimator estimator_;
+  ReportSettings settings_;
+  BoardCharacterizer characterizer_;
   ReportContent content_;
   FaultCounters faults_;
   hal::CanCounterDecoder can_counter_;

@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
   }
   const int e = board->checkpoint();
   std::fprintf(stderr, "<6>gyrochard: stopping on signal after %llu samples%s\n",
-               static_cast<unsigned long long>(board->estimator().samples()),
+               static_cast<unsigned long long>(board->characterizer().increments()),
                config.checkpoint_path.empty() ? "" : e == 0 ? ", checkpoint written" : ", checkpoint NOT written");
   close(stop_fd);
   return 0;

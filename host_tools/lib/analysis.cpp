@@ -11,9 +11,7 @@
 #include <string>
 #include <type_traits>
 
-#include "gyrochar/edf.hpp"
-#include "gyrochar/noise_id.hpp"
-#include "gyrochar/pyramid.hpp"
+#include "gyrochar/characterizer.hpp"
 
 namespace gyrochar {
 
@@ -26,20 +24,8 @@ const char* name(DataType t) {
   return "?";
 }
 
-const char* name(DevStat s) {
-  switch (s) {
-    case DevStat::adev: return "adev";
-    case DevStat::oadev: return "oadev";
-    case DevStat::mdev: return "mdev";
-    case DevStat::tdev: return "tdev";
-    case DevStat::hdev: return "hdev";
-    case DevStat::ohdev: return "ohdev";
-  }
-  return "?";
-}
-
 std::optional<DevStat> parse_dev_stat(const std::string& text) {
-  for (const DevStat s : {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::tdev, DevStat::hdev, DevStat::ohdev})
+  for (const DevStat s : all_dev_stats)
     if (text == name(s)) return s;
   return std::nullopt;
 }
@@ -83,28 +69,6 @@ std::vector<std::uint64_t> all_taus(std::uint64_t n_phase, std::uint32_t stride_
 
 namespace {
 
-// Phase relative to the line through the first two points, x'_k = (x_k - x_0) - k (x_1 - x_0).
-// Second and higher differences are unchanged, and x' stays about as small as the noise, which
-// keeps the pyramid's prefix sums small. x_k - x_0 is formed exactly (as hi + lo) and the line is
-// taken off by one fused multiply-add, so x' carries about one rounding of its own (small) size.
-class ReferenceLine {
- public:
-  double relative(double x) {
-    const std::uint64_t k = k_++;
-    if (k == 0) x0_ = x;
-    const double hi = x - x0_;
-    const double b = hi - x;
-    const double lo = (x - (hi - b)) - (x0_ + b);
-    if (k == 1) slope_ = hi;
-    return std::fma(-static_cast<double>(k), slope_, hi) + lo;
-  }
-
- private:
-  std::uint64_t k_ = 0;
-  double x0_ = 0.0;
-  double slope_ = 0.0;
-};
-
 // Zero-filled storage from calloc, whose pages the system maps on first write: the pyramid's
 // history rings for long taus cost memory only once the data reaches them (a short input with
 // the 2^16 stride factor and taus up to 2^39 stays small). The entries are aggregates of numbers,
@@ -132,20 +96,17 @@ struct EngineBase {
   virtual Analysis result(const AnalysisOptions& o) const = 0;
 };
 
-// Everything that depends on the arithmetic: the pyramid (overlapping statistics), Stable32's
-// non-overlapped ADEV/HDEV and the decimated series for noise identification.
+// The characterizer of one arithmetic over heap storage, and its read-out into rows.
 template <class Arith>
 class Engine final : public EngineBase {
   using Entry = typename Arith::Entry;
-  using X = decltype(Entry{}.x);
-  using Sum = typename Arith::Sum;
 
  public:
   Engine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list)
-      : type_(type), m_list_(m_list), history_(history_entries(stride_factor, m_list.back())),
-        states_(m_list.size()), pyramid_(history_, states_), decimated_(m_list.size()) {
+      : type_(type), history_(history_entries(stride_factor, m_list.back())), states_(m_list.size()),
+        characterizer_(history_, states_) {
     if (!history_.data()) throw std::bad_alloc();
-    if (pyramid_.configure({stride_factor, false}, m_list_) != PyramidStatus::ok)
+    if (characterizer_.configure({stride_factor, 0}, m_list) != ConfigureStatus::ok)
       throw std::invalid_argument("the taus do not fit the stride factor");
   }
 
@@ -153,144 +114,63 @@ class Engine final : public EngineBase {
     if constexpr (Arith::exact) {
       if (!(std::fabs(value) < 2147483648.0) || value != std::trunc(value))
         throw std::invalid_argument("a count must be an integer of magnitude below 2^31");
-      const auto count = static_cast<std::int32_t>(value);
-      if (values_ == 0) point(0);
-      if (__builtin_add_overflow(x_, std::int64_t{count}, &x_))
-        throw std::range_error("the accumulated count passed 2^63 pulses");
-      pyramid_.add_increment(count);
-      point(x_);
+      characterizer_.add_increment(static_cast<std::int32_t>(value));
+      if (characterizer_.phase_overflowed()) throw std::range_error("the accumulated count passed 2^63 pulses");
     } else {
       if (!std::isfinite(value)) throw std::invalid_argument("not a finite number");
-      if (type_ == DataType::phase) {
-        const double x = line_.relative(value);
-        pyramid_.add_phase_point(x);
-        point(x);
-      } else {  // frequency, integrated relative to the first value: phase in units of y tau0
-        if (values_ == 0) {
-          y0_ = value;
-          point(0.0);
-        }
-        const double dy = value - y0_;
-        x_ += dy;
-        pyramid_.add_increment(dy);
-        point(x_);
-      }
+      if (type_ == DataType::phase)
+        characterizer_.add_phase_point(value);
+      else
+        characterizer_.add_increment(value);  // frequency: phase in units of y tau0
     }
-    ++values_;
   }
 
   Analysis result(const AnalysisOptions& o) const override {
     Analysis a;
-    a.n_values = values_;
-    a.n_phase = pyramid_.phase_points();
-    a.stride_factor = pyramid_.stride_factor();
-    for (const DevStat stat : o.stats)
-      for (std::size_t i = 0; i < m_list_.size(); ++i)
-        if (const auto row = make_row(o, stat, i)) a.rows.push_back(*row);
+    a.n_values = type_ == DataType::phase ? characterizer_.phase_points() : characterizer_.increments();
+    a.n_phase = characterizer_.phase_points();
+    a.stride_factor = characterizer_.stride_factor();
+    const std::size_t taus = characterizer_.tau_count();
+    std::vector<TauSums> sums(taus);
+    take_sums(characterizer_, sums);
+    std::vector<NoiseId> noise2(taus), noise3(taus);
+    const bool frequency_input = type_ == DataType::freq;
+    if (o.alpha) {
+      std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
+      std::fill(noise3.begin(), noise3.end(), given_noise(*o.alpha));
+    } else {
+      identify_noise(sums, 2, frequency_input, noise2);
+      identify_noise(sums, 3, frequency_input, noise3);
+    }
+    const EstimateOptions options{o.tau0_s, type_ == DataType::freq ? o.tau0_s : 1.0, o.edf};
+    for (const DevStat stat : o.stats) {
+      for (std::size_t i = 0; i < taus; ++i) {
+        const NoiseId& id = stat_of(stat) == Stat::hvar ? noise3[i] : noise2[i];
+        const Estimate e = estimate(sums[i], a.n_phase, stat, id, options);
+        if (e.n == 0) continue;
+        AnalysisRow row;
+        row.stat = stat;
+        row.m = e.m;
+        row.tau_s = e.tau_s;
+        row.n = e.n;
+        row.dev = e.deviation;
+        if (e.noise.identified()) row.alpha = e.noise.alpha;
+        row.noise = e.noise;
+        row.edf_alpha = e.edf_alpha;
+        row.stride = e.stride;
+        row.edf = e.edf;
+        if (e.edf > 0) row.ci = confidence_interval(row.dev, row.edf, o.confidence);
+        a.rows.push_back(row);
+      }
+    }
     return a;
   }
 
  private:
-  // Non-overlapped terms (j = 0, m, 2m, ...) and the decimated series x[k m] for noise ID.
-  struct Decimated {
-    std::uint64_t countdown = 0;  // phase points until the next multiple of m
-    std::array<X, 3> back{};      // x at e - m, e - 2m, e - 3m
-    int have = 0;                 // entries of `back` filled
-    Sum sum_avar{}, sum_hvar{};
-    std::uint64_t n_avar = 0, n_hvar = 0;
-    NoiseIdAccumulator noise;
-  };
-
-  void point(X x) {
-    for (std::size_t i = 0; i < decimated_.size(); ++i) {
-      Decimated& d = decimated_[i];
-      if (d.countdown-- != 0) continue;
-      d.countdown = m_list_[i] - 1;
-      X a{}, h{};
-      if (d.have >= 2 && Arith::x_term2(x, d.back[0], d.back[1], a)) {
-        Arith::accumulate(d.sum_avar, a);
-        ++d.n_avar;
-      }
-      if (d.have >= 3 && Arith::x_terms(x, d.back[0], d.back[1], d.back[2], a, h)) {
-        Arith::accumulate(d.sum_hvar, h);
-        ++d.n_hvar;
-      }
-      d.back = {x, d.back[0], d.back[1]};
-      if (d.have < 3) ++d.have;
-      d.noise.add(static_cast<double>(x));
-    }
-  }
-
-  std::optional<AnalysisRow> make_row(const AnalysisOptions& o, DevStat stat, std::size_t i) const {
-    const auto r = pyramid_.result(i);
-    const Decimated& dec = decimated_[i];
-    const double unit = type_ == DataType::freq ? o.tau0_s : 1.0;  // phase unit per x step
-    AnalysisRow row;
-    row.stat = stat;
-    row.m = m_list_[i];
-    row.tau_s = static_cast<double>(row.m) * o.tau0_s;
-    row.stride = pyramid_.stride(i);
-    double var = 0.0;
-    EdfStat edf_stat = EdfStat::avar;
-    switch (stat) {
-      case DevStat::adev:  // the AVAR formula over the non-overlapped terms
-        row.n = dec.n_avar;
-        row.stride = row.m;
-        if (row.n) var = Arith::to_double(dec.sum_avar) * unit * unit / (2.0 * static_cast<double>(row.n) * row.tau_s * row.tau_s);
-        break;
-      case DevStat::oadev:
-        row.n = r.n[0];
-        var = variance(r, Stat::avar, o.tau0_s, unit);
-        break;
-      case DevStat::mdev:
-      case DevStat::tdev:
-        row.n = r.n[1];
-        var = variance(r, Stat::mvar, o.tau0_s, unit);
-        edf_stat = EdfStat::mvar;
-        break;
-      case DevStat::hdev:  // the HVAR formula over the non-overlapped terms
-        row.n = dec.n_hvar;
-        row.stride = row.m;
-        if (row.n) var = Arith::to_double(dec.sum_hvar) * unit * unit / (6.0 * static_cast<double>(row.n) * row.tau_s * row.tau_s);
-        edf_stat = EdfStat::hvar;
-        break;
-      case DevStat::ohdev:
-        row.n = r.n[2];
-        var = variance(r, Stat::hvar, o.tau0_s, unit);
-        edf_stat = EdfStat::hvar;
-        break;
-    }
-    if (row.n == 0) return std::nullopt;
-    row.dev = stat == DevStat::tdev ? std::sqrt(tvar_from_mvar(var, row.tau_s)) : std::sqrt(var);
-    row.alpha = o.alpha;
-    if (!row.alpha) {
-      NoiseIdInput in;
-      in.m = row.m;
-      in.dmax = edf_stat == EdfStat::hvar ? 3 : 2;
-      in.frequency_data = type_ == DataType::freq;
-      in.tau0_s = o.tau0_s;
-      in.avar = variance(r, Stat::avar, o.tau0_s);
-      in.mvar = variance(r, Stat::mvar, o.tau0_s);
-      const NoiseId id = identify_noise(dec.noise, in);
-      if (id.method != NoiseIdMethod::none) row.alpha = id.alpha;
-    }
-    if (row.alpha) {
-      row.edf = edf_for(edf_stat, *row.alpha, row.m, row.stride, pyramid_.phase_points());
-      row.ci = confidence_interval(row.dev, row.edf, o.confidence);
-    }
-    return row;
-  }
-
   DataType type_;
-  std::vector<std::uint64_t> m_list_;
   ZeroedArray<Entry> history_;
-  std::vector<typename Pyramid<Arith>::TauState> states_;
-  Pyramid<Arith> pyramid_;
-  std::vector<Decimated> decimated_;
-  std::uint64_t values_ = 0;
-  X x_{};             // running phase (counts, frequency)
-  double y0_ = 0.0;   // first frequency value
-  ReferenceLine line_;
+  std::vector<typename Characterizer<Arith>::TauState> states_;
+  Characterizer<Arith> characterizer_;
 };
 
 }  // namespace

@@ -1,9 +1,8 @@
 #pragma once
-// The offline analysis engine behind gyrochar-analyze. Values stream into the core pyramid (exact
-// integer arithmetic for counts; for phase and frequency, floating phase kept small relative to a
-// reference line); beside it run Stable32's non-overlapped ADEV/HDEV and the decimated series for
-// noise identification. Per tau the engine gives the deviation, its number of terms, the noise
-// exponent, the Greenhall EDF of the estimator actually used and the chi-squared interval.
+// The offline analysis engine behind gyrochar-analyze: the core characterizer (the one the board
+// runs) over heap storage sized for the file, read out by the core extractors (estimates.hpp): per
+// tau the deviation, its number of terms, the identified noise and how it was chosen, the exact EDF
+// of the estimator actually used, and the chi-squared interval.
 //
 // Memory depends on the tau list and the stride factor S, never on the number of values: the
 // history holds at most 3S (1 + levels/2) points (levels: octaves of the largest tau above S; the
@@ -19,6 +18,7 @@
 #include <vector>
 
 #include "confidence.hpp"
+#include "gyrochar/estimates.hpp"
 
 namespace gyrochar {
 
@@ -27,11 +27,8 @@ enum class DataType {
   freq,    // frequency (rate) samples y_k, averages over tau0: N values give N + 1 phase points
   counts,  // integer pulse counts per tau0 (exact): N counts give N + 1 phase points
 };
-enum class DevStat { adev, oadev, mdev, tdev, hdev, ohdev };
-
-/// "phase", "freq", "counts" / "adev", "oadev", ... Static strings, never null.
+/// "phase", "freq", "counts". A static string, never null.
 const char* name(DataType t);
-const char* name(DevStat s);
 /// The statistic called `text`, or nothing.
 std::optional<DevStat> parse_dev_stat(const std::string& text);
 
@@ -64,6 +61,7 @@ struct AnalysisOptions {
   std::uint32_t stride_factor = 0;      // S, a power of two >= 2; 0: full (resolve_stride_factor)
   double confidence = 0.682689492137086;
   std::optional<int> alpha;             // noise exponent for the EDF; empty: identified per tau
+  EdfModel edf = EdfModel::exact;       // greenhall: Stable32's approximation (comparisons)
 };
 
 struct AnalysisRow {
@@ -72,9 +70,11 @@ struct AnalysisRow {
   double tau_s = 0.0;
   std::uint64_t n = 0;          // terms in the estimate (Stable32's "#")
   double dev = 0.0;             // deviation: phase unit per second (TDEV: phase unit)
-  std::optional<int> alpha;     // noise exponent used for the EDF (fixed or identified)
+  std::optional<int> alpha;     // identified (or given) noise exponent; empty: not identified
+  NoiseId noise;                // the identification: plausible range and method
+  int edf_alpha = 0;            // the alpha whose EDF was used (the smallest of the plausible)
   std::uint64_t stride = 1;     // terms every `stride` phase points (m for adev and hdev)
-  double edf = 0.0;             // Greenhall EDF of this estimator; 0: not available
+  double edf = 0.0;             // EDF of this estimator; 0: not available
   Interval ci;                  // same unit as dev
 };
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "batch_estimators.hpp"
-#include "gyrochar/pyramid.hpp"
+#include "gyrochar/characterizer.hpp"
 
 namespace gyrochar {
 namespace {
@@ -28,18 +28,18 @@ std::vector<std::uint64_t> octave_taus(std::size_t n_points) {
   return m;
 }
 
-// A pyramid on heap storage sized for the stride factor (0 = full: S >= largest m).
-struct HeapPyramid {
+// A characterizer on heap storage sized for the stride factor (0 = full: S >= largest m).
+struct HeapCharacterizer {
   std::vector<CountArith::Entry> history;
-  std::vector<Pyramid<CountArith>::TauState> taus;
-  std::unique_ptr<Pyramid<CountArith>> pyramid;
-  HeapPyramid(std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list) {
+  std::vector<Characterizer<CountArith>::TauState> taus;
+  std::unique_ptr<Characterizer<CountArith>> pyramid;
+  HeapCharacterizer(std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list) {
     std::uint32_t s = stride_factor;
     if (s == 0) s = static_cast<std::uint32_t>(std::bit_ceil(m_list.back()));
     history.resize(history_entries(s, m_list.back()));
     taus.resize(m_list.size());
-    pyramid = std::make_unique<Pyramid<CountArith>>(history, taus);
-    if (pyramid->configure({s, false}, m_list) != PyramidStatus::ok) std::abort();
+    pyramid = std::make_unique<Characterizer<CountArith>>(history, taus);
+    if (pyramid->configure({s, 0}, m_list) != ConfigureStatus::ok) std::abort();
   }
 };
 
@@ -48,7 +48,7 @@ void PerSample(benchmark::State& state) {
   const auto& data = counts(n);
   const auto m_list = octave_taus(1ull << 40);
   for (auto _ : state) {
-    HeapPyramid p(static_cast<std::uint32_t>(state.range(0)), octave_taus(std::size_t{1} << 41));
+    HeapCharacterizer p(static_cast<std::uint32_t>(state.range(0)), octave_taus(std::size_t{1} << 41));
     for (std::size_t i = 0; i < n; ++i) p.pyramid->add_increment(data[i]);
     benchmark::DoNotOptimize(p.pyramid->result(3));
   }
@@ -60,7 +60,7 @@ void Block(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(1));
   const auto& data = counts(n);
   for (auto _ : state) {
-    HeapPyramid p(static_cast<std::uint32_t>(state.range(0)), octave_taus(std::size_t{1} << 41));
+    HeapCharacterizer p(static_cast<std::uint32_t>(state.range(0)), octave_taus(std::size_t{1} << 41));
     p.pyramid->add_increments(std::span<const std::int32_t>(data.data(), n));
     benchmark::DoNotOptimize(p.pyramid->result(3));
   }
@@ -71,7 +71,7 @@ void FullStride(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
   const auto& data = counts(n);
   for (auto _ : state) {
-    HeapPyramid p(0, octave_taus(n + 1));
+    HeapCharacterizer p(0, octave_taus(n + 1));
     p.pyramid->add_increments(std::span<const std::int32_t>(data.data(), n));
     benchmark::DoNotOptimize(p.pyramid->result(0));
   }

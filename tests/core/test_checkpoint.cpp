@@ -1,6 +1,7 @@
-// Checkpoints of the pyramid: save, restore into a fresh pyramid, go on; the result must equal,
+// Checkpoints of the characterizer: save, restore into a fresh one, go on; the result must equal,
 // bit for bit, one uninterrupted run with a gap marked at the restart (oracle: the gap semantics,
-// whose own exactness test_pyramid checks against brute force). Damaged checkpoints are detected.
+// whose own exactness test_characterizer checks against brute force), noise sums included.
+// Damaged or foreign checkpoints are detected.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -8,12 +9,12 @@
 #include <vector>
 
 #include "gyrochar/crc32.hpp"
-#include "gyrochar/pyramid.hpp"
+#include "gyrochar/characterizer.hpp"
 
 namespace gyrochar {
 namespace {
 
-using Board = StaticPyramid<CountArith, 20, 8>;
+using Board = StaticCharacterizer<CountArith, 20, 8>;
 
 std::vector<std::uint64_t> octaves(unsigned n) {
   std::vector<std::uint64_t> m;
@@ -34,9 +35,9 @@ TEST(Checkpoint, RestoreThenContinueEqualsRunWithGap) {
   for (auto& c : counts) c = 5000 + static_cast<std::int32_t>(rng() % 101);
 
   auto reference = std::make_unique<Board>();
-  ASSERT_EQ(reference->configure({8, false}, m_list), PyramidStatus::ok);
+  ASSERT_EQ(reference->configure({8, 0}, m_list), ConfigureStatus::ok);
   auto first = std::make_unique<Board>();
-  ASSERT_EQ(first->configure({8, false}, m_list), PyramidStatus::ok);
+  ASSERT_EQ(first->configure({8, 0}, m_list), ConfigureStatus::ok);
   const std::size_t cut = 123457;
   for (std::size_t i = 0; i < cut; ++i) {
     reference->add_increment(counts[i]);
@@ -46,7 +47,7 @@ TEST(Checkpoint, RestoreThenContinueEqualsRunWithGap) {
   ASSERT_EQ(first->save(bytes), bytes.size());
 
   auto second = std::make_unique<Board>();
-  ASSERT_EQ(second->configure({8, false}, m_list), PyramidStatus::ok);
+  ASSERT_EQ(second->configure({8, 0}, m_list), ConfigureStatus::ok);
   ASSERT_EQ(second->restore(bytes), RestoreStatus::ok);
   reference->mark_gap();
   for (std::size_t i = cut; i < counts.size(); ++i) {
@@ -57,7 +58,9 @@ TEST(Checkpoint, RestoreThenContinueEqualsRunWithGap) {
   for (std::size_t i = 0; i < m_list.size(); ++i) {
     const auto a = reference->result(i), b = second->result(i);
     EXPECT_EQ(a.n, b.n) << "m=" << a.m;
-    for (int s = 0; s < 3; ++s) EXPECT_TRUE(a.sum[s] == b.sum[s]) << "m=" << a.m;
+    for (std::size_t s = 0; s < sum_kinds; ++s) EXPECT_TRUE(a.sum[s] == b.sum[s]) << "m=" << a.m;
+    EXPECT_EQ(reference->noise(i).order(1).r1(), second->noise(i).order(1).r1()) << "m=" << a.m;
+    EXPECT_EQ(reference->noise(i).points(), second->noise(i).points()) << "m=" << a.m;
   }
   EXPECT_GT(second->result(15).n[0], 0u);  // m = 2^15: terms on both sides of the cut
 }
@@ -65,13 +68,13 @@ TEST(Checkpoint, RestoreThenContinueEqualsRunWithGap) {
 TEST(Checkpoint, DamageIsDetectedAndNothingChanges) {
   const auto m_list = octaves(10);
   auto board = std::make_unique<Board>();
-  ASSERT_EQ(board->configure({8, false}, m_list), PyramidStatus::ok);
+  ASSERT_EQ(board->configure({8, 0}, m_list), ConfigureStatus::ok);
   for (int i = 0; i < 10000; ++i) board->add_increment(100 + i % 7);
   std::vector<std::byte> bytes(board->checkpoint_size());
   ASSERT_EQ(board->save(bytes), bytes.size());
 
   auto target = std::make_unique<Board>();
-  ASSERT_EQ(target->configure({8, false}, m_list), PyramidStatus::ok);
+  ASSERT_EQ(target->configure({8, 0}, m_list), ConfigureStatus::ok);
   auto flipped = bytes;
   flipped[flipped.size() / 2] ^= std::byte{0x10};
   EXPECT_EQ(target->restore(flipped), RestoreStatus::corrupted);
@@ -83,10 +86,12 @@ TEST(Checkpoint, DamageIsDetectedAndNothingChanges) {
   EXPECT_EQ(target->phase_points(), 0u);  // nothing restored
 
   auto other = std::make_unique<Board>();
-  ASSERT_EQ(other->configure({16, false}, m_list), PyramidStatus::ok);
+  ASSERT_EQ(other->configure({16, 0}, m_list), ConfigureStatus::ok);
+  EXPECT_EQ(other->restore(bytes), RestoreStatus::config_mismatch);
+  ASSERT_EQ(other->configure({8, 1234}, m_list), ConfigureStatus::ok);  // another caller tag
   EXPECT_EQ(other->restore(bytes), RestoreStatus::config_mismatch);
   const auto fewer = octaves(9);
-  ASSERT_EQ(other->configure({8, false}, fewer), PyramidStatus::ok);
+  ASSERT_EQ(other->configure({8, 0}, fewer), ConfigureStatus::ok);
   EXPECT_EQ(other->restore(bytes), RestoreStatus::config_mismatch);
   std::vector<std::byte> small(bytes.size() - 1);
   EXPECT_EQ(board->save(small), 0u);

@@ -1,7 +1,7 @@
 // The board program's loop on the HAL fakes (in-process CAN bus, scripted count source, virtual
 // clock): no heap allocation after start-up, quadrature edges end up as the exact counts, a downed
 // bus costs reports but no samples, and checkpoints resume or are refused with the reason.
-// Oracles: an Estimator fed the same counts directly (same exact integer sums), the fake bus's own
+// Oracles: a characterizer fed the same counts directly (same exact integer sums), the fake bus's own
 // counters, and the checkpoint format's checks.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -75,11 +75,11 @@ struct Rig {
   }
 };
 
-void expect_same_sums(const Estimator& a, const Estimator& b) {
-  ASSERT_EQ(a.pyramid().tau_count(), b.pyramid().tau_count());
-  for (std::size_t i = 0; i < a.pyramid().tau_count(); ++i) {
-    const auto ra = a.pyramid().result(i), rb = b.pyramid().result(i);
-    for (std::size_t k = 0; k < stat_count; ++k) {
+void expect_same_sums(const Characterizer<CountArith>& a, const Characterizer<CountArith>& b) {
+  ASSERT_EQ(a.tau_count(), b.tau_count());
+  for (std::size_t i = 0; i < a.tau_count(); ++i) {
+    const auto ra = a.result(i), rb = b.result(i);
+    for (std::size_t k = 0; k < sum_kinds; ++k) {
       EXPECT_EQ(ra.n[k], rb.n[k]) << "tau " << i << " stat " << k;
       EXPECT_TRUE(ra.sum[k] == rb.sum[k]) << "tau " << i << " stat " << k;
     }
@@ -98,15 +98,15 @@ struct Encoder {
   }
 };
 
-// The oracle: an estimator fed the counts directly.
-std::unique_ptr<Estimator> direct(const Config& c, const std::vector<std::int64_t>& counts) {
-  EstimatorSettings s;
+// The oracle: a characterizer fed the counts directly.
+std::unique_ptr<BoardCharacterizer> direct(const Config& c, const std::vector<std::int64_t>& counts) {
+  ReportSettings s;
   s.tau0_s = c.tau0_s;
   s.stride_factor = c.stride_factor;
   s.octaves = c.octaves;
-  auto e = std::make_unique<Estimator>();
-  EXPECT_TRUE(e->configure(s));
-  for (const auto v : counts) e->add_count(static_cast<std::int32_t>(v));
+  auto e = std::make_unique<BoardCharacterizer>();
+  EXPECT_TRUE(configure(*e, s));
+  for (const auto v : counts) e->add_increment(static_cast<std::int32_t>(v));
   return e;
 }
 
@@ -122,7 +122,7 @@ TEST(Board, NoHeapAllocationAfterStartUp) {
   rig.run_for(5000 * ms);  // 5000 samples, 50 reports, 10 checkpoints
   armed = false;
   EXPECT_EQ(allocations.load(), 0u);
-  EXPECT_EQ(rig.board->estimator().samples(), counts.size());
+  EXPECT_EQ(rig.board->characterizer().increments(), counts.size());
   EXPECT_GT(rig.bus.frames_on_bus(), 50u * 40u);
   std::remove(c.checkpoint_path.c_str());
 }
@@ -143,8 +143,8 @@ TEST(Board, QuadratureEdgesBecomeTheExactCounts) {
       encoder.step(rig.source, q.start_ns + k * ms + static_cast<std::uint64_t>((e + 1) * ms / (n + 1)), counts[k] > 0);
   }
   rig.run_for(3000 * ms);
-  EXPECT_EQ(rig.board->estimator().samples(), counts.size());
-  expect_same_sums(rig.board->estimator(), *direct(c, counts));
+  EXPECT_EQ(rig.board->characterizer().increments(), counts.size());
+  expect_same_sums(rig.board->characterizer(), *direct(c, counts));
   EXPECT_EQ(rig.board->faults().lost_edges, 0u);
 }
 
@@ -167,8 +167,8 @@ TEST(Board, ADownedBusCostsReportsButNoSamples) {
   received = 0;
   while (listener->receive()) ++received;
   EXPECT_GT(received, 0u) << "reports resume";
-  EXPECT_EQ(rig.board->estimator().samples(), counts.size());
-  expect_same_sums(rig.board->estimator(), *direct(c, counts));
+  EXPECT_EQ(rig.board->characterizer().increments(), counts.size());
+  expect_same_sums(rig.board->characterizer(), *direct(c, counts));
 }
 
 TEST(Board, MeasuredBusLoadOfOneNodeIsUnderThreePercentOf500kbits) {
@@ -211,8 +211,8 @@ TEST(Board, FullTxQueueAndBusOffAreCountedReportedAndSurvived) {
   while (listener->receive()) {
   }
   rig.run_for(2000 * ms);
-  EXPECT_EQ(rig.board->estimator().samples(), counts.size()) << "accumulation never stopped";
-  expect_same_sums(rig.board->estimator(), *direct(c, counts));
+  EXPECT_EQ(rig.board->characterizer().increments(), counts.size()) << "accumulation never stopped";
+  expect_same_sums(rig.board->characterizer(), *direct(c, counts));
   std::optional<protocol::StatusFaultsMsg> faults;
   while (auto f = listener->receive()) {
     const protocol::Decoded d = protocol::decode(*f);
@@ -247,14 +247,14 @@ TEST(Board, EdgeStormsAreWorkedOffInBoundedPassesAndClockJumpsAreOneGap) {
     ++passes;
   }
   EXPECT_EQ(passes, (100000 + 255) / 256);
-  EXPECT_EQ(rig.board->estimator().samples(), 1u) << "the storm's interval, closed once its backlog is read";
+  EXPECT_EQ(rig.board->characterizer().increments(), 1u) << "the storm's interval, closed once its backlog is read";
   EXPECT_EQ(rig.source.counters().late_edges, 0u);
   // The clock jumps a day ahead: one pass, one gap, nothing bridged.
   rig.clock.advance(86400ull * 1000 * ms);
   rig.timer.update();
   ASSERT_TRUE(rig.board->run_once(0));
   EXPECT_EQ(rig.board->faults().sample_gaps, 1u);
-  EXPECT_EQ(rig.board->estimator().samples(), 1u);
+  EXPECT_EQ(rig.board->characterizer().increments(), 1u);
 }
 
 TEST(Board, CounterFramesFromItsElectronicsOnlyBecomeTheExactCounts) {
@@ -284,8 +284,8 @@ TEST(Board, CounterFramesFromItsElectronicsOnlyBecomeTheExactCounts) {
     timer.update();
     ASSERT_TRUE(board.run_once(0));
   }
-  EXPECT_EQ(board.estimator().samples(), counts.size());
-  expect_same_sums(board.estimator(), *direct(c, counts));
+  EXPECT_EQ(board.characterizer().increments(), counts.size());
+  expect_same_sums(board.characterizer(), *direct(c, counts));
   EXPECT_EQ(board_node->counters().received, counts.size() + 1) << "the other node's frames never reached the board";
 }
 
@@ -318,8 +318,8 @@ TEST_F(BoardCheckpoint, ResumesWithTheSameSums) {
   Rig rig(c);
   const std::string said = rig.board->resume();
   EXPECT_NE(said.find("resumed"), std::string::npos) << said;
-  EXPECT_EQ(rig.board->estimator().samples(), counts.size());
-  expect_same_sums(rig.board->estimator(), *direct(c, counts));
+  EXPECT_EQ(rig.board->characterizer().increments(), counts.size());
+  expect_same_sums(rig.board->characterizer(), *direct(c, counts));
 }
 
 TEST_F(BoardCheckpoint, ACorruptedFileIsReportedAndKeptAside) {
@@ -330,7 +330,7 @@ TEST_F(BoardCheckpoint, ACorruptedFileIsReportedAndKeptAside) {
   const std::string said = rig.board->resume();
   EXPECT_NE(said.find("CRC"), std::string::npos) << said;
   EXPECT_NE(said.find("starting fresh"), std::string::npos) << said;
-  EXPECT_EQ(rig.board->estimator().samples(), 0u);
+  EXPECT_EQ(rig.board->characterizer().increments(), 0u);
   EXPECT_TRUE(exists(c.checkpoint_path + ".bad"));
   EXPECT_FALSE(exists(c.checkpoint_path));
 }
@@ -342,7 +342,7 @@ TEST_F(BoardCheckpoint, ATruncatedFileIsReportedAndKeptAside) {
     Rig rig(c);
     const std::string said = rig.board->resume();
     EXPECT_NE(said.find("truncated"), std::string::npos) << keep << ": " << said;
-    EXPECT_EQ(rig.board->estimator().samples(), 0u);
+    EXPECT_EQ(rig.board->characterizer().increments(), 0u);
     EXPECT_TRUE(exists(c.checkpoint_path + ".bad"));
     std::rename((c.checkpoint_path + ".bad").c_str(), c.checkpoint_path.c_str());
     rewrite(b);
@@ -355,7 +355,7 @@ TEST_F(BoardCheckpoint, AnotherConfigurationIsNotResumed) {
   Rig rig(other);
   const std::string said = rig.board->resume();
   EXPECT_NE(said.find("another configuration"), std::string::npos) << said;
-  EXPECT_EQ(rig.board->estimator().samples(), 0u);
+  EXPECT_EQ(rig.board->characterizer().increments(), 0u);
   // Garbage is not a checkpoint.
   rewrite(std::string(4096, 'x'));
   Rig rig2(c);

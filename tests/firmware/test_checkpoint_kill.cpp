@@ -63,7 +63,7 @@ Config kill_config(const std::string& dir) {
     std::uint64_t j = 0, s = 0;
     while (log >> j >> s) ++restarts;
   }
-  const std::uint64_t kept = board.estimator().samples();
+  const std::uint64_t kept = board.characterizer().increments();
   const std::uint64_t first = kept + restarts * downtime_samples;  // index of this segment's first sample
   const std::string line = std::to_string(first) + " " + std::to_string(kept) + "\n";
   const int fd = open((dir + "/segments").c_str(), O_WRONLY | O_APPEND | O_CREAT, 0644);
@@ -77,7 +77,7 @@ Config kill_config(const std::string& dir) {
     timer.update();
     board.run_once(0);
   }
-  _exit(board.checkpoint() == 0 && board.estimator().samples() == total_samples ? 0 : 4);
+  _exit(board.checkpoint() == 0 && board.characterizer().increments() == total_samples ? 0 : 4);
 }
 
 TEST(CheckpointKill, RandomSigkillsLoseOnlyTheUncheckpointedData) {
@@ -125,7 +125,7 @@ TEST(CheckpointKill, RandomSigkillsLoseOnlyTheUncheckpointedData) {
   Board final_board(kill_config(dir), BoardIo{*node, nullptr, clock, timer});
   const std::string said = final_board.resume();
   ASSERT_NE(said.find("resumed"), std::string::npos) << said;
-  const auto& pyramid = final_board.estimator().pyramid();
+  const auto& pyramid = final_board.characterizer();
   std::uint64_t points = 0;
   for (const auto& x : segments) points += x.size();
   EXPECT_EQ(pyramid.phase_points(), points);
@@ -133,7 +133,7 @@ TEST(CheckpointKill, RandomSigkillsLoseOnlyTheUncheckpointedData) {
     oracle::Exact want;
     std::uint64_t offset = 0;
     for (const auto& x : segments) {
-      want += oracle::brute_force(x, pyramid.result(i).m, pyramid.stride(i), false, offset);
+      want += oracle::brute_force(x, pyramid.result(i).m, pyramid.result(i).stride, false, offset);
       offset += x.size();
     }
     const auto got = pyramid.result(i);

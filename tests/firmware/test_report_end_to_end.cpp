@@ -4,6 +4,7 @@
 // integer sums) and the decoder's own loss accounting (a complete report, nothing missing).
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <vector>
 
 #include "analysis.hpp"
@@ -22,14 +23,14 @@ TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
   g.n_rad_sqrt_s = 0.003 * units::deg_per_sqrt_h;
   GyroSimulator sim(g);
 
-  firmware::EstimatorSettings s;
+  firmware::ReportSettings s;
   s.tau0_s = g.tau0_s;
   s.pulse_weight_arcsec = 1.0;
   s.stride_factor = 8;
   s.octaves = 16;
   s.source = protocol::InputSource::simulated;
-  firmware::Estimator board;
-  ASSERT_TRUE(board.configure(s));
+  auto board = std::make_unique<firmware::BoardCharacterizer>();
+  ASSERT_TRUE(firmware::configure(*board, s));
 
   AnalysisOptions o;
   o.type = DataType::counts;
@@ -46,10 +47,10 @@ TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
   for (std::uint8_t seq = 0; seq < 4; ++seq) {  // four reports: the whole slow cycle
     for (int k = 0; k < 100000; ++k) {
       const auto c = static_cast<std::int32_t>(sim.next_count());
-      board.add_count(c);
+      board->add_increment(c);
       analyzer.add(c);
     }
-    board.report(seq, 1000u * (seq + 1), {}, content);
+    firmware::build_report(*board, s, seq, 1000u * (seq + 1), {}, content);
     for (std::size_t k = 0; k < protocol::report_frame_count(seq, s.octaves); ++k) {
       CanFrame f;
       ASSERT_EQ(protocol::encode(firmware::report_message(content, k), node, f), protocol::ProtocolError::none);

@@ -3,8 +3,8 @@
 // 128-bit integers (the oracle of the pyramid tests): sums of squared second differences (AVAR),
 // of squared third differences of the phase sums (MVAR) and of squared third differences (HVAR),
 // with their term counts. Terms whose newest point e has (offset + e) a multiple of `stride`
-// (stride 1: fully overlapped; offset: the segment's first global phase index), or e a multiple
-// of m when nonoverlapping.
+// (stride 1: fully overlapped; offset: the segment's first global phase index), or (offset + e) a
+// multiple of m when nonoverlapping (the decimated series x[k m] on the global grid).
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -32,7 +32,7 @@ inline Exact brute_force(const std::vector<std::int64_t>& x, std::uint64_t m, st
   std::vector<i128> p(x.size() + 1, 0);  // p[k] = sum_{i<k} x_i
   for (std::size_t k = 0; k < x.size(); ++k) p[k + 1] = p[k] + x[k];
   for (std::uint64_t e = 0; e < x.size(); ++e) {
-    if (nonoverlapping ? e % m != 0 : (offset + e) % stride != 0) continue;
+    if ((offset + e) % (nonoverlapping ? m : stride) != 0) continue;
     if (e >= 2 * m) {
       const i128 a = i128{x[e]} - 2 * i128{x[e - m]} + x[e - 2 * m];
       r.sum[0] += static_cast<u128>(a * a);

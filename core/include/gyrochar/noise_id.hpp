@@ -1,14 +1,8 @@
 #pragma once
-// Power-law noise identification per tau, streaming, as Stable32 does it (W. J. Riley and
-// C. A. Greenhall, "Power law noise identification using the lag 1 autocorrelation", 2004; NIST
-// SP 1065 section 5.6):
-// - with at least 30 points of the decimated phase series: the lag-1 autocorrelation r1 of the
-//   series and of its differences; difference until delta = r1/(1+r1) < 0.25 (or d = dmax),
-//   alpha = 2 - round(2 delta) - 2 d;
-// - with fewer points: the B1 ratio (standard variance of the m-averaged frequency over the
-//   Allan variance) picks mu against Barnes' B1(N, mu), and for mu = -2 the ratio
-//   R(n) = MVAR/AVAR separates white PM (1/n) from flicker PM.
-// Only running sums are kept (about 250 bytes per tau); no heap, no clock.
+// Power-law noise identification primitives (W. J. Riley and C. A. Greenhall, "Power law noise
+// identification using the lag 1 autocorrelation", 2004; NIST SP 1065 section 5.6). Streaming:
+// only running sums of a decimated series are kept (about 330 bytes per tau); no heap, no clock.
+// estimates.hpp combines them over the taus of a curve.
 #include <cstdint>
 
 namespace gyrochar {
@@ -16,10 +10,10 @@ namespace gyrochar {
 /// Lag-1 autocorrelation of a series from running sums, values shifted by the first one.
 struct Lag1Sums {
   std::uint64_t n = 0, pairs = 0;
-  double shift = 0, sum = 0, sum_sq = 0;         // of v = z - shift (shift: the first value)
+  double shift = 0, sum = 0, sum_sq = 0;            // of v = z - shift (shift: the first value)
   double sum_lag = 0, sum_left = 0, sum_right = 0;  // over adjacent pairs (v_i, v_i+1)
   double last = 0;
-  bool linked = false;                           // the next value pairs with `last`
+  bool linked = false;                              // the next value pairs with `last`
   void add(double z);
   /// The next value starts a new segment (no pair spans a gap).
   void unlink() { linked = false; }
@@ -45,23 +39,23 @@ class NoiseIdAccumulator {
   int have_ = 0;                // values of this segment seen so far (capped at 3)
 };
 
-enum class NoiseIdMethod : std::uint8_t { none, lag1, b1, b1_rn };
-
-struct NoiseId {
-  int alpha = 0;
-  NoiseIdMethod method = NoiseIdMethod::none;  // none: could not identify (too few points)
+/// The lag-1 rule: difference the series (from order dmin) until delta = r1 / (1 + r1) < 0.25 or
+/// d = dmax; then p = 2 (d + delta) estimates 2 - alpha, so alpha = 2 - round(p). sigma is the
+/// standard error of p, from the large-sample variance of r1, (1 - rho^2)^2 / n.
+struct Lag1Estimate {
+  bool valid = false;  // false with fewer than 3 values at the order reached
+  double p = 0;
+  double sigma = 0;
+  std::uint64_t points = 0;  // values of the series the estimate rests on
 };
+Lag1Estimate lag1_estimate(const NoiseIdAccumulator& acc, int dmin, int dmax);
 
-struct NoiseIdInput {
-  std::uint64_t m = 1;        // averaging factor
-  int dmax = 2;               // 2 for Allan and modified Allan, 3 for Hadamard
-  bool frequency_data = false;  // the input was frequency: differencing starts at 1
-  double avar = 0;            // overlapping AVAR at m (for B1 and R(n)), phase unit^2 / s^2
-  double mvar = 0;            // MVAR at m, same unit
-  double tau0_s = 1;          // sample interval (B1's frequency averages are in phase/(m tau0))
-};
+/// Barnes' expected B1 ratio (standard variance of n frequency averages over the Allan variance)
+/// for the exponent mu of AVAR ~ tau^mu. O(1).
+double b1_expected(double n, int mu);
 
-/// Identifies alpha at one tau. O(1), no allocation.
-NoiseId identify_noise(const NoiseIdAccumulator& acc, const NoiseIdInput& in);
+/// R(n) = MVAR/AVAR expected for white PM (alpha 2: 1/m) and flicker PM (alpha 1) with the
+/// cut-off f_h = 1/(2 tau0). O(1).
+double rn_expected(std::uint64_t m, int alpha);
 
 }  // namespace gyrochar

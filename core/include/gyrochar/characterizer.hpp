@@ -1,28 +1,30 @@
 #pragma once
-// The recursive octave-tau pyramid: streaming overlapping Allan, modified Allan and overlapping
-// Hadamard variances (TVAR derives from MVAR) in fixed memory, with no heap.
+// The characterizer: everything gyrochar accumulates from a stream of phase points, in fixed
+// memory, with no heap, one checkpoint format, read out by the extractors of estimates.hpp. The
+// board and the offline analyzer both run it, so they compute the same numbers by construction.
 //
-// Notation (phase index e = 0, 1, 2, ...; tau = m * tau0):
-//   x_e     phase (for a gyro: angle; for counts data the accumulated pulses, x_0 = 0)
-//   P_e     prefix sum of phase, P_e = sum_{i<e} x_i
-//   AVAR term   a = x[e] - 2 x[e-m] + x[e-2m]
-//   HVAR term   h = x[e] - 3 x[e-m] + 3 x[e-2m] - x[e-3m]
-//   MVAR term   t = P[e+1] - 3 P[e+1-m] + 3 P[e+1-2m] - P[e+1-3m]
-//                 = sum_{i=j}^{j+m-1} (x[i+2m] - 2 x[i+m] + x[i])  with j = e+1-3m
-//   AVAR = sum a^2 / (2 n tau^2), MVAR = sum t^2 / (2 m^2 n tau^2), HVAR = sum h^2 / (6 n tau^2),
-//   TVAR = tau^2 MVAR / 3.
+// Per averaging factor m (tau = m tau0) it keeps, from one pass over the points:
+//   - the sums of squared terms of the overlapping (or strided) Allan, modified Allan and
+//     Hadamard variances (stat.hpp has the terms), in the octave pyramid described below;
+//   - the decimated series x[0], x[m], x[2m], ...: the non-overlapped Allan and Hadamard sums
+//     (Stable32's ADEV and HDEV) and the lag-1 autocorrelation sums of noise identification.
 //
-// History. Terms for tau = r * 2^L (1 <= r <= S, S the stride factor) are formed every 2^L phase
-// points ("level L"), so their stride is m/S (1 for m <= S: exactly the fully overlapped estimator,
-// with Stable32's number of terms n). They need x and P at ages m, 2m, 3m. Past phase points live in
-// a multi-resolution history: ring level 0 keeps the last 3S points; ring level l >= 1 keeps the
-// multiples of 2^l with ages in (3S 2^(l-1), 3S 2^l], i.e. 3S/2 entries. A point leaving level l
-// moves on to level l+1 if it is a multiple of 2^(l+1). Memory is therefore
+// Notation: phase index e = 0, 1, 2, ...; x_e the phase (for counts the accumulated pulses,
+// x_0 = 0); P_e = sum_{i<e} x_i. AVAR = sum a^2 / (2 n tau^2), MVAR = sum t^2 / (2 m^2 n tau^2),
+// HVAR = sum h^2 / (6 n tau^2), TVAR = tau^2 MVAR / 3.
+//
+// The pyramid. Terms of tau = r * 2^L (1 <= r <= S, S the stride factor) are formed every 2^L
+// phase points ("level L"), so their stride is m/S (1 for m <= S: exactly the fully overlapped
+// estimator, with Stable32's number of terms n). They need x and P at ages m, 2m, 3m. Past points
+// live in a multi-resolution history: ring level 0 keeps the last 3S points; ring level l >= 1
+// keeps the multiples of 2^l with ages in (3S 2^(l-1), 3S 2^l], i.e. 3S/2 entries. A point leaving
+// level l moves on to level l+1 if it is a multiple of 2^(l+1). Memory is therefore
 // 3S + (levels - 1) * 3S/2 entries, independent of run length, and the work per point is O(S)
-// amortized (level L runs every 2^L points).
+// amortized (level L runs every 2^L points; the decimation of tau m rides on its level).
 //
-// Gaps. A gap starts a new segment: no term spans it, sums and term counts go on, so the pooled
-// estimate stays unbiased and n counts only the terms actually formed.
+// Gaps. A gap starts a new segment: no term and no difference of the decimated series spans it;
+// sums and term counts go on, so the pooled estimate stays unbiased and n counts only the terms
+// actually formed.
 //
 // Arithmetic policies:
 //   CountArith  integer counts, exact. x is int64, P is a 128-bit two's complement integer, the sums
@@ -31,24 +33,24 @@
 //               (2) each term fits in 63 bits plus sign, (3) each sum of squares stays below 2^127.
 //               Each condition is checked: (1) flags the stream, (2) skips the term and counts it in
 //               TauResult::out_of_range, (3) sets TauResult::sum_overflow.
-//   FloatArith  floating phase (files). x is kept relative to a reference line through the first
-//               two points (second and third differences are unchanged by it), P is a double-double
-//               so the third differences of P do not cancel catastrophically; sums are double.
+//   FloatArith  floating phase (files). Phase points are kept relative to the line through the
+//               first two points, frequency increments relative to the first one (differences of
+//               order two and more do not change), P is a double-double so the third differences of
+//               P do not cancel catastrophically; sums are double.
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
 
-#include <cstring>
-
 #include "gyrochar/crc32.hpp"
+#include "gyrochar/noise_id.hpp"
+#include "gyrochar/stat.hpp"
 #include "gyrochar/wide.hpp"
 
 namespace gyrochar {
-
-enum class Stat : std::uint8_t { avar = 0, mvar = 1, hvar = 2 };
-inline constexpr std::size_t stat_count = 3;
 
 // ---------------------------------------------------------------------------------------------
 // Arithmetic policies
@@ -58,11 +60,11 @@ struct CountArith {
     std::int64_t x = 0;  // phase x_e in pulses
     Int128 p;            // P_{e+1} = sum_{i<=e} x_i
   };
+  using X = std::int64_t;
   using Sum = UInt128;
   using Increment = std::int32_t;  // pulses per tau0: the exactness bounds rely on |c| < 2^31
   static constexpr bool exact = true;
 
-  static constexpr Int128 zero_prefix() { return {}; }
   static constexpr Int128 add_prefix(Int128 p, std::int64_t x) { return p + widen(x); }
 
   /// Second and third differences of x; false when a value does not fit in int64.
@@ -104,11 +106,10 @@ struct FloatArith {
     double x = 0.0;  // phase relative to the reference line
     Prefix p;        // P_{e+1} relative to the reference line's prefix sums
   };
+  using X = double;
   using Sum = double;
   using Increment = double;
   static constexpr bool exact = false;
-
-  static constexpr Prefix zero_prefix() { return {}; }
 
   static constexpr Prefix add_prefix(Prefix a, double b) {  // Knuth two-sum, then renormalize
     const double s = a.hi + b;
@@ -143,22 +144,36 @@ struct FloatArith {
 // ---------------------------------------------------------------------------------------------
 // Results
 
-/// Raw statistics of one tau. Variances follow from the sums (see variance()).
+/// The sums of one tau. Overlapping sums (terms every `stride` points) and non-overlapped sums
+/// (terms every m points, on the decimated series). variance() turns them into variances.
+enum class SumKind : std::uint8_t { avar = 0, mvar = 1, hvar = 2, avar_nonoverlapped = 3, hvar_nonoverlapped = 4 };
+inline constexpr std::size_t sum_kinds = 5;
+
 template <class Sum>
 struct TauResult {
-  std::uint64_t m = 0;                         // averaging factor, tau = m * tau0
-  std::array<Sum, stat_count> sum{};           // sums of squared terms, indexed by Stat
-  std::array<std::uint64_t, stat_count> n{};   // number of terms, indexed by Stat
-  std::uint32_t out_of_range = 0;              // terms skipped: value beyond int64 (CountArith)
-  bool sum_overflow = false;                   // a sum of squares reached 2^127 (CountArith)
+  std::uint64_t m = 0;                       // averaging factor, tau = m * tau0
+  std::uint64_t stride = 1;                  // overlapping sums: terms every `stride` points
+  std::array<Sum, sum_kinds> sum{};          // sums of squared terms, indexed by SumKind
+  std::array<std::uint64_t, sum_kinds> n{};  // number of terms, indexed by SumKind
+  std::uint32_t out_of_range = 0;            // terms skipped: value beyond int64 (CountArith)
+  bool sum_overflow = false;                 // a sum of squares reached 2^127 (CountArith)
 };
 
-/// Variance in (phase unit / s)^2 from a TauResult: tau0_s the sample interval, unit the phase unit
-/// per x step (e.g. the pulse weight in rad for counts, 1 for phase in s). Returns 0 when n = 0.
-/// O(1), no allocation. TVAR is tvar_from_mvar().
+/// The statistic a sum belongs to, and its term stride.
+constexpr Stat stat_of(SumKind k) {
+  return k == SumKind::mvar ? Stat::mvar : (k == SumKind::hvar || k == SumKind::hvar_nonoverlapped) ? Stat::hvar : Stat::avar;
+}
 template <class Sum>
-constexpr double variance(const TauResult<Sum>& r, Stat stat, double tau0_s, double unit = 1.0) {
-  const auto i = static_cast<std::size_t>(stat);
+constexpr std::uint64_t term_stride(const TauResult<Sum>& r, SumKind k) {
+  return k == SumKind::avar_nonoverlapped || k == SumKind::hvar_nonoverlapped ? r.m : r.stride;
+}
+
+/// Variance in (phase unit / s)^2 from the sums of kind k: tau0_s the sample interval, unit the
+/// phase unit per x step (e.g. the pulse weight in rad for counts, 1 for phase in s). 0 when
+/// n = 0. O(1), no allocation. TVAR is tau^2 MVAR / 3.
+template <class Sum>
+constexpr double variance(const TauResult<Sum>& r, SumKind k, double tau0_s, double unit = 1.0) {
+  const auto i = static_cast<std::size_t>(k);
   if (r.n[i] == 0) return 0.0;
   const double m = static_cast<double>(r.m);
   const double tau = m * tau0_s;
@@ -168,22 +183,20 @@ constexpr double variance(const TauResult<Sum>& r, Stat stat, double tau0_s, dou
   } else {
     sum = r.sum[i];
   }
-  const double scale[stat_count] = {2.0, 2.0 * m * m, 6.0};
-  return sum * unit * unit / (scale[i] * static_cast<double>(r.n[i]) * tau * tau);
+  const Stat s = stat_of(k);
+  const double scale = s == Stat::avar ? 2.0 : s == Stat::mvar ? 2.0 * m * m : 6.0;
+  return sum * unit * unit / (scale * static_cast<double>(r.n[i]) * tau * tau);
 }
 
-constexpr double tvar_from_mvar(double mvar, double tau_s) { return tau_s * tau_s * mvar / 3.0; }
-
 // ---------------------------------------------------------------------------------------------
-// The pyramid over caller-owned storage
+// The characterizer over caller-owned storage
 
-enum class PyramidStatus : std::uint8_t {
+enum class ConfigureStatus : std::uint8_t {
   ok,
-  bad_stride_factor,     // S must be a power of two, 2 <= S <= storage capacity
-  too_many_taus,         // more taus than the TauState storage holds
+  bad_stride_factor,     // S must be a power of two, 2 <= S <= 2^24
+  too_many_taus,         // more taus than the tau storage holds
   tau_not_representable, // m must be r * 2^L with r <= S; taus strictly increasing, m >= 1
   history_too_small,     // storage cannot hold the history for the largest tau at this S
-  nonoverlapping_needs_m_le_s,  // the non-overlapped mode needs every m <= S
 };
 
 enum class RestoreStatus : std::uint8_t {
@@ -192,12 +205,12 @@ enum class RestoreStatus : std::uint8_t {
   not_a_checkpoint, // wrong magic number
   wrong_version,    // written by another checkpoint format version
   corrupted,        // CRC mismatch
-  config_mismatch,  // another arithmetic, stride factor or tau list than the current configuration
+  config_mismatch,  // another arithmetic, stride factor, tau list or caller tag than now
 };
 
-struct PyramidConfig {
-  std::uint32_t stride_factor = 8;    // S
-  bool nonoverlapping = false;        // Stable32's non-overlapped ADEV/HDEV: only j = 0, m, 2m, ...
+struct CharacterizerConfig {
+  std::uint32_t stride_factor = 8;  // S
+  std::uint32_t tag = 0;            // the caller's configuration fingerprint, kept in checkpoints
 };
 
 /// Entries of history needed for stride factor S and taus up to m_max. O(log m_max).
@@ -208,69 +221,53 @@ constexpr std::size_t history_entries(std::uint32_t stride_factor, std::uint64_t
 }
 
 template <class Arith>
-class Pyramid;
-
-/// Storage for a StaticPyramid: the history for the worst stride factor and the tau states.
-template <class Arith, unsigned Octaves, std::uint32_t MaxStride, std::size_t MaxTaus>
-struct PyramidStorage {
-  static_assert(Octaves >= 1 && Octaves <= 63, "taus up to 2^62");
-  static_assert(MaxStride >= 2 && std::has_single_bit(MaxStride), "stride factor: power of two >= 2");
-  static constexpr std::size_t history_capacity() {
-    std::size_t most = 0;
-    for (std::uint32_t s = 2; s <= MaxStride; s *= 2) {
-      const std::size_t n = history_entries(s, std::uint64_t{1} << (Octaves - 1));
-      if (n > most) most = n;
-    }
-    return most;
-  }
-  std::array<typename Arith::Entry, history_capacity()> history{};
-  std::array<typename Pyramid<Arith>::TauState, MaxTaus> taus{};
-};
-
-template <class Arith>
-class Pyramid {
+class Characterizer {
  public:
   using Entry = typename Arith::Entry;
+  using X = typename Arith::X;
   using Sum = typename Arith::Sum;
   using Result = TauResult<Sum>;
 
   /// Per-tau state, kept in caller-owned storage.
   struct TauState {
     Result result;
-    std::uint8_t level = 0;                   // terms formed when e is a multiple of 2^level
-    std::array<std::uint8_t, 3> ring_of{};    // ring holding the point of age k*m (k = 1..3)
-    std::array<std::uint32_t, 3> back{};      // its slot is head(ring) - back, modulo the ring size
-    std::uint64_t sticky = 0;                 // OR of the sums' high words: bit 63 = overflow
+    std::uint8_t level = 0;                 // terms formed when e is a multiple of 2^level
+    std::array<std::uint8_t, 3> ring_of{};  // ring holding the point of age k*m (k = 1..3)
+    std::array<std::uint32_t, 3> back{};    // its slot is head(ring) - back, modulo the ring size
+    std::uint64_t sticky = 0;               // OR of the sums' high words: bit 63 = overflow
+    // The decimated series x[k m]:
+    std::uint64_t countdown = 0;            // runs of this level until the next multiple of m
+    std::array<X, 3> decimated{};           // the last three decimated points of this segment
+    std::uint8_t decimated_count = 0;       // how many of them are valid (0..3)
+    NoiseIdAccumulator noise;               // lag-1 autocorrelation sums
   };
 
-  /// Binds the pyramid to storage owned by the caller, which must outlive it. No allocation.
-  Pyramid(std::span<Entry> history, std::span<TauState> taus) : history_(history), taus_(taus) {}
+  /// Binds the characterizer to storage owned by the caller, which must outlive it. No allocation.
+  Characterizer(std::span<Entry> history, std::span<TauState> taus) : history_(history), taus_(taus) {}
 
   /// Configures the stride factor and the taus (strictly increasing m), and resets all state.
   /// O(taus + history). Fails (returning why, state unusable until a successful configure) when
   /// the taus or the stride do not fit the storage.
-  PyramidStatus configure(const PyramidConfig& config, std::span<const std::uint64_t> m_list) {
+  ConfigureStatus configure(const CharacterizerConfig& config, std::span<const std::uint64_t> m_list) {
     const std::uint32_t s = config.stride_factor;
-    if (s < 2 || !std::has_single_bit(s)) return PyramidStatus::bad_stride_factor;
-    if (m_list.size() > taus_.size()) return PyramidStatus::too_many_taus;
+    if (s < 2 || s > (1u << 24) || !std::has_single_bit(s)) return ConfigureStatus::bad_stride_factor;
+    if (m_list.size() > taus_.size()) return ConfigureStatus::too_many_taus;
     stride_ = s;
-    log2_stride_ = static_cast<unsigned>(std::countr_zero(s));
-    nonoverlapping_ = config.nonoverlapping;
+    tag_ = config.tag;
     ntaus_ = m_list.size();
     unsigned max_level = 0;
     std::uint64_t previous = 0;
     for (std::size_t i = 0; i < ntaus_; ++i) {
       const std::uint64_t m = m_list[i];
-      if (m <= previous || m > (std::uint64_t{1} << 62)) return PyramidStatus::tau_not_representable;
+      if (m <= previous || m > (std::uint64_t{1} << 62)) return ConfigureStatus::tau_not_representable;
       previous = m;
       unsigned level = 0;
       while ((std::uint64_t{s} << level) < m) ++level;
-      if (level >= 64 || (m & ((std::uint64_t{1} << level) - 1)) != 0)
-        return PyramidStatus::tau_not_representable;
-      if (nonoverlapping_ && level != 0) return PyramidStatus::nonoverlapping_needs_m_le_s;
+      if (level >= 64 || (m & ((std::uint64_t{1} << level) - 1)) != 0) return ConfigureStatus::tau_not_representable;
       TauState& t = taus_[i];
       t = TauState{};
       t.result.m = m;
+      t.result.stride = std::uint64_t{1} << level;
       t.level = static_cast<std::uint8_t>(level);
       for (unsigned k = 1; k <= 3; ++k) {
         const std::uint64_t age = k * m;
@@ -286,45 +283,58 @@ class Pyramid {
     }
     ring_levels_ = max_level + 1;
     fast_count_ = 0;
-    while (!nonoverlapping_ && fast_count_ < ntaus_ && taus_[fast_count_].level == 0 &&
+    while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0 &&
            (!Arith::exact || taus_[fast_count_].result.m <= fast_m_max))
       ++fast_count_;
-    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.size())
-      return PyramidStatus::history_too_small;
+    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.size()) return ConfigureStatus::history_too_small;
     restart();
-    return PyramidStatus::ok;
+    return ConfigureStatus::ok;
   }
 
-  /// Forgets all data (sums, counts, history); keeps the configuration. O(taus).
+  /// Forgets all data (sums, counts, history, noise sums); keeps the configuration. O(taus).
   void restart() {
     for (std::size_t i = 0; i < ntaus_; ++i) {
-      Result& r = taus_[i].result;
-      r.sum = {};
-      r.n = {};
-      r.out_of_range = 0;
-      r.sum_overflow = false;
-      taus_[i].sticky = 0;
+      TauState& t = taus_[i];
+      t.result.sum = {};
+      t.result.n = {};
+      t.result.out_of_range = 0;
+      t.result.sum_overflow = false;
+      t.sticky = 0;
+      t.countdown = 0;
+      t.decimated_count = 0;
+      t.noise = NoiseIdAccumulator{};
     }
     run_ = RunState{};
     run_.steady_from = 3u * stride_;
   }
 
   /// Adds the next phase point (floating phase data). O(S) amortized; no allocation; never fails.
-  /// Counts data goes through add_increment(), which keeps the input bounds exactness relies on.
-  void add_phase_point(decltype(Entry{}.x) x)
+  /// Counts go through add_increment(), which keeps the input bounds exactness relies on.
+  void add_phase_point(double x)
     requires(!Arith::exact)
   {
-    push(x);
+    // Relative to the line through the first two points: x - x0 is formed exactly (as hi + lo)
+    // and the line taken off by one fused multiply-add.
+    const std::uint64_t k = run_.line_points++;
+    if (k == 0) run_.line_x0 = x;
+    const double hi = x - run_.line_x0;
+    const double b = hi - x;
+    const double lo = (x - (hi - b)) - (run_.line_x0 + b);
+    if (k == 1) run_.line_slope = hi;
+    push(std::fma(-static_cast<double>(k), run_.line_slope, hi) + lo);
   }
+
   /// Adds the next increment of phase: a pulse count per tau0 (CountArith) or frequency * tau0
-  /// (FloatArith). The phase before the first increment of a segment is a phase point too, so N
-  /// increments give N + 1 phase points, as Stable32 treats frequency data. O(S) amortized.
-  /// CountArith: if the accumulated phase would pass 2^63 pulses, a new segment starts from 0 and
-  /// phase_overflowed() turns true.
+  /// (FloatArith, taken relative to the first one). The phase before the first increment of a
+  /// segment is a phase point too, so N increments give N + 1 phase points, as Stable32 treats
+  /// frequency data. O(S) amortized. CountArith: if the accumulated phase would pass 2^63 pulses, a
+  /// new segment starts from 0 and phase_overflowed() turns true.
   void add_increment(typename Arith::Increment dx) {
+    ++run_.increments;
     if (run_.next_e == run_.segment_start) push(run_.x);
     if constexpr (!Arith::exact) {
-      run_.x += dx;
+      if (run_.increments == 1) run_.first_increment = dx;
+      run_.x += dx - run_.first_increment;
     } else {
       if (__builtin_add_overflow(run_.x, std::int64_t{dx}, &run_.x)) {
         run_.phase_overflow = true;
@@ -343,25 +353,31 @@ class Pyramid {
     for (const T v : block) add_increment(static_cast<typename Arith::Increment>(v));
   }
 
-  /// Starts a new segment at the next phase point: no term will span the break. O(1).
+  /// Starts a new segment at the next phase point: no term and no difference of a decimated series
+  /// will span the break. O(taus).
   void mark_gap() {
     run_.segment_start = run_.next_e;
     run_.steady_from = run_.segment_start + 3u * stride_;
     run_.p_segment_start = run_.p;
+    ++run_.gaps;
+    for (std::size_t i = 0; i < ntaus_; ++i) {
+      taus_[i].decimated_count = 0;
+      taus_[i].noise.reset_segment();
+    }
   }
 
   // -------------------------------------------------------------------------------------------
   // Checkpoints: the whole state as bytes (native byte order: restore on the same kind of board),
-  // with a format version and a CRC-32 at the end. The caller stores them (atomically).
+  // with a format version, the caller's tag and a CRC-32 at the end. The caller stores them
+  // (atomically: firmware/checkpoint.hpp).
 
   static constexpr std::uint32_t checkpoint_magic = 0x43525947;  // "GYRC"
-  static constexpr std::uint16_t checkpoint_version = 1;
+  static constexpr std::uint16_t checkpoint_version = 2;
 
   /// Bytes save() writes for the current configuration. O(1).
   std::size_t checkpoint_size() const {
-    return header_bytes() + ntaus_ * sizeof(std::uint64_t) + sizeof(RunState) +
-           used_history() * sizeof(Entry) + ntaus_ * (sizeof(Result) + sizeof(std::uint64_t)) +
-           sizeof(std::uint32_t);
+    return sizeof(Header) + ntaus_ * sizeof(std::uint64_t) + sizeof(RunState) + used_history() * sizeof(Entry) +
+           ntaus_ * sizeof(TauState) + sizeof(std::uint32_t);
   }
 
   /// Writes the state into `out`; returns the bytes written, 0 when `out` is too small.
@@ -374,10 +390,7 @@ class Pyramid {
     for (std::size_t i = 0; i < ntaus_; ++i) p = put(p, &taus_[i].result.m, sizeof(std::uint64_t));
     p = put(p, &run_, sizeof run_);
     p = put(p, history_.data(), used_history() * sizeof(Entry));
-    for (std::size_t i = 0; i < ntaus_; ++i) {
-      p = put(p, &taus_[i].result, sizeof(Result));
-      p = put(p, &taus_[i].sticky, sizeof(std::uint64_t));
-    }
+    p = put(p, taus_.data(), ntaus_ * sizeof(TauState));
     const std::uint32_t crc = crc32({out.data(), static_cast<std::size_t>(p - out.data())});
     p = put(p, &crc, sizeof crc);
     return static_cast<std::size_t>(p - out.data());
@@ -388,13 +401,15 @@ class Pyramid {
   /// on. On failure nothing changes. O(history + taus), no allocation.
   RestoreStatus restore(std::span<const std::byte> in) {
     Header h{};
+    if (in.size() < sizeof h.magic) return RestoreStatus::truncated;
+    std::memcpy(&h.magic, in.data(), sizeof h.magic);
+    if (h.magic != checkpoint_magic) return RestoreStatus::not_a_checkpoint;
     if (in.size() < sizeof h) return RestoreStatus::truncated;
     std::memcpy(&h, in.data(), sizeof h);
-    if (h.magic != checkpoint_magic) return RestoreStatus::not_a_checkpoint;
     if (h.version != checkpoint_version) return RestoreStatus::wrong_version;
     const Header mine = header();
-    if (h.exact != mine.exact || h.entry_bytes != mine.entry_bytes || h.stride != mine.stride ||
-        h.ntaus != mine.ntaus || h.nonoverlapping != mine.nonoverlapping)
+    if (h.exact != mine.exact || h.entry_bytes != mine.entry_bytes || h.tau_bytes != mine.tau_bytes ||
+        h.stride != mine.stride || h.ntaus != mine.ntaus || h.tag != mine.tag)
       return RestoreStatus::config_mismatch;
     const std::size_t size = checkpoint_size();
     if (in.size() < size) return RestoreStatus::truncated;
@@ -409,57 +424,54 @@ class Pyramid {
     }
     p = get(p, &run_, sizeof run_);
     p = get(p, history_.data(), used_history() * sizeof(Entry));
-    for (std::size_t i = 0; i < ntaus_; ++i) {
-      p = get(p, &taus_[i].result, sizeof(Result));
-      p = get(p, &taus_[i].sticky, sizeof(std::uint64_t));
-    }
+    get(p, taus_.data(), ntaus_ * sizeof(TauState));
     mark_gap();
     return RestoreStatus::ok;
   }
 
+  // -------------------------------------------------------------------------------------------
+  // Read-out (the extractors of estimates.hpp build on these). All O(1), no allocation.
+
   /// True once the accumulated pulse count passed 2^63 (CountArith); a gap was inserted there.
   bool phase_overflowed() const { return run_.phase_overflow; }
-  /// Number of phase points added so far (over all segments).
+  /// Phase points added so far (over all segments).
   std::uint64_t phase_points() const { return run_.next_e; }
+  /// Increments added so far (samples of counts or frequency; 0 for phase input).
+  std::uint64_t increments() const { return run_.increments; }
+  /// Gaps marked so far (restores and phase overflows included).
+  std::uint64_t gaps() const { return run_.gaps; }
   std::size_t tau_count() const { return ntaus_; }
   std::uint32_t stride_factor() const { return stride_; }
-  /// Statistics of tau i (0 <= i < tau_count()), valid at any time. O(1), no allocation.
+  std::uint32_t tag() const { return tag_; }
+  /// Sums of tau i (0 <= i < tau_count()), valid at any time.
   Result result(std::size_t i) const {
     Result r = taus_[i].result;
     r.sum_overflow = (taus_[i].sticky >> 63) != 0;
     return r;
   }
-  /// Terms of tau i are formed every stride(i) phase points (1: fully overlapped).
-  std::uint64_t stride(std::size_t i) const { return std::uint64_t{1} << taus_[i].level; }
-  /// Copies all tau results into `out` (size >= tau_count()) without disturbing accumulation.
-  /// O(taus), no allocation. Returns the number copied.
-  std::size_t snapshot(std::span<Result> out) const {
-    std::size_t k = 0;
-    for (; k < ntaus_ && k < out.size(); ++k) out[k] = result(k);
-    return k;
-  }
+  /// The lag-1 autocorrelation sums of tau i's decimated series.
+  const NoiseIdAccumulator& noise(std::size_t i) const { return taus_[i].noise; }
 
  private:
   struct Header {
     std::uint32_t magic = checkpoint_magic;
     std::uint16_t version = checkpoint_version;
     std::uint8_t exact = Arith::exact;
-    std::uint8_t nonoverlapping = 0;
+    std::uint8_t reserved = 0;
     std::uint32_t entry_bytes = sizeof(Entry);
+    std::uint32_t tau_bytes = sizeof(TauState);
     std::uint32_t stride = 0;
+    std::uint32_t tag = 0;
     std::uint64_t ntaus = 0;
   };
   Header header() const {
     Header h;
-    h.nonoverlapping = nonoverlapping_ ? 1 : 0;
     h.stride = stride_;
+    h.tag = tag_;
     h.ntaus = ntaus_;
     return h;
   }
-  static constexpr std::size_t header_bytes() { return sizeof(Header); }
-  std::size_t used_history() const {
-    return 3u * stride_ + (ring_levels_ - 1) * (3u * stride_ / 2);
-  }
+  std::size_t used_history() const { return 3u * stride_ + (ring_levels_ - 1) * (3u * stride_ / 2); }
   static std::byte* put(std::byte* p, const void* from, std::size_t n) {
     std::memcpy(p, from, n);
     return p + n;
@@ -469,7 +481,7 @@ class Pyramid {
     return p + n;
   }
 
-  void push(decltype(Entry{}.x) x) {
+  void push(X x) {
     const std::uint64_t e = run_.next_e++;
     run_.p = Arith::add_prefix(run_.p, x);
     const Entry current{x, run_.p};
@@ -479,12 +491,40 @@ class Pyramid {
     for (unsigned ring = 0; ring < moved; ++ring) {
       if (++run_.head[ring] == ring_size(ring)) run_.head[ring] = 0;
     }
+    if (e == 0) {  // point 0 is a multiple of every m
+      for (std::size_t i = 0; i < ntaus_; ++i) decimate(taus_[i], x);
+    }
     std::size_t i = 0;
     if (e >= run_.steady_from) {
-      for (; i < fast_count_; ++i) fast_terms(taus_[i], current);
+      for (; i < fast_count_; ++i) {
+        fast_terms(taus_[i], current);
+        if (--taus_[i].countdown == 0) decimate(taus_[i], x);
+      }
     }
-    for (; i < ntaus_ && taus_[i].level < fired; ++i) form_terms(taus_[i], e, current);
+    for (; i < ntaus_ && taus_[i].level < fired; ++i) {
+      form_terms(taus_[i], e, current);
+      if (--taus_[i].countdown == 0) decimate(taus_[i], x);
+    }
     insert(e, current);
+  }
+
+  // A point of the decimated series x[k m]: the non-overlapped second and third differences, and
+  // the noise identification sums. The countdown restarts at m / 2^level runs of the level.
+  static void decimate(TauState& t, X x) {
+    t.countdown = t.result.m >> t.level;
+    Result& r = t.result;
+    X a{}, h{};
+    if (t.decimated_count >= 2 && Arith::x_term2(x, t.decimated[0], t.decimated[1], a)) {
+      t.sticky |= Arith::accumulate(r.sum[static_cast<std::size_t>(SumKind::avar_nonoverlapped)], a);
+      ++r.n[static_cast<std::size_t>(SumKind::avar_nonoverlapped)];
+    }
+    if (t.decimated_count >= 3 && Arith::x_terms(x, t.decimated[0], t.decimated[1], t.decimated[2], a, h)) {
+      t.sticky |= Arith::accumulate(r.sum[static_cast<std::size_t>(SumKind::hvar_nonoverlapped)], h);
+      ++r.n[static_cast<std::size_t>(SumKind::hvar_nonoverlapped)];
+    }
+    t.decimated = {x, t.decimated[0], t.decimated[1]};
+    if (t.decimated_count < 3) ++t.decimated_count;
+    t.noise.add(static_cast<double>(x));
   }
 
   // Steady state of a ring-0 tau (m <= S, whole history inside the segment). For counts, the input
@@ -500,10 +540,9 @@ class Pyramid {
     const auto d1 = now.x - e1.x, d2 = e1.x - e2.x, d3 = e2.x - e3.x;
     const auto a = d1 - d2;
     const auto h = a - (d2 - d3);
-    decltype(Entry{}.x) mt{};
+    X mt{};
     Arith::p_term(now.p, e1.p, e2.p, e3.p, mt);
-    t.sticky |= Arith::accumulate(r.sum[0], a) | Arith::accumulate(r.sum[1], mt) |
-                Arith::accumulate(r.sum[2], h);
+    t.sticky |= Arith::accumulate(r.sum[0], a) | Arith::accumulate(r.sum[1], mt) | Arith::accumulate(r.sum[2], h);
     ++r.n[0];
     ++r.n[1];
     ++r.n[2];
@@ -513,11 +552,10 @@ class Pyramid {
     const std::uint64_t m = t.result.m;
     const std::uint64_t span = e - run_.segment_start;  // points of this segment before e
     if (span < 2 * m) return;
-    if (nonoverlapping_ && e % m != 0) return;
     const Entry& e1 = at(t, 0);
     const Entry& e2 = at(t, 1);
     Result& r = t.result;
-    decltype(Entry{}.x) a{}, h{};
+    X a{}, h{};
     if (span < 3 * m) {
       // Only the AVAR term fits; MVAR may still use P just before the segment start.
       if (!Arith::x_term2(now.x, e1.x, e2.x, a)) {
@@ -543,7 +581,7 @@ class Pyramid {
 
   template <class P>
   static void mvar_term(TauState& ts, const P& p0, const P& p1, const P& p2, const P& p3) {
-    decltype(Entry{}.x) term{};
+    X term{};
     if (!Arith::p_term(p0, p1, p2, p3, term)) {
       ++ts.result.out_of_range;
       return;
@@ -586,10 +624,9 @@ class Pyramid {
   std::span<TauState> taus_;
   std::size_t ntaus_ = 0;
   std::uint32_t stride_ = 8;
-  unsigned log2_stride_ = 3;
-  bool nonoverlapping_ = false;
+  std::uint32_t tag_ = 0;
   unsigned ring_levels_ = 1;
-  std::size_t fast_count_ = 0;     // leading taus that take fast_terms() in the steady state
+  std::size_t fast_count_ = 0;  // leading taus that take fast_terms() in the steady state
   static constexpr std::uint64_t fast_m_max = std::uint64_t{1} << 15;
 
   // Everything that changes while data flows (with history_ and the tau states: the checkpoint).
@@ -597,25 +634,49 @@ class Pyramid {
     std::uint64_t next_e = 0;         // index of the next phase point
     std::uint64_t segment_start = 0;  // index of the current segment's first point
     std::uint64_t steady_from = 0;    // from here on fast_terms() applies
+    std::uint64_t increments = 0;     // add_increment() calls
+    std::uint64_t gaps = 0;
     decltype(Entry{}.p) p{};          // P of the next point
     decltype(Entry{}.p) p_segment_start{};
-    decltype(Entry{}.x) x{};          // running phase for add_increment()
+    X x{};                            // running phase for add_increment()
+    typename Arith::Increment first_increment{};  // FloatArith: increments are taken relative to it
+    std::uint64_t line_points = 0;    // FloatArith phase input: the reference line
+    double line_x0 = 0, line_slope = 0;
     bool phase_overflow = false;
     std::array<std::uint32_t, 64> head{};  // head[l]: slot of (e >> l) in ring l
   };
   RunState run_;
 };
 
-/// A pyramid that owns its storage: capacity fixed at compile time for taus up to 2^(Octaves-1)
-/// with any stride factor 2 <= S <= MaxStride. Not copyable (the base refers to the members).
+/// Storage for a StaticCharacterizer: the history for the worst stride factor and the tau states.
+template <class Arith, unsigned Octaves, std::uint32_t MaxStride, std::size_t MaxTaus>
+struct CharacterizerStorage {
+  static_assert(Octaves >= 1 && Octaves <= 63, "taus up to 2^62");
+  static_assert(MaxStride >= 2 && std::has_single_bit(MaxStride), "stride factor: power of two >= 2");
+  static constexpr std::size_t history_capacity() {
+    std::size_t most = 0;
+    for (std::uint32_t s = 2; s <= MaxStride; s *= 2) {
+      const std::size_t n = history_entries(s, std::uint64_t{1} << (Octaves - 1));
+      if (n > most) most = n;
+    }
+    return most;
+  }
+  std::array<typename Arith::Entry, history_capacity()> history{};
+  std::array<typename Characterizer<Arith>::TauState, MaxTaus> taus{};
+};
+
+/// A characterizer that owns its storage: capacity fixed at compile time for taus up to
+/// 2^(Octaves-1) with any stride factor 2 <= S <= MaxStride. Not copyable (the base refers to the
+/// members).
 template <class Arith, unsigned Octaves, std::uint32_t MaxStride, std::size_t MaxTaus = Octaves>
-class StaticPyramid : private PyramidStorage<Arith, Octaves, MaxStride, MaxTaus>, public Pyramid<Arith> {
-  using Storage = PyramidStorage<Arith, Octaves, MaxStride, MaxTaus>;
+class StaticCharacterizer : private CharacterizerStorage<Arith, Octaves, MaxStride, MaxTaus>,
+                            public Characterizer<Arith> {
+  using Storage = CharacterizerStorage<Arith, Octaves, MaxStride, MaxTaus>;
 
  public:
-  StaticPyramid() : Storage{}, Pyramid<Arith>(Storage::history, Storage::taus) {}
-  StaticPyramid(const StaticPyramid&) = delete;
-  StaticPyramid& operator=(const StaticPyramid&) = delete;
+  StaticCharacterizer() : Storage{}, Characterizer<Arith>(Storage::history, Storage::taus) {}
+  StaticCharacterizer(const StaticCharacterizer&) = delete;
+  StaticCharacterizer& operator=(const StaticCharacterizer&) = delete;
 };
 
 }  // namespace gyrochar

@@ -1,7 +1,7 @@
 // Greenhall & Riley (2003) EDF: the generalized autocovariance sw of the phase noise (eq. 7), the
 // filters sx (eq. 8) and sz (eq. 9), the BasicSum (eq. 10), and the large-M approximations with
 // the paper's Tables 1-3 (coefficients as published in the paper and NIST SP 1065).
-#include "gyrochar/edf.hpp"
+#include "gyrochar/greenhall_edf.hpp"
 
 #include <cmath>
 #include <limits>
@@ -155,32 +155,6 @@ double edf_greenhall(const EdfQuery& q) {
     }
   }
   return inverse > 0 ? 1.0 / inverse : 0.0;
-}
-
-double edf_for(EdfStat stat, int alpha, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase_points) {
-  if (m == 0 || stride == 0) return 0.0;
-  EdfQuery q;
-  q.alpha = alpha;
-  q.m = static_cast<double>(m);
-  q.S = static_cast<double>(m) / static_cast<double>(stride);
-  q.N = static_cast<double>(n_phase_points);
-  q.d = stat == EdfStat::hvar ? 3 : 2;
-  q.modified = stat == EdfStat::mvar;
-  return edf_greenhall(q);
-}
-
-std::uint64_t unbroken_terms(EdfStat stat, std::uint64_t m, std::uint64_t stride, std::uint64_t n) {
-  if (m == 0 || stride == 0) return 0;
-  const std::uint64_t first = stat == EdfStat::avar ? 2 * m : stat == EdfStat::mvar ? 3 * m - 1 : 3 * m;
-  if (n == 0 || first > n - 1) return 0;
-  return (n - 1) / stride - (first + stride - 1) / stride + 1;  // multiples of stride in [first, n-1]
-}
-
-double edf_for_terms(EdfStat stat, int alpha, std::uint64_t m, std::uint64_t stride, std::uint64_t n, std::uint64_t terms) {
-  const std::uint64_t whole = unbroken_terms(stat, m, stride, n);
-  if (whole == 0 || terms == 0) return 0.0;
-  const double edf = edf_for(stat, alpha, m, stride, n);
-  return terms >= whole ? edf : edf * static_cast<double>(terms) / static_cast<double>(whole);
 }
 
 }  // namespace gyrochar

@@ -1,5 +1,7 @@
 #pragma once
-// Equivalent degrees of freedom of the Allan-family variance estimators, by the algorithm of
+// Greenhall & Riley's approximation of the equivalent degrees of freedom of the Allan-family
+// variance estimators, as Stable32 and allantools compute it (gyrochar's own EDF is the exact one of
+// noise_model.hpp; this one serves comparisons with those tools). The algorithm of
 // C. A. Greenhall and W. J. Riley, "Uncertainty of stability variances based on finite
 // differences", 35th PTTI meeting, 2003 (also NIST SP 1065 section 5.2). Freestanding, no heap.
 //
@@ -25,30 +27,6 @@ struct EdfQuery {
 /// of range, or there are too few points for a single term (N < m/F + m d). O(1) except the direct
 /// sums, which have at most 100 + (d+1) terms when the tables do not apply (O(Jmax)).
 double edf_greenhall(const EdfQuery& q);
-
-/// The statistics of this project.
-enum class EdfStat : std::uint8_t {
-  avar,   // overlapping (or strided) Allan: d = 2, F = m
-  mvar,   // modified Allan (and TVAR): d = 2, F = 1
-  hvar,   // overlapping (or strided) Hadamard: d = 3, F = m
-};
-
-/// EDF of statistic `stat` at averaging factor m with terms formed every `stride` points
-/// (stride 1: fully overlapped, stride m: non-overlapped) over N phase points. O(Jmax).
-double edf_for(EdfStat stat, int alpha, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase_points);
-
-/// Terms an unbroken run of N phase points forms at averaging factor m with terms every `stride`
-/// points on the global grid (newest point e >= 2m for AVAR, e >= 3m - 1 for MVAR, e >= 3m for
-/// HVAR, e < N). O(1).
-std::uint64_t unbroken_terms(EdfStat stat, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase_points);
-
-/// EDF of a run that gaps split into segments: the EDF of an unbroken run of the same phase points
-/// scaled by the share of its terms actually formed (`terms`; those spanning a gap are not).
-/// Equal to edf_for() without gaps; against the pooled EDF of independent segments (the sum of
-/// their EDFs) it is 0 to 4 % low for segments of 25 m or longer (tests/core/test_edf.cpp), so the
-/// intervals are, if anything, slightly wide. O(Jmax).
-double edf_for_terms(EdfStat stat, int alpha, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase_points,
-                     std::uint64_t terms);
 
 /// The BasicSum of Greenhall & Riley (their eq. 10) evaluated directly, exposed for tests:
 /// 1/EDF = BasicSum(J, M, S, F) / (M sz(0)^2).

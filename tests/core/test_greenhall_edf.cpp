@@ -8,12 +8,12 @@
 #include <sstream>
 #include <string>
 
-#include "gyrochar/edf.hpp"
+#include "gyrochar/greenhall_edf.hpp"
 
 namespace gyrochar {
 namespace {
 
-TEST(Edf, MatchesReferenceTable) {
+TEST(GreenhallEdf, MatchesReferenceTable) {
   std::ifstream in(GYROCHAR_REFDATA "/edf/edf_greenhall_table.csv");
   ASSERT_TRUE(in) << "reference table missing";
   std::string line;
@@ -56,7 +56,7 @@ TEST(Edf, MatchesReferenceTable) {
   EXPECT_GT(not_implemented, 0);
 }
 
-TEST(Edf, StridedEstimatorMatchesBasicSum) {
+TEST(GreenhallEdf, StridedEstimatorMatchesBasicSum) {
   // 1 < S < m, for a small N and a large N where the closed form switches to the tables: within
   // 1 % (modified) or 5 % (unmodified, approximations of the paper) of the direct BasicSum.
   for (int alpha : {2, 1, 0, -1, -2}) {
@@ -76,55 +76,10 @@ TEST(Edf, StridedEstimatorMatchesBasicSum) {
   }
 }
 
-TEST(Edf, StrideFactorEightKeepsMostOfTheFullyOverlappedEdf) {
-  // Design brief section 2: with S = 8 MVAR keeps about 90-100 % of the fully overlapped EDF for
-  // white PM, white FM and random walk FM (oracle: that statement, checked on the formula).
-  for (int alpha : {2, 0, -2}) {
-    const double strided = edf_for(EdfStat::mvar, alpha, 1024, 128, 1000000);
-    const double full = edf_for(EdfStat::mvar, alpha, 1024, 1, 1000000);
-    EXPECT_GT(strided / full, 0.85) << alpha;
-    EXPECT_LE(strided / full, 1.0 + 1e-9) << alpha;
-  }
-}
-
-TEST(Edf, NotAvailableOutsideTheDomain) {
+TEST(GreenhallEdf, NotAvailableOutsideTheDomain) {
   EXPECT_EQ(edf_greenhall({-1, 1, 4, false, 1, 1000}), 0.0);  // d = 1 not supported here
   EXPECT_EQ(edf_greenhall({-3, 2, 4, false, 1, 1000}), 0.0);  // alpha + 2d <= 1
   EXPECT_EQ(edf_greenhall({0, 2, 600, false, 1, 1000}), 0.0);  // N < L = 1 + 2m: not a single term
-  EXPECT_EQ(edf_for(EdfStat::avar, 0, 0, 1, 1000), 0.0);
-}
-
-}  // namespace
-}  // namespace gyrochar
-
-namespace gyrochar {
-namespace {
-
-TEST(Edf, SegmentedRunsScaleByTheTermsFormed) {
-  // Without gaps the scaled EDF is edf_for() itself (oracle: the definition).
-  for (std::uint64_t stride : {1u, 8u, 64u})
-    EXPECT_EQ(edf_for_terms(EdfStat::mvar, 0, 64, stride, 100000, unbroken_terms(EdfStat::mvar, 64, stride, 100000)),
-              edf_for(EdfStat::mvar, 0, 64, stride, 100000));
-  // Term counts of an unbroken run (oracle: counting the grid points by hand): N = 20, m = 2,
-  // stride 1: AVAR e = 4..19 (16), MVAR e = 5..19 (15), HVAR e = 6..19 (14); stride 4: 4, 8, 12, 16.
-  EXPECT_EQ(unbroken_terms(EdfStat::avar, 2, 1, 20), 16u);
-  EXPECT_EQ(unbroken_terms(EdfStat::mvar, 2, 1, 20), 15u);
-  EXPECT_EQ(unbroken_terms(EdfStat::hvar, 2, 1, 20), 14u);
-  EXPECT_EQ(unbroken_terms(EdfStat::avar, 2, 4, 20), 4u);
-  EXPECT_EQ(unbroken_terms(EdfStat::avar, 8, 1, 16), 0u);
-  // k equal independent segments pool to an EDF of k EDF(N/k) (oracle: chi-squared variances add
-  // for independent segments of equal weight). The term-share scaling is at most 4 % below it
-  // (measured: 0.996..1.000 for segments of 625 m and more, 0.971..0.981 for segments of 25 m)
-  // and never above it: the confidence intervals it gives are, if anything, wider.
-  for (int alpha : {2, 1, 0, -1, -2})
-    for (std::uint64_t k : {2u, 4u, 16u, 100u}) {
-      const std::uint64_t n = 160000, m = 64, seg = n / k;
-      const double pooled = static_cast<double>(k) * edf_for(EdfStat::mvar, alpha, m, 1, seg);
-      const std::uint64_t terms = k * unbroken_terms(EdfStat::mvar, m, 1, seg);
-      const double scaled = edf_for_terms(EdfStat::mvar, alpha, m, 1, n, terms);
-      EXPECT_GT(scaled / pooled, 0.96) << "alpha " << alpha << ", " << k << " segments";
-      EXPECT_LE(scaled / pooled, 1.0 + 1e-9) << "alpha " << alpha << ", " << k << " segments";
-    }
 }
 
 }  // namespace

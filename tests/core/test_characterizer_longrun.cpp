@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "gyrochar/pyramid.hpp"
+#include "gyrochar/characterizer.hpp"
 
 namespace gyrochar {
 namespace {
@@ -33,13 +33,13 @@ void check_run(std::uint64_t n_counts) {
   std::mt19937_64 rng(2026);
   for (std::uint64_t i = 0; i < period; ++i) source.pattern.push_back(static_cast<std::int64_t>(rng() % 20001) - 10000);
 
-  auto pyramid = std::make_unique<StaticPyramid<CountArith, octaves, stride_factor>>();
+  auto c = std::make_unique<StaticCharacterizer<CountArith, octaves, stride_factor>>();
   std::vector<std::uint64_t> m_list;
   for (unsigned k = 0; k < octaves; ++k) m_list.push_back(std::uint64_t{1} << k);
-  ASSERT_EQ(pyramid->configure({stride_factor, false}, m_list), PyramidStatus::ok);
-  for (std::uint64_t i = 0; i < n_counts; ++i) pyramid->add_increment(source.count(i));
+  ASSERT_EQ(c->configure({stride_factor, 0}, m_list), ConfigureStatus::ok);
+  for (std::uint64_t i = 0; i < n_counts; ++i) c->add_increment(source.count(i));
   const std::uint64_t points = n_counts + 1;  // phase points x_0 .. x_N
-  ASSERT_EQ(pyramid->phase_points(), points);
+  ASSERT_EQ(c->phase_points(), points);
 
   // A short explicit series long enough for the largest tau, with its prefix sums.
   const std::uint64_t m_max = m_list.back();
@@ -50,7 +50,7 @@ void check_run(std::uint64_t n_counts) {
 
   for (std::size_t i = 0; i < m_list.size(); ++i) {
     const std::uint64_t m = m_list[i];
-    const std::uint64_t stride = pyramid->stride(i);
+    const std::uint64_t stride = c->result(i).stride;
     std::array<u128, 3> want_sum{};
     std::array<std::uint64_t, 3> want_n{};
     const std::uint64_t first[3] = {2 * m, 3 * m - 1, 3 * m};  // smallest newest index e per stat
@@ -73,7 +73,7 @@ void check_run(std::uint64_t n_counts) {
         want_n[s] += count;
       }
     }
-    const auto& got = pyramid->result(i);
+    const auto& got = c->result(i);
     for (int s = 0; s < 3; ++s) {
       const u128 got_sum = (u128{got.sum[s].hi} << 64) | got.sum[s].lo;
       EXPECT_EQ(got.n[s], want_n[s]) << "m=" << m << " stat " << s;
@@ -84,8 +84,8 @@ void check_run(std::uint64_t n_counts) {
   }
 }
 
-TEST(PyramidLongRun, ExactAfterOneThousandCounts) { check_run(1000); }
-TEST(PyramidLongRun, ExactAfterTwoToTheThirtyCounts) { check_run(std::uint64_t{1} << 30); }
+TEST(CharacterizerLongRun, ExactAfterOneThousandCounts) { check_run(1000); }
+TEST(CharacterizerLongRun, ExactAfterTwoToTheThirtyCounts) { check_run(std::uint64_t{1} << 30); }
 
 }  // namespace
 }  // namespace gyrochar

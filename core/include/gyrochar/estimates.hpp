@@ -1,0 +1,139 @@
+#pragma once
+// The extractors: what the characterizer's sums say, per tau. The board's reports and the offline
+// analyzer call the same functions on the same sums, so they print the same numbers.
+//
+//   take_sums()       the sums of every tau, in floating point (one snapshot)
+//   identify_noise()  the power-law noise at every tau of a curve, and how it was chosen
+//   estimate()        one statistic at one tau: deviation, number of terms, EDF
+//
+// Noise identification. Where the decimated series x[k m] has at least lag1_min_points points,
+// the lag-1 autocorrelation rule (noise_id.hpp) gives p = 2 - alpha with its standard error; the
+// alphas within one standard error of p are "plausible". Longer taus, whose series are too short
+// for the rule, take the identification of the longest tau that had enough points (a power-law
+// model changes slowly with tau). With no such tau at all (very short records), the B1 ratio and
+// R(n) = MVAR/AVAR decide, as Stable32 does.
+//
+// EDF. The EDF of the estimator actually used (its stride, its number of phase points, the terms
+// a gap removed), computed exactly for the discrete power-law noise (noise_model.hpp). Where more
+// than one alpha is plausible, the smallest of their EDFs: the widest interval the data allow.
+// EdfModel::greenhall gives Greenhall & Riley's approximation for the identified alpha instead, as
+// Stable32 and allantools print it (for comparisons; it overstates the EDF at small m).
+//
+// All functions are deterministic, allocate nothing and read no clock.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "gyrochar/characterizer.hpp"
+#include "gyrochar/noise_id.hpp"
+#include "gyrochar/stat.hpp"
+
+namespace gyrochar {
+
+/// The six deviations: Allan (non-overlapped), overlapping Allan, modified Allan, time, Hadamard
+/// (non-overlapped), overlapping Hadamard.
+enum class DevStat : std::uint8_t { adev, oadev, mdev, tdev, hdev, ohdev };
+inline constexpr std::array<DevStat, 6> all_dev_stats{DevStat::adev, DevStat::oadev, DevStat::mdev,
+                                                       DevStat::tdev, DevStat::hdev, DevStat::ohdev};
+/// "adev", "oadev", ...: a static string.
+const char* name(DevStat s);
+constexpr SumKind sum_kind(DevStat s) {
+  switch (s) {
+    case DevStat::adev: return SumKind::avar_nonoverlapped;
+    case DevStat::oadev: return SumKind::avar;
+    case DevStat::mdev:
+    case DevStat::tdev: return SumKind::mvar;
+    case DevStat::hdev: return SumKind::hvar_nonoverlapped;
+    case DevStat::ohdev: return SumKind::hvar;
+  }
+  return SumKind::avar;
+}
+constexpr Stat stat_of(DevStat s) { return stat_of(sum_kind(s)); }
+
+/// The sums of one tau in floating point. variance[k] is in (x step / tau0)^2 (variance() with
+/// tau0 = 1 and unit 1). `noise` points into the characterizer, which must outlive it.
+struct TauSums {
+  std::uint64_t m = 0;
+  std::uint64_t stride = 1;
+  std::array<double, sum_kinds> variance{};
+  std::array<std::uint64_t, sum_kinds> n{};
+  bool clean = true;  // no term out of range, no sum overflow
+  const NoiseIdAccumulator* noise = nullptr;
+};
+
+/// Fills out[0 .. tau_count) from the characterizer. O(taus), no allocation.
+template <class Arith>
+void take_sums(const Characterizer<Arith>& c, std::span<TauSums> out) {
+  for (std::size_t i = 0; i < c.tau_count() && i < out.size(); ++i) {
+    const auto r = c.result(i);
+    TauSums& t = out[i];
+    t.m = r.m;
+    t.stride = r.stride;
+    t.n = r.n;
+    for (std::size_t k = 0; k < sum_kinds; ++k) t.variance[k] = variance(r, static_cast<SumKind>(k), 1.0);
+    t.clean = r.out_of_range == 0 && !r.sum_overflow;
+    t.noise = &c.noise(i);
+  }
+}
+
+enum class NoiseIdMethod : std::uint8_t {
+  none,       // not identified: no EDF, no interval
+  given,      // alpha fixed by the user
+  lag1,       // lag-1 autocorrelation of this tau's decimated series
+  neighbour,  // taken from the longest shorter tau that the lag-1 rule identified
+  b1,         // B1 ratio (no tau had enough points for the lag-1 rule)
+  b1_rn,      // B1 ratio, white and flicker PM told apart by R(n)
+};
+/// "none", "given", "lag1", "neighbour", "b1", "b1_rn": a static string.
+const char* name(NoiseIdMethod m);
+
+struct NoiseId {
+  int alpha = 0;                               // the most likely exponent
+  int low = 0, high = 0;                       // plausible exponents: low <= alpha <= high
+  NoiseIdMethod method = NoiseIdMethod::none;
+  bool identified() const { return method != NoiseIdMethod::none; }
+};
+
+/// Decimated points the lag-1 rule needs at a tau (Riley & Greenhall: about 30).
+inline constexpr std::uint64_t lag1_min_points = 30;
+
+/// Identifies the noise at every tau of one curve (taus in increasing m). dmax = 2 for the Allan
+/// and modified Allan statistics, 3 for Hadamard; frequency_input: the data were frequency (or
+/// counts), so the lag-1 rule starts at the first difference. out.size() >= taus.size().
+/// O(taus), no allocation.
+void identify_noise(std::span<const TauSums> taus, int dmax, bool frequency_input, std::span<NoiseId> out);
+
+/// A fixed alpha, as the user gives it.
+constexpr NoiseId given_noise(int alpha) { return {alpha, alpha, alpha, NoiseIdMethod::given}; }
+
+enum class EdfModel : std::uint8_t { exact, greenhall };
+
+struct EstimateOptions {
+  double tau0_s = 1.0;  // sample interval
+  double unit = 1.0;    // phase unit of one x step (pulse weight for counts; tau0 for frequency)
+  EdfModel edf = EdfModel::exact;
+};
+
+/// One statistic at one tau. Deviations are in phase unit per second (TDEV: phase unit).
+struct Estimate {
+  DevStat stat = DevStat::oadev;
+  std::uint64_t m = 0;
+  double tau_s = 0;
+  std::uint64_t n = 0;       // terms (Stable32's "#")
+  std::uint64_t stride = 1;  // terms every `stride` phase points (m for adev and hdev)
+  double variance = 0;       // AVAR, MVAR, TVAR or HVAR in (phase unit / s)^2 (TVAR: phase unit^2)
+  double deviation = 0;
+  NoiseId noise;
+  int edf_alpha = 0;         // the alpha whose EDF was used (the smallest of the plausible ones)
+  double edf = 0;            // 0: not available (no identification, or alpha outside the statistic's range)
+  bool clean = true;
+};
+
+/// The estimate of `stat` at one tau of a run of n_phase phase points, with its EDF for `noise`.
+/// n = 0 when the tau has no term yet. O(EDF): at most a few thousand covariance evaluations per
+/// plausible alpha (noise_model.hpp).
+Estimate estimate(const TauSums& tau, std::uint64_t n_phase, DevStat stat, const NoiseId& noise,
+                  const EstimateOptions& options);
+
+}  // namespace gyrochar

@@ -1,0 +1,92 @@
+#pragma once
+// Power-law noise in discrete time, and the exact second moments of the Allan-family estimators
+// under it: the expected variance, the covariance of any two terms, the equivalent degrees of
+// freedom (EDF) of an estimate and the covariance of two estimates. One mechanism serves the
+// confidence intervals, the noise identification and the IEEE-952 fit. Freestanding, no heap.
+//
+// Noise. Phase x = (1 - B)^(-d) w, B the backshift operator, w white with unit variance and
+// d = (2 - alpha)/2, where alpha is the exponent of the frequency spectrum S_y(f) ~ f^alpha:
+//   alpha  +2 white PM (d 0)   +1 flicker PM (1/2)   0 white FM (1)   -1 flicker FM (3/2)
+//          -2 random-walk FM (2)   -3 flicker-walk FM (5/2)   -4 random-run FM (3).
+// Half-integer d is Kasdin's fractional integration with an infinite past, so every difference of
+// order > d - 1/2 is stationary. The generalized autocovariance of x (defined up to a polynomial
+// that every estimator's filter annihilates) has a closed form, with psi the digamma function:
+//   d = 0:       R(k) = [k = 0]
+//   d = j >= 1:  R(k) = (-1)^j |k| prod_{i=1}^{j-1} (k^2 - i^2) / (2 (2j-1)!)
+//   d = j + 1/2: R(k) = (-1)^(j+1) prod_{i=1}^{j} (k^2 - (i-1/2)^2) (psi(|k|+j+1/2) + psi(|k|-j+1/2)) / (2 pi (2j)!)
+// (the limits of Hosking's Gamma(1-2d) Gamma(k+d) / (Gamma(d) Gamma(1-d) Gamma(k+1-d)) at integer
+// and half-integer d). The prefix sums P of x are the same kind of noise with d + 1.
+//
+// Terms. Each statistic averages squared terms, each a fixed filter of the phase (newest point e):
+//   AVAR  x[e] - 2 x[e-m] + x[e-2m]                       (on x)
+//   HVAR  x[e] - 3 x[e-m] + 3 x[e-2m] - x[e-3m]           (on x)
+//   MVAR  P[e+1] - 3 P[e+1-m] + 3 P[e+1-2m] - P[e+1-3m]   (on P; an x filter is moved onto P
+//                                                          by x[k] = P[k+1] - P[k] to pair with it)
+// so the covariance of two terms, sum_{a,b} f_a g_b R(lag + o_a - o_b), is exact and O(1).
+//
+// Estimates. An estimate sums the squares of n terms whose newest points are first, first +
+// stride, ... (stride 1: fully overlapped; m/S: the pyramid's strided taus; m: non-overlapped).
+// For Gaussian terms with covariances c, E[sum t_i^2] = sum c_ii and
+// Cov[sum t_i^2, sum u_j^2] = 2 sum_{i,j} c(e_i - e_j)^2, so EDF = (n c(0))^2 / sum_{i,j} c(e_i - e_j)^2.
+// The double sums are sums over lags weighted by the number of pairs at each lag: exact where the
+// lags within the terms' reach are few (at most a few thousand), and otherwise a trapezoid rule on
+// nodes graded towards the lags where c is not smooth (dense there), accurate to about 1e-4
+// (tests/core/test_noise_model.cpp checks it against the exact sums).
+//
+// Every function is deterministic, allocates nothing, reads no clock and never fails hard.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "gyrochar/stat.hpp"
+
+namespace gyrochar {
+
+/// True when statistic s converges for noise alpha (alpha + 2 D > 1, alpha in -4..+2).
+constexpr bool noise_supported(Stat s, int alpha) {
+  return alpha <= 2 && alpha >= -4 && alpha + 2 * difference_order(s) > 1;
+}
+
+/// Generalized autocovariance R(k) of (1 - B)^(-twice_d / 2) w, twice_d in 0..8. O(1).
+double generalized_autocovariance(int twice_d, std::int64_t k);
+
+/// Cov[term of (a, m_a) with newest point e, term of (b, m_b) with newest point e - lag] for
+/// noise alpha with unit innovation variance, in squared phase units (the MVAR term is a SUM of m
+/// second differences). 0 when either statistic does not converge for alpha. O(1).
+double term_covariance(int alpha, Stat a, std::uint64_t m_a, Stat b, std::uint64_t m_b, std::int64_t lag);
+
+/// The terms of one estimate: newest points first, first + stride, ..., first + (n - 1) stride.
+struct TermGrid {
+  Stat stat = Stat::avar;
+  std::uint64_t m = 1;       // averaging factor
+  std::uint64_t stride = 1;  // a power of two (1: fully overlapped)
+  std::uint64_t first = 0;   // newest point of the first term
+  std::uint64_t n = 0;       // number of terms
+};
+
+/// The terms an unbroken run of n_phase points forms for (stat, m) with terms every `stride`
+/// points on the global grid (newest point a multiple of stride). n = 0 when none fits. O(1).
+TermGrid unbroken_grid(Stat stat, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase);
+
+/// Up to four power-law noises whose sums pair_sums() forms at once (a noise mixture).
+inline constexpr std::size_t max_noises = 4;
+struct NoiseSet {
+  std::array<int, max_noises> alpha{};
+  std::size_t count = 0;
+};
+
+/// Over all pairs of terms (i of grid a, j of grid b) with lag e_i - e_j, for the noises of `set`:
+///   cc[t][u] = sum c_t c_u    (c_t the term covariance of noise t, unit innovations)
+///   c[t]     = sum c_t
+/// cc is symmetric. O(nodes x taps x noises) with at most a few thousand nodes.
+struct PairSums {
+  std::array<std::array<double, max_noises>, max_noises> cc{};
+  std::array<double, max_noises> c{};
+};
+PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b);
+
+/// EDF of the estimate over `grid` for pure noise alpha: (n c(0))^2 / sum_{i,j} c(e_i - e_j)^2.
+/// 0 when the statistic does not converge for alpha or the grid has no term. See pair_sums().
+double exact_edf(int alpha, const TermGrid& grid);
+
+}  // namespace gyrochar

@@ -1,0 +1,189 @@
+// Exact second moments of the estimators under discrete power-law noise. Oracles:
+// - the term covariances against the terms written as explicit filters of the innovations w
+//   (Kasdin's impulse response of (1 - B)^-d, long enough that its tail is below 1e-9), summed
+//   directly: an independent computation of the same quantity;
+// - the quadrature of the double sums against the sums over every pair of terms;
+// - closed forms: white FM at m = 1, where the n AVAR terms are first differences of white noise
+//   (EDF 4 n^2 / (6 n - 2)); random-walk FM at m = 1, where they are white (EDF n); the
+//   expected variances 3/m^2 (white PM AVAR), 3/m^3 (white PM MVAR), (m^2 + 1)/(2 m^3) (white FM
+//   MVAR, tau0 = 1), and the IEEE-952 flicker floor: AVAR -> (2 ln 2 / pi) for unit innovations
+//   of flicker FM scaled by tau0 (B = 1);
+// - Greenhall & Riley's BasicSum (a continuous-time model) at large m, where the discrete model
+//   converges to it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "gyrochar/greenhall_edf.hpp"
+#include "gyrochar/noise_model.hpp"
+
+namespace gyrochar {
+namespace {
+
+// The term of (stat, m) with newest point e as a filter of x: coefficients of x[e - k], k >= 0.
+std::vector<double> x_filter(Stat s, std::uint64_t m) {
+  std::vector<double> f;
+  auto add = [&](std::uint64_t k, double v) {
+    if (f.size() <= k) f.resize(k + 1, 0.0);
+    f[k] += v;
+  };
+  if (s == Stat::mvar) {  // sum of m second differences: three boxes of m points
+    for (std::uint64_t i = 0; i < m; ++i) {
+      add(i, 1);
+      add(i + m, -2);
+      add(i + 2 * m, 1);
+    }
+  } else if (s == Stat::avar) {
+    add(0, 1), add(m, -2), add(2 * m, 1);
+  } else {
+    add(0, 1), add(m, -3), add(2 * m, 3), add(3 * m, -1);
+  }
+  return f;
+}
+
+// The same term as a filter of the innovations: x_filter convolved with Kasdin's response, kept to
+// `length` coefficients (beyond, the convolution would see the truncated response's end).
+std::vector<double> w_filter(int alpha, Stat s, std::uint64_t m, std::size_t length) {
+  const double d = (2.0 - alpha) / 2.0;
+  std::vector<double> h(length);
+  h[0] = 1;
+  for (std::size_t k = 1; k < length; ++k) h[k] = h[k - 1] * (static_cast<double>(k) - 1 + d) / static_cast<double>(k);
+  const auto f = x_filter(s, m);
+  std::vector<double> g(length + f.size(), 0.0);
+  for (std::size_t a = 0; a < f.size(); ++a)
+    for (std::size_t k = 0; k < length; ++k) g[a + k] += f[a] * h[k];
+  g.resize(length);
+  return g;
+}
+
+TEST(NoiseModel, TermCovariancesEqualExplicitFilterSums) {
+  for (int alpha : {2, 1, 0, -1, -2}) {
+    // Flicker responses decay slowly: a long filter keeps the neglected tail below 1e-9.
+    const std::size_t length = alpha % 2 != 0 ? 400000 : 64;
+    for (Stat a : {Stat::avar, Stat::mvar, Stat::hvar}) {
+      for (Stat b : {Stat::avar, Stat::mvar}) {
+        for (std::uint64_t ma : {1u, 3u}) {
+          const std::uint64_t mb = a == b ? ma : 2;
+          const auto ga = w_filter(alpha, a, ma, length), gb = w_filter(alpha, b, mb, length);
+          for (std::int64_t lag : {0, 1, 2, 5, -3, 11}) {
+            // Cov(term a at e, term b at e - lag) = sum_k ga[k] gb[k - lag] (innovation index e - k).
+            double direct = 0;
+            for (std::size_t k = 0; k < ga.size(); ++k) {
+              const std::int64_t j = static_cast<std::int64_t>(k) - lag;
+              if (j >= 0 && j < static_cast<std::int64_t>(gb.size())) direct += ga[k] * gb[static_cast<std::size_t>(j)];
+            }
+            const double exact = term_covariance(alpha, a, ma, b, mb, lag);
+            EXPECT_NEAR(exact, direct, 1e-7 * (1 + std::fabs(direct)))
+                << "alpha " << alpha << " stats " << int(a) << "/" << int(b) << " m " << ma << "/" << mb << " lag " << lag;
+          }
+        }
+      }
+    }
+  }
+}
+
+// Sum over every pair of terms (the definition), with c evaluated at each pair's lag.
+double all_pairs(int alpha, const TermGrid& a, const TermGrid& b) {
+  std::map<std::int64_t, double> pairs;
+  for (std::uint64_t i = 0; i < a.n; ++i)
+    for (std::uint64_t j = 0; j < b.n; ++j)
+      pairs[static_cast<std::int64_t>(a.first + i * a.stride) - static_cast<std::int64_t>(b.first + j * b.stride)] += 1;
+  double sum = 0;
+  const std::int64_t reach = static_cast<std::int64_t>(4 * (a.m + b.m)) * 64;  // as far as c is evaluated
+  for (const auto& [lag, count] : pairs) {
+    if (lag < -reach || lag > reach) continue;  // beyond: c^2 < 1e-9 of the sum, c itself roundoff
+    const double c = term_covariance(alpha, a.stat, a.m, b.stat, b.m, lag);
+    sum += count * c * c;
+  }
+  return sum;
+}
+
+TEST(NoiseModel, PairSumsEqualTheSumOverEveryPair) {
+  NoiseSet set;
+  set.count = 1;
+  for (int alpha : {2, 1, 0, -1, -2}) {
+    set.alpha[0] = alpha;
+    // Dense lattices (exact) and fully overlapped m = 1024 and 3000, where the quadrature is graded.
+    struct Case {
+      Stat a, b;
+      std::uint64_t m_a, m_b, stride_a, stride_b, n_phase;
+      double tolerance;
+    };
+    const Case cases[] = {
+        {Stat::avar, Stat::avar, 4, 4, 1, 1, 2000, 1e-11},   {Stat::mvar, Stat::mvar, 64, 64, 8, 8, 3000, 1e-11},
+        {Stat::hvar, Stat::hvar, 16, 16, 2, 2, 2000, 1e-11}, {Stat::avar, Stat::mvar, 32, 32, 4, 4, 3000, 1e-9},
+        {Stat::avar, Stat::avar, 32, 64, 4, 8, 3000, 1e-9},  {Stat::avar, Stat::avar, 1024, 1024, 1, 1, 5500, 3e-4},
+        {Stat::mvar, Stat::mvar, 3000, 3000, 1, 1, 11500, 3e-4},
+    };
+    for (const Case& k : cases) {
+      const TermGrid a = unbroken_grid(k.a, k.m_a, k.stride_a, k.n_phase);
+      const TermGrid b = unbroken_grid(k.b, k.m_b, k.stride_b, k.n_phase);
+      const double want = all_pairs(alpha, a, b);
+      const double got = pair_sums(set, a, b).cc[0][0];
+      // Flicker noises: c is summed out to 64 kernel widths (noise_model.cpp), the oracle a little
+      // further; the difference, the neglected tail, stays below 1e-5 of the sum.
+      const double tolerance = alpha % 2 != 0 ? std::max(k.tolerance, 1e-5) : k.tolerance;
+      EXPECT_NEAR(got / want, 1.0, tolerance) << "alpha " << alpha << " m " << k.m_a << "/" << k.m_b;
+    }
+  }
+}
+
+TEST(NoiseModel, ClosedFormsOfTheEdf) {
+  // White FM, m = 1, N = 4096 phase points: n = 4094 AVAR terms y_{k+1} - y_k of white y, with
+  // c(0) = 2, c(1) = -1: EDF = 4 n^2 / (6 n - 2) = 2729.6. Greenhall's approximation gives 3204.
+  const TermGrid g = unbroken_grid(Stat::avar, 1, 1, 4096);
+  ASSERT_EQ(g.n, 4094u);
+  const double n = static_cast<double>(g.n);
+  EXPECT_NEAR(exact_edf(0, g), 4 * n * n / (6 * n - 2), 1e-9);
+  EXPECT_NEAR(edf_greenhall({0, 2, 1, false, 1, 4096}), 3204, 1);
+  // Random-walk FM, m = 1: second differences of x = (1 - B)^-2 w are w itself, independent.
+  EXPECT_NEAR(exact_edf(-2, g), n, 1e-9);
+  // Non-overlapped (stride m) white PM AVAR: terms m apart share one point (c(m) = -4 of c(0) = 6).
+  const TermGrid nov = unbroken_grid(Stat::avar, 16, 16, 16 * 101);
+  EXPECT_NEAR(exact_edf(2, nov), 36.0 * 99 * 99 / (36 * 99 + 32 * 98 + 2 * 97), 1e-9);
+}
+
+TEST(NoiseModel, ExpectedVariancesMatchTheirClosedForms) {
+  for (std::uint64_t m : {1u, 2u, 7u, 64u, 1000u}) {
+    const double mm = static_cast<double>(m);
+    // AVAR = E[a^2] / (2 m^2), MVAR = E[t^2] / (2 m^4) with tau0 = 1 and unit innovations.
+    EXPECT_NEAR(term_covariance(2, Stat::avar, m, Stat::avar, m, 0) / (2 * mm * mm), 3 / (mm * mm), 1e-12);
+    EXPECT_NEAR(term_covariance(2, Stat::mvar, m, Stat::mvar, m, 0) / (2 * mm * mm * mm * mm), 3 / (mm * mm * mm),
+                1e-12 / mm);
+    EXPECT_NEAR(term_covariance(0, Stat::avar, m, Stat::avar, m, 0) / (2 * mm * mm), 1 / mm, 1e-12);
+    EXPECT_NEAR(term_covariance(0, Stat::mvar, m, Stat::mvar, m, 0) / (2 * mm * mm * mm * mm),
+                (mm * mm + 1) / (2 * mm * mm * mm), 1e-9 / mm);
+  }
+  // Flicker FM with innovations of B tau0 (tau0 = 1, B = 1) approaches the IEEE-952 floor 2 ln 2 / pi.
+  const double floor = 2 * std::log(2.0) / 3.14159265358979323846;
+  for (std::uint64_t m : {1024u, 65536u}) {
+    const double mm = static_cast<double>(m);
+    // The discrete model departs from the floor by O(1/m^2).
+    EXPECT_NEAR(term_covariance(-1, Stat::avar, m, Stat::avar, m, 0) / (2 * mm * mm) / floor, 1.0, 4 / (mm * mm) + 1e-12);
+  }
+}
+
+TEST(NoiseModel, LargeAveragingFactorsApproachGreenhallsContinuousModel) {
+  // Modified Allan, fully overlapped (F = 1, S = m): the discrete model tends to Greenhall's
+  // BasicSum as m grows (within 1 % at m = 256; the tables' own approximation is about 1 %).
+  for (int alpha : {2, 0, -1, -2}) {
+    const std::uint64_t m = 256, n_phase = 40000;
+    const double exact = exact_edf(alpha, unbroken_grid(Stat::mvar, m, 1, n_phase));
+    const double continuous = 1.0 / edf_basic_sum_inverse(alpha, 2, 256, 1, 256, n_phase);
+    EXPECT_NEAR(exact / continuous, 1.0, 0.01) << "alpha " << alpha;
+  }
+}
+
+TEST(NoiseModel, OutsideTheDomainThereIsNoEdf) {
+  EXPECT_EQ(exact_edf(-3, unbroken_grid(Stat::avar, 4, 1, 1000)), 0.0);  // AVAR diverges for alpha <= -3
+  EXPECT_GT(exact_edf(-3, unbroken_grid(Stat::hvar, 4, 1, 1000)), 0.0);  // Hadamard does not
+  EXPECT_EQ(exact_edf(0, unbroken_grid(Stat::avar, 600, 1, 1000)), 0.0); // no term fits
+  EXPECT_EQ(unbroken_grid(Stat::mvar, 4, 1, 11).n, 0u);                 // first MVAR term at e = 3m - 1 = 11
+  EXPECT_EQ(unbroken_grid(Stat::mvar, 4, 1, 12).n, 1u);
+}
+
+}  // namespace
+}  // namespace gyrochar
