@@ -25,7 +25,7 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   std::array<TauSums, max_octaves> sums{};
   std::array<NoiseId, max_octaves> noise{};
   take_sums(c, std::span(sums.data(), taus));
-  identify_noise(std::span(sums.data(), taus), 2, false, std::span(noise.data(), taus));
+  identify_noise(std::span(sums.data(), taus), c.phase_points(), 2, false, std::span(noise.data(), taus));
   const EstimateOptions options{s.tau0_s, s.pulse_weight_arcsec, EdfModel::exact};
   std::array<VariancePoint, max_octaves> points{};
   std::size_t n_points = 0;

@@ -25,6 +25,7 @@ const char* name(NoiseIdMethod m) {
     case NoiseIdMethod::none: return "none";
     case NoiseIdMethod::given: return "given";
     case NoiseIdMethod::lag1: return "lag1";
+    case NoiseIdMethod::rn: return "rn";
     case NoiseIdMethod::neighbour: return "neighbour";
     case NoiseIdMethod::b1: return "b1";
     case NoiseIdMethod::b1_rn: return "b1_rn";
@@ -38,8 +39,6 @@ int clamp_alpha(int alpha, int dmax) {
   const int lowest = dmax == 3 ? -4 : -2;
   return alpha < lowest ? lowest : alpha > 2 ? 2 : alpha;
 }
-
-int alpha_of(double p) { return 2 - static_cast<int>(std::lround(p)); }
 
 // With no tau long enough for the lag-1 rule: the B1 ratio (the standard variance of the
 // m-averaged frequency over the overlapping AVAR, as Stable32 does it) against Barnes' B1(N, mu),
@@ -96,28 +95,96 @@ double edf_of(Stat stat, int alpha, std::uint64_t m, std::uint64_t stride, std::
   return terms >= grid.n ? edf : edf * static_cast<double>(terms) / static_cast<double>(grid.n);
 }
 
+// Exponent noise types are idealizations: measured statistics are allowed this relative spread
+// beyond their sampling error before they count against a type.
+constexpr double model_spread = 0.1;
+// A power-law model changes slowly with tau: each unit of alpha away from the shorter tau's costs
+// as much as one standard deviation of evidence.
+constexpr double neighbour_weight = 1.0;
+// Alphas whose chi-squared is within this of the best are plausible (about one standard deviation).
+constexpr double plausible_chi2 = 1.0;
+
+// How far the measured R(n) = MVAR/AVAR lies from its expectation under pure noise alpha, in
+// standard deviations: ln R against ln E[MVAR]/E[AVAR] (with the second-order bias of the
+// logarithms), the variance from the exact covariances of the two estimates (noise_model.hpp) plus
+// the model spread. NaN where the ratio is not available.
+double rn_score(const TauSums& t, std::uint64_t n_phase, int alpha) {
+  const auto A = static_cast<std::size_t>(SumKind::avar), M = static_cast<std::size_t>(SumKind::mvar);
+  if (!noise_supported(Stat::avar, alpha) || t.n[A] == 0 || t.n[M] == 0 || !(t.variance[A] > 0) || !(t.variance[M] > 0))
+    return std::nan("");
+  const TermGrid a = unbroken_grid(Stat::avar, t.m, t.stride, n_phase);
+  const TermGrid b = unbroken_grid(Stat::mvar, t.m, t.stride, n_phase);
+  if (a.n == 0 || b.n == 0) return std::nan("");
+  NoiseSet set;
+  set.alpha[0] = alpha;
+  set.count = 1;
+  const double ca = term_covariance(alpha, Stat::avar, t.m, Stat::avar, t.m, 0);
+  const double cm = term_covariance(alpha, Stat::mvar, t.m, Stat::mvar, t.m, 0);
+  const double na = static_cast<double>(a.n), nm = static_cast<double>(b.n);
+  // Gaps remove terms: the relative variances grow as the share of terms formed shrinks.
+  const double share_a = na / static_cast<double>(t.n[A]), share_m = nm / static_cast<double>(t.n[M]);
+  const double va = 2 * pair_sums(set, a, a).cc[0][0] / (na * ca * na * ca) * share_a;
+  const double vm = 2 * pair_sums(set, b, b).cc[0][0] / (nm * cm * nm * cm) * share_m;
+  const double cov = 2 * pair_sums(set, a, b).cc[0][0] / (na * ca * nm * cm) * std::sqrt(share_a * share_m);
+  const double m = static_cast<double>(t.m);
+  const double expected = std::log(cm / (ca * m * m)) - vm / 2 + va / 2;
+  const double var = va + vm - 2 * cov + model_spread * model_spread;
+  return (std::log(t.variance[M] / t.variance[A]) - expected) / std::sqrt(var);
+}
+
 }  // namespace
 
-void identify_noise(std::span<const TauSums> taus, int dmax, bool frequency_input, std::span<NoiseId> out) {
+void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dmax, bool frequency_input,
+                    std::span<NoiseId> out) {
   const int dmin = frequency_input ? 1 : 0;
-  std::size_t last_lag1 = taus.size();  // none yet
+  const int lowest = dmax == 3 ? -4 : -2;
   for (std::size_t i = 0; i < taus.size() && i < out.size(); ++i) {
-    NoiseId id;
-    const Lag1Estimate e = taus[i].noise ? lag1_estimate(*taus[i].noise, dmin, dmax) : Lag1Estimate{};
-    if (e.valid && taus[i].noise->points() >= lag1_min_points) {
-      id.method = NoiseIdMethod::lag1;
-      id.alpha = clamp_alpha(alpha_of(e.p), dmax);
-      id.low = clamp_alpha(alpha_of(e.p + e.sigma), dmax);
-      id.high = clamp_alpha(alpha_of(e.p - e.sigma), dmax);
-      last_lag1 = i;
-    } else if (last_lag1 < taus.size()) {
-      id = out[last_lag1];
-      id.method = NoiseIdMethod::neighbour;
-    } else if (taus[i].noise) {
-      id = b1_identify(taus[i]);
-      id.alpha = clamp_alpha(id.alpha, dmax);
-      id.low = id.high = id.alpha;
+    const TauSums& t = taus[i];
+    const NoiseId* previous = i > 0 && out[i - 1].identified() ? &out[i - 1] : nullptr;
+    std::array<double, 7> chi2{};  // index 2 - alpha
+    bool informed = false;
+    const Lag1Estimate lag1 = t.noise ? lag1_estimate(*t.noise, dmin, dmax) : Lag1Estimate{};
+    const bool use_lag1 = lag1.valid && lag1.points >= lag1_min_points;
+    for (int alpha = 2; alpha >= lowest; --alpha) {
+      double& c = chi2[static_cast<std::size_t>(2 - alpha)];
+      if (use_lag1) {
+        const double z = (lag1.p - (2 - alpha)) / std::fmax(lag1.sigma, model_spread);
+        c += z * z;
+        informed = true;
+      }
+      {  // R(n) needs AVAR: below alpha = -2 (Hadamard only) score it as random-walk FM
+        const double z = rn_score(t, n_phase, alpha < -2 ? -2 : alpha);
+        if (std::isfinite(z)) {
+          c += z * z;
+          informed = true;
+        }
+      }
+      if (previous) c += neighbour_weight * (alpha - previous->alpha) * (alpha - previous->alpha);
     }
+    NoiseId id;
+    if (!informed) {
+      if (previous) {
+        id = *previous;
+        id.method = NoiseIdMethod::neighbour;
+      } else if (t.noise) {
+        id = b1_identify(t);
+        id.alpha = clamp_alpha(id.alpha, dmax);
+        id.low = id.high = id.alpha;
+      }
+      out[i] = id;
+      continue;
+    }
+    int best = 2;
+    for (int alpha = 2; alpha >= lowest; --alpha)
+      if (chi2[static_cast<std::size_t>(2 - alpha)] < chi2[static_cast<std::size_t>(2 - best)]) best = alpha;
+    id.alpha = best;
+    id.low = id.high = best;
+    for (int alpha = 2; alpha >= lowest; --alpha) {
+      if (chi2[static_cast<std::size_t>(2 - alpha)] > chi2[static_cast<std::size_t>(2 - best)] + plausible_chi2) continue;
+      if (alpha < id.low) id.low = alpha;
+      if (alpha > id.high) id.high = alpha;
+    }
+    id.method = use_lag1 ? NoiseIdMethod::lag1 : NoiseIdMethod::rn;
     out[i] = id;
   }
 }

@@ -1,25 +1,92 @@
+// The IEEE-952 fit by generalized least squares (see ieee952.hpp).
 #include "gyrochar/ieee952.hpp"
 
 #include <cmath>
 
+#include "gyrochar/noise_model.hpp"
+
 namespace gyrochar {
-namespace {
 
-constexpr double pi = 3.14159265358979323846;
-
-// The five basis functions: variance = sum_k coefficient_k * basis_k(tau).
-std::array<double, 5> basis(double tau, Ieee952Curve curve, double tau0) {
-  if (curve == Ieee952Curve::avar)
-    return {3.0 / (tau * tau), 1.0 / tau, 2.0 * std::log(2.0) / pi, tau / 3.0, tau * tau / 2.0};
-  const double m = tau / tau0;
-  return {3.0 * tau0 / (tau * tau * tau), (m * m + 1.0) / (2.0 * m * m * tau), 0.2977, 11.0 * tau / 40.0,
-          tau * tau / 2.0};
+const char* name(FitCurve c) {
+  switch (c) {
+    case FitCurve::avar: return "avar";
+    case FitCurve::mvar: return "mvar";
+    case FitCurve::both: return "both";
+  }
+  return "?";
 }
 
-// Solves the n x n system a x = b (Gaussian elimination, partial pivoting) and inverts a into inv.
-bool solve(std::array<std::array<double, 5>, 5> a, std::array<double, 5> b, std::size_t n, std::array<double, 5>& x,
-           std::array<std::array<double, 5>, 5>& inv) {
-  std::array<std::array<double, 5>, 5> id{};
+const char* name(FitStatus s) {
+  switch (s) {
+    case FitStatus::ok: return "ok";
+    case FitStatus::too_few_points: return "too few points";
+    case FitStatus::rejected: return "model rejected";
+    case FitStatus::singular: return "singular";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr std::size_t terms = 5;    // Q N B K R
+constexpr std::size_t noises = 4;   // Q N B K: the random ones
+constexpr std::array<int, noises> alphas{2, 0, -1, -2};
+constexpr int band_octaves = 8;     // estimates further apart are taken as uncorrelated
+constexpr double quantization_left_out = 0.01;  // share of a point that makes it unusable (non-white)
+
+// Innovation variance of term t per unit squared parameter: tau0^k.
+double innovation_scale(std::size_t t, double tau0) { return t == 0 ? 1.0 : std::pow(tau0, static_cast<double>(t)); }
+
+// E[term^2] -> variance: AVAR = E[a^2] / (2 m^2 tau0^2), MVAR = E[t^2] / (2 m^4 tau0^2).
+double normalization(Stat s, std::uint64_t m, double tau0) {
+  const double mm = static_cast<double>(m);
+  return s == Stat::mvar ? 2 * mm * mm * mm * mm * tau0 * tau0 : 2 * mm * mm * tau0 * tau0;
+}
+
+// The model's expected variance of a point per unit squared parameter: the design matrix row.
+std::array<double, terms> design(Stat s, std::uint64_t m, double tau0) {
+  std::array<double, terms> x{};
+  const double nrm = normalization(s, m, tau0);
+  for (std::size_t t = 0; t < noises; ++t)
+    x[t] = term_covariance(alphas[t], s, m, s, m, 0) * innovation_scale(t, tau0) / nrm;
+  const double tau = static_cast<double>(m) * tau0;
+  x[4] = tau * tau / 2;
+  return x;
+}
+
+int octave(std::uint64_t m) { return 63 - __builtin_clzll(m); }
+
+// In-place Cholesky of the n x n matrix a (row-major, lower triangle used). False when not positive
+// definite.
+bool cholesky(double* a, std::size_t n) {
+  for (std::size_t j = 0; j < n; ++j) {
+    double d = a[j * n + j];
+    for (std::size_t k = 0; k < j; ++k) d -= a[j * n + k] * a[j * n + k];
+    if (!(d > 0)) return false;
+    d = std::sqrt(d);
+    a[j * n + j] = d;
+    for (std::size_t i = j + 1; i < n; ++i) {
+      double s = a[i * n + j];
+      for (std::size_t k = 0; k < j; ++k) s -= a[i * n + k] * a[j * n + k];
+      a[i * n + j] = s / d;
+    }
+  }
+  return true;
+}
+
+// Solves L z = b in place (L the lower triangle of a).
+void forward(const double* a, std::size_t n, double* b, std::size_t stride_b) {
+  for (std::size_t i = 0; i < n; ++i) {
+    double s = b[i * stride_b];
+    for (std::size_t k = 0; k < i; ++k) s -= a[i * n + k] * b[k * stride_b];
+    b[i * stride_b] = s / a[i * n + i];
+  }
+}
+
+// Solves the small symmetric system a x = b (Gauss-Jordan, partial pivoting) and inverts a.
+bool solve_small(std::array<std::array<double, terms>, terms> a, std::array<double, terms> b, std::size_t n,
+                 std::array<double, terms>& x, std::array<std::array<double, terms>, terms>& inv) {
+  std::array<std::array<double, terms>, terms> id{};
   for (std::size_t i = 0; i < n; ++i) id[i][i] = 1.0;
   for (std::size_t c = 0; c < n; ++c) {
     std::size_t pivot = c;
@@ -46,100 +113,335 @@ bool solve(std::array<std::array<double, 5>, 5> a, std::array<double, 5> b, std:
   return true;
 }
 
+// The points in use, with their design rows and the workspace views.
+struct Problem {
+  std::size_t n = 0;
+  const FitPoint* point[128];
+  double tau0 = 1;
+  std::uint64_t n_phase = 0;
+  double* pair = nullptr;   // per pair (i <= j): 10 sums c_t c_u, then 4 sums c_t
+  double* sigma = nullptr;  // n x n
+  double* rows = nullptr;   // per point: x[5], y, spare
+  double* row(std::size_t i) const { return rows + i * 8; }
+  double* pair_at(std::size_t i, std::size_t j) const {
+    if (i > j) {
+      const std::size_t t = i;
+      i = j;
+      j = t;
+    }
+    return pair + (j * (j + 1) / 2 + i) * 14;
+  }
+};
+
+std::size_t cc_index(std::size_t t, std::size_t u) {
+  if (t < u) {
+    const std::size_t s = t;
+    t = u;
+    u = s;
+  }
+  return t * (t + 1) / 2 + u;  // 0..9
+}
+
+// The covariance of the points under squared parameters theta (the random terms and the ramp's
+// cross term 4 D_p D_q sum c, D the ramp's deterministic term value).
+void covariance_of_points(const Problem& pr, const std::array<double, terms>& theta) {
+  std::array<double, noises> h{};
+  for (std::size_t t = 0; t < noises; ++t) h[t] = (theta[t] > 0 ? theta[t] : 0) * innovation_scale(t, pr.tau0);
+  const double ramp = theta[4] > 0 ? theta[4] : 0;
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    for (std::size_t j = 0; j <= i; ++j) {
+      const FitPoint& a = *pr.point[i];
+      const FitPoint& b = *pr.point[j];
+      const double* g = pr.pair_at(i, j);
+      double v = 0;
+      for (std::size_t t = 0; t < noises; ++t)
+        for (std::size_t u = 0; u < noises; ++u) v += h[t] * h[u] * g[cc_index(t, u)];
+      v *= 2;
+      if (ramp > 0) {
+        const double ta = static_cast<double>(a.m) * pr.tau0, tb = static_cast<double>(b.m) * pr.tau0;
+        const double da = ta * ta * (a.stat == Stat::mvar ? static_cast<double>(a.m) : 1.0);
+        const double db = tb * tb * (b.stat == Stat::mvar ? static_cast<double>(b.m) : 1.0);
+        double lin = 0;
+        for (std::size_t t = 0; t < noises; ++t) lin += h[t] * g[10 + t];
+        v += 4 * ramp * da * db * lin;
+      }
+      // Sums over the unbroken grids; gaps removed terms (share = grid terms / terms formed).
+      const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, pr.n_phase);
+      const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, pr.n_phase);
+      const double na = static_cast<double>(a.n), nb = static_cast<double>(b.n);
+      const double share = std::sqrt(static_cast<double>(ga.n) / na * static_cast<double>(gb.n) / nb);
+      v *= share / (static_cast<double>(ga.n) * static_cast<double>(gb.n) * normalization(a.stat, a.m, pr.tau0) *
+                    normalization(b.stat, b.m, pr.tau0));
+      pr.sigma[i * pr.n + j] = v;
+      pr.sigma[j * pr.n + i] = v;
+    }
+  }
+}
+
+// Factors Sigma; where rounding or the band cut leaves it indefinite, shrinks the correlations
+// (by 10 % at a time) until it is not.
+bool factor(const Problem& pr) {
+  const std::size_t n = pr.n;
+  for (int attempt = 0; attempt < 30; ++attempt) {
+    // Cholesky works on a copy kept in the upper triangle's mirror: rebuild from the upper part.
+    double* a = pr.sigma;
+    if (cholesky(a, n)) return true;
+    const double shrink = 0.9;
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = 0; j < i; ++j) {
+        a[j * n + i] *= shrink;
+        a[i * n + j] = a[j * n + i];
+      }
+      // restore the diagonal from its mirror copy in the spare column
+      a[i * n + i] = pr.row(i)[6];
+    }
+  }
+  return false;
+}
+
+struct Solution {
+  std::array<double, terms> theta{};
+  std::array<std::array<double, terms>, terms> cov{};
+  std::array<bool, terms> active{};
+  double chi2 = 0;
+  bool ok = false;
+};
+
+// Non-negative least squares on the whitened system by trying every subset of the free terms.
+Solution solve(const Problem& pr, const std::array<bool, terms>& free, const std::array<double, terms>& fixed) {
+  Solution best;
+  const std::size_t n = pr.n;
+  // Whitened design (columns 0..4) and data (column 5): L^-1 [X y].
+  for (std::size_t c = 0; c < 6; ++c) {
+    for (std::size_t i = 0; i < n; ++i) {
+      double v = pr.row(i)[c];
+      if (c == 5) {
+        for (std::size_t t = 0; t < terms; ++t)
+          if (!free[t]) v -= fixed[t] * pr.row(i)[t];  // held terms are a known offset
+      }
+      pr.row(i)[c == 5 ? 7 : c] = v;  // y offset kept in slot 7 during whitening
+    }
+  }
+  // Column scales: the basis spans many decades.
+  std::array<double, terms> scale{};
+  double whitened[128][6];
+  for (std::size_t c = 0; c < 6; ++c) {
+    double col[128];
+    for (std::size_t i = 0; i < n; ++i) col[i] = pr.row(i)[c == 5 ? 7 : c];
+    forward(pr.sigma, n, col, 1);
+    for (std::size_t i = 0; i < n; ++i) whitened[i][c] = col[i];
+  }
+  for (std::size_t t = 0; t < terms; ++t) {
+    double s = 0;
+    for (std::size_t i = 0; i < n; ++i) s += whitened[i][t] * whitened[i][t];
+    scale[t] = s > 0 ? 1 / std::sqrt(s) : 1;
+  }
+  for (unsigned mask = 1; mask < (1u << terms); ++mask) {
+    std::size_t idx[terms];
+    std::size_t k = 0;
+    bool allowed = true;
+    for (std::size_t t = 0; t < terms; ++t) {
+      if (!(mask & (1u << t))) continue;
+      if (!free[t]) allowed = false;
+      idx[k++] = t;
+    }
+    if (!allowed || k > n) continue;
+    std::array<std::array<double, terms>, terms> ata{};
+    std::array<double, terms> atb{};
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t a = 0; a < k; ++a) {
+        const double xa = whitened[i][idx[a]] * scale[idx[a]];
+        atb[a] += xa * whitened[i][5];
+        for (std::size_t b = 0; b < k; ++b) ata[a][b] += xa * whitened[i][idx[b]] * scale[idx[b]];
+      }
+    }
+    std::array<double, terms> x{};
+    std::array<std::array<double, terms>, terms> inv{};
+    if (!solve_small(ata, atb, k, x, inv)) continue;
+    bool feasible = true;
+    for (std::size_t a = 0; a < k; ++a) feasible &= x[a] >= 0;
+    if (!feasible) continue;
+    double chi2 = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      double r = whitened[i][5];
+      for (std::size_t a = 0; a < k; ++a) r -= whitened[i][idx[a]] * scale[idx[a]] * x[a];
+      chi2 += r * r;
+    }
+    if (best.ok && chi2 >= best.chi2) continue;
+    best = Solution{};
+    best.ok = true;
+    best.chi2 = chi2;
+    for (std::size_t t = 0; t < terms; ++t) best.theta[t] = free[t] ? 0.0 : fixed[t];
+    for (std::size_t a = 0; a < k; ++a) {
+      best.theta[idx[a]] = x[a] * scale[idx[a]];
+      best.active[idx[a]] = true;
+      for (std::size_t b = 0; b < k; ++b) best.cov[idx[a]][idx[b]] = inv[a][b] * scale[idx[a]] * scale[idx[b]];
+    }
+  }
+  // With no free term (or none feasible) the held terms alone are the model.
+  if (!best.ok) {
+    double chi2 = 0;
+    for (std::size_t i = 0; i < n; ++i) chi2 += whitened[i][5] * whitened[i][5];
+    best.chi2 = chi2;
+    for (std::size_t t = 0; t < terms; ++t) best.theta[t] = free[t] ? 0.0 : fixed[t];
+    best.ok = true;
+  }
+  return best;
+}
+
+// Upper tail of chi-squared with dof degrees of freedom below 1e-4 (Wilson-Hilferty).
+bool rejected(double chi2, std::size_t dof) {
+  if (dof == 0) return false;
+  const double k = static_cast<double>(dof);
+  const double z = (std::cbrt(chi2 / k) - (1 - 2 / (9 * k))) / std::sqrt(2 / (9 * k));
+  return chi2 / k > 2 && z > 3.719;
+}
+
 }  // namespace
 
-double ieee952_variance(const std::array<double, 5>& p, double tau_s, Ieee952Curve curve, double tau0_s) {
-  const auto f = basis(tau_s, curve, tau0_s);
+double ieee952_variance(const std::array<double, 5>& p, Stat stat, std::uint64_t m, double tau0_s) {
+  const auto x = design(stat, m, tau0_s);
   double v = 0;
-  for (std::size_t k = 0; k < 5; ++k) v += p[k] * p[k] * f[k];
+  for (std::size_t t = 0; t < terms; ++t) v += p[t] * p[t] * x[t];
   return v;
 }
 
-Ieee952Fit fit_ieee952(std::span<const VariancePoint> points, Ieee952Curve curve, double tau0_s) {
+Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
+                       std::span<double> workspace) {
   Ieee952Fit out;
-  std::array<bool, 5> active{true, true, true, true, true};
-  std::array<double, 5> coef{};
-  std::array<std::array<double, 5>, 5> cov{};
-  for (int round = 0; round < 5; ++round) {  // active set: drop a negative coefficient, refit
-    std::size_t idx[5];
-    std::size_t n = 0;
-    for (std::size_t k = 0; k < 5; ++k)
-      if (active[k]) idx[n++] = k;
-    if (n == 0) return out;
-    // Column scales: the basis spans many decades; normalize for conditioning.
-    std::array<double, 5> scale{};
-    for (const auto& pt : points) {
-      if (!(pt.edf > 0) || !(pt.variance > 0) || !(pt.tau_s > 0)) continue;
-      const auto f = basis(pt.tau_s, curve, tau0_s);
-      for (std::size_t j = 0; j < n; ++j) scale[j] += f[idx[j]] * f[idx[j]] / (pt.variance * pt.variance);
+  out.curve = curve;
+  Problem pr;
+  pr.tau0 = setup.tau0_s;
+  pr.n_phase = setup.n_phase;
+  for (const FitPoint& p : points) {
+    const bool wanted = curve == FitCurve::both || (curve == FitCurve::avar) == (p.stat == Stat::avar);
+    if (!wanted || (p.stat != Stat::avar && p.stat != Stat::mvar) || p.n == 0 || !(p.variance > 0) || pr.n >= 128)
+      continue;
+    if (unbroken_grid(p.stat, p.m, p.stride, setup.n_phase).n == 0) continue;
+    pr.point[pr.n++] = &p;
+  }
+  if (workspace.size() < ieee952_workspace_doubles(pr.n) || !(setup.tau0_s > 0)) return out;
+
+  // Quantization: with the white level known (counts), a quantization-dominated point far below it
+  // means a periodic pattern.
+  const double qw2 = setup.white_quantization * setup.white_quantization;
+  std::array<bool, terms> free{true, true, true, true, true};
+  std::array<double, terms> fixed{};
+  if (qw2 > 0) {
+    for (std::size_t i = 0; i < pr.n; ++i) {
+      const FitPoint& p = *pr.point[i];
+      const double white = qw2 * design(p.stat, p.m, setup.tau0_s)[0];
+      if (white < 0.5 * p.variance) continue;
+      const double edf = exact_edf(2, unbroken_grid(p.stat, p.m, p.stride, setup.n_phase)) *
+                         static_cast<double>(p.n) /
+                         static_cast<double>(unbroken_grid(p.stat, p.m, p.stride, setup.n_phase).n);
+      const double sd = white * std::sqrt(2 / edf);
+      if (p.variance < white - 3 * sd && p.variance < 0.98 * white) out.quantization_white = false;
     }
-    for (std::size_t j = 0; j < n; ++j) scale[j] = scale[j] > 0 ? 1.0 / std::sqrt(scale[j]) : 1.0;
-    std::array<double, 5> x{};
-    bool solved = false;
-    std::size_t used = 0;
-    double chi2 = 0;
-    for (int iteration = 0; iteration < 8; ++iteration) {  // reweight with the model variances
-      std::array<std::array<double, 5>, 5> a{};
-      std::array<double, 5> b{};
-      used = 0;
-      for (const auto& pt : points) {
-        if (!(pt.edf > 0) || !(pt.variance > 0) || !(pt.tau_s > 0)) continue;
-        const auto f = basis(pt.tau_s, curve, tau0_s);
-        double model = 0;
-        for (std::size_t j = 0; j < n; ++j) model += x[j] * scale[j] * f[idx[j]];
-        const double sigma2 = solved && model > 0 ? model : pt.variance;
-        const double w = pt.edf / (2.0 * sigma2 * sigma2);
-        for (std::size_t i = 0; i < n; ++i) {
-          const double fi = f[idx[i]] * scale[i];
-          b[i] += w * fi * pt.variance;
-          for (std::size_t j = 0; j < n; ++j) a[i][j] += w * fi * f[idx[j]] * scale[j];
+    if (!out.quantization_white) {
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < pr.n; ++i) {
+        const FitPoint& p = *pr.point[i];
+        const double white = qw2 * design(p.stat, p.m, setup.tau0_s)[0];
+        if (white >= quantization_left_out * p.variance) {
+          const double tau = static_cast<double>(p.m) * setup.tau0_s;
+          if (tau * 2 > out.excluded_below_tau_s) out.excluded_below_tau_s = tau * 2;
+          continue;
         }
-        ++used;
+        pr.point[kept++] = pr.point[i];
       }
-      if (used < n) return out;
-      std::array<std::array<double, 5>, 5> inv{};
-      if (!solve(a, b, n, x, inv)) return out;
-      solved = true;
-      chi2 = 0;
-      for (const auto& pt : points) {
-        if (!(pt.edf > 0) || !(pt.variance > 0) || !(pt.tau_s > 0)) continue;
-        const auto f = basis(pt.tau_s, curve, tau0_s);
-        double model = 0;
-        for (std::size_t j = 0; j < n; ++j) model += x[j] * scale[j] * f[idx[j]];
-        const double r = pt.variance - model;
-        if (model > 0) chi2 += r * r * pt.edf / (2.0 * model * model);
-      }
-      for (std::size_t i = 0; i < n; ++i)
-        for (std::size_t j = 0; j < n; ++j) cov[idx[i]][idx[j]] = inv[i][j] * scale[i] * scale[j];
-      for (std::size_t j = 0; j < n; ++j) coef[idx[j]] = x[j] * scale[j];
+      pr.n = kept;
+      free[0] = false;
+      fixed[0] = qw2;
     }
-    // Drop the most negative coefficient (relative to its uncertainty) and refit.
-    std::size_t worst = 5;  // none
-    double worst_z = 0;
-    for (std::size_t j = 0; j < n; ++j) {
-      const std::size_t k = idx[j];
-      const double sd = std::sqrt(std::fabs(cov[k][k]));
-      const double z = sd > 0 ? coef[k] / sd : coef[k];
-      if (coef[k] < 0 && (worst == 5 || z < worst_z)) {
-        worst = k;
-        worst_z = z;
+  }
+  out.points = pr.n;
+  std::size_t n_free = 0;
+  for (bool f : free) n_free += f;
+  if (pr.n <= n_free || pr.n == 0) {
+    out.status = FitStatus::too_few_points;
+    return out;
+  }
+  pr.pair = workspace.data();
+  pr.sigma = pr.pair + pr.n * (pr.n + 1) / 2 * 14;
+  pr.rows = pr.sigma + pr.n * pr.n;
+
+  // The pair sums of every two points within the band: they depend on the geometry only.
+  NoiseSet set;
+  for (std::size_t t = 0; t < noises; ++t) set.alpha[t] = alphas[t];
+  set.count = noises;
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    const FitPoint& a = *pr.point[i];
+    const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
+    const auto x = design(a.stat, a.m, setup.tau0_s);
+    for (std::size_t t = 0; t < terms; ++t) pr.row(i)[t] = x[t];
+    pr.row(i)[5] = a.variance;
+    for (std::size_t j = 0; j <= i; ++j) {
+      const FitPoint& b = *pr.point[j];
+      double* g = pr.pair_at(i, j);
+      for (std::size_t k = 0; k < 14; ++k) g[k] = 0;
+      const int apart = octave(a.m) - octave(b.m);
+      if (apart > band_octaves || apart < -band_octaves) continue;
+      const PairSums s = pair_sums(set, ga, unbroken_grid(b.stat, b.m, b.stride, setup.n_phase));
+      for (std::size_t t = 0; t < noises; ++t) {
+        for (std::size_t u = 0; u <= t; ++u) g[cc_index(t, u)] = s.cc[t][u];
+        g[10 + t] = s.c[t];
       }
     }
-    out.points = used;
-    out.chi2_per_dof = used > n ? chi2 / static_cast<double>(used - n) : 0.0;
-    if (worst == 5) break;
-    active[worst] = false;
-    coef[worst] = 0;
   }
-  for (std::size_t k = 0; k < 5; ++k) {
-    Ieee952Parameter& p = out.p[k];
-    if (!active[k] || !(coef[k] > 0)) continue;
-    p.value = std::sqrt(coef[k]);
-    p.uncertainty = std::sqrt(std::fabs(cov[k][k])) / (2.0 * p.value);
-    // Resolved: the coefficient stands above its own uncertainty.
-    p.resolved = coef[k] > std::sqrt(std::fabs(cov[k][k]));
+
+  // First weights: each point's own EDF, no correlation.
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    const FitPoint& p = *pr.point[i];
+    const double edf = p.edf > 0 ? p.edf : static_cast<double>(p.n);
+    for (std::size_t j = 0; j < pr.n; ++j) pr.sigma[i * pr.n + j] = 0;
+    pr.sigma[i * pr.n + i] = 2 * p.variance * p.variance / edf;
   }
-  out.ok = true;
+  if (!cholesky(pr.sigma, pr.n)) {
+    out.status = FitStatus::singular;
+    return out;
+  }
+  Solution sol = solve(pr, free, fixed);
+  // Then the exact covariance under the current parameters, until they settle.
+  for (int iteration = 0; iteration < 12; ++iteration) {
+    covariance_of_points(pr, sol.theta);
+    for (std::size_t i = 0; i < pr.n; ++i) pr.row(i)[6] = pr.sigma[i * pr.n + i];
+    if (!factor(pr)) {
+      out.status = FitStatus::singular;
+      return out;
+    }
+    const Solution next = solve(pr, free, fixed);
+    double change = 0;
+    for (std::size_t t = 0; t < terms; ++t) {
+      const double scale = std::fabs(next.theta[t]) + std::sqrt(std::fabs(next.cov[t][t])) + 1e-300;
+      change = std::fmax(change, std::fabs(next.theta[t] - sol.theta[t]) / scale);
+    }
+    sol = next;
+    if (change < 1e-6) break;
+  }
+
+  std::size_t fitted = 0;
+  for (bool a : sol.active) fitted += a;
+  out.chi2 = sol.chi2;
+  out.dof = pr.n > fitted ? pr.n - fitted : 0;
+  out.birge = out.chi2_per_dof() > 1 ? std::sqrt(out.chi2_per_dof()) : 1.0;
+  out.status = rejected(out.chi2, out.dof) ? FitStatus::rejected : FitStatus::ok;
+  for (std::size_t t = 0; t < terms; ++t) {
+    Ieee952Parameter& p = out.p[t];
+    p.fitted = sol.active[t];
+    const double theta = sol.theta[t];
+    p.value = theta > 0 ? std::sqrt(theta) : 0.0;
+    const double sd = std::sqrt(std::fabs(sol.cov[t][t])) * out.birge;
+    p.uncertainty = p.value > 0 ? sd / (2 * p.value) : std::sqrt(sd);
+    if (!p.fitted || !(theta > 2 * sd)) continue;
+    for (std::size_t i = 0; i < pr.n && !p.resolved; ++i) {  // the largest contribution somewhere
+      const double mine = theta * pr.row(i)[t];
+      bool largest = true;
+      for (std::size_t u = 0; u < terms; ++u)
+        if (u != t && sol.theta[u] * pr.row(i)[u] > mine) largest = false;
+      p.resolved = largest;
+    }
+  }
   return out;
 }
 

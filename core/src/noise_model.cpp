@@ -226,14 +226,17 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
                           static_cast<std::int64_t>(b.stride),
                           static_cast<std::int64_t>(a.n),
                           static_cast<std::int64_t>(b.n)};
-  // Lags with pairs, and the reach of c: (-u_max, -u_min) for polynomial noises, with a tail of
-  // 64 kernel widths for flicker noises (c^2 falls at least as lag^-4 there: < 1e-5 of the sum).
-  std::int64_t lo = pairs.first_a - pairs.last_b, hi = pairs.last_a - pairs.first_b;
+  // Lags with pairs, and the reach of c: (-u_max, -u_min) for polynomial noises. Flicker noises
+  // reach further, with c ~ lag^-p (p = the kernel's difference order minus the leading power of
+  // R): summed directly out to three kernel widths, beyond which the sum is the integral of that
+  // power law (its share there is below 1 %, the power law's own error a few percent of it). Far
+  // out, c is a difference of huge nearly equal values and could not be evaluated directly.
+  const std::int64_t extent_lo = pairs.first_a - pairs.last_b, extent_hi = pairs.last_a - pairs.first_b;
   const std::int64_t width = k.u_max() - k.u_min() + 1;
-  const std::int64_t tail = flicker ? 64 * width : 0;
-  const std::int64_t reach_lo = -k.u_max() - tail, reach_hi = -k.u_min() + tail;
-  if (lo < reach_lo) lo = ceil_div(reach_lo, step) * step;
-  if (hi > reach_hi) hi = floor_div(reach_hi, step) * step;
+  const std::int64_t reach = flicker ? 3 * width : 0;
+  std::int64_t lo = extent_lo, hi = extent_hi;
+  if (lo < -k.u_max() - reach) lo = ceil_div(-k.u_max() - reach, step) * step;
+  if (hi > -k.u_min() + reach) hi = floor_div(-k.u_min() + reach, step) * step;
   if (lo > hi) return out;
   // Breakpoints: where an R argument crosses 0, and where the pair count has a kink.
   std::array<std::int64_t, 72> breaks{};
@@ -255,20 +258,55 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
   for (const std::int64_t v : {pairs.first_a - pairs.first_b, pairs.last_a - pairs.last_b, pairs.first_a - pairs.last_b,
                                pairs.last_a - pairs.first_b})
     add_break(v);
-  const std::uint64_t m_min = a.m < b.m ? a.m : b.m;
-  std::int64_t max_step = static_cast<std::int64_t>(m_min / 256) / step * step;
+  // Away from the breakpoints c varies on the scale of the longer term: at least 256 nodes there.
+  const std::uint64_t m_max = a.m > b.m ? a.m : b.m;
+  std::int64_t max_step = static_cast<std::int64_t>(m_max / 256) / step * step;
   if (max_step < step) max_step = step;
+  auto accumulate = [&](double w, const std::array<double, max_noises>& c) {
+    for (std::size_t t = 0; t < noises; ++t) {
+      out.c[t] += w * c[t];
+      for (std::size_t u = 0; u <= t; ++u) out.cc[t][u] += w * c[t] * c[u];
+    }
+  };
   visit_nodes(lo, hi, step, max_step, -k.u_max(), -k.u_min(), breaks.data(), n_breaks,
               [&](std::int64_t lag, double weight) {
                 const double w = weight * static_cast<double>(pairs(lag));
                 if (w == 0) return;
                 std::array<double, max_noises> c{};
                 for (std::size_t t = 0; t < noises; ++t) c[t] = covariance(k, twice_d[t], lag);
-                for (std::size_t t = 0; t < noises; ++t) {
-                  out.c[t] += w * c[t];
-                  for (std::size_t u = 0; u <= t; ++u) out.cc[t][u] += w * c[t] * c[u];
-                }
+                accumulate(w, c);
               });
+  if (flicker) {  // the power-law tails beyond lo and hi, out to the lags that have pairs
+    const double center = -0.5 * static_cast<double>(k.u_min() + k.u_max());
+    const int order = difference_order(a.stat) + difference_order(b.stat) + (a.stat == Stat::mvar ? 0 : k.level) +
+                      (b.stat == Stat::mvar ? 0 : k.level) + (a.stat == Stat::mvar) + (b.stat == Stat::mvar);
+    for (const std::int64_t edge : {lo, hi}) {
+      const bool left = edge == lo;
+      if (left ? extent_lo >= lo : extent_hi <= hi) continue;
+      const double pairs_at = static_cast<double>(pairs(edge));
+      if (pairs_at == 0) continue;
+      const double L = std::fabs(static_cast<double>(edge) - center);
+      const double L_max = std::fabs(static_cast<double>(left ? extent_lo : extent_hi) - center);
+      std::array<double, max_noises> c{}, p{};
+      for (std::size_t t = 0; t < noises; ++t) {
+        c[t] = covariance(k, twice_d[t], edge);
+        p[t] = order - (twice_d[t] - 1);  // c ~ lag^-p; 0 where c vanishes beyond the reach anyway
+      }
+      // sum over the lattice beyond the edge = integral / step - f(edge) / 2 (Euler-Maclaurin),
+      // with f = pairs(edge) c_t c_u (L / x)^(p_t + p_u) and the pair count taken as constant.
+      for (std::size_t t = 0; t < noises; ++t) {
+        if (twice_d[t] % 2 == 0) continue;
+        const double lin = L / (p[t] - 1) * (1 - std::pow(L / L_max, p[t] - 1)) / static_cast<double>(step) - 0.5;
+        out.c[t] += pairs_at * c[t] * lin;
+        for (std::size_t u = 0; u <= t; ++u) {
+          if (twice_d[u] % 2 == 0) continue;
+          const double q = p[t] + p[u];
+          const double sq = L / (q - 1) * (1 - std::pow(L / L_max, q - 1)) / static_cast<double>(step) - 0.5;
+          out.cc[t][u] += pairs_at * c[t] * c[u] * sq;
+        }
+      }
+    }
+  }
   for (std::size_t t = 0; t < noises; ++t)
     for (std::size_t u = 0; u < t; ++u) out.cc[u][t] = out.cc[t][u];
   return out;

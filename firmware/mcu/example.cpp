@@ -23,7 +23,7 @@ int main() {
     characterizer.add_increment(static_cast<std::int32_t>(1000 + (lfsr & 7u)));
   }
   gyrochar::take_sums(characterizer, sums);
-  gyrochar::identify_noise(sums, 2, false, noise);
+  gyrochar::identify_noise(sums, characterizer.phase_points(), 2, false, noise);
   const auto e = gyrochar::estimate(sums[4], characterizer.phase_points(), gyrochar::DevStat::mdev, noise[4], {});
   return e.n > 0 && e.edf > 0 ? 0 : 2;
 }

@@ -139,8 +139,8 @@ class Engine final : public EngineBase {
       std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
       std::fill(noise3.begin(), noise3.end(), given_noise(*o.alpha));
     } else {
-      identify_noise(sums, 2, frequency_input, noise2);
-      identify_noise(sums, 3, frequency_input, noise3);
+      identify_noise(sums, a.n_phase, 2, frequency_input, noise2);
+      identify_noise(sums, a.n_phase, 3, frequency_input, noise3);
     }
     const EstimateOptions options{o.tau0_s, type_ == DataType::freq ? o.tau0_s : 1.0, o.edf};
     for (const DevStat stat : o.stats) {

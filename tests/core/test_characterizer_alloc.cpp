@@ -41,7 +41,7 @@ TEST(CharacterizerAllocation, AccumulationAndReadOutAllocateNothing) {
     c.add_increment(static_cast<std::int32_t>(1000 + (i * 7919) % 13));
     if (i % 100000 == 0) {
       take_sums(c, sums);
-      identify_noise(sums, 2, false, noise);
+      identify_noise(sums, c.phase_points(), 2, false, noise);
       for (std::size_t k = 0; k < sums.size(); ++k)
         edf_sum += estimate(sums[k], c.phase_points(), DevStat::mdev, noise[k], {}).edf;
     }

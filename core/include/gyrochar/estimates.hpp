@@ -6,12 +6,16 @@
 //   identify_noise()  the power-law noise at every tau of a curve, and how it was chosen
 //   estimate()        one statistic at one tau: deviation, number of terms, EDF
 //
-// Noise identification. Where the decimated series x[k m] has at least lag1_min_points points,
-// the lag-1 autocorrelation rule (noise_id.hpp) gives p = 2 - alpha with its standard error; the
-// alphas within one standard error of p are "plausible". Longer taus, whose series are too short
-// for the rule, take the identification of the longest tau that had enough points (a power-law
-// model changes slowly with tau). With no such tau at all (very short records), the B1 ratio and
-// R(n) = MVAR/AVAR decide, as Stable32 does.
+// Noise identification weighs, for every candidate alpha, the evidence at each tau:
+//   - the lag-1 autocorrelation rule (noise_id.hpp) where the decimated series x[k m] has at least
+//     lag1_min_points points: p = 2 - alpha with its standard error;
+//   - R(n) = MVAR/AVAR against its exact expectation for pure noise alpha, with the exact variance
+//     of the ratio of the two estimates (noise_model.hpp): it separates white from flicker PM and
+//     keeps its power at long taus, where the decimated series is short;
+//   - the identification of the next shorter tau (a power-law model changes slowly with tau).
+// Each counts as a squared z-score (with a floor of 10 % for model error); the alpha with the least
+// total wins, and every alpha within one unit of it is "plausible". With none of these available
+// (very short records), the B1 ratio and R(n) decide as Stable32 does.
 //
 // EDF. The EDF of the estimator actually used (its stride, its number of phase points, the terms
 // a gap removed), computed exactly for the discrete power-law noise (noise_model.hpp). Where more
@@ -80,8 +84,9 @@ void take_sums(const Characterizer<Arith>& c, std::span<TauSums> out) {
 enum class NoiseIdMethod : std::uint8_t {
   none,       // not identified: no EDF, no interval
   given,      // alpha fixed by the user
-  lag1,       // lag-1 autocorrelation of this tau's decimated series
-  neighbour,  // taken from the longest shorter tau that the lag-1 rule identified
+  lag1,       // lag-1 autocorrelation of this tau's decimated series (with R(n) and the neighbour)
+  rn,         // R(n) = MVAR/AVAR and the neighbouring tau (too few points for the lag-1 rule)
+  neighbour,  // taken from the next shorter tau (no evidence of its own at this tau)
   b1,         // B1 ratio (no tau had enough points for the lag-1 rule)
   b1_rn,      // B1 ratio, white and flicker PM told apart by R(n)
 };
@@ -98,11 +103,13 @@ struct NoiseId {
 /// Decimated points the lag-1 rule needs at a tau (Riley & Greenhall: about 30).
 inline constexpr std::uint64_t lag1_min_points = 30;
 
-/// Identifies the noise at every tau of one curve (taus in increasing m). dmax = 2 for the Allan
-/// and modified Allan statistics, 3 for Hadamard; frequency_input: the data were frequency (or
-/// counts), so the lag-1 rule starts at the first difference. out.size() >= taus.size().
-/// O(taus), no allocation.
-void identify_noise(std::span<const TauSums> taus, int dmax, bool frequency_input, std::span<NoiseId> out);
+/// Identifies the noise at every tau of one curve (taus in increasing m) of a run of n_phase phase
+/// points. dmax = 2 for the Allan and modified Allan statistics, 3 for Hadamard (R(n) needs AVAR,
+/// which diverges below alpha = -2: there it scores as random-walk FM); frequency_input: the data were
+/// frequency, so the lag-1 rule starts at the first difference. out.size() >= taus.size().
+/// O(taus x alphas x pair_sums()), no allocation.
+void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dmax, bool frequency_input,
+                    std::span<NoiseId> out);
 
 /// A fixed alpha, as the user gives it.
 constexpr NoiseId given_noise(int alpha) { return {alpha, alpha, alpha, NoiseIdMethod::given}; }
