@@ -3,7 +3,7 @@
 # confidence intervals hold the true deviation, by Monte Carlo over power-law noise of known type
 # (tests/benchmarks/coverage_study.cpp). Only the text between the coverage markers is replaced;
 # the rest of the file belongs to other studies. Every cell also goes to a CSV file.
-#   toolchain/metrology.sh                    1000 runs per cell (about 5 minutes on 2 idle cores)
+#   toolchain/metrology.sh                    1000 runs per cell (about 2.5 minutes on 2 cores)
 #   toolchain/metrology.sh --runs 100         a quick look (the tables say how many runs)
 #   toolchain/metrology.sh --csv coverage.csv where the CSV goes (default build/perf/data/coverage.csv)
 # Exit codes: 0 written, 2 bad options, 3 docs/metrology.md has no (or a broken) coverage block.
@@ -49,7 +49,7 @@ trap 'rm -f "$tables" "$block"' EXIT
 build/perf/tests/coverage_study --runs "$runs" --csv "$csv" > "$tables"
 
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-if [ -n "$(git status --porcelain -- core host_tools/lib tests/support 2>/dev/null)" ]; then
+if [ -n "$(git status --porcelain -- core host_tools/lib tests/support tests/benchmarks/coverage_study.cpp 2>/dev/null)" ]; then
   commit="$commit with uncommitted changes to the engine or the study"
 fi
 {

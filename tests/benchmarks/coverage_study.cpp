@@ -5,9 +5,11 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <string>
 #include <vector>
@@ -41,9 +43,8 @@ std::string percent(double coverage) {
   return flagged(coverage) ? "**" + text + "**" : text;
 }
 
-void write_csv(const std::string& path, const std::vector<CoverageCell>& cells) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) throw std::runtime_error(path + ": cannot write");
+// Writes every cell to `f` (opened before the study, so a bad path fails at once) and closes it.
+bool write_csv(std::FILE* f, const std::vector<CoverageCell>& cells) {
   std::fprintf(f,
                "length,stride_factor,stat,alpha,m,terms,stride,true_dev,runs,coverage_auto,coverage_true,"
                "coverage_se,identified_right,no_interval_auto,no_interval_true,identified_p2,identified_p1,"
@@ -57,7 +58,8 @@ void write_csv(const std::string& path, const std::vector<CoverageCell>& cells) 
     for (const std::size_t n : c.identified) std::fprintf(f, ",%zu", n);
     std::fprintf(f, ",%.6g,%.6g,%.6g,%.6f\n", c.mean_edf_auto, c.edf_true, c.mc_edf, c.mean_ratio);
   }
-  if (std::fclose(f) != 0) throw std::runtime_error(path + ": cannot write");
+  const bool ok = !std::ferror(f);
+  return std::fclose(f) == 0 && ok;
 }
 
 void print_markdown(const StudySettings& s, const std::vector<CoverageCell>& cells, double wall_s) {
@@ -138,11 +140,12 @@ by the engine and with the true alpha. At every octave m with a term, a cell cou
 not depend on the number of workers.
 
 Examples:
-  coverage_study                                   full study (1000 runs, about 10 minutes on 2 cores)
+  coverage_study                                   full study (1000 runs, about 2 minutes on 2 cores)
   coverage_study --runs 200 --lengths 4096 --csv coverage.csv
   coverage_study --alphas 0,2 --stride-factors 8 --stats mdev
 
-Exit codes: 0 success, 2 bad options, 3 cannot write the CSV, 4 the engine refused a request.)");
+Exit codes: 0 success, 1 the study failed otherwise, 2 bad options, 3 cannot write the CSV,
+4 the engine refused a request.)");
   StudySettings s;
   s.lengths = {4096, 65536};
   s.stride_factors = {0, 8};
@@ -194,6 +197,11 @@ Exit codes: 0 success, 2 bad options, 3 cannot write the CSV, 4 the engine refus
     else return bad("--stats", "'" + t + "' is not oadev or mdev");
   }
 
+  std::FILE* csv_file = nullptr;
+  if (!csv.empty() && !(csv_file = std::fopen(csv.c_str(), "w"))) {
+    std::fprintf(stderr, "coverage_study: %s: cannot write: %s\n", csv.c_str(), std::strerror(errno));
+    return 3;
+  }
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   s.progress = [&](std::size_t done, std::size_t total) {
@@ -208,16 +216,15 @@ Exit codes: 0 success, 2 bad options, 3 cannot write the CSV, 4 the engine refus
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "coverage_study: engine: %s\n", e.what());
     return 4;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "coverage_study: study: %s\n", e.what());
+    return 1;
   }
   const double wall_s = elapsed();
   std::fprintf(stderr, "coverage_study: %zu cells in %.1f s wall time (%u workers)\n", cells.size(), wall_s, s.workers);
-  if (!csv.empty()) {
-    try {
-      write_csv(csv, cells);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "coverage_study: %s\n", e.what());
-      return 3;
-    }
+  if (csv_file && !write_csv(csv_file, cells)) {
+    std::fprintf(stderr, "coverage_study: %s: cannot write: %s\n", csv.c_str(), std::strerror(errno));
+    return 3;
   }
   print_markdown(s, cells, wall_s);
   return 0;

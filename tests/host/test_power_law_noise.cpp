@@ -169,7 +169,7 @@ double mvar_of(const std::vector<double>& x, std::size_t m) {
 
 TEST(PowerLawNoise, MeanEstimatesMatchTheExactExpectation) {
   // R = 1000 realizations of n = 1024 points per type; at every octave m with an MVAR term the
-  // mean of the R estimates must lie within 4 standard errors (sample s.d. / sqrt R, 0.2 % .. 7 %
+  // mean of the R estimates must lie within 4 standard errors (sample s.d. / sqrt R, 0.14 % .. 4.1 %
   // of the value) of expected_variance(). 90 comparisons of independent seeds: a correct
   // generator fails one with probability about 0.6 %; the seeds are fixed, so the test is stable.
   const std::size_t n = 1024, R = 1000;

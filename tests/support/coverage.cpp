@@ -146,59 +146,18 @@ std::vector<CoverageCell> run_coverage_study(const StudySettings& s) {
     for (std::size_t run = 0; run < s.runs; ++run)
       for (const int alpha : s.alphas) tasks.push_back({length, alpha, run});
 
-  std::vector<TaskResult> results(tasks.size());
-  std::atomic<std::size_t> next{0}, done{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto worker = [&] {
-    for (;;) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= tasks.size()) return;
-      try {
-        results[i] = analyze(s, tasks[i]);
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(failure_mutex);
-        if (!failure) failure = std::current_exception();
-        next.store(tasks.size());
-      }
-      done.fetch_add(1);
-    }
-  };
-  std::vector<std::thread> threads;
-  for (unsigned w = 0; w < std::max(1u, s.workers); ++w) threads.emplace_back(worker);
-  if (s.progress) {
-    auto last = std::chrono::steady_clock::now();
-    while (done.load() < tasks.size()) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      {
-        const std::lock_guard<std::mutex> lock(failure_mutex);
-        if (failure) break;
-      }
-      if (std::chrono::steady_clock::now() - last >= std::chrono::seconds(1)) {
-        last = std::chrono::steady_clock::now();
-        s.progress(done.load(), tasks.size());
-      }
-    }
-  }
-  for (auto& t : threads) t.join();
-  if (failure) std::rethrow_exception(failure);
-  if (s.progress) s.progress(done.load(), tasks.size());
-
-  // Reduce in task order (deterministic), keyed by cell.
-  using Key = std::tuple<std::size_t, std::size_t, std::size_t, std::size_t, std::uint64_t>;  // length, stride, stat, alpha (list indices), m
+  // Cells keyed by list positions, so they come out in the order the settings list them.
+  using Key = std::tuple<std::size_t, std::size_t, std::size_t, std::size_t, std::uint64_t>;  // length, stride, stat, alpha, m
   std::map<Key, Accumulator> cells;
   auto index_of = [](const auto& list, const auto& value) {
     return static_cast<std::size_t>(std::find(list.begin(), list.end(), value) - list.begin());
   };
-  for (std::size_t i = 0; i < tasks.size(); ++i) {
-    const Task& t = tasks[i];
-    const TaskResult& r = results[i];
+  auto reduce = [&](const Task& t, const TaskResult& r) {
     for (std::size_t si = 0; si < s.stride_factors.size(); ++si) {
       const auto& auto_rows = r.identified[si];
       const auto& true_rows = r.given[si];
-      for (std::size_t k = 0; k < auto_rows.size(); ++k) {
-        const EngineEstimate& a = auto_rows[k];
-        const Key key{index_of(lengths, t.length), si, index_of(s.stats, a.stat), index_of(s.alphas, t.alpha), a.m};
+      for (const EngineEstimate& a : auto_rows) {
+        const Key key{index_of(s.lengths, t.length), si, index_of(s.stats, a.stat), index_of(s.alphas, t.alpha), a.m};
         Accumulator& acc = cells[key];
         CoverageCell& c = acc.cell;
         if (c.runs == 0) {
@@ -224,7 +183,7 @@ std::vector<CoverageCell> run_coverage_study(const StudySettings& s) {
         const double delta = ratio - acc.ratio_mean;
         acc.ratio_mean += delta / static_cast<double>(c.runs);
         acc.ratio_m2 += delta * (ratio - acc.ratio_mean);
-        // The same estimate with the true alpha: the rows come out in the same order.
+        // The same estimate with the true alpha.
         const auto it = std::find_if(true_rows.begin(), true_rows.end(),
                                      [&](const EngineEstimate& e) { return e.stat == a.stat && e.m == a.m; });
         if (it != true_rows.end()) {
@@ -236,7 +195,53 @@ std::vector<CoverageCell> run_coverage_study(const StudySettings& s) {
         }
       }
     }
+  };
+
+  // Workers take tasks in turn; this thread reduces the finished ones strictly in task order (so
+  // the sums do not depend on scheduling) and frees them, so only the tasks between the oldest
+  // unfinished one and the newest started one are held.
+  std::vector<TaskResult> results(tasks.size());
+  std::vector<std::atomic<bool>> ready(tasks.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= tasks.size() || failed.load()) return;
+      try {
+        results[i] = analyze(s, tasks[i]);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+        failed.store(true);
+        return;
+      }
+      ready[i].store(true, std::memory_order_release);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (unsigned w = 0; w < std::max(1u, s.workers); ++w) threads.emplace_back(worker);
+  auto last = std::chrono::steady_clock::now();
+  std::size_t reduced = 0;
+  while (reduced < tasks.size() && !failed.load()) {
+    if (!ready[reduced].load(std::memory_order_acquire)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    } else {
+      reduce(tasks[reduced], results[reduced]);
+      results[reduced] = TaskResult{};
+      ++reduced;
+    }
+    if (s.progress && std::chrono::steady_clock::now() - last >= std::chrono::seconds(1)) {
+      last = std::chrono::steady_clock::now();
+      s.progress(reduced, tasks.size());
+    }
   }
+  for (auto& t : threads) t.join();
+  if (failure) std::rethrow_exception(failure);
+  if (s.progress) s.progress(reduced, tasks.size());
+
   std::vector<CoverageCell> out;
   for (auto& [key, acc] : cells) {
     CoverageCell c = acc.cell;

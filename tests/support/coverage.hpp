@@ -92,9 +92,12 @@ struct CoverageCell {
 
 /// Runs the study: for each length, alpha and run one realization of power_law_phase(), analyzed
 /// by run_engine() once per stride factor with alpha identified and once with the true alpha.
-/// Work is spread over `workers` threads; the cells are reduced in run order, so the result is
-/// the same for any number of workers. Cells come out by length, stride factor, statistic (as
-/// listed), alpha (as listed), m. Memory O(runs x cells); rethrows the first worker exception.
+/// Work is spread over `workers` threads; the calling thread reduces the finished realizations
+/// in task order, so the result is the same for any number of workers. Cells come out by length,
+/// stride factor, statistic, alpha (each as listed in the settings), then m. Time: runs x
+/// lengths x alphas realizations, each O(N log N) to make and O(N x taus) per engine pass (2 per
+/// stride factor). Memory: the cells plus the estimates of the realizations finished ahead of the
+/// oldest unfinished one. Rethrows the first exception of a worker (the engine's or the generator's).
 std::vector<CoverageCell> run_coverage_study(const StudySettings& settings);
 
 /// The binomial standard error of a coverage p over `runs` runs: sqrt(p (1 - p) / runs).
