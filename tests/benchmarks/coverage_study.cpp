@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <map>
 #include <string>
 #include <vector>
@@ -62,12 +63,13 @@ bool write_csv(std::FILE* f, const std::vector<CoverageCell>& cells) {
   return std::fclose(f) == 0 && ok;
 }
 
-void print_markdown(const StudySettings& s, const std::vector<CoverageCell>& cells, double wall_s) {
+void print_markdown(const StudySettings& s, const std::vector<CoverageCell>& cells, double wall_s, double cpu_s) {
   const double se = coverage_standard_error(nominal, s.runs);
   std::printf("%zu runs per cell (independent realizations; the same realization serves every stride factor,\n"
               "statistic and m of its noise type and length). Binomial standard error of a coverage of 68.3 %%\n"
-              "over %zu runs: %.1f points. Wall time %.0f s with %u workers.\n\n",
-              s.runs, s.runs, 100.0 * se, wall_s, s.workers);
+              "over %zu runs: %.1f points. Wall time %.0f s with %u workers, %.0f s of CPU time (the machine\n"
+              "may be shared with other jobs, so the wall time is indicative).\n\n",
+              s.runs, s.runs, 100.0 * se, wall_s, s.workers, cpu_s);
   std::printf("Each cell: coverage (%%) of the 68.3 %% interval with alpha identified by the engine / coverage\n"
               "with the true alpha given to the engine / runs in which the engine identified alpha right (%%).\n"
               "**Bold**: coverage outside 68.3 +- %.0f points. Same estimate both ways: only the EDF, and so the\n"
@@ -221,11 +223,13 @@ Exit codes: 0 success, 1 the study failed otherwise, 2 bad options, 3 cannot wri
     return 1;
   }
   const double wall_s = elapsed();
-  std::fprintf(stderr, "coverage_study: %zu cells in %.1f s wall time (%u workers)\n", cells.size(), wall_s, s.workers);
+  const double cpu_s = static_cast<double>(std::clock()) / CLOCKS_PER_SEC;  // all threads of the process
+  std::fprintf(stderr, "coverage_study: %zu cells in %.1f s wall time (%u workers), %.1f s CPU time\n", cells.size(), wall_s,
+               s.workers, cpu_s);
   if (csv_file && !write_csv(csv_file, cells)) {
     std::fprintf(stderr, "coverage_study: %s: cannot write: %s\n", csv.c_str(), std::strerror(errno));
     return 3;
   }
-  print_markdown(s, cells, wall_s);
+  print_markdown(s, cells, wall_s, cpu_s);
   return 0;
 }
