@@ -13,10 +13,11 @@ case "$job" in
 esac
 
 # Debian packages: the host build, then what only the tests need (cross compilers for the
-# microcontroller build of the core).
+# microcontroller build of the core). The host preset configures the tests too, so their own
+# libraries are here (libfftw3-dev: the power-law noise of tests/support).
 packages=(
   g++ cmake ninja-build pkg-config
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libfftw3-dev
   libboost-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libplplot-dev plplot-driver-cairo
   libgpiod-dev
 )

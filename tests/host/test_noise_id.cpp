@@ -2,14 +2,16 @@
 // and the gap rule: no difference spans a segment break.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "analysis.hpp"
 #include "gyrochar/noise_id.hpp"
-
-#include <cmath>
-#include "noise_gen.hpp"
+#include "support/power_law_noise.hpp"
 
 namespace gyrochar {
 namespace {
+
+using test_support::power_law_phase;
 
 TEST(NoiseId, IdentifiesEachPowerLawNoise) {
   for (int alpha : {2, 1, 0, -1, -2}) {
@@ -27,11 +29,15 @@ TEST(NoiseId, IdentifiesEachPowerLawNoise) {
         if (row.alpha && *row.alpha == alpha) ++right;
       }
     }
-    // The lag-1 estimator is statistical. Measured when written: 12/12 for white PM, white FM and
-    // random walk FM, 11/12 for flicker FM, 8/12 for flicker PM (taken for white PM at m = 16 and
-    // 64, where the decimated flicker phase has 94..375 points: the known weak spot of the lag-1
-    // method, which is why R(n) = MVAR/AVAR exists).
-    EXPECT_GE(right, alpha == 1 ? 8 : 11) << "alpha " << alpha << ": " << right << " of " << total;
+    // The lag-1 estimator is statistical. Measured with this generator (stationary increments,
+    // 200 seeds of 6000 points per type), identified right at m = 1, 4, 16, 64: white PM 100, 100,
+    // 98, 82 %; flicker PM 100, 92, 54, 45 % (taken for white PM where the decimated flicker
+    // phase has 94..375 points: the known weak spot of the lag-1 method, which is why
+    // R(n) = MVAR/AVAR exists); white FM 100, 100, 100, 96 %; flicker FM 100, 95, 70, 56 % (taken
+    // for random walk FM); random walk FM 100 % throughout. These three seeds: 11, 8, 12, 9, 12
+    // of 12. (The earlier generator started the flicker filter from an empty past, without
+    // burn-in, and gave 11 of 12 for flicker FM.)
+    EXPECT_GE(right, alpha == 1 || alpha == -1 ? 8 : 11) << "alpha " << alpha << ": " << right << " of " << total;
   }
 }
 
