@@ -65,6 +65,7 @@ Board::Board(const Config& config, BoardIo io)
   settings_.config_hash = hash_settings(settings_);
   if (!configure(characterizer_, settings_)) throw std::invalid_argument("estimator settings out of range");
   checkpoint_buffer_.resize(characterizer_.checkpoint_size());
+  fit_workspace_.resize(fit_workspace_doubles);
   checkpoint_period_ns_ = static_cast<std::uint64_t>(config.checkpoint_period_s * 1e9);
   start_ns_ = io.clock.now_ns();
   next_checkpoint_ns_ = start_ns_ + checkpoint_period_ns_;
@@ -152,7 +153,8 @@ void Board::on_tick() {
   if (frame_ == 0) {
     faults_.tx_dropped_frames = static_cast<std::uint32_t>(io_.can.counters().tx_dropped);
     faults_.bus_off_events = static_cast<std::uint32_t>(io_.can.counters().bus_off_events);
-    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, content_);
+    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, fit_workspace_,
+                 content_);
     frames_ = protocol::report_frame_count(seq_, config_.octaves);
     if (config_.verbose)
       BOARD_LOG("7", "report %u: %llu samples", static_cast<unsigned>(seq_),

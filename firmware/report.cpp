@@ -16,7 +16,7 @@ bool configure(BoardCharacterizer& c, const ReportSettings& s) {
 }
 
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
-                  std::uint64_t uptime_ms, const FaultCounters& f, ReportContent& out) {
+                  std::uint64_t uptime_ms, const FaultCounters& f, std::span<double> fit_workspace, ReportContent& out) {
   using namespace protocol;
   const std::size_t taus = c.tau_count();
   const std::uint64_t samples = c.increments();
@@ -27,7 +27,7 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   take_sums(c, std::span(sums.data(), taus));
   identify_noise(std::span(sums.data(), taus), c.phase_points(), 2, false, std::span(noise.data(), taus));
   const EstimateOptions options{s.tau0_s, s.pulse_weight_arcsec, EdfModel::exact};
-  std::array<VariancePoint, max_octaves> points{};
+  std::array<FitPoint, 2 * max_octaves> points{};
   std::size_t n_points = 0;
   for (std::size_t i = 0; i < taus; ++i) {
     const Estimate a = estimate(sums[i], c.phase_points(), DevStat::oadev, noise[i], options);
@@ -38,16 +38,20 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
     out.mdev[i] = {seq, idx, DevKind::mdev, static_cast<float>(m.deviation), m.edf, type, m.clean && m.n > 0};
     out.terms[i] = {seq, idx, a.n};
     out.info[i] = {seq, idx, a.m, static_cast<std::uint8_t>(std::countr_zero(sums[i].stride))};
-    if (a.n > 0 && a.edf > 0) points[n_points++] = {a.tau_s, a.variance, a.edf};
+    for (const Estimate* e : {&a, &m})
+      if (e->n > 0 && e->clean) points[n_points++] = {stat_of(e->stat), e->m, e->stride, e->n, e->variance, e->edf};
   }
   out.sampling = {seq, static_cast<float>(s.tau0_s), static_cast<std::uint16_t>(s.stride_factor)};
   out.clock = {seq, uptime_ms, version};
   out.scale = {seq, static_cast<float>(s.pulse_weight_arcsec), AngleUnit::arcsec, s.source};
   out.config = {seq, s.config_hash, s.report_period_ms};
-  const Ieee952Fit fit = fit_ieee952(std::span(points.data(), n_points), Ieee952Curve::avar, s.tau0_s);
+  // The recommended fit of both curves, in arcsec and seconds; quantization's white level is the
+  // pulse weight over sqrt(12).
+  const FitSetup setup{s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)};
+  const Ieee952Fit fit = fit_ieee952(std::span(points.data(), n_points), setup, FitCurve::both, fit_workspace);
   for (std::size_t k = 0; k < 5; ++k) {
     const Ieee952Parameter& p = fit.p[k];
-    const bool resolved = fit.ok && p.resolved && p.value > 0;
+    const bool resolved = fit.ok() && p.resolved && p.value > 0;
     out.ieee952[k] = {seq, static_cast<Ieee952Term>(k), resolved, resolved ? static_cast<float>(p.value) : 0.0f,
                       resolved ? p.uncertainty / p.value : 0.0};
   }

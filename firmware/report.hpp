@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "gyrochar/characterizer.hpp"
+#include "gyrochar/ieee952.hpp"
 #include "gyrochar/protocol.hpp"
 
 namespace gyrochar::firmware {
@@ -51,10 +52,15 @@ struct ReportContent {
   std::array<protocol::Ieee952Msg, 5> ieee952{};
 };
 
-/// Fills `out` for report `seq` from the characterizer's current state. No allocation; the EDFs
-/// and the fit dominate the cost (noise_model.hpp, ieee952.hpp).
+/// Doubles of workspace build_report() needs for the IEEE-952 fit (both curves of every tau).
+inline constexpr std::size_t fit_workspace_doubles = ieee952_workspace_doubles(2 * max_octaves);
+
+/// Fills `out` for report `seq` from the characterizer's current state. No allocation (the fit
+/// works in `fit_workspace`, at least fit_workspace_doubles); the EDFs and the fit dominate the
+/// cost (noise_model.hpp, ieee952.hpp).
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
-                  std::uint64_t uptime_ms, const FaultCounters& faults, ReportContent& out);
+                  std::uint64_t uptime_ms, const FaultCounters& faults, std::span<double> fit_workspace,
+                  ReportContent& out);
 
 /// The message at position k of report `content.status.seq` (protocol::report_slot order).
 protocol::Message report_message(const ReportContent& content, std::size_t k);

@@ -119,6 +119,7 @@ struct Problem {
   const FitPoint* point[128];
   double tau0 = 1;
   std::uint64_t n_phase = 0;
+  double spread = 0;
   double* pair = nullptr;   // per pair (i <= j): 10 sums c_t c_u, then 4 sums c_t
   double* sigma = nullptr;  // n x n
   double* rows = nullptr;   // per point: x[5], y, spare
@@ -172,6 +173,7 @@ void covariance_of_points(const Problem& pr, const std::array<double, terms>& th
       const double share = std::sqrt(static_cast<double>(ga.n) / na * static_cast<double>(gb.n) / nb);
       v *= share / (static_cast<double>(ga.n) * static_cast<double>(gb.n) * normalization(a.stat, a.m, pr.tau0) *
                     normalization(b.stat, b.m, pr.tau0));
+      if (i == j) v += pr.spread * pr.spread * a.variance * a.variance;
       pr.sigma[i * pr.n + j] = v;
       pr.sigma[j * pr.n + i] = v;
     }
@@ -203,6 +205,7 @@ struct Solution {
   std::array<double, terms> theta{};
   std::array<std::array<double, terms>, terms> cov{};
   std::array<bool, terms> active{};
+  std::array<double, terms> free_variance{};  // of each free term in the model with every free term
   double chi2 = 0;
   bool ok = false;
 };
@@ -236,6 +239,9 @@ Solution solve(const Problem& pr, const std::array<bool, terms>& free, const std
     for (std::size_t i = 0; i < n; ++i) s += whitened[i][t] * whitened[i][t];
     scale[t] = s > 0 ? 1 / std::sqrt(s) : 1;
   }
+  std::size_t n_free = 0;
+  for (bool f : free) n_free += f;
+  std::array<double, terms> free_variance{};
   for (unsigned mask = 1; mask < (1u << terms); ++mask) {
     std::size_t idx[terms];
     std::size_t k = 0;
@@ -258,6 +264,8 @@ Solution solve(const Problem& pr, const std::array<bool, terms>& free, const std
     std::array<double, terms> x{};
     std::array<std::array<double, terms>, terms> inv{};
     if (!solve_small(ata, atb, k, x, inv)) continue;
+    if (static_cast<std::size_t>(__builtin_popcount(mask)) == n_free)  // every free term: its variances
+      for (std::size_t a = 0; a < k; ++a) free_variance[idx[a]] = inv[a][a] * scale[idx[a]] * scale[idx[a]];
     bool feasible = true;
     for (std::size_t a = 0; a < k; ++a) feasible &= x[a] >= 0;
     if (!feasible) continue;
@@ -278,6 +286,7 @@ Solution solve(const Problem& pr, const std::array<bool, terms>& free, const std
       for (std::size_t b = 0; b < k; ++b) best.cov[idx[a]][idx[b]] = inv[a][b] * scale[idx[a]] * scale[idx[b]];
     }
   }
+  best.free_variance = free_variance;
   // With no free term (or none feasible) the held terms alone are the model.
   if (!best.ok) {
     double chi2 = 0;
@@ -306,6 +315,12 @@ double ieee952_variance(const std::array<double, 5>& p, Stat stat, std::uint64_t
   return v;
 }
 
+double ieee952_avar(const std::array<double, 5>& p, double tau) {
+  constexpr double flicker_floor = 0.44127120030530318;  // 2 ln 2 / pi
+  return 3 * p[0] * p[0] / (tau * tau) + p[1] * p[1] / tau + flicker_floor * p[2] * p[2] + p[3] * p[3] * tau / 3 +
+         p[4] * p[4] * tau * tau / 2;
+}
+
 Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
                        std::span<double> workspace) {
   Ieee952Fit out;
@@ -313,12 +328,22 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
   Problem pr;
   pr.tau0 = setup.tau0_s;
   pr.n_phase = setup.n_phase;
+  pr.spread = setup.model_spread;
   for (const FitPoint& p : points) {
     const bool wanted = curve == FitCurve::both || (curve == FitCurve::avar) == (p.stat == Stat::avar);
     if (!wanted || (p.stat != Stat::avar && p.stat != Stat::mvar) || p.n == 0 || !(p.variance > 0) || pr.n >= 128)
       continue;
     if (unbroken_grid(p.stat, p.m, p.stride, setup.n_phase).n == 0) continue;
     pr.point[pr.n++] = &p;
+  }
+  // At m = 1 the modified Allan estimate is the Allan one, term for term: keep it once.
+  if (curve == FitCurve::both) {
+    bool avar_at_1 = false;
+    for (std::size_t i = 0; i < pr.n; ++i) avar_at_1 |= pr.point[i]->m == 1 && pr.point[i]->stat == Stat::avar;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < pr.n; ++i)
+      if (!(avar_at_1 && pr.point[i]->m == 1 && pr.point[i]->stat == Stat::mvar)) pr.point[kept++] = pr.point[i];
+    pr.n = kept;
   }
   if (workspace.size() < ieee952_workspace_doubles(pr.n) || !(setup.tau0_s > 0)) return out;
 
@@ -395,7 +420,7 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
     const FitPoint& p = *pr.point[i];
     const double edf = p.edf > 0 ? p.edf : static_cast<double>(p.n);
     for (std::size_t j = 0; j < pr.n; ++j) pr.sigma[i * pr.n + j] = 0;
-    pr.sigma[i * pr.n + i] = 2 * p.variance * p.variance / edf;
+    pr.sigma[i * pr.n + i] = 2 * p.variance * p.variance / edf + pr.spread * pr.spread * p.variance * p.variance;
   }
   if (!cholesky(pr.sigma, pr.n)) {
     out.status = FitStatus::singular;
@@ -431,7 +456,9 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
     p.fitted = sol.active[t];
     const double theta = sol.theta[t];
     p.value = theta > 0 ? std::sqrt(theta) : 0.0;
-    const double sd = std::sqrt(std::fabs(sol.cov[t][t])) * out.birge;
+    // A free term the non-negative solution left out: the uncertainty it has in the full model.
+    const double variance = p.fitted ? sol.cov[t][t] : free[t] ? sol.free_variance[t] : 0.0;
+    const double sd = std::sqrt(std::fabs(variance)) * out.birge;
     p.uncertainty = p.value > 0 ? sd / (2 * p.value) : std::sqrt(sd);
     if (!p.fitted || !(theta > 2 * sd)) continue;
     for (std::size_t i = 0; i < pr.n && !p.resolved; ++i) {  // the largest contribution somewhere

@@ -198,7 +198,7 @@ int main(int argc, char** argv) {
   app.add_option("--stride-factor", stride_text, "S, a power of two, or full")->capture_default_str();
   app.add_option("--confidence", confidence, "confidence level of the intervals")->capture_default_str();
   app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
-  app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves");
+  app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
   app.add_option("--format", format, "table, csv or json")->capture_default_str();
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
@@ -237,9 +237,11 @@ int main(int argc, char** argv) {
     }
     if (format != "table" && format != "csv" && format != "json") bad("--format", "must be table, csv or json");
     if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
-    if (!fit_text.empty() && std::find(o.stats.begin(), o.stats.end(), DevStat::oadev) == o.stats.end() &&
-        std::find(o.stats.begin(), o.stats.end(), DevStat::mdev) == o.stats.end())
-      bad("--fit", "needs oadev or mdev in --stats");
+    // The fit uses both curves, whatever the table shows: compute them, show what was asked.
+    const std::vector<DevStat> shown = o.stats;
+    if (!fit_text.empty())
+      for (const DevStat s : {DevStat::oadev, DevStat::mdev})
+        if (std::find(o.stats.begin(), o.stats.end(), s) == o.stats.end()) o.stats.push_back(s);
 
     // Units: what the values are, and the output unit of gyro data.
     ReportUnits units;
@@ -331,8 +333,12 @@ int main(int argc, char** argv) {
     if (a.n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
     if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
 
-    Report report{a, o.type, o.tau0_s, o.confidence, units, {}};
-    if (!fit_text.empty()) report.fits = fit_curves(a, units, o.tau0_s);
+    std::vector<CurveFit> fits;
+    if (!fit_text.empty())
+      fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0);
+    Analysis displayed = a;
+    std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
+    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits)};
     const std::string text = format == "json" ? to_json(report).dump(2) + "\n"
                              : format == "csv" ? format_csv(report)
                                                : format_table(report);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <bit>
 #include <iterator>
 #include <numbers>
 
@@ -26,7 +27,34 @@ constexpr FitUnit clock_fit_units[5] = {{"Q", "s", 1}, {"N", "s^0.5", 1}, {"B", 
 
 const FitUnit* fit_units(const ReportUnits& u) { return u.gyro ? gyro_fit_units : clock_fit_units; }
 
-const char* curve_name(Ieee952Curve c) { return c == Ieee952Curve::avar ? "avar" : "mvar"; }
+const char* curve_title(FitCurve c) {
+  switch (c) {
+    case FitCurve::both: return "both curves (recommended)";
+    case FitCurve::avar: return "the Allan curve alone";
+    case FitCurve::mvar: return "the modified Allan curve alone";
+  }
+  return "?";
+}
+
+// How the noise at a row was identified, and the plausible range when it is wider than one type:
+// "lag1", "rn -1..0", "given".
+std::string identification(const AnalysisRow& row) {
+  if (!row.noise.identified()) return "-";
+  std::string s = name(row.noise.method);
+  if (row.noise.low != row.noise.high) s += fmt::format(" {}..{}", row.noise.low, row.noise.high);
+  return s;
+}
+
+std::string fit_summary(const CurveFit& f) {
+  const Ieee952Fit& fit = f.fit;
+  std::string s = fmt::format("IEEE-952 fit of {}: {} points", curve_title(f.curve), fit.points);
+  if (fit.status == FitStatus::too_few_points || fit.status == FitStatus::singular)
+    return s + fmt::format(": not identified ({})", name(fit.status));
+  s += fmt::format(", chi2/dof {:.3g} on {} dof", fit.chi2_per_dof(), fit.dof);
+  if (fit.birge > 1) s += fmt::format(", uncertainties scaled by {:.3g}", fit.birge);
+  if (fit.status == FitStatus::rejected) s += ": MODEL REJECTED, the IEEE-952 terms do not describe this curve";
+  return s;
+}
 
 }  // namespace
 
@@ -51,17 +79,20 @@ std::string ReportUnits::unit(DevStat s) const {
   return s == DevStat::tdev ? "s" : "1";
 }
 
-std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s) {
-  std::vector<CurveFit> fits;
-  for (const auto& [stat, curve] : {std::pair{DevStat::oadev, Ieee952Curve::avar}, std::pair{DevStat::mdev, Ieee952Curve::mvar}}) {
-    std::vector<VariancePoint> points;
-    for (const AnalysisRow& r : a.rows) {
-      if (r.stat != stat) continue;
-      const double dev_si = r.dev * units.phase_unit_si;
-      points.push_back({r.tau_s, dev_si * dev_si, r.edf});
-    }
-    if (!points.empty()) fits.push_back({curve, fit_ieee952(points, curve, tau0_s)});
+std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
+                                 double white_quantization_si) {
+  std::vector<FitPoint> points;
+  for (const AnalysisRow& r : a.rows) {
+    if ((r.stat != DevStat::oadev && r.stat != DevStat::mdev) || !std::has_single_bit(r.m)) continue;
+    const double dev_si = r.dev * units.phase_unit_si;
+    points.push_back({r.stat == DevStat::oadev ? Stat::avar : Stat::mvar, r.m, r.stride, r.n, dev_si * dev_si, r.edf});
   }
+  std::vector<CurveFit> fits;
+  if (points.empty()) return fits;
+  std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
+  const FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
+  for (const FitCurve curve : {FitCurve::both, FitCurve::avar, FitCurve::mvar})
+    fits.push_back({curve, fit_ieee952(points, setup, curve, workspace)});
   return fits;
 }
 
@@ -74,24 +105,32 @@ std::string format_table(const Report& r) {
                  name(r.type), u.input, a.n_values, r.tau0_s, a.stride_factor, 100.0 * r.confidence);
   fmt::format_to(to, "# deviations in {}{}\n", u.gyro ? u.rate.name : "fractional frequency",
                  u.gyro ? fmt::format(", TDEV in {}", u.rate.angle) : std::string(", TDEV in s"));
-  fmt::format_to(to, "{:<6} {:>12} {:>12} {:>12} {:>13} {:>13} {:>13} {:>6} {:>9}  {}\n", "stat", "m", "tau [s]", "n",
-                 "ci low", "dev", "ci high", "alpha", "edf", "unit");
+  fmt::format_to(to, "{:<6} {:>12} {:>12} {:>12} {:>13} {:>13} {:>13} {:>6} {:>12} {:>9}  {}\n", "stat", "m", "tau [s]",
+                 "n", "ci low", "dev", "ci high", "alpha", "noise id", "edf", "unit");
   const double k = u.factor();
   for (const AnalysisRow& row : a.rows) {
-    fmt::format_to(to, "{:<6} {:>12} {:>12.6g} {:>12} {:>13} {:>13.5e} {:>13} {:>6} {:>9}  {}\n", name(row.stat), row.m,
-                   row.tau_s, row.n, row.ci.valid ? fmt::format("{:.5e}", row.ci.low * k) : "-", row.dev * k,
+    fmt::format_to(to, "{:<6} {:>12} {:>12.6g} {:>12} {:>13} {:>13.5e} {:>13} {:>6} {:>12} {:>9}  {}\n", name(row.stat),
+                   row.m, row.tau_s, row.n, row.ci.valid ? fmt::format("{:.5e}", row.ci.low * k) : "-", row.dev * k,
                    row.ci.valid ? fmt::format("{:.5e}", row.ci.high * k) : "-",
-                   row.alpha ? fmt::format("{}", *row.alpha) : "-", row.edf > 0 ? fmt::format("{:.4g}", row.edf) : "-",
-                   u.unit(row.stat));
+                   row.alpha ? fmt::format("{}", *row.alpha) : "-", identification(row),
+                   row.edf > 0 ? fmt::format("{:.4g}", row.edf) : "-", u.unit(row.stat));
   }
   for (const CurveFit& f : r.fits) {
-    fmt::format_to(to, "# IEEE-952 fit on the {} curve: {} points, chi2/dof {:.3g}{}\n", curve_name(f.curve),
-                   f.fit.points, f.fit.chi2_per_dof, f.fit.ok ? "" : " (failed: too few points)");
+    fmt::format_to(to, "# {}\n", fit_summary(f));
+    if (!f.fit.quantization_white)
+      fmt::format_to(to, "#   quantization is not white (a periodic pattern: a rate below one pulse per sample without "
+                         "dither); taus below {:.4g} s left out, Q held at pulse weight / sqrt(12)\n",
+                     f.fit.excluded_below_tau_s);
+    if (f.fit.status == FitStatus::too_few_points || f.fit.status == FitStatus::singular) continue;
     for (std::size_t i = 0; i < 5; ++i) {
       const FitUnit& fu = fit_units(u)[i];
       const Ieee952Parameter& p = f.fit.p[i];
+      if (!p.fitted && !(i == 0 && !f.fit.quantization_white)) {
+        fmt::format_to(to, "#   {} not in the model (the fit is better without it)\n", fu.name);
+        continue;
+      }
       fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}\n", fu.name, p.value / fu.si, p.uncertainty / fu.si, fu.unit,
-                     p.resolved ? "" : "  (not resolved)");
+                     !p.fitted ? "  (held, not fitted)" : p.resolved ? "" : "  (not resolved)");
     }
   }
   return out;
@@ -132,6 +171,9 @@ nlohmann::json to_json(const Report& r) {
                     {"dev", row.dev * k},
                     {"unit", u.unit(row.stat)},
                     {"alpha", row.alpha ? json(*row.alpha) : json(nullptr)},
+                    {"noise_id", row.noise.identified() ? json(name(row.noise.method)) : json(nullptr)},
+                    {"alpha_range", row.noise.identified() ? json({row.noise.low, row.noise.high}) : json(nullptr)},
+                    {"edf_alpha", row.edf > 0 ? json(row.edf_alpha) : json(nullptr)},
                     {"edf", row.edf > 0 ? json(row.edf) : json(nullptr)},
                     {"ci_low", row.ci.valid ? json(row.ci.low * k) : json(nullptr)},
                     {"ci_high", row.ci.valid ? json(row.ci.high * k) : json(nullptr)},
@@ -141,13 +183,25 @@ nlohmann::json to_json(const Report& r) {
   if (!r.fits.empty()) {
     json fits = json::array();
     for (const CurveFit& f : r.fits) {
-      json fit = {{"curve", curve_name(f.curve)}, {"points", f.fit.points}, {"chi2_per_dof", f.fit.chi2_per_dof}, {"ok", f.fit.ok}};
+      const Ieee952Fit& fit = f.fit;
+      json one = {{"curve", name(f.curve)},
+                  {"recommended", f.curve == FitCurve::both},
+                  {"status", name(fit.status)},
+                  {"ok", fit.ok()},
+                  {"points", fit.points},
+                  {"chi2", fit.chi2},
+                  {"dof", fit.dof},
+                  {"chi2_per_dof", fit.chi2_per_dof()},
+                  {"uncertainty_scale", fit.birge},
+                  {"quantization_white", fit.quantization_white},
+                  {"excluded_below_tau", fit.excluded_below_tau_s > 0 ? json(fit.excluded_below_tau_s) : json(nullptr)}};
       for (std::size_t i = 0; i < 5; ++i) {
         const FitUnit& fu = fit_units(u)[i];
-        const Ieee952Parameter& p = f.fit.p[i];
-        fit[fu.name] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"resolved", p.resolved}, {"unit", fu.unit}};
+        const Ieee952Parameter& p = fit.p[i];
+        one[fu.name] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"fitted", p.fitted},
+                        {"resolved", p.resolved}, {"unit", fu.unit}};
       }
-      fits.push_back(std::move(fit));
+      fits.push_back(std::move(one));
     }
     j["fit"] = std::move(fits);
   }

@@ -45,16 +45,19 @@ struct ReportUnits {
   std::string unit(DevStat s) const;
 };
 
-/// An IEEE-952 fit on one curve: oadev rows give the AVAR curve, mdev rows the MVAR curve.
+/// An IEEE-952 fit (ieee952.hpp) of the curves an analysis has: the recommended fit of both
+/// curves at once, then the Allan and the modified Allan curve alone (for experts).
 struct CurveFit {
-  Ieee952Curve curve = Ieee952Curve::avar;
+  FitCurve curve = FitCurve::both;
   Ieee952Fit fit;  // parameters in SI: Q rad (s), N rad/s^0.5, B rad/s, K rad/s^1.5, R rad/s^2
 };
 
-/// Fits the AVAR curve (oadev rows) and the MVAR curve (mdev rows) that the analysis has, with the
-/// points in SI units, weighted by their EDF (rows without an EDF are left out). O(rows),
-/// allocates the result; empty when the analysis has neither curve. A fit that fails has ok false.
-std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s);
+/// Fits the oadev and mdev rows of the analysis (one point per octave, m = 2^k), with the points
+/// in SI units. white_quantization_si: the white-quantization level Q_w = pulse weight / sqrt(12)
+/// in rad for counts, 0 otherwise. O(points^2) covariance sums, allocates the workspace; empty
+/// when the analysis has neither curve. A fit that fails says why in its status.
+std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
+                                 double white_quantization_si);
 
 /// Everything a report shows. Refers to (does not own) the analysis.
 struct Report {

@@ -483,7 +483,7 @@ std::vector<double> log_grid(double lo, double hi) {
 
 // ADEV of the AVAR model with the given terms (wire units: A, s), in display units.
 double model_adev(const std::array<double, 5>& qnbkr, double tau_s, double rate) {
-  return std::sqrt(ieee952_variance(qnbkr, tau_s, Ieee952Curve::avar)) * rate;
+  return std::sqrt(ieee952_avar(qnbkr, tau_s)) * rate;
 }
 
 }  // namespace

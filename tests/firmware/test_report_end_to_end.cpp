@@ -44,13 +44,14 @@ TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
   double t = 0;
   const std::uint8_t node = 0x21;
   firmware::ReportContent content;
+  std::vector<double> workspace(firmware::fit_workspace_doubles);
   for (std::uint8_t seq = 0; seq < 4; ++seq) {  // four reports: the whole slow cycle
     for (int k = 0; k < 100000; ++k) {
       const auto c = static_cast<std::int32_t>(sim.next_count());
       board->add_increment(c);
       analyzer.add(c);
     }
-    firmware::build_report(*board, s, seq, 1000u * (seq + 1), {}, content);
+    firmware::build_report(*board, s, seq, 1000u * (seq + 1), {}, workspace, content);
     for (std::size_t k = 0; k < protocol::report_frame_count(seq, s.octaves); ++k) {
       CanFrame f;
       ASSERT_EQ(protocol::encode(firmware::report_message(content, k), node, f), protocol::ProtocolError::none);

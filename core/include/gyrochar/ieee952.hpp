@@ -16,8 +16,12 @@
 // (B is the flicker floor of ADEV divided by sqrt(2 ln 2 / pi) = 0.664); at small m they are the
 // exact expectations of the discrete estimators (the MVAR of N is N^2 (m^2 + 1)/(2 m^2 tau), ...).
 //
-// The fit. The five squared parameters enter linearly; their covariance matrix of the points
-// depends on them, so the fit iterates: covariance from the current parameters, then the
+// The fit. The five squared parameters enter linearly. The covariance of the points is the exact
+// one under the current parameters plus, on the diagonal, (model_spread x point)^2: the model is
+// an idealization of a real sensor, and where a point's own sampling error is far below 1 % (short
+// taus, EDF 10^5) it would otherwise weigh in with a precision no model has. It also keeps the
+// covariance of AVAR and MVAR at one tau, correlated up to 0.99, well conditioned. As the
+// covariance depends on the parameters, the fit iterates: covariance from the current parameters, then the
 // non-negative generalized least-squares solution (every subset of terms is tried, the best
 // feasible one kept; a term left out is "not fitted"). chi2 is the generalized residual; where
 // chi2/dof > 1 every uncertainty is scaled by sqrt(chi2/dof) (the Birge ratio), and where the model
@@ -54,6 +58,7 @@ struct FitSetup {
   double tau0_s = 1.0;
   std::uint64_t n_phase = 0;        // phase points of the run (the unbroken grids)
   double white_quantization = 0.0;  // Q_w in r when the data are counts (pulse weight / sqrt 12); 0: unknown
+  double model_spread = 0.01;       // how closely the model is taken to describe each point (relative)
 };
 
 enum class FitCurve : std::uint8_t { avar, mvar, both };
@@ -99,7 +104,12 @@ constexpr std::size_t ieee952_workspace_doubles(std::size_t points) {
 Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
                        std::span<double> workspace);
 
-/// The model's expected AVAR or MVAR at averaging factor m for parameters {Q, N, B, K, R}. O(1).
+/// The model's exact expected AVAR or MVAR at averaging factor m for parameters {Q, N, B, K, R}.
+/// O(1).
 double ieee952_variance(const std::array<double, 5>& qnbkr, Stat stat, std::uint64_t m, double tau0_s);
+
+/// IEEE 952's closed form of the AVAR at any tau (the large-m limit of the above), for drawing
+/// the model and reading it off: 3Q^2/tau^2 + N^2/tau + (2 ln 2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2.
+double ieee952_avar(const std::array<double, 5>& qnbkr, double tau_s);
 
 }  // namespace gyrochar
