@@ -110,7 +110,8 @@ bool quantization_expected_white(const SimOptions& o) {
   const double random_step_arcsec =
       std::sqrt(arw_arcsec * arw_arcsec * o.tau0_s + 2.0 * o.white_angle_arcsec * o.white_angle_arcsec);
   const double dither_step_arcsec = 2.0 * o.dither_arcsec * std::fabs(std::sin(units::pi * o.dither_hz * o.tau0_s));
-  return random_step_arcsec >= o.pulse_arcsec || dither_step_arcsec >= o.pulse_arcsec;
+  const double pulse = o.pulse_arcsec * (1 - 1e-12);  // a step of exactly one pulse, up to rounding
+  return random_step_arcsec >= pulse || dither_step_arcsec >= pulse;
 }
 
 Ieee952Truth ieee952_truth(const SimOptions& o) {
