@@ -23,8 +23,9 @@
 // 1 / (2 pi bias_time_s), each of variance B^2 ln 2 / pi and coefficient exp(-2 pi f_i tau0).
 // Inside the band the octave sum of Lorentzians equals B^2 / (pi f) to a few parts per million.
 // Anchoring the top corner at a fixed fraction of the sample rate makes the short-tau edge the
-// same for every bias_time: the ADEV floor holds within 0.3 % from 4 tau0 up to about
-// 0.07 bias_time_s (+10.5 % at tau0, +2.6 % at 2 tau0); docs/metrology.md has the figures.
+// same for every bias_time: the ADEV floor holds within 0.3 % from 4 tau0 up to 0.017 bias_time_s
+// and within 1 % up to 0.059 bias_time_s (+10.5 % at tau0, +2.6 % at 2 tau0); docs/metrology.md
+// has the figures.
 // z, z1, z2 and the AR(1) innovations are independent standard normal draws from one
 // std::mt19937_64 seeded with `seed`: a run is reproducible.
 #include <cstdint>
