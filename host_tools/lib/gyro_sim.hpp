@@ -73,7 +73,7 @@ class GyroSimulator {
   std::int64_t next_count();
   /// True angle (rad) at the end of the last interval, without the white angle noise and dither.
   double angle_rad() const { return angle_; }
-  /// Corner frequencies of the flicker band's processes (Hz), lowest first; empty when B is 0.
+  /// Corner frequencies of the flicker band's processes (Hz), lowest first; empty when B is 0. Allocates.
   std::vector<double> flicker_corners_hz() const;
 
  private:
