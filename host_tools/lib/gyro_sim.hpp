@@ -1,20 +1,42 @@
 #pragma once
 // A simulated ring laser gyro with known IEEE Std 952 parameters, streaming in constant memory:
-// pulse counts per tau0 interval from the true angle of
-//   earth/input rate + angle random walk N + rate random walk K + rate ramp R
-//   + bias instability B + white angle noise Q_extra, quantized by the pulse weight (which adds
-//   quantization noise with Q = pulse_weight / sqrt(12)) and an optional sinusoidal dither.
-// The fractional pulse is carried over, so no angle is ever lost: the sum of the counts equals
-// floor(total angle / pulse weight).
-// Bias instability is flicker rate noise, S(f) = B^2 / (pi f) one-sided (AVAR floor (2 ln 2 / pi)
-// B^2), made in constant memory as a sum of first-order Markov processes with corner frequencies
-// an octave apart from 1/(2 pi bias_time_s) up to the Nyquist frequency, each of variance
-// B^2 ln 2 / pi: their spectra add up to B^2 / (pi f) within a few percent inside that band.
+// pulse counts per tau0 interval. Sample k (k = 1, 2, ...) ends at t_k = k tau0; over the interval
+// (t_{k-1}, t_k] the simulator adds, exactly as written (docs/metrology.md, "The simulator and its
+// conventions", derives each term's Allan deviation and the measured agreement):
+//   input rate + rate ramp:   (rate + R t_mid) tau0, t_mid = (k - 1/2) tau0 (exact integral of R t)
+//   angle random walk N:      N sqrt(tau0) z                        (white rate noise of density N)
+//   rate random walk K:       the exact integral of a Brownian rate of diffusion K over the
+//                             interval: the rate held at the start times tau0, plus
+//                             K tau0^1.5 (z1 / 2 + z2 / sqrt(12)); the rate then steps by
+//                             K sqrt(tau0) z1 (the same z1)
+//   bias instability B:       sum_i s_i tau0, each s_i a first-order Gauss-Markov (AR(1)) rate
+//                             updated at the start of the interval and held over it
+// and observes, at t_k, angle + white angle noise q z + dither A sin(2 pi f t_k). The count is
+// floor(observed / pulse weight) minus the same at t_{k-1} (0 at t_0 = 0): the fractional pulse
+// is carried over, so no angle is ever lost. The quantization error (the fractional pulse) is a
+// white angle noise of Q = pulse_weight / sqrt(12) only when the fraction at the sample instants
+// is randomized (random angle increments of about a pulse or more per sample); a steady rate below
+// a pulse per sample gives a periodic pattern instead (docs/metrology.md).
+// Bias instability is flicker rate noise, one-sided S(f) = B^2 / (pi f) (AVAR floor
+// (2 ln 2 / pi) B^2, ADEV 0.664 B), made as a sum of AR(1) rates with corner frequencies an octave
+// apart, from f_top = flicker_top_corner / tau0 down to the first corner at or below
+// 1 / (2 pi bias_time_s), each of variance B^2 ln 2 / pi and coefficient exp(-2 pi f_i tau0).
+// Inside the band the octave sum of Lorentzians equals B^2 / (pi f) to a few parts per million.
+// Anchoring the top corner at a fixed fraction of the sample rate makes the short-tau edge the
+// same for every bias_time: the ADEV floor holds within 0.3 % from 4 tau0 up to 0.017 bias_time_s
+// and within 1 % up to 0.059 bias_time_s (+10.5 % at tau0, +2.6 % at 2 tau0); docs/metrology.md
+// has the figures.
+// z, z1, z2 and the AR(1) innovations are independent standard normal draws from one
+// std::mt19937_64 seeded with `seed`: a run is reproducible.
 #include <cstdint>
 #include <random>
 #include <vector>
 
 namespace gyrochar {
+
+/// Top corner of the flicker band times tau0 (0.34 / tau0, below the Nyquist frequency 0.5 / tau0):
+/// the value that keeps the ADEV floor flattest from 4 tau0 on (docs/metrology.md).
+inline constexpr double flicker_top_corner = 0.34;
 
 struct GyroParameters {
   double tau0_s = 0.01;
@@ -25,7 +47,7 @@ struct GyroParameters {
   double k_rad_s_sqrt_s = 0.0;                      // rate random walk
   double r_rad_s2 = 0.0;                            // rate ramp
   double b_rad_s = 0.0;                             // bias instability
-  double bias_time_s = 1e5;                         // longest correlation time of the flicker band
+  double bias_time_s = 1e5;                         // the flicker band reaches down to 1/(2 pi bias_time_s)
   double dither_amplitude_rad = 0.0;
   double dither_frequency_hz = 0.0;
   std::uint64_t seed = 1;
@@ -43,11 +65,16 @@ inline constexpr double deg_per_h_per_h = pi / 180.0 / 3600.0 / 3600.0;  // rad/
 
 class GyroSimulator {
  public:
+  /// Allocates the flicker processes (one per octave of the band, a few dozen at most); nothing
+  /// afterwards. Expects tau0_s > 0, pulse_weight_rad > 0 and bias_time_s > tau0_s when b_rad_s > 0
+  /// (gyrochar-sim checks its options; see check_parameters in sim_truth.hpp).
   explicit GyroSimulator(const GyroParameters& p);
-  /// Pulses in the next tau0 interval. O(1), no allocation.
+  /// Pulses in the next tau0 interval. O(flicker processes), no allocation.
   std::int64_t next_count();
   /// True angle (rad) at the end of the last interval, without the white angle noise and dither.
   double angle_rad() const { return angle_; }
+  /// Corner frequencies of the flicker band's processes (Hz), lowest first; empty when B is 0. Allocates.
+  std::vector<double> flicker_corners_hz() const;
 
  private:
   GyroParameters p_;
@@ -56,8 +83,10 @@ class GyroSimulator {
   std::uint64_t k_ = 0;
   double angle_ = 0.0;         // integrated rate (rad)
   double rrw_rate_ = 0.0;      // rate random walk state (rad/s)
+  double arw_step_rad_ = 0.0;  // N sqrt(tau0)
+  double rrw_step_rad_s_ = 0.0;  // K sqrt(tau0)
   struct Markov {
-    double decay = 0, drive = 0, state = 0;
+    double decay = 0, drive = 0, state = 0, corner_hz = 0;
   };
   std::vector<Markov> flicker_;  // bias instability processes
   std::int64_t pulses_ = 0;    // pulses emitted so far

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "gyro_sim.hpp"
+#include "sim_truth.hpp"
 #include "gyrochar/protocol.hpp"
 #include "hal/linux/socketcan.hpp"
 
@@ -100,8 +101,14 @@ int main(int argc, char** argv) {
   CLI::App app{"gyrochar-sim: pulse counts of a simulated ring laser gyro with known parameters.",
                "gyrochar-sim"};
   app.footer(R"(Parameters are in the units gyro data sheets use; the quantization noise follows from the pulse
-weight (Q = pulse weight / sqrt(12)). Bias instability is flicker rate noise over the band from
-1e5 s down to 2 tau0.
+weight (Q = pulse weight / sqrt(12), white only when the angle moves at random by a pulse or more
+per sample, or a dither moves it). Bias instability is flicker rate noise (ADEV floor 0.664 B)
+over the band from 1/(2 pi --bias-time) up to 0.34 / tau0. docs/metrology.md gives each term's
+model and its Allan deviation.
+
+Output: two '#' header lines, then one count per line. The first describes the run; the second,
+"# gyrochar-sim truth: key=value ...", repeats every parameter and the IEEE-952 truth (Q arcsec,
+N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h/h, Q_white yes/no) for programs to read.
 
 With --can the counts also go out as CounterInput frames (0x0CFF50xx, docs/protocol.md section 8)
 from node --can-node, one per tau0 interval, paced on the monotonic clock at tau0 / --speed; the
@@ -115,22 +122,24 @@ Examples:
   gyrochar-sim --duration 60 --tau0 0.01 --arw 0.003 --can vcan0 --can-node 128 --speed 4 --out counts.txt
 
 Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not available.)");
-  GyroParameters p;
-  double duration_s = 3600, pulse_arcsec = 1.0, rate_dph = 15.041, q_arcsec = 0, arw = 0, rrw = 0, ramp = 0, bias = 0;
-  double dither_arcsec = 0, dither_hz = 0;
+  SimOptions o;
   std::string out = "-";
-  app.add_option("--duration", duration_s, "simulated time in seconds")->capture_default_str();
-  app.add_option("--tau0", p.tau0_s, "sample interval in seconds")->capture_default_str();
-  app.add_option("--pulse-weight", pulse_arcsec, "angle per pulse in arcsec")->capture_default_str();
-  app.add_option("--rate", rate_dph, "input rate in deg/h (earth rate by default)")->capture_default_str();
-  app.add_option("--white-angle", q_arcsec, "white angle noise beyond quantization, arcsec")->capture_default_str();
-  app.add_option("--arw", arw, "angle random walk N in deg/sqrt(h)")->capture_default_str();
-  app.add_option("--rrw", rrw, "rate random walk K in deg/h/sqrt(h)")->capture_default_str();
-  app.add_option("--bias-instability", bias, "bias instability B in deg/h (flicker rate noise)")->capture_default_str();
-  app.add_option("--ramp", ramp, "rate ramp R in deg/h/h")->capture_default_str();
-  app.add_option("--dither", dither_arcsec, "dither amplitude in arcsec")->capture_default_str();
-  app.add_option("--dither-hz", dither_hz, "dither frequency in Hz")->capture_default_str();
-  app.add_option("--seed", p.seed, "random seed (runs are reproducible)")->capture_default_str();
+  app.add_option("--duration", o.duration_s, "simulated time in seconds")->capture_default_str();
+  app.add_option("--tau0", o.tau0_s, "sample interval in seconds")->capture_default_str();
+  app.add_option("--pulse-weight", o.pulse_arcsec, "angle per pulse in arcsec")->capture_default_str();
+  app.add_option("--rate", o.rate_deg_per_h, "input rate in deg/h (earth rate by default)")->capture_default_str();
+  app.add_option("--white-angle", o.white_angle_arcsec, "white angle noise beyond quantization, arcsec")
+      ->capture_default_str();
+  app.add_option("--arw", o.arw_deg_per_sqrt_h, "angle random walk N in deg/sqrt(h)")->capture_default_str();
+  app.add_option("--rrw", o.rrw_deg_per_h_sqrt_h, "rate random walk K in deg/h/sqrt(h)")->capture_default_str();
+  app.add_option("--bias-instability", o.bias_deg_per_h, "bias instability B in deg/h (flicker rate noise)")
+      ->capture_default_str();
+  app.add_option("--bias-time", o.bias_time_s, "the flicker band reaches down to 1/(2 pi BIAS_TIME), seconds")
+      ->capture_default_str();
+  app.add_option("--ramp", o.ramp_deg_per_h2, "rate ramp R in deg/h/h")->capture_default_str();
+  app.add_option("--dither", o.dither_arcsec, "dither amplitude in arcsec")->capture_default_str();
+  app.add_option("--dither-hz", o.dither_hz, "dither frequency in Hz")->capture_default_str();
+  app.add_option("--seed", o.seed, "random seed (runs are reproducible)")->capture_default_str();
   app.add_option("--out", out, "output file, '-' for standard output")->capture_default_str();
   std::string can_interface;
   unsigned can_node = 0x80;
@@ -152,27 +161,13 @@ Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not
     std::fprintf(stderr, "gyrochar-sim: %s: %s\n", what, why);
     return 2;
   };
-  if (!(p.tau0_s > 0)) return bad("--tau0", "must be positive");
-  if (!(duration_s >= p.tau0_s)) return bad("--duration", "must be at least tau0");
-  if (!(duration_s / p.tau0_s <= 1e12)) return bad("--duration", "more than 10^12 samples of tau0");
-  if (!std::isfinite(rate_dph) || std::fabs(rate_dph) > 1e9) return bad("--rate", "must be a finite rate in deg/h");
-  if (!(pulse_arcsec > 0)) return bad("--pulse-weight", "must be positive");
-  for (double v : {q_arcsec, arw, rrw, ramp, bias, dither_arcsec, dither_hz})
-    if (!(v >= 0) || !std::isfinite(v)) return bad("noise parameters", "must be finite and >= 0");
+  if (const auto problem = check_parameters(o)) return bad(problem->what, problem->why);
   if (can_node > protocol::max_node_address) return bad("--can-node", "must be an address 0..253");
   if (!(speed > 0) || !std::isfinite(speed)) return bad("--speed", "must be positive");
   if (can_interface.empty() && (app.count("--can-node") || app.count("--speed")))
     return bad("--can-node, --speed", "only apply with --can");
   if (!can_interface.empty() && !app.count("--out")) out.clear();  // frames only
-  p.pulse_weight_rad = pulse_arcsec * units::arcsec;
-  p.rate_rad_s = rate_dph * units::deg_per_h;
-  p.q_rad = q_arcsec * units::arcsec;
-  p.n_rad_sqrt_s = arw * units::deg_per_sqrt_h;
-  p.k_rad_s_sqrt_s = rrw * units::deg_per_h_sqrt_h;
-  p.r_rad_s2 = ramp * units::deg_per_h_per_h;
-  p.b_rad_s = bias * units::deg_per_h;
-  p.dither_amplitude_rad = dither_arcsec * units::arcsec;
-  p.dither_frequency_hz = dither_hz;
+  const GyroParameters p = gyro_parameters(o);
   std::unique_ptr<CounterInputSender> sender;
   if (!can_interface.empty()) {
     try {
@@ -187,12 +182,10 @@ Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not
     std::fprintf(stderr, "gyrochar-sim: %s: cannot write: %s\n", out.c_str(), std::strerror(errno));
     return 3;
   }
-  if (f != nullptr)
-    std::fprintf(f, "# gyrochar-sim counts: tau0 %g s, pulse weight %g arcsec, rate %g deg/h, ARW %g deg/sqrt(h), "
-               "RRW %g deg/h/sqrt(h), ramp %g deg/h/h, seed %llu\n", p.tau0_s, pulse_arcsec, rate_dph, arw, rrw, ramp,
-               static_cast<unsigned long long>(p.seed));
+  if (f != nullptr)  // the description, then the machine-readable truth (sim_truth.hpp)
+    std::fprintf(f, "%s\n%s\n", format_sim_description_line(o).c_str(), format_sim_truth_line(o).c_str());
   GyroSimulator sim(p);
-  const auto n = static_cast<std::uint64_t>(std::llround(duration_s / p.tau0_s));
+  const auto n = static_cast<std::uint64_t>(std::llround(o.duration_s / o.tau0_s));
   if (sender) sender->send_next(0);  // the start: Count 0
   for (std::uint64_t k = 0; k < n; ++k) {
     const std::int64_t count = sim.next_count();

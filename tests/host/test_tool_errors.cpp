@@ -45,6 +45,7 @@ TEST(ToolErrors, SimulatorNamesWhatIsWrong) {
   expect("gyrochar-sim", "--rate nan --duration 1", 2, "--rate:");
   expect("gyrochar-sim", "--arw -1 --duration 1", 2, "noise parameters:");
   expect("gyrochar-sim", "--arw inf --duration 1", 2, "noise parameters:");
+  expect("gyrochar-sim", "--bias-instability 0.05 --bias-time 0.001 --duration 1", 2, "--bias-time:");
   expect("gyrochar-sim", "--duration 1 --out /nonexistent-dir/counts.txt", 3, "/nonexistent-dir/counts.txt:");
   expect("gyrochar-sim", "--duration 1 --can nosuchcan9", 4, "--can:");
   expect("gyrochar-sim", "--duration 1 --speed 2", 2, "--can-node, --speed:");

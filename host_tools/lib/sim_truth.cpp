@@ -1,0 +1,218 @@
+#include "sim_truth.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <system_error>
+
+namespace gyrochar {
+
+namespace {
+
+constexpr std::string_view truth_prefix = "# gyrochar-sim truth:";
+constexpr std::uint64_t truth_format = 1;
+
+// The parameters on the truth line, in the order written. One table for writer and parser.
+struct NumberKey {
+  std::string_view key;
+  double SimOptions::*field;
+};
+constexpr std::array<NumberKey, 12> number_keys{{
+    {"duration_s", &SimOptions::duration_s},
+    {"tau0_s", &SimOptions::tau0_s},
+    {"pulse_arcsec", &SimOptions::pulse_arcsec},
+    {"rate_deg_per_h", &SimOptions::rate_deg_per_h},
+    {"white_angle_arcsec", &SimOptions::white_angle_arcsec},
+    {"arw_deg_per_sqrt_h", &SimOptions::arw_deg_per_sqrt_h},
+    {"rrw_deg_per_h_sqrt_h", &SimOptions::rrw_deg_per_h_sqrt_h},
+    {"bias_deg_per_h", &SimOptions::bias_deg_per_h},
+    {"bias_time_s", &SimOptions::bias_time_s},
+    {"ramp_deg_per_h2", &SimOptions::ramp_deg_per_h2},
+    {"dither_arcsec", &SimOptions::dither_arcsec},
+    {"dither_hz", &SimOptions::dither_hz},
+}};
+
+// The truth in the units of the IEEE-952 fit, and each unit in SI.
+struct TruthKey {
+  std::string_view key;
+  double Ieee952Truth::*field;
+  double unit;
+};
+constexpr std::array<TruthKey, 5> truth_keys{{
+    {"Q_arcsec", &Ieee952Truth::q_rad, units::arcsec},
+    {"N_deg_per_sqrt_h", &Ieee952Truth::n_rad_sqrt_s, units::deg_per_sqrt_h},
+    {"B_deg_per_h", &Ieee952Truth::b_rad_s, units::deg_per_h},
+    {"K_deg_per_h_sqrt_h", &Ieee952Truth::k_rad_s_sqrt_s, units::deg_per_h_sqrt_h},
+    {"R_deg_per_h2", &Ieee952Truth::r_rad_s2, units::deg_per_h_per_h},
+}};
+
+void append_number(std::string& out, double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back exactly
+  out.append(buf, r.ptr);
+}
+
+void append_integer(std::string& out, std::uint64_t v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+bool read_number(std::string_view text, double& v) {
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+  return r.ec == std::errc() && r.ptr == text.data() + text.size() && std::isfinite(v);
+}
+
+bool read_integer(std::string_view text, std::uint64_t& v) {
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+  return r.ec == std::errc() && r.ptr == text.data() + text.size();
+}
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+}  // namespace
+
+std::optional<ParameterProblem> check_parameters(const SimOptions& o) {
+  if (!(o.tau0_s > 0) || !std::isfinite(o.tau0_s)) return ParameterProblem{"--tau0", "must be positive"};
+  if (!(o.duration_s >= o.tau0_s)) return ParameterProblem{"--duration", "must be at least tau0"};
+  if (!(o.duration_s / o.tau0_s <= 1e12)) return ParameterProblem{"--duration", "more than 10^12 samples of tau0"};
+  if (!std::isfinite(o.rate_deg_per_h) || std::fabs(o.rate_deg_per_h) > 1e9)
+    return ParameterProblem{"--rate", "must be a finite rate in deg/h"};
+  if (!(o.pulse_arcsec > 0) || !std::isfinite(o.pulse_arcsec)) return ParameterProblem{"--pulse-weight", "must be positive"};
+  for (double v : {o.white_angle_arcsec, o.arw_deg_per_sqrt_h, o.rrw_deg_per_h_sqrt_h, o.ramp_deg_per_h2,
+                   o.bias_deg_per_h, o.dither_arcsec, o.dither_hz})
+    if (!(v >= 0) || !std::isfinite(v)) return ParameterProblem{"noise parameters", "must be finite and >= 0"};
+  if (o.bias_deg_per_h > 0 && !(o.bias_time_s > o.tau0_s && o.bias_time_s <= 1e15 * o.tau0_s))
+    return ParameterProblem{"--bias-time", "must exceed tau0 (and stay within 10^15 tau0) for bias instability"};
+  return std::nullopt;
+}
+
+GyroParameters gyro_parameters(const SimOptions& o) {
+  GyroParameters p;
+  p.tau0_s = o.tau0_s;
+  p.pulse_weight_rad = o.pulse_arcsec * units::arcsec;
+  p.rate_rad_s = o.rate_deg_per_h * units::deg_per_h;
+  p.q_rad = o.white_angle_arcsec * units::arcsec;
+  p.n_rad_sqrt_s = o.arw_deg_per_sqrt_h * units::deg_per_sqrt_h;
+  p.k_rad_s_sqrt_s = o.rrw_deg_per_h_sqrt_h * units::deg_per_h_sqrt_h;
+  p.r_rad_s2 = o.ramp_deg_per_h2 * units::deg_per_h_per_h;
+  p.b_rad_s = o.bias_deg_per_h * units::deg_per_h;
+  p.bias_time_s = o.bias_time_s;
+  p.dither_amplitude_rad = o.dither_arcsec * units::arcsec;
+  p.dither_frequency_hz = o.dither_hz;
+  p.seed = o.seed;
+  return p;
+}
+
+bool quantization_expected_white(const SimOptions& o) {
+  const double arw_arcsec = o.arw_deg_per_sqrt_h * units::deg_per_sqrt_h / units::arcsec;  // arcsec/sqrt(s)
+  const double random_step_arcsec =
+      std::sqrt(arw_arcsec * arw_arcsec * o.tau0_s + 2.0 * o.white_angle_arcsec * o.white_angle_arcsec);
+  const double dither_step_arcsec = 2.0 * o.dither_arcsec * std::fabs(std::sin(units::pi * o.dither_hz * o.tau0_s));
+  const double pulse = o.pulse_arcsec * (1 - 1e-12);  // a step of exactly one pulse, up to rounding
+  return random_step_arcsec >= pulse || dither_step_arcsec >= pulse;
+}
+
+Ieee952Truth ieee952_truth(const SimOptions& o) {
+  const GyroParameters p = gyro_parameters(o);
+  Ieee952Truth t;
+  t.q_rad = std::sqrt(p.q_rad * p.q_rad + p.pulse_weight_rad * p.pulse_weight_rad / 12.0);
+  t.n_rad_sqrt_s = p.n_rad_sqrt_s;
+  t.b_rad_s = p.b_rad_s;
+  t.k_rad_s_sqrt_s = p.k_rad_s_sqrt_s;
+  t.r_rad_s2 = p.r_rad_s2;
+  t.quantization_white = quantization_expected_white(o);
+  return t;
+}
+
+std::string format_sim_description_line(const SimOptions& o) {
+  char buf[640];
+  std::snprintf(buf, sizeof buf,
+                "# gyrochar-sim counts: tau0 %g s, pulse weight %g arcsec, rate %g deg/h, white angle %g arcsec, "
+                "ARW %g deg/sqrt(h), bias instability %g deg/h (band down to 1/(2 pi %g s)), RRW %g deg/h/sqrt(h), "
+                "ramp %g deg/h/h, dither %g arcsec at %g Hz, seed %llu",
+                o.tau0_s, o.pulse_arcsec, o.rate_deg_per_h, o.white_angle_arcsec, o.arw_deg_per_sqrt_h,
+                o.bias_deg_per_h, o.bias_time_s, o.rrw_deg_per_h_sqrt_h, o.ramp_deg_per_h2, o.dither_arcsec,
+                o.dither_hz, static_cast<unsigned long long>(o.seed));
+  return buf;
+}
+
+std::string format_sim_truth_line(const SimOptions& o) {
+  std::string out(truth_prefix);
+  out += " format=";
+  append_integer(out, truth_format);
+  for (const NumberKey& k : number_keys) {
+    out += ' ';
+    out += k.key;
+    out += '=';
+    append_number(out, o.*k.field);
+  }
+  out += " seed=";
+  append_integer(out, o.seed);
+  const Ieee952Truth t = ieee952_truth(o);
+  for (const TruthKey& k : truth_keys) {
+    out += ' ';
+    out += k.key;
+    out += '=';
+    append_number(out, t.*k.field / k.unit);
+  }
+  out += t.quantization_white ? " Q_white=yes" : " Q_white=no";
+  return out;
+}
+
+std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
+  if (!line.starts_with(truth_prefix)) return std::nullopt;
+  line.remove_prefix(truth_prefix.size());
+  SimTruth r;
+  // Bits of the keys seen: the numbers, then format, seed, the truths and Q_white.
+  constexpr unsigned n_numbers = number_keys.size(), bit_format = n_numbers, bit_seed = n_numbers + 1,
+                     bit_truth = n_numbers + 2, bit_white = bit_truth + truth_keys.size();
+  constexpr std::uint32_t all = (std::uint32_t{1} << (bit_white + 1)) - 1;
+  std::uint32_t seen = 0;
+  auto first_time = [&seen](unsigned bit) {
+    const bool fresh = (seen & (std::uint32_t{1} << bit)) == 0;
+    seen |= std::uint32_t{1} << bit;
+    return fresh;
+  };
+  std::uint64_t format = 0;
+  std::size_t at = 0;
+  while (true) {
+    while (at < line.size() && is_blank(line[at])) ++at;
+    if (at == line.size()) break;
+    std::size_t end = at;
+    while (end < line.size() && !is_blank(line[end])) ++end;
+    const std::string_view token = line.substr(at, end - at);
+    at = end;
+    const std::size_t eq = token.find('=');
+    if (eq == std::string_view::npos || eq == 0) return std::nullopt;
+    const std::string_view key = token.substr(0, eq), value = token.substr(eq + 1);
+    bool known = false;
+    for (unsigned i = 0; i < n_numbers && !known; ++i) {
+      if (key != number_keys[i].key) continue;
+      known = true;
+      if (!first_time(i) || !read_number(value, r.options.*number_keys[i].field)) return std::nullopt;
+    }
+    for (unsigned i = 0; i < truth_keys.size() && !known; ++i) {
+      if (key != truth_keys[i].key) continue;
+      known = true;
+      double v = 0;
+      if (!first_time(bit_truth + i) || !read_number(value, v) || v < 0) return std::nullopt;
+      r.truth.*truth_keys[i].field = v * truth_keys[i].unit;
+    }
+    if (known) continue;
+    if (key == "format") {
+      if (!first_time(bit_format) || !read_integer(value, format)) return std::nullopt;
+    } else if (key == "seed") {
+      if (!first_time(bit_seed) || !read_integer(value, r.options.seed)) return std::nullopt;
+    } else if (key == "Q_white") {
+      if (!first_time(bit_white) || (value != "yes" && value != "no")) return std::nullopt;
+      r.truth.quantization_white = value == "yes";
+    }
+    // Any other key belongs to a later format: ignored.
+  }
+  if (seen != all || format != truth_format || check_parameters(r.options)) return std::nullopt;
+  return r;
+}
+
+}  // namespace gyrochar

@@ -1,0 +1,99 @@
+#pragma once
+// gyrochar-sim's parameters and the IEEE Std 952 truth they imply, written as one machine-readable
+// comment line at the top of its output and read back by any later program (an analyzer that
+// shows the truth beside its fit, a test):
+//
+//   # gyrochar-sim truth: format=1 duration_s=7200 tau0_s=0.01 ... Q_arcsec=0.288675 ... Q_white=no
+//
+// Grammar: the prefix "# gyrochar-sim truth:", then key=value tokens separated by blanks, in any
+// order, each key once. Values are decimal numbers as std::to_chars writes them (the shortest text
+// that reads back to the same double), an unsigned integer for seed and format, yes/no for
+// Q_white. Keys carry their unit: the simulator's parameters in the units of its command line
+// (format, duration_s, tau0_s, pulse_arcsec, rate_deg_per_h, white_angle_arcsec,
+// arw_deg_per_sqrt_h, rrw_deg_per_h_sqrt_h, bias_deg_per_h, bias_time_s, ramp_deg_per_h2,
+// dither_arcsec, dither_hz, seed), then the truth in the units of the IEEE-952 fit (Q_arcsec,
+// N_deg_per_sqrt_h, B_deg_per_h, K_deg_per_h_sqrt_h, R_deg_per_h2, Q_white). A reader ignores keys
+// it does not know: adding keys keeps format=1; only a change in the meaning of a key raises it,
+// and a reader refuses a format it does not know.
+//
+// The data readers skip '#' lines, so the header costs them nothing. The writer (gyrochar-sim) and
+// the parser share format_sim_truth_line and the key list below: they cannot drift apart.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "gyro_sim.hpp"
+
+namespace gyrochar {
+
+/// gyrochar-sim's simulation options, in the units of its command line (defaults included).
+struct SimOptions {
+  double duration_s = 3600;
+  double tau0_s = 0.01;
+  double pulse_arcsec = 1.0;
+  double rate_deg_per_h = 15.041;  // earth rate
+  double white_angle_arcsec = 0;
+  double arw_deg_per_sqrt_h = 0;
+  double rrw_deg_per_h_sqrt_h = 0;
+  double bias_deg_per_h = 0;
+  double bias_time_s = 1e5;
+  double ramp_deg_per_h2 = 0;
+  double dither_arcsec = 0;
+  double dither_hz = 0;
+  std::uint64_t seed = 1;
+};
+
+/// The IEEE-952 truth of a simulation, SI units (rad, s).
+struct Ieee952Truth {
+  double q_rad = 0;            // total white angle noise sqrt(q^2 + pulse^2 / 12)
+  double n_rad_sqrt_s = 0;     // angle random walk
+  double b_rad_s = 0;          // bias instability (ADEV floor / 0.664)
+  double k_rad_s_sqrt_s = 0;   // rate random walk
+  double r_rad_s2 = 0;         // rate ramp
+  bool quantization_white = false;  // the pulse quantization is expected to be white (below)
+};
+
+struct SimTruth {
+  SimOptions options;  // exactly as written
+  Ieee952Truth truth;  // as written, converted to SI
+};
+
+/// A parameter gyrochar-sim refuses: `what` names the option ("--tau0"), `why` says why. Static
+/// strings.
+struct ParameterProblem {
+  const char* what = "";
+  const char* why = "";
+};
+
+/// The first problem with `o`, or nothing: tau0 > 0; duration >= tau0 and at most 10^12 samples;
+/// a finite rate within 10^9 deg/h; pulse weight > 0; noise levels, dither and its frequency
+/// finite and >= 0; with bias instability, tau0 < bias_time <= 10^15 tau0. O(1).
+std::optional<ParameterProblem> check_parameters(const SimOptions& o);
+
+/// The simulator's parameters (SI) for `o`. O(1).
+GyroParameters gyro_parameters(const SimOptions& o);
+
+/// Whether the quantization error is expected to be white: true when the angle at the sample
+/// instants moves at random by at least one pulse between samples, sqrt(N^2 tau0 + 2 q^2) >= pulse
+/// (the correlation of two quantization errors is then below 0.61 exp(-2 pi^2) = 2e-9), or when
+/// the dither moves it by at least a pulse per sample, 2 A |sin(pi f tau0)| >= pulse (a
+/// deterministic whitening: docs/metrology.md gives the residual departures). O(1).
+bool quantization_expected_white(const SimOptions& o);
+
+/// The IEEE-952 truth of `o`: Q = sqrt(q^2 + pulse^2 / 12), N, B, K, R, in SI. The dither is not
+/// an IEEE-952 term (its AVAR, 4 A^2 sin^4(pi f tau) / tau^2, is not in the truth). O(1).
+Ieee952Truth ieee952_truth(const SimOptions& o);
+
+/// The human-readable first header line ("# gyrochar-sim counts: tau0 0.01 s, ..."), no newline.
+std::string format_sim_description_line(const SimOptions& o);
+/// The machine-readable truth line ("# gyrochar-sim truth: format=1 ..."), no newline. Allocates.
+std::string format_sim_truth_line(const SimOptions& o);
+
+/// Reads a truth line (trailing blanks, '\r' or '\n' allowed). Nothing when the line is not one:
+/// wrong prefix, a token without '=', a repeated key, a value that is not a complete number of its
+/// kind (or not finite), a missing key, format other than 1, or parameters check_parameters
+/// refuses. O(line length); allocates nothing beyond the result.
+std::optional<SimTruth> parse_sim_truth_line(std::string_view line);
+
+}  // namespace gyrochar

@@ -1,0 +1,178 @@
+// gyrochar-sim's truth line: what the writer formats, the parser reads back (every parameter
+// exactly, the IEEE-952 truth to the last bits of its unit conversion), what it refuses, and what
+// the program itself writes. Oracles: the options given (round trip), the closed-form truth
+// Q = sqrt(q^2 + pulse^2 / 12) in arcsec and the identity of N, B, K, R in the fit's units.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include "sim_truth.hpp"
+
+namespace gyrochar {
+namespace {
+
+void expect_same_options(const SimOptions& a, const SimOptions& b) {
+  EXPECT_EQ(a.duration_s, b.duration_s);
+  EXPECT_EQ(a.tau0_s, b.tau0_s);
+  EXPECT_EQ(a.pulse_arcsec, b.pulse_arcsec);
+  EXPECT_EQ(a.rate_deg_per_h, b.rate_deg_per_h);
+  EXPECT_EQ(a.white_angle_arcsec, b.white_angle_arcsec);
+  EXPECT_EQ(a.arw_deg_per_sqrt_h, b.arw_deg_per_sqrt_h);
+  EXPECT_EQ(a.rrw_deg_per_h_sqrt_h, b.rrw_deg_per_h_sqrt_h);
+  EXPECT_EQ(a.bias_deg_per_h, b.bias_deg_per_h);
+  EXPECT_EQ(a.bias_time_s, b.bias_time_s);
+  EXPECT_EQ(a.ramp_deg_per_h2, b.ramp_deg_per_h2);
+  EXPECT_EQ(a.dither_arcsec, b.dither_arcsec);
+  EXPECT_EQ(a.dither_hz, b.dither_hz);
+  EXPECT_EQ(a.seed, b.seed);
+}
+
+SimOptions awkward() {
+  SimOptions o;
+  o.duration_s = 14400.000000000002;
+  o.tau0_s = 0.1;
+  o.pulse_arcsec = 1.0 / 3;
+  o.rate_deg_per_h = -15.041;
+  o.white_angle_arcsec = 2.5e-7;
+  o.arw_deg_per_sqrt_h = 0.005;
+  o.rrw_deg_per_h_sqrt_h = 0.15;
+  o.bias_deg_per_h = 0.05;
+  o.bias_time_s = 3.3e4;
+  o.ramp_deg_per_h2 = 1e-3;
+  o.dither_arcsec = 120;
+  o.dither_hz = 437.3;
+  o.seed = std::numeric_limits<std::uint64_t>::max();
+  return o;
+}
+
+TEST(SimHeader, RoundTripKeepsEveryParameterExactly) {
+  for (const SimOptions& o : {SimOptions{}, awkward()}) {
+    const std::string line = format_sim_truth_line(o);
+    ASSERT_EQ(line.rfind("# gyrochar-sim truth: format=1 ", 0), 0u) << line;
+    const auto t = parse_sim_truth_line(line);
+    ASSERT_TRUE(t) << line;
+    expect_same_options(t->options, o);
+    const Ieee952Truth want = ieee952_truth(o);
+    EXPECT_NEAR(t->truth.q_rad, want.q_rad, 1e-15 * want.q_rad);
+    EXPECT_NEAR(t->truth.n_rad_sqrt_s, want.n_rad_sqrt_s, 1e-15 * want.n_rad_sqrt_s);
+    EXPECT_NEAR(t->truth.b_rad_s, want.b_rad_s, 1e-15 * want.b_rad_s);
+    EXPECT_NEAR(t->truth.k_rad_s_sqrt_s, want.k_rad_s_sqrt_s, 1e-15 * want.k_rad_s_sqrt_s);
+    EXPECT_NEAR(t->truth.r_rad_s2, want.r_rad_s2, 1e-15 * want.r_rad_s2);
+    EXPECT_EQ(t->truth.quantization_white, want.quantization_white);
+    EXPECT_TRUE(parse_sim_truth_line(line + "\r\n"));
+  }
+}
+
+TEST(SimHeader, TruthIsTheIeee952Model) {
+  // Q = sqrt(q^2 + pulse^2 / 12); N, B, K, R as given, in SI.
+  const SimOptions o = awkward();
+  const Ieee952Truth t = ieee952_truth(o);
+  const double q_arcsec = std::sqrt(o.white_angle_arcsec * o.white_angle_arcsec + o.pulse_arcsec * o.pulse_arcsec / 12);
+  EXPECT_NEAR(t.q_rad, q_arcsec * units::arcsec, 1e-15 * t.q_rad);
+  EXPECT_DOUBLE_EQ(t.n_rad_sqrt_s, 0.005 * units::deg_per_sqrt_h);
+  EXPECT_DOUBLE_EQ(t.b_rad_s, 0.05 * units::deg_per_h);
+  EXPECT_DOUBLE_EQ(t.k_rad_s_sqrt_s, 0.15 * units::deg_per_h_sqrt_h);
+  EXPECT_DOUBLE_EQ(t.r_rad_s2, 1e-3 * units::deg_per_h_per_h);
+  // 1 arcsec pulses, nothing else: Q = 1/sqrt(12) arcsec = 0.288675 arcsec, written as such.
+  const SimOptions plain;
+  EXPECT_NE(format_sim_truth_line(plain).find(" Q_arcsec=0.28867513459481287 "), std::string::npos);
+}
+
+TEST(SimHeader, QuantizationWhitenessFlag) {
+  SimOptions o;  // earth rate, 1 arcsec pulses, tau0 0.01 s: 0.15 pulse per sample, periodic
+  EXPECT_FALSE(quantization_expected_white(o));
+  o.arw_deg_per_sqrt_h = 0.003;  // 0.018 arcsec per sample
+  EXPECT_FALSE(quantization_expected_white(o));
+  o.arw_deg_per_sqrt_h = 1.0 / 60 / std::sqrt(o.tau0_s);  // one pulse per sample
+  EXPECT_TRUE(quantization_expected_white(o));
+  o = SimOptions{};
+  o.white_angle_arcsec = 0.7;  // increment 0.99 pulse
+  EXPECT_FALSE(quantization_expected_white(o));
+  o.white_angle_arcsec = 1 / std::sqrt(2.0);  // increment sqrt(2) q = 1 pulse
+  EXPECT_TRUE(quantization_expected_white(o));
+  o = SimOptions{};
+  o.dither_arcsec = 5;
+  o.dither_hz = 437.3;  // 0.373 cycle per sample after aliasing: up to 9 pulses per sample
+  EXPECT_TRUE(quantization_expected_white(o));
+  o.dither_hz = 400;  // synchronous with the sampling: invisible
+  EXPECT_FALSE(quantization_expected_white(o));
+  o.dither_hz = 100.3;  // 0.003 cycle per sample: 0.09 pulse per sample
+  EXPECT_FALSE(quantization_expected_white(o));
+}
+
+TEST(SimHeader, RefusesWhatIsNotATruthLine) {
+  const std::string good = format_sim_truth_line(SimOptions{});
+  auto replaced = [&good](const std::string& from, const std::string& to) {
+    std::string s = good;
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return s.replace(at, from.size(), to);
+  };
+  EXPECT_FALSE(parse_sim_truth_line(""));
+  EXPECT_FALSE(parse_sim_truth_line("# gyrochar-sim counts: tau0 0.01 s"));
+  EXPECT_FALSE(parse_sim_truth_line(good.substr(1)));                          // no '#'
+  EXPECT_FALSE(parse_sim_truth_line(replaced(" seed=1", "")));                 // missing key
+  EXPECT_FALSE(parse_sim_truth_line(good + " seed=2"));                        // repeated key
+  EXPECT_FALSE(parse_sim_truth_line(replaced("format=1", "format=2")));        // unknown format
+  EXPECT_FALSE(parse_sim_truth_line(replaced("tau0_s=0.01", "tau0_s=0.01x")));  // trailing garbage
+  EXPECT_FALSE(parse_sim_truth_line(replaced("tau0_s=0.01", "tau0_s=")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("tau0_s=0.01", "tau0_s=nan")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("tau0_s=0.01", "tau0_s=-0.01")));  // check_parameters
+  EXPECT_FALSE(parse_sim_truth_line(replaced("arw_deg_per_sqrt_h=0", "arw_deg_per_sqrt_h=inf")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("seed=1", "seed=-1")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("Q_white=no", "Q_white=maybe")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("B_deg_per_h=0", "B_deg_per_h=-1")));
+  EXPECT_FALSE(parse_sim_truth_line(good + " orphan"));                        // a token without '='
+  EXPECT_FALSE(parse_sim_truth_line(good + " =3"));
+  // Later formats may add keys; blanks may be tabs; order does not matter.
+  EXPECT_TRUE(parse_sim_truth_line(good + " temperature_C=25"));
+  EXPECT_TRUE(parse_sim_truth_line(replaced(" seed=1", "\tseed=1\t")));
+  const auto moved = parse_sim_truth_line(replaced(" seed=1", "") + " seed=1");
+  ASSERT_TRUE(moved);
+  EXPECT_EQ(moved->options.seed, 1u);
+}
+
+TEST(SimHeader, TheProgramWritesTheTruthLine) {
+  const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_sim_header.txt";
+  const std::string command = GYROCHAR_BINARY_DIR
+      "/host_tools/gyrochar-sim --duration 2 --tau0 0.1 --pulse-weight 0.5 --rate -3 --white-angle 0.25 --arw 0.005 "
+      "--rrw 0.15 --bias-instability 0.05 --bias-time 2000 --ramp 0.01 --dither 7 --dither-hz 437.3 --seed 99 --out " +
+      out;
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  std::ifstream in(out);
+  std::string first, second, value;
+  std::getline(in, first);
+  std::getline(in, second);
+  int values = 0;
+  while (std::getline(in, value)) ++values;
+  std::remove(out.c_str());
+  EXPECT_EQ(first.rfind("# gyrochar-sim counts: tau0 0.1 s, pulse weight 0.5 arcsec", 0), 0u) << first;
+  const auto t = parse_sim_truth_line(second);
+  ASSERT_TRUE(t) << second;
+  SimOptions want;
+  want.duration_s = 2;
+  want.tau0_s = 0.1;
+  want.pulse_arcsec = 0.5;
+  want.rate_deg_per_h = -3;
+  want.white_angle_arcsec = 0.25;
+  want.arw_deg_per_sqrt_h = 0.005;
+  want.rrw_deg_per_h_sqrt_h = 0.15;
+  want.bias_deg_per_h = 0.05;
+  want.bias_time_s = 2000;
+  want.ramp_deg_per_h2 = 0.01;
+  want.dither_arcsec = 7;
+  want.dither_hz = 437.3;
+  want.seed = 99;
+  expect_same_options(t->options, want);
+  EXPECT_EQ(second, format_sim_truth_line(want));
+  EXPECT_EQ(values, 20);
+}
+
+}  // namespace
+}  // namespace gyrochar
