@@ -95,7 +95,6 @@ TEST(AnalyzeCli, BadInputsGetExitCodeTwoAndAReason) {
   expect_bad_input("--type phase --tau0 1 --taus 500,600 " + good, "too few");
   expect_bad_input("--type phase --tau0 1 --taus all - < " + good, "--taus");  // stdin: no count
   expect_bad_input("--type phase --tau0 1 --format xml " + good, "--format");
-  expect_bad_input("--type phase --tau0 1 --fit ieee952 --stats adev " + good, "--fit");
   expect_bad_input("--type phase --tau0 1 --unit furlong " + good, "--unit");
   expect_bad_input("--type phase --tau0 1 --rate-unit deg/h " + good, "--rate-unit");  // clock data
   expect_bad_input("--type phase --tau0 1 --nominal-hz 1e7 " + good, "--nominal-hz");
@@ -205,7 +204,9 @@ TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
                         file_with("white.txt", counts));
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  ASSERT_EQ(j["fit"].size(), 2u);  // avar and mvar curves
+  ASSERT_EQ(j["fit"].size(), 3u);  // both curves (recommended), then avar and mvar alone
+  EXPECT_EQ(j["fit"][0]["curve"], "both");
+  EXPECT_TRUE(j["fit"][0]["recommended"].get<bool>());
   const double n_true = 2.0 / 3600.0 * std::sqrt(3600.0 / 0.001);
   for (const auto& fit : j["fit"]) {
     EXPECT_EQ(fit["N"]["unit"], "deg/sqrt(h)");
@@ -213,7 +214,8 @@ TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
     EXPECT_NEAR(fit["N"]["value"].get<double>(), n_true, 3 * fit["N"]["uncertainty"].get<double>()) << fit["curve"];
   }
   const Outcome table = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 " + temp("white.txt"));
-  EXPECT_NE(table.out.find("IEEE-952 fit on the avar curve"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("IEEE-952 fit of both curves (recommended)"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("IEEE-952 fit of the Allan curve alone"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("deg/sqrt(h)"), std::string::npos) << table.out;
 }
 
