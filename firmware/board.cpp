@@ -55,7 +55,7 @@ const char* restore_reason(RestoreStatus s) {
 
 Board::Board(const Config& config, BoardIo io)
     : config_(config), io_(io), can_counter_(static_cast<std::uint8_t>(config.counter_node)),
-      checkpoint_file_(config.checkpoint_path) {
+      checkpoint_file_(config.checkpoint_path), report_work_(config.octaves) {
   settings_.tau0_s = config.tau0_s;
   settings_.pulse_weight_arcsec = config.pulse_weight_arcsec;
   settings_.stride_factor = config.stride_factor;
@@ -65,7 +65,6 @@ Board::Board(const Config& config, BoardIo io)
   settings_.config_hash = hash_settings(settings_);
   if (!configure(characterizer_, settings_)) throw std::invalid_argument("estimator settings out of range");
   checkpoint_buffer_.resize(characterizer_.checkpoint_size());
-  fit_workspace_.resize(fit_workspace_doubles);
   checkpoint_period_ns_ = static_cast<std::uint64_t>(config.checkpoint_period_s * 1e9);
   start_ns_ = io.clock.now_ns();
   next_checkpoint_ns_ = start_ns_ + checkpoint_period_ns_;
@@ -153,8 +152,7 @@ void Board::on_tick() {
   if (frame_ == 0) {
     faults_.tx_dropped_frames = static_cast<std::uint32_t>(io_.can.counters().tx_dropped);
     faults_.bus_off_events = static_cast<std::uint32_t>(io_.can.counters().bus_off_events);
-    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, fit_workspace_,
-                 content_);
+    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, report_work_, content_);
     frames_ = protocol::report_frame_count(seq_, config_.octaves);
     if (config_.verbose)
       BOARD_LOG("7", "report %u: %llu samples", static_cast<unsigned>(seq_),

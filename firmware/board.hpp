@@ -59,7 +59,7 @@ class Board final : public hal::CountSink {
   hal::CanCounterDecoder can_counter_;
   CheckpointFile checkpoint_file_;
   std::vector<std::byte> checkpoint_buffer_;
-  std::vector<double> fit_workspace_;
+  ReportWorkspace report_work_;
   std::uint64_t start_ns_ = 0, next_checkpoint_ns_ = 0, checkpoint_period_ns_ = 0;
   std::uint8_t seq_ = 0;
   std::size_t frame_ = 0, frames_ = 1;

@@ -15,8 +15,15 @@ bool configure(BoardCharacterizer& c, const ReportSettings& s) {
   return c.configure({s.stride_factor, s.config_hash}, std::span(m_list.data(), s.octaves)) == ConfigureStatus::ok;
 }
 
+ReportWorkspace::ReportWorkspace(unsigned octaves)
+    : fit_(ieee952_workspace_doubles(2 * octaves)),
+      // Pairs of taus within the fit's band (8 octaves): at most 17 x 4 per tau; a table less than
+      // half full keeps the probes short.
+      entries_(std::size_t{octaves} * 17 * 4 * 2),
+      cache_(entries_) {}
+
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
-                  std::uint64_t uptime_ms, const FaultCounters& f, std::span<double> fit_workspace, ReportContent& out) {
+                  std::uint64_t uptime_ms, const FaultCounters& f, ReportWorkspace& work, ReportContent& out) {
   using namespace protocol;
   const std::size_t taus = c.tau_count();
   const std::uint64_t samples = c.increments();
@@ -25,13 +32,13 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   std::array<TauSums, max_octaves> sums{};
   std::array<NoiseId, max_octaves> noise{};
   take_sums(c, std::span(sums.data(), taus));
-  identify_noise(std::span(sums.data(), taus), c.phase_points(), 2, false, std::span(noise.data(), taus));
+  identify_noise(std::span(sums.data(), taus), c.phase_points(), 2, false, std::span(noise.data(), taus), &work.cache());
   const EstimateOptions options{s.tau0_s, s.pulse_weight_arcsec, EdfModel::exact};
   std::array<FitPoint, 2 * max_octaves> points{};
   std::size_t n_points = 0;
   for (std::size_t i = 0; i < taus; ++i) {
-    const Estimate a = estimate(sums[i], c.phase_points(), DevStat::oadev, noise[i], options);
-    const Estimate m = estimate(sums[i], c.phase_points(), DevStat::mdev, noise[i], options);
+    const Estimate a = estimate(sums[i], c.phase_points(), DevStat::oadev, noise[i], options, &work.cache());
+    const Estimate m = estimate(sums[i], c.phase_points(), DevStat::mdev, noise[i], options, &work.cache());
     const NoiseType type = noise[i].identified() ? noise_type(noise[i].alpha) : NoiseType::not_identified;
     const auto idx = static_cast<std::uint8_t>(i);
     out.adev[i] = {seq, idx, DevKind::adev, static_cast<float>(a.deviation), a.edf, type, a.clean && a.n > 0};
@@ -48,7 +55,7 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   // The recommended fit of both curves, in arcsec and seconds; quantization's white level is the
   // pulse weight over sqrt(12).
   const FitSetup setup{s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)};
-  const Ieee952Fit fit = fit_ieee952(std::span(points.data(), n_points), setup, FitCurve::both, fit_workspace);
+  const Ieee952Fit fit = fit_ieee952(std::span(points.data(), n_points), setup, FitCurve::both, work.fit(), &work.cache());
   for (std::size_t k = 0; k < 5; ++k) {
     const Ieee952Parameter& p = fit.p[k];
     const bool resolved = fit.ok() && p.resolved && p.value > 0;

@@ -1,11 +1,13 @@
 #pragma once
 // The board's reports: the characterizer (core/, the same one the offline analyzer runs) read out
-// by the core extractors and the IEEE-952 fit, turned into the protocol's messages. No heap:
-// capacities are fixed (40 octave taus, stride factor up to 64); the firmware's event loop and the
-// host simulation share this code.
+// by the core extractors and the IEEE-952 fit, turned into the protocol's messages. Capacities are
+// fixed (40 octave taus, stride factor up to 64) and the report's workspace is allocated once, at
+// start-up; the firmware's event loop and the host simulation share this code.
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "gyrochar/characterizer.hpp"
 #include "gyrochar/ieee952.hpp"
@@ -52,15 +54,25 @@ struct ReportContent {
   std::array<protocol::Ieee952Msg, 5> ieee952{};
 };
 
-/// Doubles of workspace build_report() needs for the IEEE-952 fit (both curves of every tau).
-inline constexpr std::size_t fit_workspace_doubles = ieee952_workspace_doubles(2 * max_octaves);
+/// What build_report() works in, allocated once for `octaves` taus: the IEEE-952 fit's workspace
+/// and the cache of the covariance sums behind the EDFs, the noise identification and the fit
+/// (noise_model.hpp: computed once per pair of taus, then O(1) per report as the run grows).
+class ReportWorkspace {
+ public:
+  explicit ReportWorkspace(unsigned octaves);
+  std::span<double> fit() { return fit_; }
+  PairSumCache& cache() { return cache_; }
 
-/// Fills `out` for report `seq` from the characterizer's current state. No allocation (the fit
-/// works in `fit_workspace`, at least fit_workspace_doubles); the EDFs and the fit dominate the
-/// cost (noise_model.hpp, ieee952.hpp).
+ private:
+  std::vector<double> fit_;
+  std::vector<PairSumCache::Entry> entries_;
+  PairSumCache cache_;
+};
+
+/// Fills `out` for report `seq` from the characterizer's current state. No allocation: everything
+/// is worked out in `work` (built for the same number of octaves).
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
-                  std::uint64_t uptime_ms, const FaultCounters& faults, std::span<double> fit_workspace,
-                  ReportContent& out);
+                  std::uint64_t uptime_ms, const FaultCounters& faults, ReportWorkspace& work, ReportContent& out);
 
 /// The message at position k of report `content.status.seq` (protocol::report_slot order).
 protocol::Message report_message(const ReportContent& content, std::size_t k);

@@ -72,23 +72,30 @@ NoiseId b1_identify(const TauSums& t) {
   return out;
 }
 
-double edf_of(Stat stat, int alpha, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase, std::uint64_t terms,
-              EdfModel model) {
-  if (!noise_supported(stat, alpha)) return 0.0;
-  const TermGrid grid = unbroken_grid(stat, m, stride, n_phase);
-  if (grid.n == 0 || terms == 0) return 0.0;
+// The EDF of the estimate over `grid` (with `terms` formed: gaps remove some) for noise alpha.
+// Allan and modified Allan: (n c(0))^2 / sum c^2 with the sum from `allan` (pair_sums of the five
+// Allan noises over the grid with itself); Hadamard: exact_edf(). Greenhall's approximation on
+// request.
+double edf_of(Stat stat, int alpha, const TermGrid& grid, std::uint64_t terms, std::uint64_t n_phase, EdfModel model,
+              const PairSums& allan) {
+  if (!noise_supported(stat, alpha) || grid.n == 0 || terms == 0) return 0.0;
   double edf = 0;
   if (model == EdfModel::greenhall) {
     EdfQuery q;
     q.alpha = alpha;
     q.d = difference_order(stat);
-    q.m = static_cast<double>(m);
+    q.m = static_cast<double>(grid.m);
     q.modified = stat == Stat::mvar;
-    q.S = static_cast<double>(m) / static_cast<double>(stride);
+    q.S = static_cast<double>(grid.m) / static_cast<double>(grid.stride);
     q.N = static_cast<double>(n_phase);
     edf = edf_greenhall(q);
-  } else {
+  } else if (stat == Stat::hvar) {
     edf = exact_edf(alpha, grid);
+  } else {
+    const double sum = allan.cc[static_cast<std::size_t>(2 - alpha)][static_cast<std::size_t>(2 - alpha)];
+    const double c0 = term_covariance(alpha, stat, grid.m, stat, grid.m, 0);
+    const double n = static_cast<double>(grid.n);
+    edf = sum > 0 ? n * n * c0 * c0 / sum : 0.0;
   }
   // Gaps remove terms: scale by the share formed (0 to 4 % below the pooled EDF of independent
   // segments of 25 m or more, docs/core.md: the interval errs on the wide side).
@@ -104,38 +111,46 @@ constexpr double neighbour_weight = 1.0;
 // Alphas whose chi-squared is within this of the best are plausible (about one standard deviation).
 constexpr double plausible_chi2 = 1.0;
 
-// How far the measured R(n) = MVAR/AVAR lies from its expectation under pure noise alpha, in
-// standard deviations: ln R against ln E[MVAR]/E[AVAR] (with the second-order bias of the
-// logarithms), the variance from the exact covariances of the two estimates (noise_model.hpp) plus
-// the model spread. NaN where the ratio is not available.
-double rn_score(const TauSums& t, std::uint64_t n_phase, int alpha) {
+PairSums allan_sums(PairSumCache* cache, const TermGrid& a, const TermGrid& b) {
+  return cache ? cache->get(a, b) : pair_sums(allan_noises(), a, b);
+}
+
+// How far the measured R(n) = MVAR/AVAR lies from its expectation under each pure noise alpha
+// (2 .. -2), in standard deviations: ln R against ln E[MVAR]/E[AVAR] (with the second-order bias
+// of the logarithms), the variance from the exact covariances of the two estimates
+// (noise_model.hpp) plus the model spread. NaN where the ratio is not available.
+std::array<double, 5> rn_scores(const TauSums& t, std::uint64_t n_phase, PairSumCache* cache) {
+  std::array<double, 5> z;
+  z.fill(std::nan(""));
   const auto A = static_cast<std::size_t>(SumKind::avar), M = static_cast<std::size_t>(SumKind::mvar);
-  if (!noise_supported(Stat::avar, alpha) || t.n[A] == 0 || t.n[M] == 0 || !(t.variance[A] > 0) || !(t.variance[M] > 0))
-    return std::nan("");
+  if (t.n[A] == 0 || t.n[M] == 0 || !(t.variance[A] > 0) || !(t.variance[M] > 0)) return z;
   const TermGrid a = unbroken_grid(Stat::avar, t.m, t.stride, n_phase);
   const TermGrid b = unbroken_grid(Stat::mvar, t.m, t.stride, n_phase);
-  if (a.n == 0 || b.n == 0) return std::nan("");
-  NoiseSet set;
-  set.alpha[0] = alpha;
-  set.count = 1;
-  const double ca = term_covariance(alpha, Stat::avar, t.m, Stat::avar, t.m, 0);
-  const double cm = term_covariance(alpha, Stat::mvar, t.m, Stat::mvar, t.m, 0);
+  if (a.n == 0 || b.n == 0) return z;
+  const PairSums aa = allan_sums(cache, a, a), mm = allan_sums(cache, b, b), am = allan_sums(cache, a, b);
   const double na = static_cast<double>(a.n), nm = static_cast<double>(b.n);
   // Gaps remove terms: the relative variances grow as the share of terms formed shrinks.
   const double share_a = na / static_cast<double>(t.n[A]), share_m = nm / static_cast<double>(t.n[M]);
-  const double va = 2 * pair_sums(set, a, a).cc[0][0] / (na * ca * na * ca) * share_a;
-  const double vm = 2 * pair_sums(set, b, b).cc[0][0] / (nm * cm * nm * cm) * share_m;
-  const double cov = 2 * pair_sums(set, a, b).cc[0][0] / (na * ca * nm * cm) * std::sqrt(share_a * share_m);
   const double m = static_cast<double>(t.m);
-  const double expected = std::log(cm / (ca * m * m)) - vm / 2 + va / 2;
-  const double var = va + vm - 2 * cov + model_spread * model_spread;
-  return (std::log(t.variance[M] / t.variance[A]) - expected) / std::sqrt(var);
+  const double measured = std::log(t.variance[M] / t.variance[A]);
+  for (std::size_t k = 0; k < 5; ++k) {
+    const int alpha = 2 - static_cast<int>(k);
+    const double ca = term_covariance(alpha, Stat::avar, t.m, Stat::avar, t.m, 0);
+    const double cm = term_covariance(alpha, Stat::mvar, t.m, Stat::mvar, t.m, 0);
+    const double va = 2 * aa.cc[k][k] / (na * ca * na * ca) * share_a;
+    const double vm = 2 * mm.cc[k][k] / (nm * cm * nm * cm) * share_m;
+    const double cov = 2 * am.cc[k][k] / (na * ca * nm * cm) * std::sqrt(share_a * share_m);
+    const double expected = std::log(cm / (ca * m * m)) - vm / 2 + va / 2;
+    const double var = va + vm - 2 * cov + model_spread * model_spread;
+    z[k] = (measured - expected) / std::sqrt(var);
+  }
+  return z;
 }
 
 }  // namespace
 
 void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dmax, bool frequency_input,
-                    std::span<NoiseId> out) {
+                    std::span<NoiseId> out, PairSumCache* cache) {
   const int dmin = frequency_input ? 1 : 0;
   const int lowest = dmax == 3 ? -4 : -2;
   for (std::size_t i = 0; i < taus.size() && i < out.size(); ++i) {
@@ -145,6 +160,7 @@ void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dm
     bool informed = false;
     const Lag1Estimate lag1 = t.noise ? lag1_estimate(*t.noise, dmin, dmax) : Lag1Estimate{};
     const bool use_lag1 = lag1.valid && lag1.points >= lag1_min_points;
+    const std::array<double, 5> rn = rn_scores(t, n_phase, cache);
     for (int alpha = 2; alpha >= lowest; --alpha) {
       double& c = chi2[static_cast<std::size_t>(2 - alpha)];
       if (use_lag1) {
@@ -153,7 +169,7 @@ void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dm
         informed = true;
       }
       {  // R(n) needs AVAR: below alpha = -2 (Hadamard only) score it as random-walk FM
-        const double z = rn_score(t, n_phase, alpha < -2 ? -2 : alpha);
+        const double z = rn[static_cast<std::size_t>(2 - (alpha < -2 ? -2 : alpha))];
         if (std::isfinite(z)) {
           c += z * z;
           informed = true;
@@ -190,7 +206,7 @@ void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dm
 }
 
 Estimate estimate(const TauSums& t, std::uint64_t n_phase, DevStat stat, const NoiseId& noise,
-                  const EstimateOptions& o) {
+                  const EstimateOptions& o, PairSumCache* cache) {
   Estimate e;
   e.stat = stat;
   e.m = t.m;
@@ -206,17 +222,24 @@ Estimate estimate(const TauSums& t, std::uint64_t n_phase, DevStat stat, const N
   e.deviation = std::sqrt(e.variance);
   if (!noise.identified()) return e;
   const Stat s = stat_of(stat);
+  const TermGrid grid = unbroken_grid(s, t.m, e.stride, n_phase);
+  PairSums allan;
+  if (o.edf == EdfModel::exact && s != Stat::hvar && grid.n > 0) allan = allan_sums(cache, grid, grid);
   if (o.edf == EdfModel::greenhall) {
     e.edf_alpha = noise.alpha;
-    e.edf = edf_of(s, noise.alpha, t.m, e.stride, n_phase, e.n, o.edf);
+    e.edf = edf_of(s, noise.alpha, grid, e.n, n_phase, o.edf, allan);
     return e;
   }
   for (int alpha = noise.low; alpha <= noise.high; ++alpha) {  // the smallest plausible EDF
-    const double edf = edf_of(s, alpha, t.m, e.stride, n_phase, e.n, o.edf);
+    const double edf = edf_of(s, alpha, grid, e.n, n_phase, o.edf, allan);
     if (edf > 0 && (e.edf == 0 || edf < e.edf)) {
       e.edf = edf;
       e.edf_alpha = alpha;
     }
+  }
+  if (e.edf > 0) {  // gaps scale it as they scale the EDF
+    const double nu3 = exact_skew_dof(e.edf_alpha, grid);
+    e.skew_dof = e.n >= grid.n ? nu3 : nu3 * static_cast<double>(e.n) / static_cast<double>(grid.n);
   }
   return e;
 }

@@ -30,7 +30,7 @@ namespace {
 
 constexpr std::size_t terms = 5;    // Q N B K R
 constexpr std::size_t noises = 4;   // Q N B K: the random ones
-constexpr std::array<int, noises> alphas{2, 0, -1, -2};
+constexpr std::array<int, noises> alphas{2, 0, -1, -2};  // Q N B K
 constexpr int band_octaves = 8;     // estimates further apart are taken as uncorrelated
 constexpr double quantization_left_out = 0.01;  // share of a point that makes it unusable (non-white)
 
@@ -322,7 +322,7 @@ double ieee952_avar(const std::array<double, 5>& p, double tau) {
 }
 
 Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
-                       std::span<double> workspace) {
+                       std::span<double> workspace, PairSumCache* cache) {
   Ieee952Fit out;
   out.curve = curve;
   Problem pr;
@@ -391,10 +391,9 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
   pr.sigma = pr.pair + pr.n * (pr.n + 1) / 2 * 14;
   pr.rows = pr.sigma + pr.n * pr.n;
 
-  // The pair sums of every two points within the band: they depend on the geometry only.
-  NoiseSet set;
-  for (std::size_t t = 0; t < noises; ++t) set.alpha[t] = alphas[t];
-  set.count = noises;
+  // The pair sums of every two points within the band: they depend on the geometry only. Of the
+  // five Allan noises (index 2 - alpha) the model has four.
+  constexpr std::array<std::size_t, noises> allan_index{0, 2, 3, 4};
   for (std::size_t i = 0; i < pr.n; ++i) {
     const FitPoint& a = *pr.point[i];
     const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
@@ -407,10 +406,11 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
       for (std::size_t k = 0; k < 14; ++k) g[k] = 0;
       const int apart = octave(a.m) - octave(b.m);
       if (apart > band_octaves || apart < -band_octaves) continue;
-      const PairSums s = pair_sums(set, ga, unbroken_grid(b.stat, b.m, b.stride, setup.n_phase));
+      const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, setup.n_phase);
+      const PairSums s = cache ? cache->get(ga, gb) : pair_sums(allan_noises(), ga, gb);
       for (std::size_t t = 0; t < noises; ++t) {
-        for (std::size_t u = 0; u <= t; ++u) g[cc_index(t, u)] = s.cc[t][u];
-        g[10 + t] = s.c[t];
+        for (std::size_t u = 0; u <= t; ++u) g[cc_index(t, u)] = s.cc[allan_index[t]][allan_index[u]];
+        g[10 + t] = s.c[allan_index[t]];
       }
     }
   }

@@ -159,7 +159,8 @@ class Engine final : public EngineBase {
         row.edf_alpha = e.edf_alpha;
         row.stride = e.stride;
         row.edf = e.edf;
-        if (e.edf > 0) row.ci = confidence_interval(row.dev, row.edf, o.confidence);
+        row.skew_dof = o.edf == EdfModel::exact ? e.skew_dof : 0.0;  // Greenhall's: Stable32's plain intervals
+        if (e.edf > 0) row.ci = confidence_interval(row.dev, row.edf, o.confidence, row.skew_dof);
         a.rows.push_back(row);
       }
     }

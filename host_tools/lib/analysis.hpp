@@ -75,6 +75,7 @@ struct AnalysisRow {
   int edf_alpha = 0;            // the alpha whose EDF was used (the smallest of the plausible)
   std::uint64_t stride = 1;     // terms every `stride` phase points (m for adev and hdev)
   double edf = 0.0;             // EDF of this estimator; 0: not available
+  double skew_dof = 0.0;        // skewness of its distribution (confidence.hpp); 0: plain chi-squared
   Interval ci;                  // same unit as dev
 };
 

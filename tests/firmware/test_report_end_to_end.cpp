@@ -44,7 +44,7 @@ TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
   double t = 0;
   const std::uint8_t node = 0x21;
   firmware::ReportContent content;
-  std::vector<double> workspace(firmware::fit_workspace_doubles);
+  firmware::ReportWorkspace workspace(s.octaves);
   for (std::uint8_t seq = 0; seq < 4; ++seq) {  // four reports: the whole slow cycle
     for (int k = 0; k < 100000; ++k) {
       const auto c = static_cast<std::int32_t>(sim.next_count());

@@ -20,6 +20,8 @@
 // EDF. The EDF of the estimator actually used (its stride, its number of phase points, the terms
 // a gap removed), computed exactly for the discrete power-law noise (noise_model.hpp). Where more
 // than one alpha is plausible, the smallest of their EDFs: the widest interval the data allow.
+// With it the skewness of the estimate's distribution (skew_dof), for intervals that match three
+// moments instead of two.
 // EdfModel::greenhall gives Greenhall & Riley's approximation for the identified alpha instead, as
 // Stable32 and allantools print it (for comparisons; it overstates the EDF at small m).
 //
@@ -31,6 +33,7 @@
 
 #include "gyrochar/characterizer.hpp"
 #include "gyrochar/noise_id.hpp"
+#include "gyrochar/noise_model.hpp"
 #include "gyrochar/stat.hpp"
 
 namespace gyrochar {
@@ -109,7 +112,7 @@ inline constexpr std::uint64_t lag1_min_points = 30;
 /// frequency, so the lag-1 rule starts at the first difference. out.size() >= taus.size().
 /// O(taus x alphas x pair_sums()), no allocation.
 void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dmax, bool frequency_input,
-                    std::span<NoiseId> out);
+                    std::span<NoiseId> out, PairSumCache* cache = nullptr);
 
 /// A fixed alpha, as the user gives it.
 constexpr NoiseId given_noise(int alpha) { return {alpha, alpha, alpha, NoiseIdMethod::given}; }
@@ -134,13 +137,14 @@ struct Estimate {
   NoiseId noise;
   int edf_alpha = 0;         // the alpha whose EDF was used (the smallest of the plausible ones)
   double edf = 0;            // 0: not available (no identification, or alpha outside the statistic's range)
+  double skew_dof = 0;       // nu3 of noise_model.hpp (the distribution's skewness); 0: plain chi-squared
   bool clean = true;
 };
 
 /// The estimate of `stat` at one tau of a run of n_phase phase points, with its EDF for `noise`.
-/// n = 0 when the tau has no term yet. O(EDF): at most a few thousand covariance evaluations per
-/// plausible alpha (noise_model.hpp).
+/// n = 0 when the tau has no term yet. O(EDF): pair_sums() of noise_model.hpp, at most a few
+/// thousand covariance evaluations, or O(1) from `cache` (optional; so for identify_noise()).
 Estimate estimate(const TauSums& tau, std::uint64_t n_phase, DevStat stat, const NoiseId& noise,
-                  const EstimateOptions& options);
+                  const EstimateOptions& options, PairSumCache* cache = nullptr);
 
 }  // namespace gyrochar

@@ -40,6 +40,7 @@
 #include <cstdint>
 #include <span>
 
+#include "gyrochar/noise_model.hpp"
 #include "gyrochar/stat.hpp"
 
 namespace gyrochar {
@@ -100,9 +101,10 @@ constexpr std::size_t ieee952_workspace_doubles(std::size_t points) {
 
 /// Fits the model to the points of `curve` (points of the other statistic are ignored; any
 /// order). `workspace` holds at least ieee952_workspace_doubles(points.size()) doubles. O(P^2 x
-/// pair_sums()) for the covariances, then O(P^3) per iteration; no allocation; never fails hard.
+/// pair_sums()) for the covariances (O(P^2) from `cache`, optional), then O(P^3) per iteration;
+/// no allocation; never fails hard.
 Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
-                       std::span<double> workspace);
+                       std::span<double> workspace, PairSumCache* cache = nullptr);
 
 /// The model's exact expected AVAR or MVAR at averaging factor m for parameters {Q, N, B, K, R}.
 /// O(1).
