@@ -369,8 +369,9 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
         const FitPoint& p = *pr.point[i];
         const double white = qw2 * design(p.stat, p.m, setup.tau0_s)[0];
         if (white >= quantization_left_out * p.variance) {
-          const double tau = static_cast<double>(p.m) * setup.tau0_s;
-          if (tau * 2 > out.excluded_below_tau_s) out.excluded_below_tau_s = tau * 2;
+          double& below = out.excluded_below_tau_s[p.stat == Stat::avar ? 0 : 1];
+          const double next_octave = 2 * static_cast<double>(p.m) * setup.tau0_s;
+          if (next_octave > below) below = next_octave;
           continue;
         }
         pr.point[kept++] = pr.point[i];

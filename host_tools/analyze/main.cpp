@@ -314,6 +314,7 @@ int main(int argc, char** argv) {
     } catch (const std::invalid_argument& e) {
       bad("--taus", e.what());
     }
+    std::vector<std::string> header;
     try {
       DataFile file(path, column);
       Progress p(show_progress, "analyzing", file);
@@ -326,6 +327,7 @@ int main(int argc, char** argv) {
         }
         p.value();
       }
+      header = file.header();
     } catch (const DataFileError& e) {
       bad_data(path, e);
     }
@@ -338,7 +340,8 @@ int main(int argc, char** argv) {
       fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0);
     Analysis displayed = a;
     std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
-    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits)};
+    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt};
+    if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);
     const std::string text = format == "json" ? to_json(report).dump(2) + "\n"
                              : format == "csv" ? format_csv(report)
                                                : format_table(report);

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <bit>
+#include <cmath>
 #include <iterator>
 #include <numbers>
 
@@ -43,6 +45,17 @@ std::string identification(const AnalysisRow& row) {
   std::string s = name(row.noise.method);
   if (row.noise.low != row.noise.high) s += fmt::format(" {}..{}", row.noise.low, row.noise.high);
   return s;
+}
+
+// "AVAR below 655 s, MVAR below 5.12 s"
+std::string excluded_text(const Ieee952Fit& fit) {
+  std::string s;
+  for (std::size_t k = 0; k < 2; ++k) {
+    if (!(fit.excluded_below_tau_s[k] > 0)) continue;
+    if (!s.empty()) s += ", ";
+    s += fmt::format("{} below {:.4g} s", k == 0 ? "AVAR" : "MVAR", fit.excluded_below_tau_s[k]);
+  }
+  return s.empty() ? "none" : s;
 }
 
 std::string fit_summary(const CurveFit& f) {
@@ -96,6 +109,28 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   return fits;
 }
 
+std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, DataType type, double tau0_s,
+                                     double pulse_weight_rad) {
+  if (type != DataType::counts) return std::nullopt;
+  for (const std::string& line : header) {
+    const auto t = parse_sim_truth_line(line);
+    if (!t) continue;
+    const auto same = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::fabs(b); };
+    if (!same(t->options.tau0_s, tau0_s) || !same(t->options.pulse_arcsec * deg_rad / 3600.0, pulse_weight_rad))
+      return std::nullopt;
+    return t->truth;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+std::array<double, 5> truth_values(const Ieee952Truth& t) {
+  return {t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2};
+}
+
+}  // namespace
+
 std::string format_table(const Report& r) {
   const Analysis& a = r.analysis;
   const ReportUnits& u = r.units;
@@ -119,18 +154,23 @@ std::string format_table(const Report& r) {
     fmt::format_to(to, "# {}\n", fit_summary(f));
     if (!f.fit.quantization_white)
       fmt::format_to(to, "#   quantization is not white (a periodic pattern: a rate below one pulse per sample without "
-                         "dither); taus below {:.4g} s left out, Q held at pulse weight / sqrt(12)\n",
-                     f.fit.excluded_below_tau_s);
+                         "dither): points it reaches left out ({}), Q held at pulse weight / sqrt(12)\n",
+                     excluded_text(f.fit));
     if (f.fit.status == FitStatus::too_few_points || f.fit.status == FitStatus::singular) continue;
     for (std::size_t i = 0; i < 5; ++i) {
       const FitUnit& fu = fit_units(u)[i];
       const Ieee952Parameter& p = f.fit.p[i];
       if (!p.fitted && !(i == 0 && !f.fit.quantization_white)) {
-        fmt::format_to(to, "#   {} not in the model (the fit is better without it)\n", fu.name);
+        fmt::format_to(to, "#   {} not in the model (the fit is better without it){}\n", fu.name,
+                       r.truth ? fmt::format("   simulated {:.4g} {}", truth_values(*r.truth)[i] / fu.si, fu.unit) : "");
         continue;
       }
-      fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}\n", fu.name, p.value / fu.si, p.uncertainty / fu.si, fu.unit,
-                     !p.fitted ? "  (held, not fitted)" : p.resolved ? "" : "  (not resolved)");
+      const std::string truth = r.truth ? fmt::format("   simulated {:.4g}", truth_values(*r.truth)[i] / fu.si) : "";
+      if (!p.fitted)
+        fmt::format_to(to, "#   {} = {:.4g} {}  (held, not fitted){}\n", fu.name, p.value / fu.si, fu.unit, truth);
+      else
+        fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}{}\n", fu.name, p.value / fu.si, p.uncertainty / fu.si, fu.unit,
+                       p.resolved ? "" : "  (not resolved)", truth);
     }
   }
   return out;
@@ -194,7 +234,8 @@ nlohmann::json to_json(const Report& r) {
                   {"chi2_per_dof", fit.chi2_per_dof()},
                   {"uncertainty_scale", fit.birge},
                   {"quantization_white", fit.quantization_white},
-                  {"excluded_below_tau", fit.excluded_below_tau_s > 0 ? json(fit.excluded_below_tau_s) : json(nullptr)}};
+                  {"excluded_below_tau", {{"avar", fit.excluded_below_tau_s[0] > 0 ? json(fit.excluded_below_tau_s[0]) : json(nullptr)},
+                                          {"mvar", fit.excluded_below_tau_s[1] > 0 ? json(fit.excluded_below_tau_s[1]) : json(nullptr)}}}};
       for (std::size_t i = 0; i < 5; ++i) {
         const FitUnit& fu = fit_units(u)[i];
         const Ieee952Parameter& p = fit.p[i];
@@ -204,6 +245,14 @@ nlohmann::json to_json(const Report& r) {
       fits.push_back(std::move(one));
     }
     j["fit"] = std::move(fits);
+  }
+  if (r.truth) {
+    json truth = {{"quantization_white", r.truth->quantization_white}};
+    for (std::size_t i = 0; i < 5; ++i) {
+      const FitUnit& fu = fit_units(u)[i];
+      truth[fu.name] = {{"value", truth_values(*r.truth)[i] / fu.si}, {"unit", fu.unit}};
+    }
+    j["simulated"] = std::move(truth);
   }
   return j;
 }

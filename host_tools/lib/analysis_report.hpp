@@ -18,6 +18,7 @@
 
 #include "analysis.hpp"
 #include "gyrochar/ieee952.hpp"
+#include "sim_truth.hpp"
 
 namespace gyrochar {
 
@@ -59,6 +60,12 @@ struct CurveFit {
 std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
                                  double white_quantization_si);
 
+/// The truth a simulated input carries (gyrochar-sim's header, sim_truth.hpp), shown beside the
+/// fitted terms when the data are counts with the simulator's own tau0 and pulse weight.
+/// Nothing otherwise. O(header lines).
+std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, DataType type, double tau0_s,
+                                     double pulse_weight_rad);
+
 /// Everything a report shows. Refers to (does not own) the analysis.
 struct Report {
   const Analysis& analysis;
@@ -67,6 +74,7 @@ struct Report {
   double confidence = 0.683;
   ReportUnits units;
   std::vector<CurveFit> fits;
+  std::optional<Ieee952Truth> truth;  // a simulation's truth, shown beside the fits
 };
 
 /// Aligned table for people: a header line (data, units, stride factor, confidence), one line per

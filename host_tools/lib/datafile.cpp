@@ -92,8 +92,14 @@ bool DataFile::next(double& value) {
     unsigned fields = 0;
     switch (parse_data_line(buffer_, column_, value, fields)) {
       case LineKind::value:
+        seen_value_ = true;
         return true;
       case LineKind::blank:
+        if (!seen_value_ && !buffer_.empty() && buffer_[0] == '#' && header_.size() < max_header_lines) {
+          std::string text = buffer_;
+          while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+          header_.push_back(std::move(text));
+        }
         continue;
       case LineKind::missing_column:
         throw DataFileError("line has " + std::to_string(fields) + " column(s), column " +

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <zlib.h>
 
@@ -54,6 +55,9 @@ class DataFile {
   std::uint64_t bytes_read() const;
   /// Size of the file in bytes, 0 when unknown (standard input, pipes).
   std::uint64_t size_bytes() const { return size_; }
+  /// The '#' lines before the first value (at most 64, without their line ends): where a
+  /// producer such as gyrochar-sim describes the data.
+  const std::vector<std::string>& header() const { return header_; }
 
  private:
   bool read_line();
@@ -63,6 +67,9 @@ class DataFile {
   std::uint64_t line_ = 0;
   std::uint64_t size_ = 0;
   std::string buffer_;
+  bool seen_value_ = false;
+  static constexpr std::size_t max_header_lines = 64;
+  std::vector<std::string> header_;
 };
 
 }  // namespace gyrochar

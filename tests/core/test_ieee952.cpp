@@ -178,13 +178,14 @@ TEST(Ieee952, PeriodicQuantizationIsDetectedAndItsTausLeftOut) {
     if (pt.m == 1 && pt.stat == Stat::avar) pt.variance = 0.6 * ieee952_variance({qw, 0, 0, 0, 0}, Stat::avar, 1, tau0);
   const Ieee952Fit f = fit(pts, FitCurve::both, qw);
   EXPECT_FALSE(f.quantization_white);
-  EXPECT_GT(f.excluded_below_tau_s, tau0);
+  EXPECT_GT(f.excluded_below_tau_s[0], tau0);
   EXPECT_FALSE(f.p[0].fitted);
   EXPECT_NEAR(f.p[1].value / truth[1], 1.0, 1e-3);  // N from the taus quantization leaves alone
   // The same curve without the deficit: white, nothing left out.
   const Ieee952Fit white = fit(exact_points(p), FitCurve::both, qw);
   EXPECT_TRUE(white.quantization_white);
-  EXPECT_EQ(white.excluded_below_tau_s, 0.0);
+  EXPECT_EQ(white.excluded_below_tau_s[0], 0.0);
+  EXPECT_EQ(white.excluded_below_tau_s[1], 0.0);
 }
 
 TEST(Ieee952, AModelThatDoesNotDescribeTheCurveIsRejected) {

@@ -70,8 +70,8 @@ TEST(SimulatedGyro, TheReadmePipelineFindsNFromTheModifiedCurve) {
   ASSERT_TRUE(fit.ok()) << name(fit.status) << ", chi2/dof " << fit.chi2_per_dof();
   EXPECT_FALSE(fit.quantization_white);
   const double n = fit.p[1].value / units::deg_per_sqrt_h;
-  std::printf("N = %.5f +- %.5f deg/sqrt(h), chi2/dof %.3g, taus below %.3g s left out\n", n,
-              fit.p[1].uncertainty / units::deg_per_sqrt_h, fit.chi2_per_dof(), fit.excluded_below_tau_s);
+  std::printf("N = %.5f +- %.5f deg/sqrt(h), chi2/dof %.3g, MVAR taus below %.3g s left out\n", n,
+              fit.p[1].uncertainty / units::deg_per_sqrt_h, fit.chi2_per_dof(), fit.excluded_below_tau_s[1]);
   EXPECT_NEAR(n, 0.003, 0.0003);
   EXPECT_NEAR(fit.p[1].value, 0.003 * units::deg_per_sqrt_h, 3 * fit.p[1].uncertainty);
   EXPECT_FALSE(fit.p[2].resolved) << "no bias instability";

@@ -89,7 +89,7 @@ struct Ieee952Fit {
   double birge = 1;                     // factor applied to the uncertainties (>= 1)
   std::size_t points = 0;               // points used
   bool quantization_white = true;       // false: periodic quantization detected (counts only)
-  double excluded_below_tau_s = 0;      // points below this tau were left out (non-white quantization)
+  std::array<double, 2> excluded_below_tau_s{};  // AVAR, MVAR points below these taus left out (non-white)
   bool ok() const { return status == FitStatus::ok; }
   double chi2_per_dof() const { return dof ? chi2 / static_cast<double>(dof) : 0.0; }
 };
