@@ -9,18 +9,33 @@ namespace {
 
 constexpr double pi = 3.14159265358979323846;
 
-// psi(n + 1/2) for any integer n (psi(1/2 - n) = psi(1/2 + n) by the reflection formula, since
-// cot(pi (n + 1/2)) = 0). Small arguments by the recurrence psi(z + 1) = psi(z) + 1/z from
-// psi(1/2) = -gamma - 2 ln 2, large ones by the asymptotic series (error below 1e-17 for z >= 16).
-double digamma_half(std::int64_t n) {
-  const double a = static_cast<double>(n < 0 ? -n : n);
-  if (a < 16) {
-    double s = -1.96351002602142347944;  // psi(1/2)
-    for (double i = 0; i < a; i += 1) s += 1.0 / (i + 0.5);
-    return s;
+// psi(n + 1/2) for 0 <= n < 64, by the recurrence psi(z + 1) = psi(z) + 1/z from psi(1/2) =
+// -gamma - 2 ln 2.
+constexpr std::array<double, 64> digamma_half_table = [] {
+  std::array<double, 64> t{};
+  t[0] = -1.96351002602142347944;
+  for (std::size_t n = 1; n < t.size(); ++n) t[n] = t[n - 1] + 1.0 / (static_cast<double>(n) - 0.5);
+  return t;
+}();
+
+// psi(a + j + 1/2) for j = -2 .. 2 (out[j + 2]), any integer a >= 0. psi(1/2 - n) = psi(1/2 + n) by
+// the reflection formula (cot(pi (n + 1/2)) = 0). Small arguments from the table, large ones from
+// one asymptotic series (error below 1e-17 for z >= 64) and the recurrence for the neighbours.
+void digamma_row(std::int64_t a, std::array<double, 5>& out) {
+  if (a < 62) {
+    for (std::int64_t j = -2; j <= 2; ++j) {
+      const std::int64_t n = a + j < 0 ? -(a + j) : a + j;
+      out[static_cast<std::size_t>(j + 2)] = digamma_half_table[static_cast<std::size_t>(n)];
+    }
+    return;
   }
-  const double z = a + 0.5, w = 1.0 / (z * z);
-  return std::log(z) - 0.5 / z - w * (1.0 / 12 - w * (1.0 / 120 - w * (1.0 / 252 - w * (1.0 / 240 - w / 132))));
+  const double z = static_cast<double>(a) + 0.5, w = 1.0 / (z * z);
+  const double psi = std::log(z) - 0.5 / z - w * (1.0 / 12 - w * (1.0 / 120 - w * (1.0 / 252 - w * (1.0 / 240 - w / 132))));
+  out[2] = psi;
+  out[3] = psi + 1.0 / z;
+  out[4] = out[3] + 1.0 / (z + 1);
+  out[1] = psi - 1.0 / (z - 1);
+  out[0] = out[1] - 1.0 / (z - 2);
 }
 
 double factorial(int n) {
@@ -100,11 +115,65 @@ Kernel kernel(Stat a, std::uint64_t m_a, Stat b, std::uint64_t m_b) {
   return k;
 }
 
+// R(twice_d, k) for several noises at one argument, sharing the digamma values (flicker noises).
+struct ManyR {
+  std::array<int, max_noises> twice_d{};
+  std::size_t count = 0;
+  bool flicker = false;
+  void at(std::int64_t k, std::array<double, max_noises>& out) const;
+};
+
+double integer_r(int twice_d, double a) {  // R for integer d >= 1, a = |k|
+  const int j = twice_d / 2;
+  double p = a;
+  for (int i = 1; i < j; ++i) p *= a * a - static_cast<double>(i) * i;
+  return (j % 2 ? -p : p) / (2 * factorial(2 * j - 1));
+}
+
+// psi(n + 1/2) for any integer n (beyond the shared row).
+double digamma_half(std::int64_t n) {
+  std::array<double, 5> row{};
+  digamma_row(n < 0 ? -n : n, row);
+  return row[2];
+}
+
+double flicker_r(int twice_d, std::int64_t ak, const std::array<double, 5>& psi) {  // d = j + 1/2
+  const int j = (twice_d - 1) / 2;
+  const double a = static_cast<double>(ak);
+  double p = 1;
+  for (int i = 1; i <= j; ++i) p *= a * a - (i - 0.5) * (i - 0.5);
+  const double s = j <= 2 ? psi[static_cast<std::size_t>(2 + j)] + psi[static_cast<std::size_t>(2 - j)]
+                          : digamma_half(ak + j) + digamma_half(ak - j);
+  return (j % 2 ? p : -p) * s / (2 * pi * factorial(2 * j));
+}
+
+void ManyR::at(std::int64_t k, std::array<double, max_noises>& out) const {
+  const std::int64_t ak = k < 0 ? -k : k;
+  const double a = static_cast<double>(ak);
+  std::array<double, 5> psi{};
+  if (flicker) digamma_row(ak, psi);
+  for (std::size_t t = 0; t < count; ++t) {
+    const int d = twice_d[t];
+    out[t] = d <= 0 ? (k == 0 ? 1.0 : 0.0) : d % 2 == 0 ? integer_r(d, a) : flicker_r(d, ak, psi);
+  }
+}
+
 double covariance(const Kernel& k, int twice_d, std::int64_t lag) {
   double c = 0;
   for (int i = 0; i < k.count; ++i)
     c += k.w[static_cast<std::size_t>(i)] * generalized_autocovariance(twice_d, lag + k.u[static_cast<std::size_t>(i)]);
   return c;
+}
+
+// c_t(lag) of every noise of `r` at once.
+void covariances(const Kernel& k, const ManyR& r, std::int64_t lag, std::array<double, max_noises>& c) {
+  c.fill(0.0);
+  std::array<double, max_noises> values{};
+  for (int i = 0; i < k.count; ++i) {
+    r.at(lag + k.u[static_cast<std::size_t>(i)], values);
+    const double w = k.w[static_cast<std::size_t>(i)];
+    for (std::size_t t = 0; t < r.count; ++t) c[t] += w * values[t];
+  }
 }
 
 std::int64_t floor_div(std::int64_t a, std::int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
@@ -169,20 +238,13 @@ void visit_nodes(std::int64_t lo, std::int64_t hi, std::int64_t step, std::int64
 }  // namespace
 
 double generalized_autocovariance(int twice_d, std::int64_t k) {
-  const double a = static_cast<double>(k < 0 ? -k : k);
-  if (twice_d <= 0) return k == 0 ? 1.0 : 0.0;
-  if (twice_d % 2 == 0) {
-    const int j = twice_d / 2;
-    double p = a;
-    for (int i = 1; i < j; ++i) p *= a * a - static_cast<double>(i) * i;
-    return (j % 2 ? -p : p) / (2 * factorial(2 * j - 1));
-  }
-  const int j = (twice_d - 1) / 2;
-  double p = 1;
-  for (int i = 1; i <= j; ++i) p *= a * a - (i - 0.5) * (i - 0.5);
-  const std::int64_t ak = k < 0 ? -k : k;
-  const double s = digamma_half(ak + j) + digamma_half(ak - j);
-  return (j % 2 ? p : -p) * s / (2 * pi * factorial(2 * j));
+  ManyR r;
+  r.twice_d[0] = twice_d;
+  r.count = 1;
+  r.flicker = twice_d > 0 && twice_d % 2 != 0;
+  std::array<double, max_noises> out{};
+  r.at(k, out);
+  return out[0];
 }
 
 double term_covariance(int alpha, Stat a, std::uint64_t m_a, Stat b, std::uint64_t m_b, std::int64_t lag) {
@@ -208,15 +270,16 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
   const std::uint64_t coarse = a.stride < b.stride ? b.stride : a.stride;
   if (coarse % fine != 0) return out;  // strides must nest (powers of two always do)
   const Kernel k = kernel(a.stat, a.m, b.stat, b.m);
-  std::array<int, max_noises> twice_d{};
-  bool flicker = false;
-  std::size_t noises = 0;
+  ManyR many;
   for (std::size_t t = 0; t < set.count && t < max_noises; ++t) {
     if (!noise_supported(a.stat, set.alpha[t]) || !noise_supported(b.stat, set.alpha[t])) return out;
-    twice_d[t] = 2 - set.alpha[t] + 2 * k.level;
-    flicker |= twice_d[t] % 2 != 0;
-    noises = t + 1;
+    many.twice_d[t] = 2 - set.alpha[t] + 2 * k.level;
+    many.flicker |= many.twice_d[t] % 2 != 0;
+    many.count = t + 1;
   }
+  const auto& twice_d = many.twice_d;
+  const bool flicker = many.flicker;
+  const std::size_t noises = many.count;
   const auto step = static_cast<std::int64_t>(fine);
   const PairCounter pairs{static_cast<std::int64_t>(a.first),
                           static_cast<std::int64_t>(a.first + (a.n - 1) * a.stride),
@@ -273,7 +336,7 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
                 const double w = weight * static_cast<double>(pairs(lag));
                 if (w == 0) return;
                 std::array<double, max_noises> c{};
-                for (std::size_t t = 0; t < noises; ++t) c[t] = covariance(k, twice_d[t], lag);
+                covariances(k, many, lag, c);
                 accumulate(w, c);
               });
   if (flicker) {  // the power-law tails beyond lo and hi, out to the lags that have pairs
@@ -288,10 +351,8 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
       const double L = std::fabs(static_cast<double>(edge) - center);
       const double L_max = std::fabs(static_cast<double>(left ? extent_lo : extent_hi) - center);
       std::array<double, max_noises> c{}, p{};
-      for (std::size_t t = 0; t < noises; ++t) {
-        c[t] = covariance(k, twice_d[t], edge);
-        p[t] = order - (twice_d[t] - 1);  // c ~ lag^-p; 0 where c vanishes beyond the reach anyway
-      }
+      covariances(k, many, edge, c);
+      for (std::size_t t = 0; t < noises; ++t) p[t] = order - (twice_d[t] - 1);  // c ~ lag^-p
       // sum over the lattice beyond the edge = integral / step - f(edge) / 2 (Euler-Maclaurin),
       // with f = pairs(edge) c_t c_u (L / x)^(p_t + p_u) and the pair count taken as constant.
       for (std::size_t t = 0; t < noises; ++t) {

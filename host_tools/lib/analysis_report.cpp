@@ -103,9 +103,13 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   std::vector<CurveFit> fits;
   if (points.empty()) return fits;
   std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
+  // The three fits share the covariance sums of their points: computed once, in a cache with room
+  // for every pair.
+  std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
+  PairSumCache cache(entries);
   const FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
   for (const FitCurve curve : {FitCurve::both, FitCurve::avar, FitCurve::mvar})
-    fits.push_back({curve, fit_ieee952(points, setup, curve, workspace)});
+    fits.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache)});
   return fits;
 }
 

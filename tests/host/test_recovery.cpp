@@ -1,0 +1,51 @@
+// The recovery study (docs/metrology.md, tests/benchmarks/recovery_study.cpp) in small: simulated
+// gyros through the analyzer and the recommended IEEE-952 fit. Oracle: the simulator's parameters
+// (sim_truth.hpp). Loose bounds, 4 standard errors from the study's targets over the pooled runs:
+// resolved terms within 2 stated sigma of the truth in at least 80 % (target 95 %, standard error
+// about 3 points here), terms of zero truth called resolved in at most 15 % (target 5 %), every fit
+// usable, and the periodic quantization of a rate below one pulse per sample found.
+#include <gtest/gtest.h>
+
+#include "support/recovery.hpp"
+
+namespace gyrochar::test_support {
+namespace {
+
+TEST(Recovery, SimulatedGyrosComeBackWithinTheirStatedUncertainties) {
+  RecoverySettings s;
+  s.scenarios.clear();
+  for (const Scenario& full : standard_scenarios()) {
+    // Half an hour (at tau0 0.1 s but for the periodic quantization, which needs its 0.01 s to stay
+    // below one pulse per sample): enough taus for three terms, fast enough for the suite.
+    if (full.name != "ARW + bias instability" && full.name != "ARW + rate ramp" && full.name != "ARW, periodic quantization")
+      continue;
+    Scenario short_run = full;
+    short_run.sim.duration_s = 1800;
+    if (full.name != "ARW, periodic quantization") short_run.sim.tau0_s = 0.1;  // 0.15 pulse per sample kept
+    s.scenarios.push_back(short_run);
+  }
+  ASSERT_EQ(s.scenarios.size(), 3u);
+  s.runs = 16;
+  const auto cells = run_recovery_study(s);
+  std::size_t resolved = 0, within2 = 0, absent = 0, false_resolved = 0;
+  for (const RecoveryCell& c : cells) {
+    EXPECT_EQ(c.ok, c.runs) << c.scenario << ": every fit usable";
+    for (const TermTally& t : c.terms) {
+      resolved += t.resolved - t.false_resolved;
+      within2 += t.within2;
+      absent += t.runs - t.present;
+      false_resolved += t.false_resolved;
+    }
+    std::printf("%s: N resolved in %zu of %zu, within 1 sigma %zu, 2 sigma %zu; chi2/dof %.2f\n", c.scenario.c_str(),
+                c.terms[1].resolved, c.runs, c.terms[1].within1, c.terms[1].within2, c.mean_chi2_per_dof);
+  }
+  ASSERT_GT(resolved, 0u);
+  EXPECT_GE(static_cast<double>(within2) / static_cast<double>(resolved), 0.80) << within2 << " of " << resolved;
+  EXPECT_LE(static_cast<double>(false_resolved) / static_cast<double>(absent), 0.15) << false_resolved << " of " << absent;
+  const RecoveryCell& periodic = cells.at(0);
+  EXPECT_EQ(periodic.scenario, "ARW, periodic quantization");
+  EXPECT_EQ(periodic.quantization_white, 0u) << "a rate of 0.15 pulse per sample without dither is periodic";
+}
+
+}  // namespace
+}  // namespace gyrochar::test_support

@@ -1,0 +1,162 @@
+#include "support/recovery.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "analysis.hpp"
+#include "analysis_report.hpp"
+
+namespace gyrochar::test_support {
+
+std::vector<Scenario> standard_scenarios() {
+  auto make = [](const char* name, double hours, double tau0, auto&& set) {
+    Scenario s{name, {}};
+    s.sim.duration_s = hours * 3600;
+    s.sim.tau0_s = tau0;
+    set(s.sim);
+    return s;
+  };
+  return {
+      // The README's pipeline without and with a whitener: 0.15 pulse per sample of earth rate.
+      make("ARW, periodic quantization", 2, 0.01, [](SimOptions& o) { o.arw_deg_per_sqrt_h = 0.003; }),
+      make("ARW, quantization whitened", 2, 0.01,
+           [](SimOptions& o) {
+             o.arw_deg_per_sqrt_h = 0.003;
+             o.white_angle_arcsec = 1;  // a random dither residue of a pulse
+           }),
+      // The reports: bias instability, rate random walk, a large ARW alone.
+      make("ARW + bias instability", 4, 0.1,
+           [](SimOptions& o) {
+             o.white_angle_arcsec = 1;
+             o.arw_deg_per_sqrt_h = 0.005;
+             o.bias_deg_per_h = 0.05;
+           }),
+      make("ARW + rate random walk", 4, 0.1,
+           [](SimOptions& o) {
+             o.white_angle_arcsec = 1;
+             o.arw_deg_per_sqrt_h = 0.01;
+             o.rrw_deg_per_h_sqrt_h = 0.1;
+           }),
+      make("ARW + rate ramp", 4, 0.1,
+           [](SimOptions& o) {
+             o.white_angle_arcsec = 1;
+             o.arw_deg_per_sqrt_h = 0.005;
+             o.ramp_deg_per_h2 = 1;
+           }),
+      make("large ARW alone", 0.5, 0.1, [](SimOptions& o) { o.arw_deg_per_sqrt_h = 0.1; }),
+      // A complete ring laser gyro: every term dominates somewhere.
+      make("complete RLG", 6, 0.01,
+           [](SimOptions& o) {
+             o.pulse_arcsec = 2;
+             o.white_angle_arcsec = 3;
+             o.arw_deg_per_sqrt_h = 0.003;
+             o.bias_deg_per_h = 0.05;
+             o.rrw_deg_per_h_sqrt_h = 0.15;
+           }),
+  };
+}
+
+Recovery recover(const SimOptions& sim) {
+  GyroSimulator gyro(gyro_parameters(sim));
+  AnalysisOptions o;
+  o.type = DataType::counts;
+  o.tau0_s = sim.tau0_s;
+  const auto n = static_cast<std::uint64_t>(std::llround(sim.duration_s / sim.tau0_s));
+  o.m_list = octave_taus(n + 1);
+  o.stats = {DevStat::oadev, DevStat::mdev};
+  Analyzer analyzer(o);
+  for (std::uint64_t k = 0; k < n; ++k) analyzer.add(static_cast<double>(gyro.next_count()));
+  ReportUnits units;
+  units.gyro = true;
+  units.phase_unit_si = sim.pulse_arcsec * units::arcsec;
+  const auto fits = fit_curves(analyzer.result(), units, sim.tau0_s, units.phase_unit_si / std::sqrt(12.0));
+  return {fits.at(0).fit, ieee952_truth(sim)};
+}
+
+namespace {
+
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15u;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9u;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBu;
+  return x ^ (x >> 31);
+}
+
+void tally(RecoveryCell& cell, const Recovery& r) {
+  const Ieee952Fit& f = r.fit;
+  ++cell.runs;
+  cell.ok += f.status == FitStatus::ok;
+  cell.rejected += f.status == FitStatus::rejected;
+  cell.too_few += f.status == FitStatus::too_few_points;
+  cell.singular += f.status == FitStatus::singular;
+  cell.quantization_white += f.quantization_white;
+  cell.mean_chi2_per_dof += (f.chi2_per_dof() - cell.mean_chi2_per_dof) / static_cast<double>(cell.runs);
+  const std::array<double, 5> truth{r.truth.q_rad, r.truth.n_rad_sqrt_s, r.truth.b_rad_s, r.truth.k_rad_s_sqrt_s,
+                                    r.truth.r_rad_s2};
+  for (std::size_t k = 0; k < 5; ++k) {
+    TermTally& t = cell.terms[k];
+    const Ieee952Parameter& p = f.p[k];
+    ++t.runs;
+    const bool present = truth[k] > 0;
+    t.present += present;
+    const bool usable = f.ok();
+    t.fitted += usable && p.fitted;
+    t.held += usable && !p.fitted && k == 0 && !f.quantization_white;
+    if (!usable || !p.resolved) continue;
+    ++t.resolved;
+    if (!present) {
+      ++t.false_resolved;
+      continue;
+    }
+    const double off = std::fabs(p.value - truth[k]);
+    t.within1 += off <= p.uncertainty;
+    t.within2 += off <= 2 * p.uncertainty;
+  }
+}
+
+}  // namespace
+
+std::vector<RecoveryCell> run_recovery_study(const RecoverySettings& s) {
+  const std::size_t total = s.scenarios.size() * s.runs;
+  std::vector<Recovery> results(total);
+  std::atomic<std::size_t> next{0}, done{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= total) return;
+      SimOptions sim = s.scenarios[i / s.runs].sim;
+      sim.seed = splitmix(splitmix(s.seed) ^ (i / s.runs) * 0x100000001B3u ^ (i % s.runs));
+      try {
+        results[i] = recover(sim);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+        next.store(total);
+      }
+      ++done;
+    }
+  };
+  std::vector<std::thread> threads;
+  for (unsigned w = 0; w < (s.workers ? s.workers : 1); ++w) threads.emplace_back(worker);
+  while (done.load() < total && !failure) {
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    if (s.progress) s.progress(done.load(), total);
+  }
+  for (auto& t : threads) t.join();
+  if (failure) std::rethrow_exception(failure);
+  std::vector<RecoveryCell> cells(s.scenarios.size());
+  for (std::size_t i = 0; i < total; ++i) {  // in run order: the tallies do not depend on scheduling
+    RecoveryCell& c = cells[i / s.runs];
+    c.scenario = s.scenarios[i / s.runs].name;
+    tally(c, results[i]);
+  }
+  return cells;
+}
+
+}  // namespace gyrochar::test_support

@@ -1,0 +1,72 @@
+#pragma once
+// Monte Carlo recovery of simulated gyros by the IEEE-952 fit: simulate a gyro with known
+// parameters many times (gyrochar-sim's simulator), analyze its counts as gyrochar-analyze does
+// (the characterizer, the exact EDFs, the recommended fit of both curves) and count how often each
+// fitted term lies within one and two of its stated standard uncertainties of the truth, and how
+// often a term whose truth is zero is nevertheless called resolved. Used by
+// tests/benchmarks/recovery_study.cpp (the full study, docs/metrology.md) and
+// tests/host/test_recovery.cpp (a small, fast version).
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "gyrochar/ieee952.hpp"
+#include "sim_truth.hpp"
+
+namespace gyrochar::test_support {
+
+/// One simulated gyro of the study: a name for the tables and the simulator's options (the seed
+/// is replaced per run).
+struct Scenario {
+  std::string name;
+  SimOptions sim;
+};
+
+/// The grid of docs/metrology.md: quantization made white by a random dither residue and left
+/// periodic (no dither), angle random walk, bias instability, rate random walk and rate ramp in
+/// the combinations of the reports and a complete RLG.
+std::vector<Scenario> standard_scenarios();
+
+/// One run: the fit and the truth it is judged against (SI units).
+struct Recovery {
+  Ieee952Fit fit;
+  Ieee952Truth truth;
+};
+
+/// Simulates `sim`, analyzes the counts (stride factor full, octave taus) and fits both curves.
+/// O(samples). Throws what the analyzer throws.
+Recovery recover(const SimOptions& sim);
+
+/// The tally of one term over the runs of a scenario.
+struct TermTally {
+  std::size_t runs = 0;
+  std::size_t present = 0;         // runs whose truth is not zero
+  std::size_t fitted = 0;          // the fit kept the term in its model
+  std::size_t resolved = 0;        // ... and called it resolved
+  std::size_t within1 = 0, within2 = 0;  // resolved and within 1 (2) stated sigma of a non-zero truth
+  std::size_t false_resolved = 0;  // resolved although the truth is zero
+  std::size_t held = 0;            // not fitted but held at a known value (Q of periodic quantization)
+};
+
+struct RecoveryCell {
+  std::string scenario;
+  std::size_t runs = 0;
+  std::size_t ok = 0, rejected = 0, too_few = 0, singular = 0;  // fit status counts
+  std::size_t quantization_white = 0;                            // runs that found it white
+  double mean_chi2_per_dof = 0;
+  std::array<TermTally, 5> terms{};                              // Q N B K R
+};
+
+struct RecoverySettings {
+  std::vector<Scenario> scenarios = standard_scenarios();
+  std::size_t runs = 100;   // per scenario
+  unsigned workers = 2;     // results do not depend on it
+  std::uint64_t seed = 1;   // run r of scenario s is seeded by a hash of both and this
+  std::function<void(std::size_t done, std::size_t total)> progress;
+};
+
+std::vector<RecoveryCell> run_recovery_study(const RecoverySettings& settings);
+
+}  // namespace gyrochar::test_support
