@@ -17,9 +17,9 @@ bool configure(BoardCharacterizer& c, const ReportSettings& s) {
 
 ReportWorkspace::ReportWorkspace(unsigned octaves)
     : fit_(ieee952_workspace_doubles(2 * octaves)),
-      // Pairs of taus within the fit's band (8 octaves): at most 17 x 4 per tau; a table less than
-      // half full keeps the probes short.
-      entries_(std::size_t{octaves} * 17 * 4 * 2),
+      // Every pair of the fit's points (both curves of every tau): a table less than half full
+      // keeps the probes short.
+      entries_(std::size_t{octaves} * octaves * 4 * 2 + 64),
       cache_(entries_) {}
 
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,

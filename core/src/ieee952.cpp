@@ -31,7 +31,12 @@ namespace {
 constexpr std::size_t terms = 5;    // Q N B K R
 constexpr std::size_t noises = 4;   // Q N B K: the random ones
 constexpr std::array<int, noises> alphas{2, 0, -1, -2};  // Q N B K
-constexpr int band_octaves = 8;     // estimates further apart are taken as uncorrelated
+// Estimates further apart keep only the white PM part of their covariance. It is exact at any
+// distance and need not decay: fully overlapped Allan estimates share the sum of x^2 and stay
+// correlated by about 0.5 across every tau up to the stride factor. The other noises' correlations
+// fall below 0.02 there (random-walk FM decays slowest, by about 0.7 an octave), and further apart
+// their sums could no longer be evaluated accurately (a difference of nearly equal huge numbers).
+constexpr int band_octaves = 10;
 constexpr double quantization_left_out = 0.01;  // share of a point that makes it unusable (non-white)
 
 // Innovation variance of term t per unit squared parameter: tau0^k.
@@ -180,23 +185,20 @@ void covariance_of_points(const Problem& pr, const std::array<double, terms>& th
   }
 }
 
-// Factors Sigma; where rounding or the band cut leaves it indefinite, shrinks the correlations
-// (by 10 % at a time) until it is not.
+// Factors Sigma; where the band cut leaves it indefinite, raises its diagonal by the least relative
+// amount that makes it definite (from 1e-6, doubling): the points then weigh a little less, their
+// correlations are kept.
 bool factor(const Problem& pr) {
   const std::size_t n = pr.n;
-  for (int attempt = 0; attempt < 30; ++attempt) {
-    // Cholesky works on a copy kept in the upper triangle's mirror: rebuild from the upper part.
-    double* a = pr.sigma;
-    if (cholesky(a, n)) return true;
-    const double shrink = 0.9;
+  double* a = pr.sigma;
+  for (double raise = 0; raise < 1; raise = raise == 0 ? 1e-6 : 2 * raise) {
+    // Cholesky writes the lower triangle and the diagonal; the upper triangle keeps Sigma, the
+    // rows' slot 6 its diagonal.
     for (std::size_t i = 0; i < n; ++i) {
-      for (std::size_t j = 0; j < i; ++j) {
-        a[j * n + i] *= shrink;
-        a[i * n + j] = a[j * n + i];
-      }
-      // restore the diagonal from its mirror copy in the spare column
-      a[i * n + i] = pr.row(i)[6];
+      for (std::size_t j = 0; j < i; ++j) a[i * n + j] = a[j * n + i];
+      a[i * n + i] = pr.row(i)[6] * (1 + raise);
     }
+    if (cholesky(a, n)) return true;
   }
   return false;
 }
@@ -406,9 +408,11 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
       double* g = pr.pair_at(i, j);
       for (std::size_t k = 0; k < 14; ++k) g[k] = 0;
       const int apart = octave(a.m) - octave(b.m);
-      if (apart > band_octaves || apart < -band_octaves) continue;
+      const bool far = apart > band_octaves || apart < -band_octaves;
       const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, setup.n_phase);
-      const PairSums s = cache ? cache->get(ga, gb) : pair_sums(allan_noises(), ga, gb);
+      NoiseSet white_pm = allan_noises();
+      white_pm.count = 1;
+      const PairSums s = cache ? cache->get(ga, gb, far) : pair_sums(far ? white_pm : allan_noises(), ga, gb);
       for (std::size_t t = 0; t < noises; ++t) {
         for (std::size_t u = 0; u <= t; ++u) g[cc_index(t, u)] = s.cc[allan_index[t]][allan_index[u]];
         g[10 + t] = s.c[allan_index[t]];

@@ -452,17 +452,19 @@ void add_scaled(PairSums& out, const PairSums& a, double k, const PairSums& b) {
 
 }  // namespace
 
-PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b) {
-  const NoiseSet set = allan_noises();
+PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b, bool white_pm_only) {
+  NoiseSet set = allan_noises();
+  if (white_pm_only) set.count = 1;  // alpha = 2 comes first
   if (entries_.empty() || a.stat == Stat::hvar || b.stat == Stat::hvar) return pair_sums(set, a, b);
   // Open addressing on the grids' shape.
   std::uint64_t h = (a.m * 0x9E3779B97F4A7C15u) ^ (b.m * 0xC2B2AE3D27D4EB4Fu) ^ (a.stride << 7) ^ (b.stride << 13) ^
-                    (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5);
+                    (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5) ^
+                    (white_pm_only ? 0x5555u : 0u);
   Entry* entry = nullptr;
   for (std::size_t probe = 0; probe < entries_.size(); ++probe) {
-    Entry& e = entries_[(h + probe) % entries_.size()];
+    Entry& e = entries_[static_cast<std::size_t>((h + probe) % entries_.size())];
     if (!e.used || (e.stat_a == a.stat && e.stat_b == b.stat && e.m_a == a.m && e.m_b == b.m &&
-                    e.stride_a == a.stride && e.stride_b == b.stride)) {
+                    e.stride_a == a.stride && e.stride_b == b.stride && e.white_pm_only == white_pm_only)) {
       entry = &e;
       break;
     }
@@ -488,6 +490,7 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b) {
   entry->used = true;
   entry->stat_a = a.stat, entry->stat_b = b.stat, entry->m_a = a.m, entry->m_b = b.m;
   entry->stride_a = a.stride, entry->stride_b = b.stride;
+  entry->white_pm_only = white_pm_only;
   // Linear once the coarse grid spans the terms' reach 32 times over: the flicker tails (summed
   // out to the lags that have pairs) then change by less than 1e-4 of the sums.
   const std::uint64_t coarse = a_coarse ? a.stride : b.stride;

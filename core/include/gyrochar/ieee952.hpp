@@ -17,11 +17,12 @@
 // exact expectations of the discrete estimators (the MVAR of N is N^2 (m^2 + 1)/(2 m^2 tau), ...).
 //
 // The fit. The five squared parameters enter linearly. The covariance of the points is the exact
-// one under the current parameters plus, on the diagonal, (model_spread x point)^2: the model is
-// an idealization of a real sensor, and where a point's own sampling error is far below 1 % (short
-// taus, EDF 10^5) it would otherwise weigh in with a precision no model has. It also keeps the
-// covariance of AVAR and MVAR at one tau, correlated up to 0.99, well conditioned. As the
-// covariance depends on the parameters, the fit iterates: covariance from the current parameters, then the
+// one under the current parameters plus, on the diagonal, (model_spread x point)^2, 0.1 % by
+// default: the model is an idealization, and where a point's own sampling error is far below that
+// (short taus, EDF 10^6) it would otherwise weigh in with a precision no model has; it also keeps
+// the covariance of AVAR and MVAR at one tau, correlated up to 0.99, well conditioned. Estimates
+// more than 10 octaves apart keep only the white PM part of their covariance (ieee952.cpp says
+// why). As the covariance depends on the parameters, the fit iterates: covariance from the current parameters, then the
 // non-negative generalized least-squares solution (every subset of terms is tried, the best
 // feasible one kept; a term left out is "not fitted"). chi2 is the generalized residual; where
 // chi2/dof > 1 every uncertainty is scaled by sqrt(chi2/dof) (the Birge ratio), and where the model
@@ -59,7 +60,7 @@ struct FitSetup {
   double tau0_s = 1.0;
   std::uint64_t n_phase = 0;        // phase points of the run (the unbroken grids)
   double white_quantization = 0.0;  // Q_w in r when the data are counts (pulse weight / sqrt 12); 0: unknown
-  double model_spread = 0.01;       // how closely the model is taken to describe each point (relative)
+  double model_spread = 0.001;      // how closely the model is taken to describe each point (relative)
 };
 
 enum class FitCurve : std::uint8_t { avar, mvar, both };

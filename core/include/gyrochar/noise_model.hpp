@@ -120,6 +120,7 @@ class PairSumCache {
   struct Entry {
     bool used = false;
     bool linear = false;
+    bool white_pm_only = false;
     Stat stat_a = Stat::avar, stat_b = Stat::avar;
     std::uint64_t m_a = 0, m_b = 0, stride_a = 0, stride_b = 0;
     std::uint64_t from = 0;         // linear: valid from this many coarse terms
@@ -127,8 +128,10 @@ class PairSumCache {
     PairSums slope, sums;           // linear: sums = slope * n + sums (the intercept)
   };
   explicit PairSumCache(std::span<Entry> storage) : entries_(storage) {}
-  /// pair_sums(allan_noises(), a, b), from the cache where it can. O(1) once cached.
-  PairSums get(const TermGrid& a, const TermGrid& b);
+  /// pair_sums(allan_noises(), a, b), from the cache where it can. O(1) once cached. With
+  /// white_pm_only, the sums of white PM alone (the other noises left 0): what the fit keeps of
+  /// estimates far apart.
+  PairSums get(const TermGrid& a, const TermGrid& b, bool white_pm_only = false);
   /// Forgets everything (a new configuration). O(capacity).
   void clear();
 
