@@ -609,7 +609,7 @@ NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals
     if (const std::optional<double> to_wire = wire_per_si(node)) {
       std::array<double, 5> wire{};
       for (std::size_t k = 0; k < 5; ++k) wire[k] = (*truth)[k] * *to_wire;
-      PlotLine line{std::nullopt, "simulated gyro's model (truth)", grid, {}};
+      PlotLine line{std::nullopt, "simulated gyro (truth)", grid, {}};
       for (const double tau : grid) line.dev.push_back(model_adev(wire, tau, u.rate));
       p.truth = std::move(line);
     }
@@ -618,9 +618,8 @@ NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals
   // What the node's fit says, before any model line is drawn.
   const auto& fit = node.ieee952_summary;
   if (fit && fit->status == Ieee952Status::rejected) {
-    p.notes.push_back(fmt::format("IEEE-952 fit REJECTED (chi2/dof {:.3g}): the model does not describe "
-                                  "this curve, no model drawn",
-                                  fit->chi2_per_dof));
+    p.notes.push_back(fmt::format("IEEE-952 fit REJECTED (chi2/dof {:.3g}):", fit->chi2_per_dof));
+    p.notes.push_back("the model does not describe the curve");
     return p;
   }
   if (fit && fit->status != Ieee952Status::ok) {
@@ -634,10 +633,11 @@ NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals
       const std::optional<double> tau = fit_excluded_below_tau_s(node, k);
       return tau ? fmt::format("{:.3g} s", *tau) : std::string("?");
     };
-    std::string note = "quantization not white: fit leaves out";
+    std::string note = "left out:";
     const auto [avar, mvar] = fit->excluded_below_log2_m;
-    if (avar != 0) note += " ADEV below " + below(0);
-    if (mvar != 0) note += std::string(avar != 0 ? "," : "") + " MDEV below " + below(1);
+    if (avar != 0) note += " ADEV < " + below(0);
+    if (mvar != 0) note += std::string(avar != 0 ? "," : "") + " MDEV < " + below(1);
+    p.notes.push_back("quantization not white, fit");
     p.notes.push_back(note);
   }
 
@@ -671,7 +671,7 @@ NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals
   if (fit && !fit->quantization_white && !in_model(node.ieee952[0]) && node.scale)
     model[0] = static_cast<double>(node.scale->angle_per_pulse) / std::sqrt(12.0);  // Q held there
   PlotLine sum{std::nullopt,
-               fit ? fmt::format("IEEE-952 model (sum), chi2/dof {:.3g}", fit->chi2_per_dof) : "IEEE-952 model (sum)",
+               fit ? fmt::format("IEEE-952 model, chi2/dof {:.2g}", fit->chi2_per_dof) : "IEEE-952 model (sum)",
                grid,
                {}};
   for (const double tau : grid) sum.dev.push_back(model_adev(model, tau, u.rate));

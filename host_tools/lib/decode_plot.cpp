@@ -105,7 +105,7 @@ void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
   }
   const double y_lo = std::floor(std::log10(y.lo) - 0.05), y_hi = std::ceil(std::log10(y.hi) + 0.05);
   const double x_lo = std::log10(p.tau_min_s), x_hi = std::log10(p.tau_max_s);
-  pls.vpor(0.08, 0.64, 0.10, 0.92);
+  pls.vpor(0.08, 0.60, 0.10, 0.92);  // the legend, outside on the right, gets the rest
   pls.wind(x_lo, x_hi, y_lo, y_hi);
   pls.col0(grid_colour);
   pls.width(0.5);

@@ -240,8 +240,9 @@ TEST(DecodeOutput, PlotOfARejectedFitDrawsNoModelAndSaysSo) {
   EXPECT_EQ(p.adev.size(), 10u);  // the measurements are still drawn
   EXPECT_TRUE(p.terms.empty());
   EXPECT_TRUE(p.read_offs.empty());
-  ASSERT_EQ(p.notes.size(), 1u);
-  EXPECT_EQ(p.notes[0], "IEEE-952 fit REJECTED (chi2/dof 12.5): the model does not describe this curve, no model drawn");
+  ASSERT_EQ(p.notes.size(), 2u);  // two legend lines
+  EXPECT_EQ(p.notes[0], "IEEE-952 fit REJECTED (chi2/dof 12.5):");
+  EXPECT_EQ(p.notes[1], "the model does not describe the curve");
 
   v.ieee952_summary->status = Ieee952Status::too_few_points;
   const NodePlot none = plot_data(v, RateUnit::deg_per_h, intervals);
@@ -260,7 +261,7 @@ TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
   const NodePlot p = plot_data(v, RateUnit::deg_per_h, intervals, &truth);
   ASSERT_EQ(p.terms.size(), 2u);  // N's own line and the model
   EXPECT_EQ(p.terms[0].term, Ieee952Term::angle_random_walk);
-  EXPECT_EQ(p.terms[1].label, "IEEE-952 model (sum), chi2/dof 0.875");
+  EXPECT_EQ(p.terms[1].label, "IEEE-952 model, chi2/dof 0.88");
   // Oracle: IEEE 952's closed form, 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2, Q = 1/sqrt(12) arcsec;
   // deg/h is numerically arcsec/s.
   const double q2 = 1.0 / 12, floor = 2 * std::log(2.0) / std::numbers::pi;
@@ -275,8 +276,9 @@ TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
     const double t = p.truth->tau_s[j];
     expect_rel(p.truth->dev[j], std::sqrt(3 * 2.5 * 2.5 / (t * t) + 0.12 * 0.12 / t), 1e-12);
   }
-  ASSERT_EQ(p.notes.size(), 1u);
-  EXPECT_EQ(p.notes[0], "quantization not white: fit leaves out ADEV below 1 s, MDEV below 0.5 s");  // 0.125 x 2^3, 2^2
+  ASSERT_EQ(p.notes.size(), 2u);
+  EXPECT_EQ(p.notes[0], "quantization not white, fit");
+  EXPECT_EQ(p.notes[1], "left out: ADEV < 1 s, MDEV < 0.5 s");  // 0.125 s x 2^3, 2^2
   EXPECT_EQ(p.read_offs.size(), 1u);  // N at 1 s only: B is not resolved
 
   // A node reporting pulses: no angle to put the truth in.
