@@ -1,6 +1,8 @@
 #include "report.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <span>
 
 #include "gyrochar/estimates.hpp"
@@ -14,6 +16,40 @@ bool configure(BoardCharacterizer& c, const ReportSettings& s) {
   for (unsigned k = 0; k < s.octaves; ++k) m_list[k] = std::uint64_t{1} << k;
   return c.configure({s.stride_factor, s.config_hash}, std::span(m_list.data(), s.octaves)) == ConfigureStatus::ok;
 }
+
+namespace {
+
+protocol::Ieee952Status status_on_wire(FitStatus s) {
+  switch (s) {
+    case FitStatus::ok: return protocol::Ieee952Status::ok;
+    case FitStatus::too_few_points: return protocol::Ieee952Status::too_few_points;
+    case FitStatus::rejected: return protocol::Ieee952Status::rejected;
+    case FitStatus::singular: return protocol::Ieee952Status::singular;
+  }
+  return protocol::Ieee952Status::singular;
+}
+
+/// The summary page of `fit`. The taus below which points were left out are 2 m tau0 of the
+/// longest one left out: on the wire as log2 of 2m, rounded up (exact for the octave taus), 1..31.
+protocol::Ieee952SummaryMsg ieee952_summary(const Ieee952Fit& fit, std::uint8_t seq, double tau0_s) {
+  protocol::Ieee952SummaryMsg m;
+  m.seq = seq;
+  m.status = status_on_wire(fit.status);
+  const double chi2_per_dof = fit.chi2_per_dof();
+  const double largest = static_cast<double>(std::numeric_limits<float>::max());
+  m.chi2_per_dof = static_cast<float>(std::isfinite(chi2_per_dof) ? std::clamp(chi2_per_dof, 0.0, largest) : largest);
+  m.points = static_cast<std::uint32_t>(fit.points);
+  m.quantization_white = fit.quantization_white;
+  for (std::size_t k = 0; k < 2 && !fit.quantization_white; ++k) {
+    const double below_m = fit.excluded_below_tau_s[k] / tau0_s;
+    if (!(below_m > 1)) continue;
+    const double code = std::ceil(std::log2(below_m) - 1e-6);  // 2m tau0 / tau0 may miss 2m by an ulp
+    m.excluded_below_log2_m[k] = static_cast<std::uint8_t>(std::clamp(code, 1.0, 31.0));
+  }
+  return m;
+}
+
+}  // namespace
 
 ReportWorkspace::ReportWorkspace(unsigned octaves)
     : fit_(ieee952_workspace_doubles(2 * octaves)),
@@ -56,12 +92,17 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   // pulse weight over sqrt(12).
   const FitSetup setup{s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)};
   const Ieee952Fit fit = fit_ieee952(std::span(points.data(), n_points), setup, FitCurve::both, work.fit(), &work.cache());
+  // A term in the model goes out with its value and uncertainty, resolved or not (an upper-bound
+  // reading); Resolved also needs an accepted fit. A term left out or held fixed goes out as zeros.
   for (std::size_t k = 0; k < 5; ++k) {
     const Ieee952Parameter& p = fit.p[k];
-    const bool resolved = fit.ok() && p.resolved && p.value > 0;
-    out.ieee952[k] = {seq, static_cast<Ieee952Term>(k), resolved, resolved ? static_cast<float>(p.value) : 0.0f,
-                      resolved ? p.uncertainty / p.value : 0.0};
+    const bool fitted = p.fitted && p.value > 0;
+    const bool resolved = fitted && fit.ok() && p.resolved;
+    out.ieee952[k] = {seq, static_cast<Ieee952Term>(k), resolved, fitted ? static_cast<float>(p.value) : 0.0f,
+                      fitted ? p.uncertainty / p.value : 0.0, fitted};
   }
+  out.ieee952_summary = ieee952_summary(fit, seq, s.tau0_s);
+  out.fit = fit;
 }
 
 protocol::Message report_message(const ReportContent& c, std::size_t k) {
@@ -78,7 +119,7 @@ protocol::Message report_message(const ReportContent& c, std::size_t k) {
     case Slot::clock: return c.clock;
     case Slot::scale: return c.scale;
     case Slot::config: return c.config;
-    case Slot::ieee952: return c.ieee952[s.index];
+    case Slot::ieee952: return s.index == ieee952_summary_page ? Message{c.ieee952_summary} : Message{c.ieee952[s.index]};
   }
   return c.status;
 }

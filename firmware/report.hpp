@@ -52,6 +52,8 @@ struct ReportContent {
   protocol::MetaScaleMsg scale;
   protocol::MetaConfigMsg config;
   std::array<protocol::Ieee952Msg, 5> ieee952{};
+  protocol::Ieee952SummaryMsg ieee952_summary;
+  Ieee952Fit fit;  // the fit the IEEE-952 frames were made from (for logs and tests)
 };
 
 /// What build_report() works in, allocated once for `octaves` taus: the IEEE-952 fit's workspace

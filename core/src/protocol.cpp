@@ -19,6 +19,8 @@ constexpr double edf_log2_offset = -4.0;
 constexpr double rel_uncertainty_step = 1e-4;  // 0.01 %
 constexpr std::uint16_t min_report_period_ms = 100;
 constexpr std::uint16_t max_report_period_ms = 2000;
+constexpr unsigned excluded_code_bits = 5;  // Ieee952 summary: log2 m below which points were left out
+constexpr unsigned ieee952_resolved_bit = 8u, ieee952_fitted_bit = 16u;  // Ieee952 term pages, byte 0
 
 // --- little-endian fields --------------------------------------------------------------------
 
@@ -101,6 +103,12 @@ ProtocolError check(const MetaConfigMsg& m) {
 ProtocolError check(const Ieee952Msg& m) {
   return ok_if(m.term <= Ieee952Term::rate_ramp && nonnegative(m.value) && !std::isnan(m.rel_uncertainty) &&
                m.rel_uncertainty >= 0.0);
+}
+ProtocolError check(const Ieee952SummaryMsg& m) {
+  const auto [avar, mvar] = m.excluded_below_log2_m;
+  constexpr unsigned max_code = (1u << excluded_code_bits) - 1;
+  return ok_if(m.status <= Ieee952Status::singular && nonnegative(m.chi2_per_dof) && avar <= max_code &&
+               mvar <= max_code && (!m.quantization_white || (avar == 0 && mvar == 0)));
 }
 ProtocolError check(const CounterInputMsg&) { return ProtocolError::none; }
 
@@ -222,13 +230,25 @@ ProtocolError decode_metadata(const CanFrame& f, Message& out) {
 }
 
 ProtocolError decode_ieee952(const CanFrame& f, Message& out) {
-  const unsigned term = f.data[0] & 7u;
-  if (term > code(Ieee952Term::rate_ramp)) return ProtocolError::unknown_page;
-  if (f.data[0] & 0xF0u) return ProtocolError::reserved_bits;
+  const unsigned page = f.data[0] & 7u;
+  if (page == ieee952_summary_page) {
+    Ieee952SummaryMsg m;
+    m.seq = f.data[1];
+    m.excluded_below_log2_m[0] = u8(f.data[0] >> 3u);
+    m.chi2_per_dof = get_float(f, 2);
+    m.points = f.data[6];
+    m.excluded_below_log2_m[1] = u8(f.data[7] & 0x1Fu);
+    m.quantization_white = (f.data[7] & 0x20u) != 0;
+    m.status = static_cast<Ieee952Status>(f.data[7] >> 6u);
+    return accept(m, out);
+  }
+  if (page > code(Ieee952Term::rate_ramp)) return ProtocolError::unknown_page;
+  if (f.data[0] & 0xE0u) return ProtocolError::reserved_bits;
   Ieee952Msg m;
   m.seq = f.data[1];
-  m.term = static_cast<Ieee952Term>(term);
-  m.resolved = (f.data[0] & 8u) != 0;
+  m.term = static_cast<Ieee952Term>(page);
+  m.resolved = (f.data[0] & ieee952_resolved_bit) != 0;
+  m.fitted = (f.data[0] & ieee952_fitted_bit) != 0;
   m.value = get_float(f, 2);
   m.rel_uncertainty = static_cast<double>(get(f, 6, 2)) * rel_uncertainty_step;
   return accept(m, out);
@@ -305,6 +325,16 @@ const char* name(InputSource s) {
     case InputSource::strobe_counter: return "strobe_counter";
     case InputSource::can_counter: return "can_counter";
     case InputSource::simulated: return "simulated";
+  }
+  return "invalid";
+}
+
+const char* name(Ieee952Status s) {
+  switch (s) {
+    case Ieee952Status::ok: return "ok";
+    case Ieee952Status::too_few_points: return "too_few_points";
+    case Ieee952Status::rejected: return "rejected";
+    case Ieee952Status::singular: return "singular";
   }
   return "invalid";
 }
@@ -397,10 +427,20 @@ ProtocolError encode(const MetaConfigMsg& msg, std::uint8_t node, CanFrame& fram
 
 ProtocolError encode(const Ieee952Msg& msg, std::uint8_t node, CanFrame& frame) {
   return encode_with(msg, node, ieee952_id, report_len, frame, [&](CanFrame& f) {
-    f.data[0] = u8(code(msg.term) | (msg.resolved ? 8u : 0u));
+    f.data[0] = u8(code(msg.term) | (msg.resolved ? ieee952_resolved_bit : 0u) | (msg.fitted ? ieee952_fitted_bit : 0u));
     f.data[1] = msg.seq;
     put_float(f, 2, msg.value);
     put(f, 6, 2, rel_uncertainty_code(msg.rel_uncertainty));
+  });
+}
+
+ProtocolError encode(const Ieee952SummaryMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, ieee952_id, report_len, frame, [&](CanFrame& f) {
+    f.data[0] = u8(ieee952_summary_page | unsigned{msg.excluded_below_log2_m[0]} << 3);
+    f.data[1] = msg.seq;
+    put_float(f, 2, msg.chi2_per_dof);
+    f.data[6] = u8(static_cast<unsigned>(saturate(msg.points, 8)));
+    f.data[7] = u8(unsigned{msg.excluded_below_log2_m[1]} | (msg.quantization_white ? 0x20u : 0u) | code(msg.status) << 6);
   });
 }
 
@@ -452,15 +492,26 @@ namespace {
 constexpr std::size_t fast_frames(std::size_t tau_count) { return 2 + 2 * tau_count; }
 constexpr std::size_t metadata_pages = 4;
 constexpr std::size_t ieee952_terms = 5;
-constexpr std::size_t slow_list_length(std::size_t tau_count) { return metadata_pages + 2 * tau_count + ieee952_terms; }
-constexpr std::size_t slow_part_length(std::size_t tau_count) {
-  return (slow_list_length(tau_count) + slow_cycle_reports - 1) / slow_cycle_reports;
+/// Metadata pages, tau info and terms per tau, the IEEE-952 terms and (version 2) the fit summary.
+constexpr std::size_t slow_list_length(std::size_t tau_count, std::uint8_t protocol_version) {
+  return metadata_pages + 2 * tau_count + ieee952_terms + (protocol_version >= 2 ? 1 : 0);
 }
+/// Versions 1 and 2 cut into parts of the same length (9 + 2T is odd, 10 + 2T the next integer).
+constexpr std::size_t slow_part_length(std::size_t tau_count) {
+  return (slow_list_length(tau_count, 1) + slow_cycle_reports - 1) / slow_cycle_reports;
+}
+constexpr bool part_lengths_agree() {
+  for (std::size_t t = 0; t <= max_taus; ++t)
+    if ((slow_list_length(t, 2) + slow_cycle_reports - 1) / slow_cycle_reports != slow_part_length(t)) return false;
+  return true;
+}
+static_assert(part_lengths_agree(), "the summary must not move any frame of the version-1 schedule");
 std::size_t slow_part_begin(std::uint8_t seq, std::size_t tau_count) {
   return seq % slow_cycle_reports * slow_part_length(tau_count);
 }
 
-/// Entry j of the slow list: metadata pages, tau info for every tau, terms for every tau, IEEE-952.
+/// Entry j of the slow list: metadata pages, tau info for every tau, terms for every tau, IEEE-952
+/// terms, then the fit summary (version 2; the caller keeps j below the version's list length).
 ReportSlot slow_slot(std::size_t j, std::size_t tau_count) {
   if (j < metadata_pages) {
     constexpr Slot pages[metadata_pages] = {Slot::sampling, Slot::clock, Slot::scale, Slot::config};
@@ -474,14 +525,15 @@ ReportSlot slow_slot(std::size_t j, std::size_t tau_count) {
 }
 }  // namespace
 
-std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count) {
+std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version) {
   const std::size_t begin = slow_part_begin(seq, tau_count);
-  const std::size_t total = slow_list_length(tau_count);
+  const std::size_t total = slow_list_length(tau_count, protocol_version);
   const std::size_t part = begin >= total ? 0 : std::min(slow_part_length(tau_count), total - begin);
   return fast_frames(tau_count) + part;
 }
 
-ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position) {
+ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position,
+                       std::uint8_t /*protocol_version: same positions, only the count differs*/) {
   if (position == 0) return {Slot::status, 0};
   if (position == 1) return {Slot::faults, 0};
   if (position < fast_frames(tau_count)) {

@@ -3,7 +3,9 @@
 // report pacing) through the HAL fakes: a scripted count source, a virtual clock and timer, and an
 // in-process CAN bus with optional frame loss. The host decoder (the pipeline of gyrochar-decode)
 // follows every node, shows its table as the run goes, and leaves a CSV and an ADEV/MDEV plot.
-// Hours of gyro time pass in seconds.
+// Hours of gyro time pass in seconds. The demo knows each gyro's true IEEE-952 parameters
+// (sim_truth.hpp, the simulator's own options): the view shows them beside every node's fitted
+// terms, and the plot draws the true model beside the fitted one.
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
@@ -17,6 +19,7 @@
 #include "decode_plot.hpp"
 #include "decode_session.hpp"
 #include "gyro_sim.hpp"
+#include "sim_truth.hpp"
 #include "hal/fake/fake_can_bus.hpp"
 #include "hal/fake/fake_clock.hpp"
 #include "hal/fake/fake_count_source.hpp"
@@ -97,6 +100,7 @@ int main(int argc, char** argv) {
   bus.set_loss(loss);
   auto host = bus.attach(1 << 16);
   std::vector<std::unique_ptr<Node>> gyros;
+  decoding::TrueTermsByNode truth;  // what the decoder cannot know: each simulated gyro's parameters
   for (unsigned i = 0; i < nodes; ++i) {
     firmware::Config c;
     c.node = static_cast<std::uint8_t>(0x10 + i);
@@ -104,15 +108,25 @@ int main(int argc, char** argv) {
     c.tau0_s = tau0;
     c.octaves = octaves;
     c.report_period_s = 1.0;
-    GyroParameters g;
-    g.tau0_s = tau0;
-    g.q_rad = 2 * units::arcsec;
-    g.n_rad_sqrt_s = (0.002 + 0.001 * i) * units::deg_per_sqrt_h;
-    g.b_rad_s = 0.01 * units::deg_per_h;
-    g.k_rad_s_sqrt_s = 0.03 * units::deg_per_h_sqrt_h;
-    g.seed = 100 + i;
+    // 1 arcsec pulses at the earth rate with 2 arcsec of white angle noise (so the quantization is
+    // white), ARW 0.002, 0.003, ... deg/sqrt(h), bias instability 0.01 deg/h, RRW 0.03 deg/h/sqrt(h).
+    SimOptions o;
+    o.duration_s = hours * 3600;
+    o.tau0_s = tau0;
+    o.pulse_arcsec = 1.0;
+    o.white_angle_arcsec = 2.0;
+    o.arw_deg_per_sqrt_h = 0.002 + 0.001 * i;
+    o.bias_deg_per_h = 0.01;
+    o.rrw_deg_per_h_sqrt_h = 0.03;
+    o.seed = 100 + i;
+    if (const auto problem = check_parameters(o)) {
+      std::fprintf(stderr, "gyrochar-demo: options: %s: %s\n", problem->what, problem->why);
+      return exit_usage;
+    }
+    const Ieee952Truth t = ieee952_truth(o);
+    truth[c.node] = {t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2};
     try {
-      gyros.push_back(std::make_unique<Node>(c, g, bus, clock));
+      gyros.push_back(std::make_unique<Node>(c, gyro_parameters(o), bus, clock));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "gyrochar-demo: node %u: %s\n", i, e.what());
       return exit_usage;
@@ -136,7 +150,8 @@ int main(int argc, char** argv) {
   std::vector<std::int64_t> counts;
   auto show = [&] {
     if (tty) std::fputs("\033[H\033[J", stdout);
-    std::fputs(decoding::format_view(session.decoder(), session.input(), so.shown, so.rate_unit, session.intervals())
+    std::fputs(decoding::format_view(session.decoder(), session.input(), so.shown, so.rate_unit, session.intervals(),
+                                     &truth)
                    .c_str(),
                stdout);
     std::fflush(stdout);
@@ -175,8 +190,11 @@ int main(int argc, char** argv) {
   }
   if (!plot_prefix.empty()) {
     std::vector<decoding::NodePlot> panels;
-    for (const auto& [address, node] : session.decoder().nodes())
-      panels.push_back(decoding::plot_data(node, so.rate_unit, session.intervals()));
+    for (const auto& [address, node] : session.decoder().nodes()) {
+      const auto known = truth.find(address);
+      panels.push_back(decoding::plot_data(node, so.rate_unit, session.intervals(),
+                                           known == truth.end() ? nullptr : &known->second));
+    }
     std::string why;
     if (!decoding::write_plot(plot_prefix, panels, so.confidence, why)) {
       std::fprintf(stderr, "gyrochar-demo: plot: %s\n", why.c_str());

@@ -41,8 +41,32 @@ template <class T>
 Json json_or_null(bool known, T value) {
   return known ? Json(value) : Json(nullptr);
 }
+template <class T>
+Json json_or_null(const std::optional<T>& value) {
+  return value ? Json(*value) : Json(nullptr);
+}
+
+/// Wire value (the node's angle unit) per SI value (rad): the same factor for every IEEE-952 term,
+/// whose other dimensions are seconds on both sides. Nothing for pulses or an unknown unit.
+std::optional<double> wire_per_si(const NodeView& node) {
+  if (!node.scale || node.scale->angle_unit == AngleUnit::pulse) return std::nullopt;
+  const double deg = degrees_per(node.scale->angle_unit);
+  if (!(deg > 0)) return std::nullopt;
+  return 180.0 / std::numbers::pi / deg;
+}
+
+/// A term is in the node's model when fitted (a version-1 node: when resolved).
+bool in_model(const Ieee952View& t) { return t.received && (t.fitted || t.resolved); }
 
 }  // namespace
+
+std::optional<double> fit_excluded_below_tau_s(const NodeView& node, std::size_t k) {
+  if (!node.ieee952_summary || k > 1) return std::nullopt;
+  const std::uint8_t c = node.ieee952_summary->excluded_below_log2_m[k];
+  if (c == 0) return 0.0;
+  if (!node.sampling) return std::nullopt;
+  return static_cast<double>(node.sampling->tau0_s) * std::ldexp(1.0, c);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Units
@@ -161,6 +185,8 @@ void tau_rows(const NodeView& node, const ReportTracker::Report& report, const U
     r.n = t.n;
     r.adev = dev_cell(t.adev, report.adev[i], units.rate, intervals);
     r.mdev = dev_cell(t.mdev, report.mdev[i], units.rate, intervals);
+    r.fit = node.ieee952_summary;
+    r.fit_excluded_below_tau_s = {fit_excluded_below_tau_s(node, 0), fit_excluded_below_tau_s(node, 1)};
     out.push_back(r);
   }
 }
@@ -173,7 +199,9 @@ CsvWriter::CsvWriter(std::FILE* out, double confidence) : out_(out), confidence_
       "time_s,node,seq,tau_index,m,tau_s,n,"
       "adev,adev_low,adev_high,adev_edf,adev_noise,adev_status,"
       "mdev,mdev_low,mdev_high,mdev_edf,mdev_noise,mdev_status,"
-      "rate_unit,ci_level,session\n",
+      "rate_unit,ci_level,session,"
+      "fit_status,fit_chi2_per_dof,fit_points,fit_quantization_white,"
+      "fit_avar_excluded_below_tau_s,fit_mvar_excluded_below_tau_s\n",
       out_);
 }
 
@@ -196,7 +224,15 @@ void CsvWriter::row(const TauRow& r, const Units& units) {
     field(c->status != DevCell::Status::missing, name(c->noise));
     field(true, name(c->status));
   }
-  fmt::format_to(out, FMT_COMPILE("{},{},{}\n"), units.rate_name, confidence_, r.session);
+  fmt::format_to(out, FMT_COMPILE("{},{},{},"), units.rate_name, confidence_, r.session);
+  const bool fit = r.fit.has_value();
+  field(fit, fit ? name(r.fit->status) : "");
+  field(fit, fit ? r.fit->chi2_per_dof : 0.0f);
+  field(fit, fit ? r.fit->points : 0u);
+  field(fit, fit && r.fit->quantization_white ? "true" : "false");
+  field(r.fit_excluded_below_tau_s[0].has_value(), r.fit_excluded_below_tau_s[0].value_or(0.0));
+  if (r.fit_excluded_below_tau_s[1]) fmt::format_to(out, FMT_COMPILE("{}"), *r.fit_excluded_below_tau_s[1]);
+  line_.push_back('\n');
   std::fwrite(line_.data(), 1, line_.size(), out_);
 }
 
@@ -294,11 +330,23 @@ void JsonlWriter::report(double time_s, const NodeView& node, std::uint8_t seq, 
   Json ieee = Json::object();
   for (std::size_t k = 0; k < 5; ++k) {
     const Ieee952View& p = node.ieee952[k];
+    const bool fitted = in_model(p);
     ieee[term_letters[k]] = !p.received ? Json(nullptr)
-                                        : Json{{"resolved", p.resolved},
-                                               {"value", json_or_null(p.resolved, p.value * units.ieee[k])},
+                                        : Json{{"fitted", fitted},
+                                               {"resolved", p.resolved},
+                                               {"value", json_or_null(fitted, p.value * units.ieee[k])},
                                                {"unit", units.ieee_name[k]},
-                                               {"rel_uncertainty", json_or_null(p.resolved, p.rel_uncertainty)}};
+                                               {"rel_uncertainty", json_or_null(fitted, p.rel_uncertainty)}};
+  }
+  Json fit(nullptr);
+  if (const auto& f = node.ieee952_summary) {
+    fit = Json{{"curve", "both"},
+               {"status", name(f->status)},
+               {"chi2_per_dof", f->chi2_per_dof},
+               {"points", f->points},
+               {"quantization_white", f->quantization_white},
+               {"avar_excluded_below_tau_s", json_or_null(fit_excluded_below_tau_s(node, 0))},
+               {"mvar_excluded_below_tau_s", json_or_null(fit_excluded_below_tau_s(node, 1))}};
   }
   const Json j{{"type", "report"},
                {"time_s", time_s},
@@ -317,7 +365,8 @@ void JsonlWriter::report(double time_s, const NodeView& node, std::uint8_t seq, 
                {"health", health_json(node.health)},
                {"metadata", meta},
                {"rate_unit", units.rate_name},
-               {"ieee952", ieee}};
+               {"ieee952", ieee},
+               {"ieee952_fit", fit}};
   line(j.dump());
 }
 
@@ -389,7 +438,60 @@ std::string dev_text(const TauView::Dev& d, double rate, ConfidenceIntervals& in
                   : fmt::format("{:>11.4e}  {:24}", value, "(no EDF)");
 }
 
-void node_view(std::string& s, const NodeView& v, RateUnit rate_unit, ConfidenceIntervals& intervals) {
+std::string seconds_text(const std::optional<double>& tau_s, std::uint8_t log2_m) {
+  return tau_s ? fmt::format("{:.4g} s", *tau_s) : fmt::format("m < 2^{}", log2_m);
+}
+
+/// The IEEE-952 part of a node's view: the summary's headline, then the terms, then what the
+/// reader must not miss (a rejected model, short taus left out), each on its own line.
+void ieee952_view(std::string& s, const NodeView& v, const Units& u, const TrueTerms* truth) {
+  auto out = std::back_inserter(s);
+  const auto& fit = v.ieee952_summary;
+  const bool made = !fit || fit->status == Ieee952Status::ok || fit->status == Ieee952Status::rejected;
+  if (!fit) {
+    s += "  IEEE-952 (node's fit):";  // a version-1 node, or its summary has not arrived yet
+  } else if (made) {
+    fmt::format_to(out, "  IEEE-952 (node's fit of both curves, chi2/dof {:.3g} on {} points):", fit->chi2_per_dof,
+                   fit->points);
+  } else {
+    fmt::format_to(out, "  IEEE-952 (node's fit of both curves): no fit: {} ({} points)",
+                   fit->status == Ieee952Status::too_few_points ? "too few points" : "singular", fit->points);
+  }
+  const std::optional<double> si_to_wire = truth ? wire_per_si(v) : std::nullopt;
+  for (std::size_t k = 0; k < 5 && made; ++k) {
+    const Ieee952View& p = v.ieee952[k];
+    const double shown = u.ieee[k];
+    if (!p.received) {
+      fmt::format_to(out, "  {} -", term_letters[k]);
+    } else if (in_model(p)) {
+      fmt::format_to(out, "  {} {:.4g} {} ({}+-{:.1f}%)", term_letters[k], p.value * shown, u.ieee_name[k],
+                     p.resolved ? "" : "not resolved, ", 100.0 * p.rel_uncertainty);
+    } else if (k == 0 && fit && !fit->quantization_white) {
+      if (v.scale)
+        fmt::format_to(out, "  Q held at {:.4g} {} (pulse weight/sqrt(12))",
+                       static_cast<double>(v.scale->angle_per_pulse) / std::sqrt(12.0) * shown, u.ieee_name[k]);
+      else
+        s += "  Q held at pulse weight/sqrt(12)";
+    } else {
+      fmt::format_to(out, "  {} {}", term_letters[k], fit ? "not fitted" : "not resolved");
+    }
+    if (si_to_wire) fmt::format_to(out, ", simulated {:.4g}", (*truth)[k] * *si_to_wire * shown);
+  }
+  s += '\n';
+  if (fit && fit->status == Ieee952Status::rejected)
+    s += "  MODEL REJECTED: the IEEE-952 terms do not describe this curve\n";
+  if (fit && !fit->quantization_white) {
+    const auto [avar, mvar] = fit->excluded_below_log2_m;
+    s += "  quantization not white: short taus left out";
+    if (avar != 0) fmt::format_to(out, " (AVAR below {}", seconds_text(fit_excluded_below_tau_s(v, 0), avar));
+    if (mvar != 0) fmt::format_to(out, "{}MVAR below {}", avar != 0 ? ", " : " (", seconds_text(fit_excluded_below_tau_s(v, 1), mvar));
+    if (avar != 0 || mvar != 0) s += ')';
+    s += ", Q held at pulse weight/sqrt(12)\n";
+  }
+}
+
+void node_view(std::string& s, const NodeView& v, RateUnit rate_unit, ConfidenceIntervals& intervals,
+               const TrueTerms* truth) {
   const Units u = units_for(v, rate_unit);
   auto out = std::back_inserter(s);
   fmt::format_to(out, "\nnode 0x{:02X}  {}  {}  session {}", v.address, v.online ? "online" : "OFFLINE",
@@ -426,30 +528,24 @@ void node_view(std::string& s, const NodeView& v, RateUnit rate_unit, Confidence
     fmt::format_to(out, "  {:>11} {:>13}  {}  {}  {:>9}  {}\n", tau, n, dev_text(t.adev, u.rate, intervals),
                    dev_text(t.mdev, u.rate, intervals), edf, noise);
   }
-  s += "  IEEE-952 (node's fit):";
-  for (std::size_t k = 0; k < 5; ++k) {
-    const Ieee952View& p = v.ieee952[k];
-    if (!p.received)
-      fmt::format_to(out, "  {} -", term_letters[k]);
-    else if (!p.resolved)
-      fmt::format_to(out, "  {} not resolved", term_letters[k]);
-    else
-      fmt::format_to(out, "  {} {:.4g} {} (+-{:.1f}%)", term_letters[k], p.value * u.ieee[k], u.ieee_name[k],
-                     100.0 * p.rel_uncertainty);
-  }
-  s += '\n';
+  ieee952_view(s, v, u, truth);
 }
 
 }  // namespace
 
 std::string format_view(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown, RateUnit rate_unit,
-                        ConfidenceIntervals& intervals) {
+                        ConfidenceIntervals& intervals, const TrueTermsByNode* truth) {
   std::string s = "gyrochar-decode: " + input_text(decoder, input) + "\n";
   if (!input.bus.empty()) s += "  " + input.bus + "\n";
   std::size_t count = 0;
   for (const auto& [address, v] : decoder.nodes()) {
     if (!shown[address]) continue;
-    node_view(s, v, rate_unit, intervals);
+    const TrueTerms* known = nullptr;
+    if (truth != nullptr) {
+      const auto it = truth->find(address);
+      if (it != truth->end()) known = &it->second;
+    }
+    node_view(s, v, rate_unit, intervals, known);
     ++count;
   }
   if (count == 0) s += "\nno gyrochar node seen yet\n";
@@ -488,7 +584,7 @@ double model_adev(const std::array<double, 5>& qnbkr, double tau_s, double rate)
 
 }  // namespace
 
-NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals& intervals) {
+NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals& intervals, const TrueTerms* truth) {
   const Units u = units_for(node, rate_unit);
   NodePlot p;
   p.title = fmt::format("node 0x{:02X}, session {}", node.address, node.session);
@@ -509,20 +605,58 @@ NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals
   p.tau_min_s = lo / 2.0;
   p.tau_max_s = hi * 2.0;
   const std::vector<double> grid = log_grid(p.tau_min_s, p.tau_max_s);
+  if (truth != nullptr) {
+    if (const std::optional<double> to_wire = wire_per_si(node)) {
+      std::array<double, 5> wire{};
+      for (std::size_t k = 0; k < 5; ++k) wire[k] = (*truth)[k] * *to_wire;
+      PlotLine line{std::nullopt, "simulated gyro (truth)", grid, {}};
+      for (const double tau : grid) line.dev.push_back(model_adev(wire, tau, u.rate));
+      p.truth = std::move(line);
+    }
+  }
+
+  // What the node's fit says, before any model line is drawn.
+  const auto& fit = node.ieee952_summary;
+  if (fit && fit->status == Ieee952Status::rejected) {
+    p.notes.push_back(fmt::format("IEEE-952 fit REJECTED (chi2/dof {:.3g}):", fit->chi2_per_dof));
+    p.notes.push_back("the model does not describe the curve");
+    return p;
+  }
+  if (fit && fit->status != Ieee952Status::ok) {
+    p.notes.push_back(fmt::format("no IEEE-952 fit: {}", fit->status == Ieee952Status::too_few_points
+                                                              ? "too few points"
+                                                              : "singular"));
+    return p;
+  }
+  if (fit && !fit->quantization_white) {
+    const auto below = [&](std::size_t k) {
+      const std::optional<double> tau = fit_excluded_below_tau_s(node, k);
+      return tau ? fmt::format("{:.3g} s", *tau) : std::string("?");
+    };
+    std::string note = "left out:";
+    const auto [avar, mvar] = fit->excluded_below_log2_m;
+    if (avar != 0) note += " ADEV < " + below(0);
+    if (mvar != 0) note += std::string(avar != 0 ? "," : "") + " MDEV < " + below(1);
+    p.notes.push_back("quantization not white, fit");
+    p.notes.push_back(note);
+  }
+
   const auto inside = [&](double tau) { return tau >= p.tau_min_s && tau <= p.tau_max_s; };
   // Where each term's ADEV equals its parameter (s); B has its own rule below.
   static constexpr std::array<double, 5> read_tau_s{std::numbers::sqrt3, 1.0, 0.0, 3.0, std::numbers::sqrt2};
   static constexpr std::array<const char*, 5> read_label{"Q at sqrt(3) s", "N at 1 s", "0.664 B", "K at 3 s",
                                                          "R at sqrt(2) s"};
   constexpr auto b_index = static_cast<std::size_t>(Ieee952Term::bias_instability);
-  std::array<double, 5> all{};
-  std::size_t resolved = 0;
+  std::array<double, 5> model{};  // the fitted model, wire units
+  std::size_t fitted = 0;
   for (std::size_t k = 0; k < 5; ++k) {
     const Ieee952View& t = node.ieee952[k];
-    if (!t.received || !t.resolved) continue;
-    ++resolved;
+    if (!in_model(t)) continue;
+    ++fitted;
+    model[k] = t.value;
+    if (!t.resolved) continue;
     std::array<double, 5> one{};
-    one[k] = all[k] = t.value;
+    one[k] = t.value;
     PlotLine line{static_cast<Ieee952Term>(k),
                   fmt::format("{} {:.3g} {} (±{:.2g}%)", term_letters[k], t.value * u.ieee[k], u.ieee_name[k],
                               100.0 * t.rel_uncertainty),
@@ -533,16 +667,21 @@ NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals
     if (k != b_index && inside(read_tau_s[k]))
       p.read_offs.push_back({read_tau_s[k], model_adev(one, read_tau_s[k], u.rate), read_label[k]});
   }
-  if (resolved == 0) return p;
-  PlotLine sum{std::nullopt, "IEEE-952 model (sum)", grid, {}};
-  for (const double tau : grid) sum.dev.push_back(model_adev(all, tau, u.rate));
-  if (all[b_index] > 0) {  // B: the floor, at the sum's minimum within the points
+  if (fitted == 0) return p;
+  if (fit && !fit->quantization_white && !in_model(node.ieee952[0]) && node.scale)
+    model[0] = static_cast<double>(node.scale->angle_per_pulse) / std::sqrt(12.0);  // Q held there
+  PlotLine sum{std::nullopt,
+               fit ? fmt::format("IEEE-952 model, chi2/dof {:.2g}", fit->chi2_per_dof) : "IEEE-952 model (sum)",
+               grid,
+               {}};
+  for (const double tau : grid) sum.dev.push_back(model_adev(model, tau, u.rate));
+  if (node.ieee952[b_index].resolved && model[b_index] > 0) {  // B: the floor, at the sum's minimum within the points
     std::optional<std::size_t> floor;
     for (std::size_t k = 0; k < grid.size(); ++k) {
       if (grid[k] >= lo && grid[k] <= hi && (!floor || sum.dev[k] < sum.dev[*floor])) floor = k;
     }
     std::array<double, 5> b{};
-    b[b_index] = all[b_index];
+    b[b_index] = model[b_index];
     if (floor) p.read_offs.push_back({grid[*floor], model_adev(b, grid[*floor], u.rate), read_label[b_index]});
   }
   p.terms.push_back(std::move(sum));

@@ -2,7 +2,9 @@
 // What gyrochar-decode makes of the Decoder's node views: display units, confidence intervals, one
 // row per tau per closed report, and the formats built from them: CSV and JSON lines for recording
 // (columns in host_tools/decode/README.md), a text table for the terminal, and the series of the
-// ADEV/MDEV plot with the IEEE-952 model lines.
+// ADEV/MDEV plot with the IEEE-952 model lines. The node's IEEE-952 fit is shown with its summary
+// (protocol version 2: status, chi2/dof, points, quantization); where a gyro's true parameters are
+// known (a simulation), they are shown beside the fit.
 //
 // Units. Deviations arrive in the node's angle unit A per second (metadata AngleUnit). They are
 // shown in the chosen rate unit, the IEEE-952 terms in gyro units (Q arcsec, N deg/sqrt(h), B deg/h,
@@ -15,6 +17,7 @@
 #include <bitset>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -46,6 +49,20 @@ struct Units {
 
 /// The units of `node` for the rate unit `choice`. O(1); allocates the unit names.
 Units units_for(const NodeView& node, RateUnit choice);
+
+// ---------------------------------------------------------------------------------------------
+// The IEEE-952 fit
+
+/// The true IEEE-952 parameters of a node's gyro, where known (a simulation's), in SI: Q rad,
+/// N rad/sqrt(s), B rad/s, K rad/s/sqrt(s), R rad/s^2. Shown beside the node's fit; never for a
+/// node reporting pulses (no angle to convert to).
+using TrueTerms = std::array<double, 5>;
+using TrueTermsByNode = std::map<std::uint8_t, TrueTerms>;
+
+/// The tau below which the node's fit left out the AVAR (k = 0) or MVAR (k = 1) points (periodic
+/// quantization): tau0 2^c, in s; 0 when none were; nullopt while the summary or tau0 is unknown.
+/// O(1).
+std::optional<double> fit_excluded_below_tau_s(const NodeView& node, std::size_t k);
 
 // ---------------------------------------------------------------------------------------------
 // Confidence intervals
@@ -121,6 +138,10 @@ struct TauRow {
   double tau_s = 0.0;   // 0 while unknown
   std::uint64_t n = 0;  // latest AVAR term count received (slow cycle, every 4 reports); 0 unknown
   DevCell adev, mdev;
+  // The node's latest IEEE-952 fit summary (empty: a version-1 node, or not received yet) and the
+  // taus below which it left points out (fit_excluded_below_tau_s()).
+  std::optional<protocol::Ieee952SummaryMsg> fit;
+  std::array<std::optional<double>, 2> fit_excluded_below_tau_s{};
 };
 
 /// The rows of the report of `node` that has just closed (one per tau of its TauCount), from the
@@ -164,8 +185,9 @@ class CsvWriter {
   fmt::memory_buffer line_;
 };
 
-/// JSON lines, one object per line, told apart by "type": "tau" (the CSV row), "report" (one per
-/// closed report: status, node faults, link health, metadata, IEEE-952 terms), "event" (restart,
+/// JSON lines, one object per line, told apart by "type": "tau" (the CSV row but its fit_ columns),
+/// "report" (one per closed report: status, node faults, link health, metadata, IEEE-952 terms and
+/// the fit's summary), "event" (restart,
 /// offline, online, duplicate) and "summary" (once, at the end: input counters and every node's
 /// link health).
 class JsonlWriter {
@@ -189,9 +211,11 @@ class JsonlWriter {
 
 /// The terminal view: input counters, then per shown node its state, metadata, link health, node
 /// faults, the tau table (tau, ADEV and MDEV with confidence intervals, n, EDF, noise) and the
-/// IEEE-952 terms. Plain text, no terminal control codes. O(nodes x taus).
+/// IEEE-952 fit (its summary, and each term: value and uncertainty, whether resolved; with `truth`,
+/// the true value of the nodes it names beside). Plain text, no terminal control codes.
+/// O(nodes x taus).
 std::string format_view(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown, RateUnit rate_unit,
-                        ConfidenceIntervals& intervals);
+                        ConfidenceIntervals& intervals, const TrueTermsByNode* truth = nullptr);
 
 /// The end-of-run summary for stderr: one line for the input, one per node with its link health.
 /// Each line starts with "gyrochar-decode: ".
@@ -217,7 +241,10 @@ struct NodePlot {
   std::string title;                  // "node 0x10, session 0"
   std::string rate_name;              // unit of every deviation
   std::vector<PlotPoint> adev, mdev;  // valid values with a known tau
-  std::vector<PlotLine> terms;        // resolved IEEE-952 terms, then their sum ("model")
+  std::vector<PlotLine> terms;        // resolved IEEE-952 terms, then the fitted model ("sum")
+  std::optional<PlotLine> truth;      // the true model (simulation), drawn dashed beside the fit
+  std::vector<std::string> notes;     // legend lines without a symbol: the fit rejected, short taus
+                                      // left out (quantization not white), no fit
   std::vector<ReadOffPoint> read_offs;
   double tau_min_s = 0.0, tau_max_s = 0.0;  // the tau axis: the points' range widened by 2 on each
                                             // side (0, 0 when there are no points)
@@ -227,8 +254,12 @@ struct NodePlot {
 /// (design brief section 3): Q sqrt(3)/tau, N/sqrt(tau), sqrt(2 ln2/pi) B, K sqrt(tau/3),
 /// R tau/sqrt(2), and read off where the term equals its parameter: Q at tau = sqrt(3) s, N at 1 s,
 /// K at 3 s, R at sqrt(2) s, and B as the floor 0.664 B at the minimum of the model's sum within
-/// the points' taus. Lines span the tau axis; read-off points outside it are left out.
-/// O(taus + line points); allocates.
-NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals& intervals);
+/// the points' taus. The sum is the fitted model: every fitted term, resolved or not, and Q at
+/// pulse weight / sqrt(12) where the node held it there (quantization not white). A fit the node
+/// rejected, or could not make, draws no model line and says so in `notes`. With `truth` (SI), its
+/// model is drawn too (`truth`, the same closed form). Lines span the tau axis; read-off points
+/// outside it are left out. O(taus + line points); allocates.
+NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals& intervals,
+                   const TrueTerms* truth = nullptr);
 
 }  // namespace gyrochar::decoding

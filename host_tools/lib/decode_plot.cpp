@@ -30,9 +30,10 @@ enum Colour : PLINT {
   k_colour,
   r_colour,
   sum_colour,
-  grid_colour
+  grid_colour,
+  truth_colour
 };
-constexpr std::array<std::array<PLINT, 3>, 11> palette{{
+constexpr std::array<std::array<PLINT, 3>, 12> palette{{
     {255, 255, 255},  // background: white
     {0, 0, 0},        // axes, text, read-off points: black
     {31, 119, 180},   // ADEV: blue
@@ -44,6 +45,7 @@ constexpr std::array<std::array<PLINT, 3>, 11> palette{{
     {23, 190, 207},   // R: cyan
     {90, 90, 90},     // the model's sum: dark grey
     {215, 215, 215},  // grid: light grey
+    {227, 119, 194},  // the simulated (true) model: pink
 }};
 
 // Character heights relative to PLplot's default.
@@ -103,7 +105,7 @@ void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
   }
   const double y_lo = std::floor(std::log10(y.lo) - 0.05), y_hi = std::ceil(std::log10(y.hi) + 0.05);
   const double x_lo = std::log10(p.tau_min_s), x_hi = std::log10(p.tau_max_s);
-  pls.vpor(0.08, 0.64, 0.10, 0.92);
+  pls.vpor(0.08, 0.60, 0.10, 0.92);  // the legend, outside on the right, gets the rest
   pls.wind(x_lo, x_hi, y_lo, y_hi);
   pls.col0(grid_colour);
   pls.width(0.5);
@@ -120,25 +122,29 @@ void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
   std::vector<PLINT> opts{PL_LEGEND_SYMBOL, PL_LEGEND_SYMBOL}, colours{adev_colour, mdev_colour}, styles{1, 1};
   std::vector<const char*> glyphs{adev_glyph, mdev_glyph};
 
-  for (const PlotLine& line : p.terms) {
+  const auto draw_line = [&](const PlotLine& line, PLINT colour, PLINT style, PLFLT width) {
     std::vector<PLFLT> x, v;
     for (std::size_t k = 0; k < line.tau_s.size(); ++k) {
       if (!(line.dev[k] > 0)) continue;
       x.push_back(std::log10(line.tau_s[k]));
       v.push_back(std::log10(line.dev[k]));
     }
-    const bool sum = !line.term;
-    const PLINT colour = sum ? sum_colour : term_colours[static_cast<std::size_t>(*line.term)];
     pls.col0(colour);
-    pls.lsty(sum ? 1 : 2);
-    pls.width(sum ? 2.0 : 1.5);
+    pls.lsty(style);
+    pls.width(width);
     pls.line(static_cast<PLINT>(x.size()), x.data(), v.data());
     text.push_back(line.label);
     opts.push_back(PL_LEGEND_LINE);
     colours.push_back(colour);
-    styles.push_back(sum ? 1 : 2);
+    styles.push_back(style);
     glyphs.push_back("");
+  };
+  for (const PlotLine& line : p.terms) {
+    const bool sum = !line.term;
+    draw_line(line, sum ? sum_colour : term_colours[static_cast<std::size_t>(*line.term)], sum ? 1 : 2,
+              sum ? 2.0 : 1.5);
   }
+  if (p.truth) draw_line(*p.truth, truth_colour, 3, 2.0);  // long dashes: told apart from the terms'
   pls.lsty(1);
   draw_series(pls, p.adev, adev_colour, adev_glyph);
   draw_series(pls, p.mdev, mdev_colour, mdev_glyph);
@@ -158,6 +164,13 @@ void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
     colours.push_back(ink);
     styles.push_back(1);
     glyphs.push_back(read_off_glyph);
+  }
+  for (const std::string& note : p.notes) {  // text only: what the fit says
+    text.push_back(note);
+    opts.push_back(PL_LEGEND_NONE);
+    colours.push_back(ink);
+    styles.push_back(1);
+    glyphs.push_back("");
   }
 
   const auto n = static_cast<PLINT>(text.size());

@@ -1,8 +1,9 @@
 #pragma once
 // The ADEV/MDEV plot of gyrochar-decode, drawn with PLplot's cairo drivers (Debian
 // plplot-driver-cairo): one log-log panel per node with both deviations and their confidence
-// intervals as error bars, each resolved IEEE-952 term as its own line, the model's sum and the
-// read-off points (decode_output.hpp, plot_data()).
+// intervals as error bars, each resolved IEEE-952 term as its own line, the model's sum, the
+// read-off points, the simulated model where known (dashed), and in the legend what the node's fit
+// says: rejected (no model drawn), short taus left out (decode_output.hpp, plot_data()).
 #include <string>
 #include <vector>
 

@@ -91,6 +91,7 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
             open_report(v, a, msg.seq);
           }
           v.clock = msg;
+          relayout_if_version_changed(v, a);
           mark_slot(v, a, Slot::clock, 0);
         } else if constexpr (std::is_same_v<M, MetaScaleMsg>) {
           v.scale = msg;
@@ -103,8 +104,13 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
           v.config = msg;
           mark_slot(v, a, Slot::config, 0);
         } else if constexpr (std::is_same_v<M, Ieee952Msg>) {
-          v.ieee952[static_cast<std::size_t>(msg.term)] = {true, msg.resolved, msg.value, msg.rel_uncertainty};
+          v.ieee952[static_cast<std::size_t>(msg.term)] = {true, msg.resolved, msg.value, msg.rel_uncertainty,
+                                                           msg.fitted || msg.resolved};
           mark_slot(v, a, Slot::ieee952, static_cast<std::uint8_t>(msg.term));
+        } else if constexpr (std::is_same_v<M, Ieee952SummaryMsg>) {
+          v.ieee952_summary = msg;
+          relayout_if_version_changed(v, a);
+          mark_slot(v, a, Slot::ieee952, ieee952_summary_page);
         }
       },
       message);
@@ -130,15 +136,23 @@ void Decoder::open_report(NodeView& v, Assembly& a, std::uint8_t seq) {
   a.seq = seq;
   a.lost_at_open = lost;
   a.tau_count = v.have_status ? v.status.tau_count : 0;
+  a.version = v.schedule_version();
   a.received.fill(false);
+  layout(a);
+}
+
+void Decoder::relayout_if_version_changed(const NodeView& v, Assembly& a) {
+  // Versions 1 and 2 put every frame at the same position (protocol.hpp): what was received stays.
+  if (a.version == v.schedule_version()) return;
+  a.version = v.schedule_version();
   layout(a);
 }
 
 void Decoder::layout(Assembly& a) {
   a.position.fill(-1);
-  const std::size_t frames = report_frame_count(a.seq, a.tau_count);
+  const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version);
   for (std::size_t k = 0; k < frames && k < a.received.size(); ++k) {
-    const ReportSlot s = report_slot(a.seq, a.tau_count, k);
+    const ReportSlot s = report_slot(a.seq, a.tau_count, k, a.version);
     a.position[static_cast<std::size_t>(s.slot) * max_taus + s.index] = static_cast<std::int16_t>(k);
   }
 }
@@ -146,7 +160,7 @@ void Decoder::layout(Assembly& a) {
 void Decoder::close_report(NodeView& v, Assembly& a) {
   if (!a.open) return;
   a.open = false;
-  const std::size_t frames = report_frame_count(a.seq, a.tau_count);
+  const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version);
   std::uint64_t missing = 0;
   for (std::size_t k = 0; k < frames && k < a.received.size(); ++k) missing += a.received[k] ? 0 : 1;
   v.health.frames_missing += missing;

@@ -31,11 +31,15 @@ struct TauView {
   Dev adev, mdev;
 };
 
+/// One IEEE-952 term of the node's latest fit.
 struct Ieee952View {
   bool received = false;
-  bool resolved = false;
-  float value = 0.0f;          // in the term's unit (protocol::Ieee952Term)
+  bool resolved = false;       // significant and dominating somewhere, in an accepted fit
+  float value = 0.0f;          // in the term's unit (protocol::Ieee952Term); 0 unless fitted
   double rel_uncertainty = 0.0;
+  bool fitted = false;         // in the fitted model: value and uncertainty are the fit's even when
+                               // not resolved (an upper-bound reading). A version-1 node sends no
+                               // Fitted flag: there it is the Resolved flag.
 };
 
 /// Link health of one node: what went missing and what went wrong, since the decoder started.
@@ -67,7 +71,18 @@ struct NodeView {
   std::optional<protocol::MetaConfigMsg> config;
   std::array<TauView, protocol::max_taus> taus{};
   std::array<Ieee952View, 5> ieee952{};
+  /// The fit's summary (protocol version 2, slow cycle); empty until received, and always for a
+  /// version-1 node, which has none.
+  std::optional<protocol::Ieee952SummaryMsg> ieee952_summary;
   LinkHealth health;
+
+  /// The protocol version whose schedule the node follows: the clock page's, before it arrives 2
+  /// once a summary page came (only version 2 sends one), else 1. A version-1 report then misses
+  /// nothing, and a version-2 report opened before the clock page only leaves its summary
+  /// uncounted.
+  std::uint8_t schedule_version() const {
+    return clock ? clock->protocol_version : ieee952_summary ? std::uint8_t{2} : std::uint8_t{1};
+  }
 
   /// tau in seconds of tau index i, 0 while tau0 or m is unknown.
   double tau_s(std::size_t i) const {
@@ -104,10 +119,12 @@ class Decoder {
     std::uint8_t seq = 0;
     std::uint8_t lost_at_open = 0;  // reports counted lost when the current report opened
     std::uint8_t tau_count = 0;
+    std::uint8_t version = 1;  // the schedule's protocol version (NodeView::schedule_version())
     std::array<bool, 512> received{};  // by slot position in the report
     std::array<std::int16_t, 11 * protocol::max_taus> position{};  // (slot, index) -> position, -1: not in this report
   };
   static void layout(Assembly& a);
+  static void relayout_if_version_changed(const NodeView& v, Assembly& a);
 
   void accept(NodeView& v, Assembly& a, const protocol::Message& message);
   void open_report(NodeView& v, Assembly& a, std::uint8_t seq);

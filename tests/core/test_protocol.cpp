@@ -98,6 +98,18 @@ TEST(ProtocolLayout, FramesMatchTheSpecificationByteForByte) {
   const CanFrame ieee = encoded(Ieee952Msg{4, Ieee952Term::bias_instability, true, 2.0f, 0.1234}, 0x2A);
   EXPECT_EQ(ieee.id, 0x18FF432Au);
   EXPECT_EQ(bytes(ieee), (std::array<std::uint8_t, 8>{0x0A, 0x04, 0x00, 0x00, 0x00, 0x40, 0xD2, 0x04}));
+  // Version 2: Fitted is bit 4; fitted but not resolved: 0x02 | 0x10.
+  const CanFrame fitted = encoded(Ieee952Msg{4, Ieee952Term::bias_instability, false, 2.0f, 0.1234, true}, 0x2A);
+  EXPECT_EQ(bytes(fitted), (std::array<std::uint8_t, 8>{0x12, 0x04, 0x00, 0x00, 0x00, 0x40, 0xD2, 0x04}));
+
+  // The fit summary, page 5: AVAR code 7 in bits 3-7 (0x05 | 7 << 3 = 0x3D); chi2/dof 1.5f =
+  // 0x3FC00000; 40 points; MVAR code 6, QuantizationWhite 0, status rejected (2 << 6): 0x86.
+  const CanFrame summary = encoded(Ieee952SummaryMsg{9, Ieee952Status::rejected, 1.5f, 40, false, {7, 6}}, 0x2A);
+  EXPECT_EQ(summary.id, 0x18FF432Au);
+  EXPECT_EQ(bytes(summary), (std::array<std::uint8_t, 8>{0x3D, 0x09, 0x00, 0x00, 0xC0, 0x3F, 0x28, 0x86}));
+  // White quantization (bit 61: 0x20 in byte 7), status ok, nothing left out.
+  const CanFrame white = encoded(Ieee952SummaryMsg{9, Ieee952Status::ok, 1.5f, 40, true, {0, 0}}, 0x2A);
+  EXPECT_EQ(bytes(white), (std::array<std::uint8_t, 8>{0x05, 0x09, 0x00, 0x00, 0xC0, 0x3F, 0x28, 0x20}));
 
   const CanFrame counter = encoded(CounterInputMsg{0xA1B2C3D4, 0x55, true, false}, 0x10);
   EXPECT_EQ(counter.id, 0x0CFF5010u);
@@ -120,8 +132,9 @@ std::vector<Message> typical_messages() {
       MetaClockMsg{17, 3600000, version},
       MetaScaleMsg{17, 1.5f, AngleUnit::arcsec, InputSource::gpio_quadrature},
       MetaConfigMsg{17, 0xDEADBEEF, 500},
-      Ieee952Msg{17, Ieee952Term::angle_random_walk, true, 3.0e-5f, 0.0125},
+      Ieee952Msg{17, Ieee952Term::angle_random_walk, true, 3.0e-5f, 0.0125, true},
       CounterInputMsg{4000000000u, 200, false, true},
+      Ieee952SummaryMsg{17, Ieee952Status::ok, 0.9375f, 24, false, {5, 4}},
   };
 }
 
@@ -155,6 +168,11 @@ TEST(ProtocolRoundTrip, EveryFieldAtItsLimits) {
       MetaConfigMsg{255, 0xFFFFFFFF, 2000},
       Ieee952Msg{0, Ieee952Term::quantization, false, 0.0f, 0.0},
       Ieee952Msg{255, Ieee952Term::rate_ramp, true, FLT_MAX, 6.5535},
+      Ieee952Msg{255, Ieee952Term::rate_ramp, false, FLT_MAX, 6.5535, true},
+      Ieee952Msg{255, Ieee952Term::rate_ramp, true, FLT_MAX, 6.5535, true},
+      Ieee952SummaryMsg{0, Ieee952Status::ok, 0.0f, 0, true, {0, 0}},
+      Ieee952SummaryMsg{255, Ieee952Status::singular, FLT_MAX, 255, false, {31, 31}},
+      Ieee952SummaryMsg{1, Ieee952Status::too_few_points, FLT_TRUE_MIN, 1, false, {1, 0}},
       CounterInputMsg{0, 0, false, false},
       CounterInputMsg{0xFFFFFFFF, 255, true, true},
   };
@@ -190,6 +208,10 @@ TEST(ProtocolRoundTrip, EveryEnumerationValue) {
     const auto term = static_cast<Ieee952Term>(k);
     EXPECT_EQ(std::get<Ieee952Msg>(round_trip(Ieee952Msg{1, term, true, 1.0f, 0.5})).term, term);
   }
+  for (int k = 0; k < 4; ++k) {
+    const auto status = static_cast<Ieee952Status>(k);
+    EXPECT_EQ(std::get<Ieee952SummaryMsg>(round_trip(Ieee952SummaryMsg{1, status, 1.0f, 9, true, {}})).status, status);
+  }
 }
 
 // --- saturation and quantization -----------------------------------------------------------
@@ -205,6 +227,8 @@ TEST(ProtocolQuantization, CountsSaturateAtTheirFieldWidth) {
   EXPECT_EQ(faults.bus_off_events, 63u);
   EXPECT_EQ(std::get<TauTermsMsg>(round_trip(TauTermsMsg{1, 1, ~std::uint64_t{0}})).n, max48);
   EXPECT_EQ(std::get<MetaClockMsg>(round_trip(MetaClockMsg{1, max40 + 1, 1})).uptime_ms, max40);
+  EXPECT_EQ(std::get<Ieee952SummaryMsg>(round_trip(Ieee952SummaryMsg{1, Ieee952Status::ok, 1.0f, 256, true, {}})).points,
+            255u);
 }
 
 TEST(ProtocolQuantization, EdfIsWithinHalfAStepOfLog2) {
@@ -235,6 +259,34 @@ TEST(ProtocolQuantization, EveryEdfNoiseAndValidCodeIsCanonical) {
     ASSERT_EQ(d.error, ProtocolError::none) << tail;
     EXPECT_EQ(bytes(encoded(d.message, d.node)), bytes(f)) << tail;
   }
+}
+
+TEST(ProtocolQuantization, EverySummaryCodeIsCanonicalOrOutOfRange) {
+  // Exhaustive over the summary page's codes (byte 0 bits 3-7, all of byte 7, points 0, 1, 128,
+  // 255): every combination decodes, except QuantizationWhite with a tau left out, and what decodes
+  // re-encodes unchanged.
+  CanFrame f = encoded(Ieee952SummaryMsg{3, Ieee952Status::ok, 0.5f, 10, true, {}}, 0x07);
+  int accepted = 0;
+  for (unsigned avar = 0; avar < 32; ++avar) {
+    for (unsigned tail = 0; tail < 256; ++tail) {
+      for (unsigned points : {0u, 1u, 128u, 255u}) {
+        f.data[0] = static_cast<std::uint8_t>(ieee952_summary_page | avar << 3);
+        f.data[6] = static_cast<std::uint8_t>(points);
+        f.data[7] = static_cast<std::uint8_t>(tail);
+        const Decoded d = decode(f);
+        const bool white = (tail & 0x20u) != 0, none_left_out = avar == 0 && (tail & 0x1Fu) == 0;
+        if (white && !none_left_out) {
+          EXPECT_EQ(d.error, ProtocolError::out_of_range) << avar << " " << tail;
+          continue;
+        }
+        ASSERT_EQ(d.error, ProtocolError::none) << avar << " " << tail;
+        EXPECT_EQ(bytes(encoded(d.message, d.node)), bytes(f)) << avar << " " << tail;
+        ++accepted;
+      }
+    }
+  }
+  // Per points value: not white, any AVAR code x any MVAR code x any status; white, only codes 0.
+  EXPECT_EQ(accepted, 4 * (32 * 32 * 4 + 4));
 }
 
 TEST(ProtocolQuantization, RelativeUncertaintyInHundredthsOfAPercent) {
@@ -305,6 +357,24 @@ TEST(ProtocolEncode, RejectsWhatTheWireCannotCarryAndLeavesTheFrameAlone) {
   EXPECT_EQ(rejects(Ieee952Msg{1, Ieee952Term::quantization, true, nan_f, 0.1}), range);
   EXPECT_EQ(rejects(Ieee952Msg{1, Ieee952Term::quantization, true, 1.0f, -0.1}), range);
   EXPECT_EQ(rejects(Ieee952Msg{1, Ieee952Term::quantization, true, 1.0f, double(nan_f)}), range);
+  const Ieee952SummaryMsg summary{1, Ieee952Status::ok, 1.0f, 10, false, {3, 2}};
+  Ieee952SummaryMsg bad = summary;
+  bad.status = static_cast<Ieee952Status>(4);
+  EXPECT_EQ(rejects(bad), range);
+  for (float chi2 : {nan_f, inf_f, -1.0f, -FLT_TRUE_MIN}) {
+    bad = summary;
+    bad.chi2_per_dof = chi2;
+    EXPECT_EQ(rejects(bad), range) << chi2;
+  }
+  for (std::size_t k = 0; k < 2; ++k) {
+    bad = summary;
+    bad.excluded_below_log2_m[k] = 32;  // 5 bits
+    EXPECT_EQ(rejects(bad), range) << k;
+    bad = summary;
+    bad.quantization_white = true;  // white quantization leaves nothing out
+    bad.excluded_below_log2_m[1 - k] = 0;
+    EXPECT_EQ(rejects(bad), range) << k;
+  }
 }
 
 /// decode() of a valid frame of `m` after `mutate` changed it.
@@ -331,6 +401,7 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
   const Message scale = MetaScaleMsg{1, 1.0f, AngleUnit::deg, InputSource::unknown};
   const Message config = MetaConfigMsg{1, 7, 1000};
   const Message ieee = Ieee952Msg{1, Ieee952Term::bias_instability, true, 1.0f, 0.1};
+  const Message summary = Ieee952SummaryMsg{1, Ieee952Status::ok, 1.0f, 10, true, {0, 0}};
   const Message counter = CounterInputMsg{1, 1, false, false};
 
   // Envelope, in the order decode() checks it.
@@ -351,13 +422,15 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
   // Multiplexor values without a layout.
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[0] = 2; }), ProtocolError::unknown_page);
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[0] = 3; }), ProtocolError::unknown_page);
-  for (std::uint8_t term : {5, 6, 7}) {
+  for (std::uint8_t term : {6, 7}) {  // 0-4: the terms, 5: the fit summary
     EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { f.data[0] = term; }), ProtocolError::unknown_page);
+    EXPECT_EQ(decode_mutated(summary, [&](CanFrame& f) { f.data[0] = term; }), ProtocolError::unknown_page);
   }
 
   // Reserved bits.
   for (std::uint8_t bit = 4; bit < 8; ++bit) {
     EXPECT_EQ(decode_mutated(status, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    if (bit == 4) continue;  // Fitted since version 2
     EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
   }
   for (std::uint8_t bit = 2; bit < 8; ++bit) {
@@ -390,7 +463,30 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
   EXPECT_EQ(decode_mutated(config, [](CanFrame& f) { f.data[6] = 0xD1, f.data[7] = 0x07; }), range);  // 2001 ms
   for (float bad : {nan_f, -1.0f, inf_f}) {
     EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
+    EXPECT_EQ(decode_mutated(summary, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;  // chi2/dof
   }
+  // White quantization with points left out.
+  EXPECT_EQ(decode_mutated(summary, [](CanFrame& f) { f.data[0] |= 1u << 3; }), range);
+  EXPECT_EQ(decode_mutated(summary, [](CanFrame& f) { f.data[7] |= 1u; }), range);
+}
+
+TEST(ProtocolDecode, VersionOneIeee952FramesStillDecode) {
+  // A version-1 node: Fitted (then reserved) is 0, an unresolved term is all zeros. Written out by
+  // hand from the version-1 layout: term N resolved, 3.0e-5f = 0x37FBA882, 1.25 % = 125.
+  CanFrame f;
+  f.id = 0x18FF4310;
+  f.extended = true;
+  f.len = 8;
+  const std::array<std::uint8_t, 8> resolved{0x09, 0x21, 0x82, 0xA8, 0xFB, 0x37, 0x7D, 0x00};
+  std::copy(resolved.begin(), resolved.end(), f.data.begin());
+  Decoded d = decode(f);
+  ASSERT_EQ(d.error, ProtocolError::none) << name(d.error);
+  EXPECT_EQ(std::get<Ieee952Msg>(d.message), (Ieee952Msg{0x21, Ieee952Term::angle_random_walk, true, 3.0e-5f, 0.0125, false}));
+  const std::array<std::uint8_t, 8> unresolved{0x04, 0x21, 0, 0, 0, 0, 0, 0};
+  std::copy(unresolved.begin(), unresolved.end(), f.data.begin());
+  d = decode(f);
+  ASSERT_EQ(d.error, ProtocolError::none) << name(d.error);
+  EXPECT_EQ(std::get<Ieee952Msg>(d.message), (Ieee952Msg{0x21, Ieee952Term::rate_ramp, false, 0.0f, 0.0, false}));
 }
 
 TEST(ProtocolDecode, RandomFramesNeverCrashAndAcceptedOnesAreCanonical) {
@@ -458,63 +554,98 @@ TEST(ProtocolNames, EveryValueHasItsOwnName) {
   for (int k = 0; k < 5; ++k) seen.push_back(name(static_cast<AngleUnit>(k)));
   for (int k = 0; k < 5; ++k) seen.push_back(name(static_cast<InputSource>(k)));
   for (int k = 0; k < 5; ++k) seen.push_back(name(static_cast<Ieee952Term>(k)));
+  for (int k = 0; k < 4; ++k) seen.push_back(name(static_cast<Ieee952Status>(k)));
   for (int k = 0; k <= static_cast<int>(ProtocolError::out_of_range); ++k)
     seen.push_back(name(static_cast<ProtocolError>(k)));
   for (const std::string& s : seen) EXPECT_NE(s, "invalid");
   EXPECT_STREQ(name(static_cast<NoiseType>(9)), "invalid");
   EXPECT_STREQ(name(static_cast<AngleUnit>(9)), "invalid");
+  EXPECT_STREQ(name(static_cast<Ieee952Status>(4)), "invalid");
 }
 
 // --- schedule and bus load -----------------------------------------------------------------
 
 TEST(ProtocolSchedule, FastFramesEveryReportSlowListOncePerCycle) {
-  for (std::size_t taus : {0u, 1u, 3u, 32u, 40u, 64u}) {
-    // Brute force: count every slot over the four reports of a cycle.
-    std::map<std::pair<Slot, int>, int> count;
-    std::size_t longest = 0;
-    for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) {
-      const std::size_t n = report_frame_count(seq, taus);
-      longest = std::max(longest, n);
-      ASSERT_GE(n, 2 + 2 * taus);
-      EXPECT_EQ(report_slot(seq, taus, 0).slot, Slot::status);  // the heartbeat opens every report
-      EXPECT_EQ(report_slot(seq, taus, 1).slot, Slot::faults);
+  for (std::uint8_t protocol_version : {std::uint8_t{1}, std::uint8_t{2}}) {
+    for (std::size_t taus : {0u, 1u, 3u, 32u, 40u, 64u}) {
+      // Brute force: count every slot over the four reports of a cycle.
+      std::map<std::pair<Slot, int>, int> count;
+      std::size_t longest = 0;
+      for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) {
+        const std::size_t n = report_frame_count(seq, taus, protocol_version);
+        longest = std::max(longest, n);
+        ASSERT_GE(n, 2 + 2 * taus);
+        EXPECT_EQ(report_slot(seq, taus, 0, protocol_version).slot, Slot::status);  // the heartbeat opens every report
+        EXPECT_EQ(report_slot(seq, taus, 1, protocol_version).slot, Slot::faults);
+        for (std::size_t i = 0; i < taus; ++i) {
+          const ReportSlot a = report_slot(seq, taus, 2 + 2 * i, protocol_version);
+          const ReportSlot m = report_slot(seq, taus, 3 + 2 * i, protocol_version);
+          EXPECT_EQ(a.slot, Slot::adev);
+          EXPECT_EQ(m.slot, Slot::mdev);
+          EXPECT_EQ(a.index, i);
+          EXPECT_EQ(m.index, i);
+        }
+        for (std::size_t p = 2 + 2 * taus; p < n; ++p) {
+          const ReportSlot s = report_slot(seq, taus, p, protocol_version);
+          ++count[{s.slot, s.index}];
+        }
+      }
+      // Every slow item exactly once per cycle: 4 metadata pages, tau info and terms per tau, 5
+      // terms and (version 2) the fit summary.
+      std::size_t slow = 0;
+      for (Slot s : {Slot::sampling, Slot::clock, Slot::scale, Slot::config}) {
+        EXPECT_EQ((count[{s, 0}]), 1);
+        ++slow;
+      }
       for (std::size_t i = 0; i < taus; ++i) {
-        const ReportSlot a = report_slot(seq, taus, 2 + 2 * i), m = report_slot(seq, taus, 3 + 2 * i);
-        EXPECT_EQ(a.slot, Slot::adev);
-        EXPECT_EQ(m.slot, Slot::mdev);
-        EXPECT_EQ(a.index, i);
-        EXPECT_EQ(m.index, i);
+        EXPECT_EQ((count[{Slot::tau_info, static_cast<int>(i)}]), 1) << i;
+        EXPECT_EQ((count[{Slot::terms, static_cast<int>(i)}]), 1) << i;
+        slow += 2;
       }
-      for (std::size_t p = 2 + 2 * taus; p < n; ++p) {
-        const ReportSlot s = report_slot(seq, taus, p);
-        ++count[{s.slot, s.index}];
+      for (int t = 0; t < 5; ++t) {
+        EXPECT_EQ((count[{Slot::ieee952, t}]), 1) << t;
+        ++slow;
+      }
+      if (protocol_version >= 2) {
+        EXPECT_EQ((count[{Slot::ieee952, int{ieee952_summary_page}}]), 1);
+        ++slow;
+      }
+      EXPECT_EQ(count.size(), slow);
+      EXPECT_EQ(longest, 2 + 2 * taus + (slow + 3) / 4) << taus;
+      // The cycle follows seq modulo 4, so it survives the wrap 255 -> 0.
+      for (unsigned seq = 0; seq < 256; ++seq) {
+        const auto s = static_cast<std::uint8_t>(seq);
+        ASSERT_EQ(report_frame_count(s, taus, protocol_version), report_frame_count(s % 4, taus, protocol_version));
+        const std::size_t last = report_frame_count(s, taus, protocol_version) - 1;
+        EXPECT_EQ(report_slot(s, taus, last, protocol_version).slot, report_slot(s % 4, taus, last, protocol_version).slot);
+        EXPECT_EQ(report_slot(s, taus, last, protocol_version).index, report_slot(s % 4, taus, last, protocol_version).index);
       }
     }
-    // Every slow item exactly once per cycle: 4 metadata pages, tau info and terms per tau, 5 terms.
-    std::size_t slow = 0;
-    for (Slot s : {Slot::sampling, Slot::clock, Slot::scale, Slot::config}) {
-      EXPECT_EQ((count[{s, 0}]), 1);
-      ++slow;
+  }
+}
+
+TEST(ProtocolSchedule, VersionTwoOnlyAppendsTheSummary) {
+  // Brute force over every tau count: the version-1 frames keep their positions in version 2, and
+  // over a cycle version 2 has exactly one frame more, the summary, last in its report.
+  for (std::size_t taus = 0; taus <= max_taus; ++taus) {
+    std::size_t extra = 0;
+    for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) {
+      const std::size_t v1 = report_frame_count(seq, taus, 1), v2 = report_frame_count(seq, taus, 2);
+      ASSERT_GE(v2, v1);
+      extra += v2 - v1;
+      for (std::size_t p = 0; p < v1; ++p) {
+        const ReportSlot a = report_slot(seq, taus, p, 1), b = report_slot(seq, taus, p, 2);
+        EXPECT_EQ(a.slot, b.slot) << taus << " " << int(seq) << " " << p;
+        EXPECT_EQ(a.index, b.index) << taus << " " << int(seq) << " " << p;
+      }
+      if (v2 > v1) {
+        const ReportSlot s = report_slot(seq, taus, v2 - 1, 2);
+        EXPECT_EQ(s.slot, Slot::ieee952);
+        EXPECT_EQ(s.index, ieee952_summary_page);
+      }
     }
-    for (std::size_t i = 0; i < taus; ++i) {
-      EXPECT_EQ((count[{Slot::tau_info, static_cast<int>(i)}]), 1) << i;
-      EXPECT_EQ((count[{Slot::terms, static_cast<int>(i)}]), 1) << i;
-      slow += 2;
-    }
-    for (int t = 0; t < 5; ++t) {
-      EXPECT_EQ((count[{Slot::ieee952, t}]), 1) << t;
-      ++slow;
-    }
-    EXPECT_EQ(count.size(), slow);
-    EXPECT_EQ(longest, 2 + 2 * taus + (slow + 3) / 4) << taus;
-    // The cycle follows seq modulo 4, so it survives the wrap 255 -> 0.
-    for (unsigned seq = 0; seq < 256; ++seq) {
-      const auto s = static_cast<std::uint8_t>(seq);
-      ASSERT_EQ(report_frame_count(s, taus), report_frame_count(s % 4, taus));
-      const std::size_t last = report_frame_count(s, taus) - 1;
-      EXPECT_EQ(report_slot(s, taus, last).slot, report_slot(s % 4, taus, last).slot);
-      EXPECT_EQ(report_slot(s, taus, last).index, report_slot(s % 4, taus, last).index);
-    }
+    EXPECT_EQ(extra, 1u) << taus;
+    EXPECT_EQ(report_frame_count(0, taus), report_frame_count(0, taus, version));  // the default is the current
   }
 }
 
@@ -523,11 +654,12 @@ TEST(ProtocolBusLoad, WorstCaseFrameLengthsAndLoadPerNode) {
   EXPECT_EQ(worst_case_frame_bits(0), 80u);
   EXPECT_EQ(worst_case_frame_bits(6), 140u);
   EXPECT_EQ(worst_case_frame_bits(8), 160u);
-  // 32 taus, one report per second: longest report 2 + 64 + ceil(73 / 4) = 85 frames of 160 bits.
+  // 32 taus, one report per second: longest report 2 + 64 + ceil(74 / 4) = 85 frames of 160 bits
+  // (version 1: ceil(73 / 4), the same 85: the summary fills a shorter report).
   const double load32 = worst_case_bus_load(32, 1.0, 500000.0);
   EXPECT_DOUBLE_EQ(load32, 85 * 160 / 500000.0);
   EXPECT_LE(load32, 0.03);
-  // 40 taus (the design brief's example): 2 + 80 + ceil(89 / 4) = 105 frames.
+  // 40 taus (the design brief's example): 2 + 80 + ceil(90 / 4) = 105 frames.
   EXPECT_DOUBLE_EQ(worst_case_bus_load(40, 1.0, 500000.0), 105 * 160 / 500000.0);
 }
 

@@ -88,9 +88,18 @@ Expected expected(const MetaConfigMsg& m) {
 }
 Expected expected(const Ieee952Msg& m) {
   static const char* const value_signal[] = {"Q", "N", "B", "K", "R"};
-  return {{{"Term", static_cast<int>(m.term)}, {"Resolved", m.resolved ? 1 : 0}, {"Seq", m.seq},
-           {value_signal[static_cast<int>(m.term)], physical(m.value)}, {"RelUncertainty", m.rel_uncertainty * 100.0}},
+  const std::string p = value_signal[static_cast<int>(m.term)];
+  return {{{"Term", static_cast<int>(m.term)}, {p + "_Resolved", m.resolved ? 1 : 0}, {p + "_Fitted", m.fitted ? 1 : 0},
+           {"Seq", m.seq}, {p, physical(m.value)}, {p + "_RelUncertainty", m.rel_uncertainty * 100.0}},
           {{"Term", name(m.term)}}};
+}
+Expected expected(const Ieee952SummaryMsg& m) {
+  // The codec has no name for the summary page's multiplexor value: the DBC calls it fit_summary.
+  return {{{"Term", ieee952_summary_page}, {"Seq", m.seq}, {"AvarExcludedLog2M", m.excluded_below_log2_m[0]},
+           {"Chi2PerDof", physical(m.chi2_per_dof)}, {"FitPoints", m.points},
+           {"MvarExcludedLog2M", m.excluded_below_log2_m[1]}, {"QuantizationWhite", m.quantization_white ? 1 : 0},
+           {"FitStatus", static_cast<int>(m.status)}},
+          {{"Term", "fit_summary"}, {"FitStatus", name(m.status)}}};
 }
 Expected expected(const CounterInputMsg& m) {
   return {{{"Count", m.count}, {"Seq", m.seq}, {"CountError", m.count_error ? 1 : 0},
@@ -115,7 +124,9 @@ Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
     case Slot::scale: return MetaScaleMsg{seq, 1.5f, AngleUnit::arcsec, InputSource::strobe_counter};
     case Slot::config: return MetaConfigMsg{seq, 0xC0FFEE01u, 1000};
     case Slot::ieee952:
-      return Ieee952Msg{seq, static_cast<Ieee952Term>(i), i != 4, 0.001f * static_cast<float>(i + 1), 0.05 * (i + 1)};
+      if (i == ieee952_summary_page) return Ieee952SummaryMsg{seq, Ieee952Status::ok, 0.875f, 6, true, {0, 0}};
+      return Ieee952Msg{seq, static_cast<Ieee952Term>(i), i < 3, i < 4 ? 0.001f * static_cast<float>(i + 1) : 0.0f,
+                        i < 4 ? 0.05 * (i + 1) : 0.0, i < 4};  // K fitted, not resolved; R not fitted
   }
   return StatusMsg{};
 }
@@ -153,8 +164,13 @@ std::vector<Entry> frames() {
       MetaScaleMsg{3, 4.2e-4f, AngleUnit::deg, InputSource::simulated},
       MetaConfigMsg{255, 0xFFFFFFFFu, 2000},
       MetaConfigMsg{0, 0, 100},
-      Ieee952Msg{255, Ieee952Term::rate_ramp, true, FLT_MAX, 6.5535},
-      Ieee952Msg{0, Ieee952Term::quantization, false, 0.0f, 0.0},
+      Ieee952Msg{255, Ieee952Term::rate_ramp, true, FLT_MAX, 6.5535, true},
+      Ieee952Msg{0, Ieee952Term::quantization, false, 0.0f, 0.0, false},
+      Ieee952Msg{7, Ieee952Term::angle_random_walk, true, 1.0e-4f, 0.02, false},  // as a version-1 node sends it
+      Ieee952SummaryMsg{255, Ieee952Status::rejected, FLT_MAX, 255, false, {31, 31}},
+      Ieee952SummaryMsg{0, Ieee952Status::too_few_points, 0.0f, 0, true, {0, 0}},
+      Ieee952SummaryMsg{1, Ieee952Status::singular, 0.0f, 3, false, {4, 0}},
+      Ieee952SummaryMsg{2, Ieee952Status::ok, 1.25f, 48, false, {0, 5}},
       CounterInputMsg{0xFFFFFFFFu, 255, true, true},
       CounterInputMsg{0, 0, false, false},
       CounterInputMsg{123456789, 17, false, true},

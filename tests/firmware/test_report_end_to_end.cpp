@@ -1,9 +1,13 @@
 // Board to host over the protocol: simulated gyro counts -> the board's estimator -> report frames
 // (the codec) -> the host decoder. Oracles: the offline analyzer on the same counts (the decoded
 // ADEV and MDEV must equal its values rounded to float32, exactly: both come from the same exact
-// integer sums) and the decoder's own loss accounting (a complete report, nothing missing).
+// integer sums), the decoder's own loss accounting (a complete report, nothing missing), and the
+// board's own IEEE-952 fit (ReportContent::fit): the decoded summary and terms must say what it says,
+// to the wire's resolution.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -14,6 +18,35 @@
 
 namespace gyrochar {
 namespace {
+
+/// The decoded IEEE-952 summary and terms against the fit the board made them from.
+void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, double tau0_s) {
+  ASSERT_TRUE(v.ieee952_summary.has_value());
+  const protocol::Ieee952SummaryMsg& s = *v.ieee952_summary;
+  EXPECT_STREQ(name(s.status), fit.status == FitStatus::ok               ? "ok"
+                               : fit.status == FitStatus::too_few_points ? "too_few_points"
+                               : fit.status == FitStatus::rejected       ? "rejected"
+                                                                         : "singular");
+  EXPECT_EQ(s.chi2_per_dof, static_cast<float>(fit.chi2_per_dof()));
+  EXPECT_EQ(s.points, fit.points);
+  EXPECT_EQ(s.quantization_white, fit.quantization_white);
+  for (std::size_t k = 0; k < 2; ++k) {
+    // On the wire: log2(2m) of the longest tau left out; the octave taus make it exact.
+    const double below_s = s.excluded_below_log2_m[k] == 0 ? 0.0 : tau0_s * std::ldexp(1.0, s.excluded_below_log2_m[k]);
+    EXPECT_NEAR(below_s, fit.excluded_below_tau_s[k], 1e-12 * fit.excluded_below_tau_s[k]) << k;
+  }
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Ieee952Parameter& p = fit.p[k];
+    const Ieee952View& t = v.ieee952[k];
+    const bool fitted = p.fitted && p.value > 0;
+    EXPECT_EQ(t.fitted, fitted) << k;
+    EXPECT_EQ(t.resolved, fitted && fit.ok() && p.resolved) << k;
+    EXPECT_EQ(t.value, fitted ? static_cast<float>(p.value) : 0.0f) << k;
+    // 0.01 % steps, saturating at 655.35 %.
+    const double rel = fitted ? std::min(p.uncertainty / p.value, 6.5535) : 0.0;
+    EXPECT_NEAR(t.rel_uncertainty, rel, 0.5e-4 + 1e-12) << k;
+  }
+}
 
 TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
   GyroParameters g;
@@ -85,6 +118,47 @@ TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
   }
   EXPECT_GE(compared, 2u * 15);
   EXPECT_TRUE(v.ieee952[1].resolved);  // angle random walk is there and resolved
+  // The summary and the terms travel in report 3 (16 taus: the last part of the slow cycle), the
+  // last one built: `content` holds the fit they came from.
+  EXPECT_TRUE(content.fit.quantization_white);  // 2 arcsec of white angle noise: the counts are random
+  expect_decoded_fit_is_the_boards(v, content.fit, s.tau0_s);
+}
+
+TEST(ReportEndToEnd, PeriodicQuantizationReachesTheDecoderAsTheBoardsFitSaysIt) {
+  // A steady rate of 0.15 pulse per sample with almost no noise: the quantization error is periodic,
+  // the fit leaves the short taus out and holds Q (ieee952.hpp). The decoder must hear exactly that.
+  GyroParameters g;
+  g.tau0_s = 0.01;
+  g.pulse_weight_rad = units::arcsec;
+  g.rate_rad_s = 15 * units::arcsec;  // 15 arcsec/s
+  g.n_rad_sqrt_s = 0.0005 * units::deg_per_sqrt_h;
+  g.seed = 7;
+  GyroSimulator sim(g);
+  firmware::ReportSettings s;
+  s.tau0_s = g.tau0_s;
+  s.octaves = 16;
+  auto board = std::make_unique<firmware::BoardCharacterizer>();
+  ASSERT_TRUE(firmware::configure(*board, s));
+  Decoder decoder;
+  double t = 0;
+  firmware::ReportContent content;
+  firmware::ReportWorkspace workspace(s.octaves);
+  for (std::uint8_t seq = 0; seq < 4; ++seq) {
+    for (int k = 0; k < 100000; ++k) board->add_increment(static_cast<std::int32_t>(sim.next_count()));
+    firmware::build_report(*board, s, seq, 1000u * (seq + 1), {}, workspace, content);
+    for (std::size_t k = 0; k < protocol::report_frame_count(seq, s.octaves); ++k) {
+      CanFrame f;
+      ASSERT_EQ(protocol::encode(firmware::report_message(content, k), 0x22, f), protocol::ProtocolError::none);
+      decoder.feed(f, t += 0.001);
+    }
+  }
+  decoder.flush();
+  const NodeView& v = decoder.nodes().at(0x22);
+  EXPECT_EQ(v.health.frames_missing, 0u);
+  EXPECT_FALSE(content.fit.quantization_white);
+  EXPECT_GT(content.fit.excluded_below_tau_s[0] + content.fit.excluded_below_tau_s[1], 0.0);
+  EXPECT_FALSE(v.ieee952[0].fitted);  // Q held, not fitted
+  expect_decoded_fit_is_the_boards(v, content.fit, s.tau0_s);
 }
 
 }  // namespace

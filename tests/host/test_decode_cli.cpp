@@ -74,6 +74,9 @@ struct NodeSpec {
   std::uint8_t taus = 6;
   AngleUnit unit = AngleUnit::arcsec;
   float tau0_s = 0.01f;
+  std::uint8_t protocol_version = version;  // 1: no fit summary, no Fitted flag
+  Ieee952Status fit = Ieee952Status::ok;
+  bool quantization_white = true;           // false: AVAR below 8 tau0, MVAR below 4 tau0 left out
 };
 
 float adev_of(const NodeSpec& n, std::uint8_t seq, std::size_t i) {
@@ -86,6 +89,7 @@ std::uint64_t n_of(std::uint8_t seq, std::size_t i) { return 1000u * (seq + 1u) 
 std::uint64_t m_of(std::size_t i) { return std::uint64_t{1} << i; }
 float ieee_of(std::size_t k) { return 0.001f * static_cast<float>(k + 1); }
 bool ieee_resolved(std::size_t k) { return k != 4; }  // R not resolved
+float chi2_per_dof_of(const NodeSpec& n) { return n.fit == Ieee952Status::rejected ? 7.5f : 0.75f; }
 
 Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t samples) {
   switch (s.slot) {
@@ -104,13 +108,28 @@ Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t
     case Slot::sampling:
       return MetaSamplingMsg{seq, n.tau0_s, 8};
     case Slot::clock:
-      return MetaClockMsg{seq, samples * 10, version};
+      return MetaClockMsg{seq, samples * 10, n.protocol_version};
     case Slot::scale:
       return MetaScaleMsg{seq, 1.0f, n.unit, InputSource::simulated};
     case Slot::config:
       return MetaConfigMsg{seq, 0xC0FFEEu, 1000};
-    case Slot::ieee952:
-      return Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), ieee_resolved(s.index), ieee_of(s.index), 0.125};
+    case Slot::ieee952: {
+      if (s.index == ieee952_summary_page) {
+        const std::array<std::uint8_t, 2> left_out = n.quantization_white ? std::array<std::uint8_t, 2>{0, 0}
+                                                                          : std::array<std::uint8_t, 2>{3, 2};
+        return Ieee952SummaryMsg{seq, n.fit, chi2_per_dof_of(n), 10, n.quantization_white, left_out};
+      }
+      // A rejected fit resolves nothing; its terms are still in the model. Q is held, not fitted,
+      // where quantization is not white.
+      const bool held = s.index == 0 && !n.quantization_white;
+      const bool fitted = n.protocol_version >= 2 && ieee_resolved(s.index) && !held;
+      return Ieee952Msg{seq,
+                        static_cast<Ieee952Term>(s.index),
+                        ieee_resolved(s.index) && n.fit == Ieee952Status::ok && !held,
+                        held ? 0.0f : ieee_of(s.index),
+                        held ? 0.0 : 0.125,
+                        fitted};
+    }
   }
   return {};
 }
@@ -135,9 +154,9 @@ class LogWriter {
     st.m.resize(n.taus);
     st.n.resize(n.taus);
     Expected e{n.address, seq, st.session, {}, {}, std::vector<bool>(n.taus), std::vector<bool>(n.taus)};
-    const std::size_t frames = report_frame_count(seq, n.taus);
+    const std::size_t frames = report_frame_count(seq, n.taus, n.protocol_version);
     for (std::size_t k = 0; k < frames; ++k) {
-      const ReportSlot s = report_slot(seq, n.taus, k);
+      const ReportSlot s = report_slot(seq, n.taus, k, n.protocol_version);
       if (drop && drop(s)) continue;
       CanFrame f;
       EXPECT_EQ(encode(message(n, seq, s, samples), n.address, f), ProtocolError::none);
@@ -385,6 +404,115 @@ TEST(DecodeCli, RatesInDegreesPerHourAndPulsesNeverConverted) {
   EXPECT_TRUE(contains(r.out, "rates [pulse/s] (pulses: not converted)")) << r.out;
   EXPECT_TRUE(contains(r.out, "rates [deg/h]")) << r.out;
   EXPECT_TRUE(contains(r.out, "N 0.002 pulse/sqrt(s)")) << r.out;  // as sent: no conversion
+}
+
+/// The part of the terminal view about node `address`.
+std::string node_section(const std::string& view, std::uint8_t address) {
+  char head[16];
+  std::snprintf(head, sizeof head, "\nnode 0x%02X", address);
+  const std::size_t begin = view.find(head);
+  if (begin == std::string::npos) return "";
+  return view.substr(begin, view.find("\nnode 0x", begin + 1) - begin);
+}
+
+TEST(DecodeCli, TheFitSummaryIsShownAndRecordedAndAVersionOneNodeHasNone) {
+  // Four nodes: an accepted fit with white quantization, a rejected one with short taus left out,
+  // a fit that could not be made, and a version-1 node (no summary at all).
+  const std::map<std::uint8_t, NodeSpec> nodes{
+      {0x40, {0x40, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::ok, true}},
+      {0x41, {0x41, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::rejected, false}},
+      {0x42, {0x42, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::too_few_points, true}},
+      {0x43, {0x43, 5, AngleUnit::arcsec, 0.01f, 1, Ieee952Status::ok, true}}};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 6; ++seq)
+    for (const auto& [address, n] : nodes) log.report(n, seq, 300.0 + seq + 0.1 * (address - 0x40), 100u * (seq + 1));
+  const std::string csv_path = temp("fit.csv"), jsonl_path = temp("fit.jsonl"), prefix = temp("fit_plot");
+  const Outcome r = run(log.write("fit.log") + " --view final --rate-unit native --csv " + csv_path + " --jsonl " +
+                        jsonl_path + " --plot " + prefix);
+  ASSERT_EQ(r.code, 0) << r.err;
+
+  // The view.
+  const std::string ok = node_section(r.out, 0x40), rejected = node_section(r.out, 0x41),
+                    none = node_section(r.out, 0x42), v1 = node_section(r.out, 0x43);
+  EXPECT_TRUE(contains(ok, "IEEE-952 (node's fit of both curves, chi2/dof 0.75 on 10 points):  Q 0.001 arcsec (+-12.5%)"))
+      << ok;
+  EXPECT_TRUE(contains(ok, "  R not fitted")) << ok;
+  EXPECT_FALSE(contains(ok, "REJECTED")) << ok;
+  EXPECT_FALSE(contains(ok, "quantization not white")) << ok;
+  EXPECT_TRUE(contains(rejected, "chi2/dof 7.5 on 10 points")) << rejected;
+  EXPECT_TRUE(contains(rejected, "N 0.002 arcsec/sqrt(s) (not resolved, +-12.5%)")) << rejected;
+  EXPECT_TRUE(contains(rejected, "\n  MODEL REJECTED: the IEEE-952 terms do not describe this curve\n")) << rejected;
+  // tau0 2^3 and tau0 2^2 with tau0 = 0.01 s.
+  EXPECT_TRUE(contains(rejected, "\n  quantization not white: short taus left out (AVAR below 0.08 s, MVAR below 0.04 s)"))
+      << rejected;
+  EXPECT_TRUE(contains(rejected, "Q held at 0.2887 arcsec (pulse weight/sqrt(12))")) << rejected;
+  EXPECT_TRUE(contains(none, "IEEE-952 (node's fit of both curves): no fit: too few points (10 points)")) << none;
+  EXPECT_TRUE(contains(v1, "  IEEE-952 (node's fit):  Q 0.001 arcsec (+-12.5%)")) << v1;
+  EXPECT_TRUE(contains(v1, "  R not resolved")) << v1;
+  EXPECT_TRUE(contains(v1, "protocol 1")) << v1;
+  EXPECT_FALSE(contains(v1, "chi2/dof")) << v1;
+
+  // Every report of every node is complete: version 1 has no summary frame to miss.
+  // 5 taus: 12 fast frames; slow parts of 5, 5, 5 and 4 (version 1) or 5 (version 2) frames.
+  EXPECT_TRUE(contains(r.err, "node 0x43: frames 101; reports 6 complete, 0 incomplete, 0 lost; frames missing 0;"))
+      << r.err;
+  for (const char* node : {"node 0x40", "node 0x41", "node 0x42"})
+    EXPECT_TRUE(contains(r.err, std::string(node) + ": frames 102; reports 6 complete, 0 incomplete, 0 lost; frames missing 0;"))
+        << r.err;
+
+  // The CSV: the summary of the node's latest fit on every row, empty for version 1. The first
+  // report (part 0 of the slow cycle) has no summary yet.
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 4u * 6 * 5);
+  std::size_t with_fit = 0;
+  for (const auto& row : csv.rows) {
+    const NodeSpec& n = nodes.at(static_cast<std::uint8_t>(std::stoi(csv.get(row, "node"))));
+    const int seq = std::stoi(csv.get(row, "seq"));
+    if (n.protocol_version == 1 || seq < 3) {
+      for (const char* column : {"fit_status", "fit_chi2_per_dof", "fit_points", "fit_quantization_white",
+                                 "fit_avar_excluded_below_tau_s", "fit_mvar_excluded_below_tau_s"})
+        EXPECT_EQ(csv.get(row, column), "") << column;
+      continue;
+    }
+    ++with_fit;
+    EXPECT_EQ(csv.get(row, "fit_status"), name(n.fit));
+    EXPECT_EQ(std::stof(csv.get(row, "fit_chi2_per_dof")), chi2_per_dof_of(n));
+    EXPECT_EQ(csv.get(row, "fit_points"), "10");
+    EXPECT_EQ(csv.get(row, "fit_quantization_white"), n.quantization_white ? "true" : "false");
+    const double avar = n.quantization_white ? 0.0 : 8 * static_cast<double>(n.tau0_s);
+    const double mvar = n.quantization_white ? 0.0 : 4 * static_cast<double>(n.tau0_s);
+    EXPECT_EQ(std::stod(csv.get(row, "fit_avar_excluded_below_tau_s")), avar);
+    EXPECT_EQ(std::stod(csv.get(row, "fit_mvar_excluded_below_tau_s")), mvar);
+  }
+  EXPECT_EQ(with_fit, 3u * 3 * 5);
+
+  // The JSON lines: the report records carry the summary (null for version 1) and each term's
+  // Fitted flag, with its value whenever fitted.
+  std::map<int, Json> last;
+  for (const Json& j : read_jsonl(jsonl_path))
+    if (j.at("type") == "report") last[j.at("node").get<int>()] = j;
+  ASSERT_EQ(last.size(), 4u);
+  EXPECT_TRUE(last[0x43].at("ieee952_fit").is_null());
+  EXPECT_EQ(last[0x43].at("ieee952").at("N").at("fitted"), true);  // version 1: resolved, so fitted
+  const Json& fit = last[0x41].at("ieee952_fit");
+  EXPECT_EQ(fit.at("curve"), "both");
+  EXPECT_EQ(fit.at("status"), "rejected");
+  EXPECT_EQ(fit.at("chi2_per_dof").get<double>(), 7.5);
+  EXPECT_EQ(fit.at("points"), 10);
+  EXPECT_EQ(fit.at("quantization_white"), false);
+  EXPECT_EQ(fit.at("avar_excluded_below_tau_s").get<double>(), 8 * static_cast<double>(0.01f));  // tau0 2^3
+  EXPECT_EQ(fit.at("mvar_excluded_below_tau_s").get<double>(), 4 * static_cast<double>(0.01f));
+  const Json& n_term = last[0x41].at("ieee952").at("N");
+  EXPECT_EQ(n_term.at("fitted"), true);
+  EXPECT_EQ(n_term.at("resolved"), false);
+  EXPECT_EQ(n_term.at("value").get<double>(), static_cast<double>(ieee_of(1)));
+  EXPECT_EQ(last[0x40].at("ieee952_fit").at("status"), "ok");
+  EXPECT_EQ(last[0x40].at("ieee952_fit").at("avar_excluded_below_tau_s").get<double>(), 0.0);
+  EXPECT_TRUE(last[0x41].at("ieee952").at("R").at("value").is_null());  // not fitted
+
+  // The plot: the rejected fit is named in the legend (drawn text in the SVG).
+  const std::string svg = read_file(prefix + ".svg");
+  EXPECT_GT(svg.size(), 1000u);
 }
 
 TEST(DecodeCli, LostFramesAndReportsAreShownNeverPaperedOver) {

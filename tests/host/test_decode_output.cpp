@@ -217,6 +217,99 @@ TEST(DecodeOutput, PlotDrawsEachIeeeTermAsItsOwnLineAndReadsItOff) {
   EXPECT_EQ(fewer.read_offs.size(), 3u);
 }
 
+/// A node with ten octave taus (0.125 .. 64 s) in arcsec, its fit's terms in arcsec and s.
+NodeView node_with_curve(const std::array<float, 5>& qnbkr) {
+  NodeView v = node_in(AngleUnit::arcsec);
+  v.status.tau_count = 10;
+  v.sampling = MetaSamplingMsg{0, 0.125f, 8};
+  for (std::size_t i = 0; i < 10; ++i) {
+    v.taus[i].m = std::uint64_t{1} << i;
+    v.taus[i].adev = {true, 1.0f / static_cast<float>(i + 1), 50.0, NoiseType::white_fm, true};
+    v.taus[i].mdev = {true, 0.5f / static_cast<float>(i + 1), 50.0, NoiseType::white_fm, true};
+  }
+  for (std::size_t k = 0; k < 5; ++k) v.ieee952[k] = {true, qnbkr[k] > 0, qnbkr[k], 0.1, qnbkr[k] > 0};
+  return v;
+}
+
+TEST(DecodeOutput, PlotOfARejectedFitDrawsNoModelAndSaysSo) {
+  NodeView v = node_with_curve({2.0f, 0.1f, 0.01f, 0.0f, 0.0f});
+  v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::rejected, 12.5f, 20, true, {0, 0}};
+  for (auto& t : v.ieee952) t.resolved = false;  // a rejected fit resolves nothing
+  ConfidenceIntervals intervals(0.683);
+  const NodePlot p = plot_data(v, RateUnit::deg_per_h, intervals);
+  EXPECT_EQ(p.adev.size(), 10u);  // the measurements are still drawn
+  EXPECT_TRUE(p.terms.empty());
+  EXPECT_TRUE(p.read_offs.empty());
+  ASSERT_EQ(p.notes.size(), 2u);  // two legend lines
+  EXPECT_EQ(p.notes[0], "IEEE-952 fit REJECTED (chi2/dof 12.5):");
+  EXPECT_EQ(p.notes[1], "the model does not describe the curve");
+
+  v.ieee952_summary->status = Ieee952Status::too_few_points;
+  const NodePlot none = plot_data(v, RateUnit::deg_per_h, intervals);
+  EXPECT_TRUE(none.terms.empty());
+  ASSERT_EQ(none.notes.size(), 1u);
+  EXPECT_EQ(none.notes[0], "no IEEE-952 fit: too few points");
+}
+
+TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
+  // Q held (quantization not white, pulse weight 1 arcsec), N resolved, B fitted but not resolved.
+  NodeView v = node_with_curve({0.0f, 0.1f, 0.01f, 0.0f, 0.0f});
+  v.ieee952[2].resolved = false;
+  v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::ok, 0.875f, 18, false, {3, 2}};
+  const TrueTerms truth{2.5 * std::numbers::pi / 648000, 0.12 * std::numbers::pi / 648000, 0.0, 0.0, 0.0};  // arcsec -> rad
+  ConfidenceIntervals intervals(0.683);
+  const NodePlot p = plot_data(v, RateUnit::deg_per_h, intervals, &truth);
+  ASSERT_EQ(p.terms.size(), 2u);  // N's own line and the model
+  EXPECT_EQ(p.terms[0].term, Ieee952Term::angle_random_walk);
+  EXPECT_EQ(p.terms[1].label, "IEEE-952 model, chi2/dof 0.88");
+  // Oracle: IEEE 952's closed form, 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2, Q = 1/sqrt(12) arcsec;
+  // deg/h is numerically arcsec/s.
+  const double q2 = 1.0 / 12, floor = 2 * std::log(2.0) / std::numbers::pi;
+  for (std::size_t j = 0; j < p.terms[1].tau_s.size(); ++j) {
+    const double t = p.terms[1].tau_s[j];
+    expect_rel(p.terms[1].dev[j], std::sqrt(3 * q2 / (t * t) + static_cast<double>(0.1f) * 0.1f / t +
+                                            floor * static_cast<double>(0.01f) * 0.01f),
+               1e-12);
+  }
+  ASSERT_TRUE(p.truth.has_value());
+  for (std::size_t j = 0; j < p.truth->tau_s.size(); ++j) {
+    const double t = p.truth->tau_s[j];
+    expect_rel(p.truth->dev[j], std::sqrt(3 * 2.5 * 2.5 / (t * t) + 0.12 * 0.12 / t), 1e-12);
+  }
+  ASSERT_EQ(p.notes.size(), 2u);
+  EXPECT_EQ(p.notes[0], "quantization not white, fit");
+  EXPECT_EQ(p.notes[1], "left out: ADEV < 1 s, MDEV < 0.5 s");  // 0.125 s x 2^3, 2^2
+  EXPECT_EQ(p.read_offs.size(), 1u);  // N at 1 s only: B is not resolved
+
+  // A node reporting pulses: no angle to put the truth in.
+  NodeView pulses = v;
+  pulses.scale->angle_unit = AngleUnit::pulse;
+  EXPECT_FALSE(plot_data(pulses, RateUnit::deg_per_h, intervals, &truth).truth.has_value());
+}
+
+TEST(DecodeOutput, ViewShowsTheSimulatedValueBesideEachTerm) {
+  // Through the decoder, from frames: a node in arcsec with N = 0.18 arcsec/sqrt(s) = 0.003 deg/sqrt(h).
+  Decoder decoder;
+  double t = 1.0;
+  for (const Message& m : std::vector<Message>{
+           StatusMsg{3, NodeState::running, 1, 100}, MetaScaleMsg{3, 1.0f, AngleUnit::arcsec, InputSource::simulated},
+           Ieee952Msg{3, Ieee952Term::angle_random_walk, true, 0.18f, 0.018, true},
+           Ieee952Msg{3, Ieee952Term::bias_instability, false, 0.01f, 1.5, true},  // 0.01 arcsec/s = 0.01 deg/h
+           Ieee952SummaryMsg{3, Ieee952Status::ok, 0.93f, 24, true, {0, 0}}})
+    decoder.feed(frame_of(m, 0x12), t += 0.01);
+  TrueTermsByNode truth;
+  truth[0x12] = {0.0, 0.003 * std::numbers::pi / 180 / 60, 0.01 * std::numbers::pi / 180 / 3600, 0.0, 0.0};
+  InputCounters input;
+  ConfidenceIntervals intervals(0.683);
+  const std::string view = format_view(decoder, input, NodeFilter{}.set(), RateUnit::deg_per_h, intervals, &truth);
+  EXPECT_NE(view.find("IEEE-952 (node's fit of both curves, chi2/dof 0.93 on 24 points):"), std::string::npos) << view;
+  EXPECT_NE(view.find("  N 0.003 deg/sqrt(h) (+-1.8%), simulated 0.003"), std::string::npos) << view;
+  EXPECT_NE(view.find("  B 0.01 deg/h (not resolved, +-150.0%), simulated 0.01"), std::string::npos) << view;
+  EXPECT_NE(view.find("  K -, simulated 0"), std::string::npos) << view;  // K's frame not received
+  const std::string plain = format_view(decoder, input, NodeFilter{}.set(), RateUnit::deg_per_h, intervals);
+  EXPECT_EQ(plain.find(", simulated"), std::string::npos) << plain;
+}
+
 TEST(DecodeOutput, LineReaderGivesWholeLinesWhateverTheReads) {
   int fds[2];
   ASSERT_EQ(pipe(fds), 0);

@@ -12,12 +12,18 @@ namespace {
 
 using namespace protocol;
 
-// The frames of report `seq` of a node with `taus` taus, values derived from (seq, tau).
+const Ieee952SummaryMsg fit_summary{0, Ieee952Status::ok, 0.93f, 24, true, {0, 0}};
+
+// The frames of report `seq` of a node with `taus` taus, values derived from (seq, tau), speaking
+// protocol version `protocol_version` (1: no summary page, no Fitted flag; B is fitted but not
+// resolved in version 2, and goes out as zeros in version 1).
 std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t taus, std::uint64_t samples,
-                             std::uint64_t uptime_ms = 0, std::uint32_t hash = 7) {
+                             std::uint64_t uptime_ms = 0, std::uint32_t hash = 7,
+                             std::uint8_t protocol_version = version) {
   std::vector<CanFrame> frames;
-  for (std::size_t k = 0; k < report_frame_count(seq, taus); ++k) {
-    const ReportSlot s = report_slot(seq, taus, k);
+  const bool v2 = protocol_version >= 2;
+  for (std::size_t k = 0; k < report_frame_count(seq, taus, protocol_version); ++k) {
+    const ReportSlot s = report_slot(seq, taus, k, protocol_version);
     Message m;
     switch (s.slot) {
       case Slot::status: m = StatusMsg{seq, NodeState::running, taus, samples}; break;
@@ -27,10 +33,21 @@ std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t t
       case Slot::terms: m = TauTermsMsg{seq, s.index, samples - 2}; break;
       case Slot::tau_info: m = TauInfoMsg{seq, s.index, std::uint64_t{1} << s.index, 0}; break;
       case Slot::sampling: m = MetaSamplingMsg{seq, 0.01f, 8}; break;
-      case Slot::clock: m = MetaClockMsg{seq, uptime_ms ? uptime_ms : samples * 10, version}; break;
+      case Slot::clock: m = MetaClockMsg{seq, uptime_ms ? uptime_ms : samples * 10, protocol_version}; break;
       case Slot::scale: m = MetaScaleMsg{seq, 1.5f, AngleUnit::arcsec, InputSource::simulated}; break;
       case Slot::config: m = MetaConfigMsg{seq, hash, 1000}; break;
-      case Slot::ieee952: m = Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.25f, 0.1}; break;
+      case Slot::ieee952:
+        if (s.index == ieee952_summary_page) {
+          Ieee952SummaryMsg f = fit_summary;
+          f.seq = seq;
+          m = f;
+        } else if (s.index == 2) {  // B: in the model, not resolved
+          m = v2 ? Ieee952Msg{seq, Ieee952Term::bias_instability, false, 0.5f, 2.0, true}
+                 : Ieee952Msg{seq, Ieee952Term::bias_instability, false, 0.0f, 0.0};
+        } else {
+          m = Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.25f, 0.1, v2};
+        }
+        break;
     }
     CanFrame f;
     EXPECT_EQ(encode(m, node, f), ProtocolError::none);
@@ -61,7 +78,51 @@ TEST(Decoder, CompleteReportsCarryEveryValue) {
   EXPECT_EQ(v.taus[3].m, 8u);
   EXPECT_DOUBLE_EQ(v.tau_s(3), static_cast<double>(0.01f) * 8);
   EXPECT_FLOAT_EQ(v.taus[3].adev.dev, 0.25f);
-  EXPECT_TRUE(v.ieee952[2].resolved);
+  EXPECT_TRUE(v.ieee952[1].resolved);
+  EXPECT_TRUE(v.ieee952[1].fitted);
+  EXPECT_FALSE(v.ieee952[2].resolved);  // B in the model, not resolved: its value still arrives
+  EXPECT_TRUE(v.ieee952[2].fitted);
+  EXPECT_FLOAT_EQ(v.ieee952[2].value, 0.5f);
+  EXPECT_DOUBLE_EQ(v.ieee952[2].rel_uncertainty, 2.0);
+  ASSERT_TRUE(v.ieee952_summary.has_value());
+  Ieee952SummaryMsg want = fit_summary;
+  want.seq = v.ieee952_summary->seq;
+  EXPECT_EQ(*v.ieee952_summary, want);
+  EXPECT_EQ(v.schedule_version(), 2);
+}
+
+TEST(Decoder, VersionOneNodeHasNoSummaryAndMissesNothing) {
+  // A version-1 node's reports have no summary frame: the decoder expects none (its clock page says
+  // version 1), and reads Resolved as fitted.
+  Feed feed;
+  for (std::uint8_t s = 0; s < 8; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, 1));
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.reports_complete, 8u);
+  EXPECT_EQ(v.health.frames_missing, 0u);
+  EXPECT_FALSE(v.ieee952_summary.has_value());
+  EXPECT_EQ(v.schedule_version(), 1);
+  EXPECT_TRUE(v.ieee952[1].resolved);
+  EXPECT_TRUE(v.ieee952[1].fitted);
+  EXPECT_FALSE(v.ieee952[2].resolved);
+  EXPECT_FALSE(v.ieee952[2].fitted);
+}
+
+TEST(Decoder, VersionTwoNodeJoinedLateMissesNothingAndItsLostSummaryCounts) {
+  // Joining in the cycle's last report (3 taus: the summary is in part 3, the clock page in part
+  // 0): the summary arrives before the clock page and tells the decoder the node's version.
+  Feed feed;
+  for (std::uint8_t s = 3; s < 8; ++s) feed.frames(report(6, s, 3, 1000 + s * 100));
+  auto lost = report(6, 11, 3, 2100);
+  lost.pop_back();  // the summary, last of its report
+  feed.frames(lost);
+  feed.decoder.flush();
+  const NodeView& v = feed.node(6);
+  EXPECT_EQ(v.health.reports_complete, 5u);
+  EXPECT_EQ(v.health.reports_incomplete, 1u);
+  EXPECT_EQ(v.health.frames_missing, 1u);
+  ASSERT_TRUE(v.ieee952_summary.has_value());
+  EXPECT_EQ(v.ieee952_summary->seq, 7);
 }
 
 TEST(Decoder, MissingFramesAndLostReportsAreCounted) {

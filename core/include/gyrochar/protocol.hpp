@@ -1,6 +1,8 @@
 #pragma once
-// The gyrochar CAN protocol, version 1: one value type per frame kind, encode() and decode()
-// between those values and CanFrame, and the report schedule. docs/protocol.md is the specification,
+// The gyrochar CAN protocol, version 2: one value type per frame kind, encode() and decode()
+// between those values and CanFrame, and the report schedule. The codec decodes version 1 frames
+// too (version 2 only adds: the IEEE-952 fit summary page and the Fitted flag of the term frames,
+// both of which a version-1 node never sends), and the schedule of either version is available. docs/protocol.md is the specification,
 // docs/gyrochar.dbc describes the same frames for CAN tools (tests/dbc checks it against this codec).
 // The board firmware and the host decoder both use this codec; there is no other.
 //
@@ -10,6 +12,7 @@
 //
 // Every function is O(1) unless stated, allocates nothing, throws nothing and reads no clock.
 #include <cstddef>
+#include <array>
 #include <cstdint>
 #include <variant>
 
@@ -17,7 +20,8 @@
 
 namespace gyrochar::protocol {
 
-inline constexpr std::uint8_t version = 1;
+inline constexpr std::uint8_t version = 2;             // what this codec's nodes send
+inline constexpr std::uint8_t oldest_version = 1;      // the oldest version decoders accept
 inline constexpr std::size_t max_taus = 64;          // tau index is 6 bits
 inline constexpr std::uint8_t max_node_address = 0xFD;  // J1939: 0xFE null, 0xFF global
 
@@ -78,6 +82,16 @@ enum class Ieee952Term : std::uint8_t {
   bias_instability = 2,   // B, A/s
   rate_random_walk = 3,   // K, A/s^1.5
   rate_ramp = 4,          // R, A/s^2
+};
+/// The Ieee952 frame's multiplexor value (its "Term" field) of the fit summary page (version 2).
+inline constexpr std::uint8_t ieee952_summary_page = 5;
+
+/// Outcome of the node's IEEE-952 fit (the values of gyrochar::FitStatus, core/ieee952.hpp).
+enum class Ieee952Status : std::uint8_t {
+  ok = 0,
+  too_few_points = 1,  // fewer points than terms to fit: no fit
+  rejected = 2,        // the model does not describe the curve (chi2/dof > 2 and p < 1e-4)
+  singular = 3,        // the covariance of the points or the normal equations could not be solved
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -167,15 +181,36 @@ struct MetaConfigMsg {
   bool operator==(const MetaConfigMsg&) const = default;
 };
 
-/// One IEEE-952 parameter of the latest fit, in the slow cycle.
+/// One IEEE-952 parameter of the latest fit, in the slow cycle (Ieee952 pages 0-4).
 struct Ieee952Msg {
   std::uint8_t seq = 0;
   Ieee952Term term = Ieee952Term::quantization;
-  bool resolved = false;        // the fit resolved this term (value and uncertainty meaningful)
+  bool resolved = false;        // the fit resolved this term: significant, and the largest term at
+                                // one of the taus fitted at least
   float value = 0.0f;           // >= 0, finite, in the term's unit (see Ieee952Term)
   double rel_uncertainty = 0.0; // standard uncertainty / value, >= 0; on the wire in 0.01 % steps,
                                 // saturating at 655.35 %
+  bool fitted = false;          // version 2: the term is in the fitted model, so value and
+                                // uncertainty are the fit's even when not resolved (an upper-bound
+                                // reading). Version-1 nodes send 0 (their Resolved implies fitted);
+                                // a version-2 node sets it whenever it sets resolved.
   bool operator==(const Ieee952Msg&) const = default;
+};
+
+/// The IEEE-952 fit's summary (Ieee952 page 5, version 2), in the slow cycle beside the terms.
+struct Ieee952SummaryMsg {
+  std::uint8_t seq = 0;
+  Ieee952Status status = Ieee952Status::too_few_points;
+  float chi2_per_dof = 0.0f;      // generalized chi-squared per degree of freedom; finite, >= 0
+                                  // (0 when no fit was made or no degree of freedom was left)
+  std::uint32_t points = 0;       // points (AVAR and MVAR estimates) the fit used; 8 bits, saturates
+  bool quantization_white = true; // false: periodic quantization of the counts was detected, the
+                                  // short taus it reaches were left out and Q was held at
+                                  // pulse weight / sqrt(12) rather than fitted
+  /// AVAR [0] and MVAR [1] points with averaging factor m < 2^c were left out of the fit because of
+  /// that quantization; 0: none. 0..31 (5 bits); both 0 when quantization_white.
+  std::array<std::uint8_t, 2> excluded_below_log2_m{};
+  bool operator==(const Ieee952SummaryMsg&) const = default;
 };
 
 /// Counter input: sent by the gyro's readout electronics to the board once per sample interval.
@@ -189,7 +224,7 @@ struct CounterInputMsg {
 
 using Message = std::variant<StatusMsg, StatusFaultsMsg, TauDevMsg, TauTermsMsg, TauInfoMsg,
                              MetaSamplingMsg, MetaClockMsg, MetaScaleMsg, MetaConfigMsg, Ieee952Msg,
-                             CounterInputMsg>;
+                             CounterInputMsg, Ieee952SummaryMsg>;
 
 // ---------------------------------------------------------------------------------------------
 // Codec
@@ -198,7 +233,7 @@ enum class ProtocolError : std::uint8_t {
   none = 0,
   error_frame,    // the controller reported an error frame
   not_extended,   // 11-bit identifier
-  fd_frame,       // CAN FD frame: protocol version 1 is classic CAN only
+  fd_frame,       // CAN FD frame: protocol versions 1 and 2 are classic CAN only
   unknown_id,     // not one of the identifiers above (PGN or priority differ)
   bad_address,    // node address 0xFE or 0xFF
   wrong_length,   // data length differs from the frame kind's (8, counter input 6)
@@ -215,6 +250,7 @@ const char* name(NodeState s);
 const char* name(AngleUnit u);
 const char* name(InputSource s);
 const char* name(Ieee952Term t);
+const char* name(Ieee952Status s);
 
 /// Encodes one message sent by node `node` (0..max_node_address) into `frame`: a classic frame with
 /// an extended identifier, 8 data bytes (counter input: 6), unused data bytes zero.
@@ -230,6 +266,7 @@ ProtocolError encode(const MetaClockMsg& msg, std::uint8_t node, CanFrame& frame
 ProtocolError encode(const MetaScaleMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const MetaConfigMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Ieee952Msg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const Ieee952SummaryMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Message& msg, std::uint8_t node, CanFrame& frame);
 
@@ -246,9 +283,14 @@ Decoded decode(const CanFrame& frame);
 
 // ---------------------------------------------------------------------------------------------
 // Report schedule (docs/protocol.md, "Report schedule"). Every report carries the fast frames
-// (status, faults, ADEV and MDEV of every tau); the slow list (metadata, tau info, terms, IEEE-952)
-// is cut into slow_cycle_reports equal parts, one part per report, chosen by seq. Both the node
-// (what to send) and the decoder (what to expect) derive a report's frames from seq and tau count.
+// (status, faults, ADEV and MDEV of every tau); the slow list (metadata, tau info, terms, IEEE-952
+// terms and, from version 2, the fit summary) is cut into slow_cycle_reports equal parts, one part
+// per report, chosen by seq. Both the node (what to send) and the decoder (what to expect) derive a
+// report's frames from seq, tau count and the node's protocol version.
+//
+// The version-2 slow list is version 1's with the summary appended; its length 10 + 2T is even
+// where version 1's 9 + 2T is odd, so both cut into parts of the same length ceil(L/4): every frame
+// keeps its position, and one report of the cycle has one frame more.
 
 inline constexpr std::size_t slow_cycle_reports = 4;
 
@@ -257,14 +299,17 @@ enum class Slot : std::uint8_t {
 };
 struct ReportSlot {
   Slot slot = Slot::status;
-  std::uint8_t index = 0;  // tau index (adev, mdev, terms, tau_info) or Ieee952Term (ieee952)
+  std::uint8_t index = 0;  // tau index (adev, mdev, terms, tau_info); for ieee952 the page:
+                           // an Ieee952Term (0-4) or ieee952_summary_page (5)
 };
 
-/// Number of frames in report `seq` for `tau_count` taus (<= max_taus).
-std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count);
+/// Number of frames in report `seq` for `tau_count` taus (<= max_taus) of a node speaking
+/// `protocol_version` (1, or 2 and above: the current schedule).
+std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version = version);
 /// Frame `position` (< report_frame_count()) of report `seq`, in sending order: status, faults,
 /// ADEV and MDEV of tau 0, 1, ..., then this report's part of the slow list.
-ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position);
+ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position,
+                       std::uint8_t protocol_version = version);
 
 /// Worst-case bits on the wire of a classic data frame with a 29-bit identifier and `data_bytes`
 /// (<= 8) data bytes, with the maximum number of stuff bits and the 3-bit interframe space:
@@ -275,7 +320,8 @@ constexpr std::uint32_t worst_case_frame_bits(std::uint32_t data_bytes) {
 }
 
 /// Worst-case share of a bus of `bitrate_bps` taken by one node reporting `tau_count` taus every
-/// `report_period_s` seconds (the longest report of the slow cycle). O(slow_cycle_reports).
+/// `report_period_s` seconds (the longest report of the slow cycle, current version).
+/// O(slow_cycle_reports).
 double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps);
 
 }  // namespace gyrochar::protocol
