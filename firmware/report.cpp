@@ -69,7 +69,8 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   std::array<NoiseId, max_octaves> noise{};
   take_sums(c, std::span(sums.data(), taus));
   identify_noise(std::span(sums.data(), taus), c.phase_points(), 2, false, std::span(noise.data(), taus), &work.cache());
-  const EstimateOptions options{s.tau0_s, s.pulse_weight_arcsec, EdfModel::exact};
+  // The wire carries the EDF; the skewness stays home (decoders use the plain chi-squared).
+  const EstimateOptions options{s.tau0_s, s.pulse_weight_arcsec, EdfModel::exact, false};
   std::array<FitPoint, 2 * max_octaves> points{};
   std::size_t n_points = 0;
   for (std::size_t i = 0; i < taus; ++i) {
@@ -89,7 +90,12 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   out.scale = {seq, static_cast<float>(s.pulse_weight_arcsec), AngleUnit::arcsec, s.source};
   out.config = {seq, s.config_hash, s.report_period_ms};
   // The recommended fit of both curves, in arcsec and seconds; quantization's white level is the
-  // pulse weight over sqrt(12).
+  // pulse weight over sqrt(12). Only for the reports that carry the Ieee952 frames (one in
+  // protocol::slow_cycle_reports): the others keep the last fit, which they do not send.
+  bool carries_fit = false;
+  for (std::size_t k = 0; k < report_frame_count(seq, taus) && !carries_fit; ++k)
+    carries_fit = report_slot(seq, taus, k).slot == Slot::ieee952;
+  if (!carries_fit) return;
   const FitSetup setup{s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)};
   const Ieee952Fit fit = fit_ieee952(std::span(points.data(), n_points), setup, FitCurve::both, work.fit(), &work.cache());
   // A term in the model goes out with its value and uncertainty, resolved or not (an upper-bound

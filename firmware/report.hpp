@@ -71,8 +71,10 @@ class ReportWorkspace {
   PairSumCache cache_;
 };
 
-/// Fills `out` for report `seq` from the characterizer's current state. No allocation: everything
-/// is worked out in `work` (built for the same number of octaves).
+/// Fills `out` for report `seq` from the characterizer's current state: the deviations, EDFs and
+/// noise types of every report, and the IEEE-952 fit for the reports that carry its frames (the
+/// others keep the last one). No allocation: everything is worked out in `work` (built for the
+/// same number of octaves).
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
                   std::uint64_t uptime_ms, const FaultCounters& faults, ReportWorkspace& work, ReportContent& out);
 

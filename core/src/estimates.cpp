@@ -237,7 +237,9 @@ Estimate estimate(const TauSums& t, std::uint64_t n_phase, DevStat stat, const N
       e.edf_alpha = alpha;
     }
   }
-  if (e.edf > 0) {  // gaps scale it as they scale the EDF
+  // The shape beyond two moments: it moves an interval by a fraction of its width of order
+  // sqrt(2 / EDF) squared, nothing worth its cost above an EDF of 100. Gaps scale it as the EDF.
+  if (o.skewness && e.edf > 0 && e.edf < 100) {
     const double nu3 = exact_skew_dof(e.edf_alpha, grid);
     e.skew_dof = e.n >= grid.n ? nu3 : nu3 * static_cast<double>(e.n) / static_cast<double>(grid.n);
   }

@@ -478,9 +478,11 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b, bool white_pm_o
     return out;
   }
   // Short grids: the last sums, scaled with the coarse grid's terms while both grids have grown by
-  // less than 2 % (the sums are nearly proportional to it: errors of a few 1e-4).
-  if (entry->used && !entry->linear && a.n >= entry->n_a && b.n >= entry->n_b && 50 * (a.n - entry->n_a) <= entry->n_a &&
-      50 * (b.n - entry->n_b) <= entry->n_b) {
+  // less than 2 % (the sums are nearly proportional to it: the EDF moves by less than 1e-3), or by
+  // 10 % for grids of different taus (their covariance only weights the fit: 1 % at most).
+  const std::uint64_t growth = a.m == b.m ? 50 : 10;
+  if (entry->used && !entry->linear && a.n >= entry->n_a && b.n >= entry->n_b &&
+      growth * (a.n - entry->n_a) <= entry->n_a && growth * (b.n - entry->n_b) <= entry->n_b) {
     PairSums out;
     add_scaled(out, entry->sums, static_cast<double>(n) / static_cast<double>(a_coarse ? entry->n_a : entry->n_b),
                PairSums{});
@@ -491,16 +493,16 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b, bool white_pm_o
   entry->stat_a = a.stat, entry->stat_b = b.stat, entry->m_a = a.m, entry->m_b = b.m;
   entry->stride_a = a.stride, entry->stride_b = b.stride;
   entry->white_pm_only = white_pm_only;
-  // Linear once the coarse grid spans the terms' reach 32 times over: the flicker tails (summed
+  // Linear once the coarse grid spans the terms' reach 8 times over: the flicker tails (summed
   // out to the lags that have pairs) then change by less than 1e-4 of the sums.
   const std::uint64_t coarse = a_coarse ? a.stride : b.stride;
   const std::uint64_t span = 3 * (a.m > b.m ? a.m : b.m) + 2;
-  const std::uint64_t from = (32 * span) / coarse + 4;
+  const std::uint64_t from = (8 * span) / coarse + 4;
   if (n >= from) {
     const std::uint64_t first = first_newest_point(a.stat, a.m) > first_newest_point(b.stat, b.m)
                                     ? first_newest_point(a.stat, a.m)
                                     : first_newest_point(b.stat, b.m);
-    const std::uint64_t n1 = first + (from + 2) * coarse, n2 = n1 + 32 * span + 8 * coarse;
+    const std::uint64_t n1 = first + (from + 2) * coarse, n2 = n1 + 8 * span + 8 * coarse;
     const TermGrid a1 = unbroken_grid(a.stat, a.m, a.stride, n1), b1 = unbroken_grid(b.stat, b.m, b.stride, n1);
     const TermGrid a2 = unbroken_grid(a.stat, a.m, a.stride, n2), b2 = unbroken_grid(b.stat, b.m, b.stride, n2);
     const PairSums s1 = pair_sums(set, a1, b1), s2 = pair_sums(set, a2, b2);

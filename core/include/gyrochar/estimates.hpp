@@ -123,6 +123,7 @@ struct EstimateOptions {
   double tau0_s = 1.0;  // sample interval
   double unit = 1.0;    // phase unit of one x step (pulse weight for counts; tau0 for frequency)
   EdfModel edf = EdfModel::exact;
+  bool skewness = true;  // also the skew degrees of freedom (where the EDF is below 100)
 };
 
 /// One statistic at one tau. Deviations are in phase unit per second (TDEV: phase unit).

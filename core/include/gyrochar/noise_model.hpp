@@ -112,9 +112,9 @@ NoiseSet allan_noises();
 /// coarser grid's number of terms (exactly, for a grid with itself; to within one term for two
 /// grids): the cache keeps that function, computed once, and evaluates it in O(1). For shorter
 /// grids it keeps the last sums with the term counts they were computed for, and scales them with
-/// the coarser grid's terms until either grid has grown by 2 % (errors of a few 1e-4). A full
-/// table is not an error: the sums are then computed afresh. No allocation; Allan and modified
-/// Allan only.
+/// the coarser grid's terms until either grid has grown by 2 % (10 % for grids of different taus,
+/// whose covariance only weights the IEEE-952 fit). A full table is not an error: the sums are
+/// then computed afresh. No allocation; Allan and modified Allan only.
 class PairSumCache {
  public:
   struct Entry {
