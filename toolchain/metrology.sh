@@ -1,85 +1,115 @@
 #!/usr/bin/env bash
-# Regenerates the coverage block of docs/metrology.md: how often the offline engine's 68.3 %
-# confidence intervals hold the true deviation, by Monte Carlo over power-law noise of known type
-# (tests/benchmarks/coverage_study.cpp). Only the text between the coverage markers is replaced;
-# the rest of the file belongs to other studies. Every cell also goes to a CSV file.
-#   toolchain/metrology.sh                    1000 runs per cell (about 2.5 minutes on 2 cores)
-#   toolchain/metrology.sh --runs 100         a quick look (the tables say how many runs)
-#   toolchain/metrology.sh --csv coverage.csv where the CSV goes (default build/perf/data/coverage.csv)
-# Exit codes: 0 written, 2 bad options, 3 docs/metrology.md has no (or a broken) coverage block.
+# Regenerates the Monte Carlo blocks of docs/metrology.md (like toolchain/benchmarks.sh does for
+# BENCHMARKS.md): how often the offline engine's 68.3 % confidence intervals hold the true deviation
+# (tests/benchmarks/coverage_study.cpp), and how well the IEEE-952 fit recovers simulated gyros
+# (tests/benchmarks/recovery_study.cpp). Only the text between each block's markers is replaced.
+#   toolchain/metrology.sh                       both studies, full size (about 25 minutes on 2 cores)
+#   toolchain/metrology.sh --only coverage       one of them (coverage or recovery)
+#   toolchain/metrology.sh --runs 100            a quick look (the tables say how many runs)
+#   toolchain/metrology.sh --csv coverage.csv    where the coverage CSV goes (default build/perf/data/coverage.csv)
+# Exit codes: 0 written, 2 bad options, 3 docs/metrology.md has no (or a broken) block.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-runs=1000
+runs=""
+only=""
 csv=build/perf/data/coverage.csv
 while [ $# -gt 0 ]; do
   case "$1" in
     --runs) runs=${2:?metrology.sh: --runs needs a number}; shift 2 ;;
+    --only) only=${2:?metrology.sh: --only needs coverage or recovery}; shift 2 ;;
     --csv) csv=${2:?metrology.sh: --csv needs a path}; shift 2 ;;
-    -h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "metrology.sh: unknown option: $1 (see --help)" >&2; exit 2 ;;
   esac
 done
-case "$runs" in ''|*[!0-9]*) echo "metrology.sh: --runs: not a number: $runs" >&2; exit 2 ;; esac
+case "$runs" in *[!0-9]*) echo "metrology.sh: --runs: not a number: $runs" >&2; exit 2 ;; esac
+case "$only" in ""|coverage|recovery) ;; *) echo "metrology.sh: --only: coverage or recovery, not $only" >&2; exit 2 ;; esac
 
 doc=docs/metrology.md
-begin='<!-- coverage:begin -->'
-end='<!-- coverage:end -->'
-if [ ! -f "$doc" ]; then
-  printf '# Metrology\n\n%s\n%s\n' "$begin" "$end" > "$doc"
-fi
-if [ "$(grep -cxF "$begin" "$doc")" != 1 ] || [ "$(grep -cxF "$end" "$doc")" != 1 ] ||
-   [ "$(grep -nxF "$begin" "$doc" | cut -d: -f1)" -ge "$(grep -nxF "$end" "$doc" | cut -d: -f1)" ]; then
-  echo "metrology.sh: $doc: needs exactly one line '$begin' before one line '$end'" >&2
-  exit 3
-fi
+check_block() {  # the doc has exactly one begin line before one end line
+  local begin="<!-- $1:begin -->" end="<!-- $1:end -->"
+  if [ "$(grep -cxF "$begin" "$doc")" != 1 ] || [ "$(grep -cxF "$end" "$doc")" != 1 ] ||
+     [ "$(grep -nxF "$begin" "$doc" | cut -d: -f1)" -ge "$(grep -nxF "$end" "$doc" | cut -d: -f1)" ]; then
+    echo "metrology.sh: $doc: needs exactly one line '$begin' before one line '$end'" >&2
+    exit 3
+  fi
+}
+for study in coverage recovery; do [ -z "$only" ] || [ "$only" = "$study" ] && check_block "$study"; done
 
-# The same Release build as toolchain/benchmarks.sh (build/perf), only the study's target.
+# The same Release build as toolchain/benchmarks.sh (build/perf), only the studies' targets.
 for p in g++ cmake ninja-build pkg-config libbenchmark-dev libfftw3-dev libcli11-dev libfmt-dev; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || {
     echo "metrology.sh: installing $p" >&2; apt-get install -y -qq "$p" >/dev/null; }
 done
 cmake -S . -B build/perf -G Ninja -DCMAKE_BUILD_TYPE=Release -DGYROCHAR_BENCHMARKS=ON >/dev/null
-cmake --build build/perf --target coverage_study >/dev/null
+cmake --build build/perf --target coverage_study recovery_study >/dev/null
 mkdir -p "$(dirname "$csv")"
 
-tables=$(mktemp)
-block=$(mktemp)
-trap 'rm -f "$tables" "$block"' EXIT
-build/perf/tests/coverage_study --runs "$runs" --csv "$csv" > "$tables"
-
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-if [ -n "$(git status --porcelain -- core host_tools/lib tests/support tests/benchmarks/coverage_study.cpp 2>/dev/null)" ]; then
-  commit="$commit with uncommitted changes to the engine or the study"
+if [ -n "$(git status --porcelain -- core host_tools/lib tests/support tests/benchmarks 2>/dev/null)" ]; then
+  commit="$commit with uncommitted changes to the engine or the studies"
 fi
-{
-echo "$begin"
-echo "## Confidence-interval coverage (Monte Carlo)"
-echo
-echo "Regenerated by \`toolchain/metrology.sh\` on $(date -u +%Y-%m-%d) at commit $commit: $(nproc) cores,"
-echo "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), g++ $(g++ -dumpversion), Release build."
-echo
-echo "Does the 68.3 % interval the offline engine prints hold the true deviation 68.3 % of the time?"
-echo "Phase noise of each power-law type (S_y(f) ~ f^alpha, tau0 = 1, unit innovations) is made by"
-echo "\`tests/support/power_law_noise.hpp\` (integer types exactly, flicker by Kasdin's filter with a"
-echo "burn-in, stationary increments); each realization of N phase points goes through the engine"
-echo "(\`gyrochar::Analyzer\`, type phase, confidence 0.682689) with the stride factor full (every tau"
-echo "fully overlapped) or 8, once with the noise type identified by the engine per tau and once with the"
-echo "true alpha given. The truth is the exact expectation of the AVAR or MVAR of that noise (the sum of"
-echo "squares of the term's filter, \`expected_variance\`; closed forms for white PM, white FM and random"
-echo "walk FM). Every octave m with at least one term is a row. The CSV (\`coverage_study --csv\`) also"
-echo "holds, per cell, the stated EDFs, the Monte Carlo EDF, how often each alpha was identified and the"
-echo "mean of estimate / truth."
-echo
-cat "$tables"
-echo "$end"
-} > "$block"
+machine="$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), g++ $(g++ -dumpversion), Release build"
 
-# Replace the lines from the begin marker to the end marker with the new block.
-awk -v begin="$begin" -v end="$end" -v block="$block" '
-  $0 == begin { while ((getline line < block) > 0) print line; skipping = 1; next }
-  $0 == end { skipping = 0; next }
-  !skipping { print }
-' "$doc" > "$doc.new"
-mv "$doc.new" "$doc"
-echo "metrology.sh: wrote the coverage block of $doc (CSV: $csv)" >&2
+# write_block NAME TITLE INTRO-FILE TABLES-FILE: replaces the block NAME of the doc.
+write_block() {
+  local begin="<!-- $1:begin -->" end="<!-- $1:end -->" block
+  block=$(mktemp)
+  {
+    echo "$begin"
+    echo "## $2"
+    echo
+    echo "Regenerated by \`toolchain/metrology.sh\` on $(date -u +%Y-%m-%d) at commit $commit: $machine."
+    echo
+    cat "$3"
+    echo
+    cat "$4"
+    echo "$end"
+  } > "$block"
+  awk -v begin="$begin" -v end="$end" -v block="$block" '
+    $0 == begin { while ((getline line < block) > 0) print line; skipping = 1; next }
+    $0 == end { skipping = 0; next }
+    !skipping { print }
+  ' "$doc" > "$doc.new"
+  mv "$doc.new" "$doc"
+  rm -f "$block"
+}
+
+intro=$(mktemp)
+tables=$(mktemp)
+trap 'rm -f "$intro" "$tables"' EXIT
+
+if [ -z "$only" ] || [ "$only" = coverage ]; then
+  build/perf/tests/coverage_study ${runs:+--runs "$runs"} --csv "$csv" > "$tables"
+  cat > "$intro" <<'EOF'
+Does the 68.3 % interval the offline engine prints hold the true deviation 68.3 % of the time?
+Phase noise of each power-law type (S_y(f) ~ f^alpha, tau0 = 1, unit innovations) is made by
+`tests/support/power_law_noise.hpp` (integer types exactly, flicker by Kasdin's filter with a
+burn-in, stationary increments); each realization of N phase points goes through the engine
+(`gyrochar::Analyzer`, type phase, confidence 0.682689) with the stride factor full (every tau
+fully overlapped) or 8, once with the noise type identified by the engine per tau and once with the
+true alpha given. The truth is the exact expectation of the AVAR or MVAR of that noise (the sum of
+squares of the term's filter, `expected_variance`; closed forms for white PM, white FM and random
+walk FM), computed in the test support, independently of the engine. Every octave m with at least
+one term is a row. The CSV (`coverage_study --csv`) also holds, per cell, the stated EDFs, the
+Monte Carlo EDF, how often each alpha was identified and the mean of estimate / truth.
+EOF
+  write_block coverage "Confidence-interval coverage (Monte Carlo)" "$intro" "$tables"
+  echo "metrology.sh: wrote the coverage block of $doc (CSV: $csv)" >&2
+fi
+
+if [ -z "$only" ] || [ "$only" = recovery ]; then
+  build/perf/tests/recovery_study ${runs:+--runs "$runs"} > "$tables"
+  cat > "$intro" <<'EOF'
+Does the IEEE-952 fit find the terms a gyro really has, with uncertainties that mean what they say?
+Each scenario is a gyro simulated by `gyrochar-sim`'s simulator (its terms checked against their
+closed forms above), analyzed as `gyrochar-analyze --type counts --fit ieee952` does (stride factor
+full, octave taus) and judged by the recommended fit of both curves (`tests/support/recovery.cpp`).
+A term counts as "within 1 sigma" when it is resolved and lies within its stated standard
+uncertainty of the simulator's value; "false resolved" is a term resolved although the simulator
+does not have it. The pooled figures take every resolved term of every scenario.
+EOF
+  write_block recovery "Recovery of simulated gyros by the IEEE-952 fit (Monte Carlo)" "$intro" "$tables"
+  echo "metrology.sh: wrote the recovery block of $doc" >&2
+fi
