@@ -257,6 +257,7 @@ Json health_json(const LinkHealth& h) {
               {"restarts", h.restarts},
               {"offline_events", h.offline_events},
               {"duplicates", h.duplicates},
+              {"not_decoded", h.not_decoded},
               {"rejected", rejected}};
 }
 
@@ -274,6 +275,8 @@ const char* name(DecoderEvent e) {
       return "rejected_frame";
     case DecoderEvent::duplicate:
       return "duplicate";
+    case DecoderEvent::unknown_version:
+      return "unknown_version";
   }
   return "invalid";
 }
@@ -415,9 +418,10 @@ std::string rejected_text(const LinkHealth& h) {
 std::string health_text(const LinkHealth& h) {
   return fmt::format(
       "frames {}; reports {} complete, {} incomplete, {} lost; frames missing {}; restarts {}; "
-      "offline {}; duplicates {}; rejected {}",
+      "offline {}; duplicates {}; rejected {}{}",
       h.frames, h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing, h.restarts,
-      h.offline_events, h.duplicates, rejected_text(h));
+      h.offline_events, h.duplicates, rejected_text(h),
+      h.not_decoded ? fmt::format("; not decoded {} (unknown protocol version)", h.not_decoded) : "");
 }
 
 std::string input_text(const Decoder& decoder, const InputCounters& in) {
@@ -502,6 +506,9 @@ void node_view(std::string& s, const NodeView& v, RateUnit rate_unit, Confidence
                    v.clock->protocol_version);
   if (v.config)
     fmt::format_to(out, "  config 0x{:08X}  report {} ms", v.config->config_hash, v.config->report_period_ms);
+  if (v.unknown_version != 0)
+    fmt::format_to(out, "\n  NOT DECODED: the node speaks protocol version {}, this decoder knows 1 to {} "
+                   "(values below are from before)", v.unknown_version, protocol::version);
   s += "\n ";
   if (v.sampling) fmt::format_to(out, " tau0 {} s  S {} ", v.sampling->tau0_s, v.sampling->stride_factor);
   if (v.scale) {

@@ -105,7 +105,7 @@ void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
   }
   if (e == DecoderEvent::report_closed || e == DecoderEvent::restart) tracker_.close(node.address);
   const bool noteworthy = e == DecoderEvent::restart || e == DecoderEvent::offline || e == DecoderEvent::online ||
-                          e == DecoderEvent::duplicate;
+                          e == DecoderEvent::duplicate || e == DecoderEvent::unknown_version;
   if (noteworthy && record && jsonl_) jsonl_->event(input_.now_s, e, node);
 }
 

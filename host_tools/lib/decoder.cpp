@@ -17,17 +17,32 @@ void Decoder::feed(const CanFrame& frame, double t_s) {
   NodeView& v = nodes_[d.node];
   v.address = d.node;
   Assembly& a = assembly_[d.node];
+  if (!v.online) {
+    v.online = true;
+    emit(DecoderEvent::online, v, a.seq);
+  }
+  v.last_frame_s = t_s;
+  if (const auto* clock = std::get_if<MetaClockMsg>(&d.message); clock && d.error == ProtocolError::none) {
+    // docs/protocol.md 2.2: a version this decoder does not know stops the node's decoding (its
+    // frames may mean something else); a known one announced again starts a new session.
+    if (clock->protocol_version > protocol::version && v.unknown_version == 0) {
+      close_report(v, a);
+      v.unknown_version = clock->protocol_version;
+      emit(DecoderEvent::unknown_version, v, a.seq);
+    } else if (clock->protocol_version <= protocol::version && v.unknown_version != 0) {
+      restart(v, a);
+    }
+  }
+  if (v.unknown_version != 0) {
+    ++v.health.not_decoded;
+    return;
+  }
   if (d.error != ProtocolError::none) {
     ++rejected_;
     ++v.health.rejected[d.error];
     emit(DecoderEvent::rejected_frame, v, a.seq);
     return;
   }
-  if (!v.online) {
-    v.online = true;
-    emit(DecoderEvent::online, v, a.seq);
-  }
-  v.last_frame_s = t_s;
   ++v.health.frames;
   accept(v, a, d.message);
 }

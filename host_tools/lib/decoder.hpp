@@ -52,6 +52,7 @@ struct LinkHealth {
   std::uint64_t restarts = 0;           // Seq/SampleCount/Uptime backwards, config or tau count change
   std::uint64_t offline_events = 0;     // silences of 3 s or more
   std::uint64_t duplicates = 0;         // a slot received twice in one report: address conflict
+  std::uint64_t not_decoded = 0;        // frames of a protocol version this decoder does not know
   std::map<protocol::ProtocolError, std::uint64_t> rejected;  // frames decode() refused
 };
 
@@ -75,6 +76,9 @@ struct NodeView {
   /// version-1 node, which has none.
   std::optional<protocol::Ieee952SummaryMsg> ieee952_summary;
   LinkHealth health;
+  /// Non-zero: the ProtocolVersion the node announced, newer than this decoder's; its frames are no
+  /// longer decoded (counted in health.not_decoded) until it announces a known version again.
+  std::uint8_t unknown_version = 0;
 
   /// The protocol version whose schedule the node follows: the clock page's, before it arrives 2
   /// once a summary page came (only version 2 sends one), else 1. A version-1 report then misses
@@ -90,7 +94,7 @@ struct NodeView {
   }
 };
 
-enum class DecoderEvent { report_closed, restart, offline, online, rejected_frame, duplicate };
+enum class DecoderEvent { report_closed, restart, offline, online, rejected_frame, duplicate, unknown_version };
 
 class Decoder {
  public:

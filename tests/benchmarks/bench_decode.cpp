@@ -50,7 +50,8 @@ Message message(std::uint8_t node, std::uint8_t seq, ReportSlot s, std::uint64_t
     case Slot::config:
       return MetaConfigMsg{seq, 7, 1000};
     case Slot::ieee952:
-      return Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.01f, 0.1};
+      if (s.index == ieee952_summary_page) return Ieee952SummaryMsg{seq, Ieee952Status::ok, 0.9f, 15, true, {}};
+      return Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.01f, 0.1, true};
   }
   return {};
 }

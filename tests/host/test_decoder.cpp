@@ -3,6 +3,7 @@
 // purpose; the expected counts follow from what the test removed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "decoder.hpp"
@@ -123,6 +124,46 @@ TEST(Decoder, VersionTwoNodeJoinedLateMissesNothingAndItsLostSummaryCounts) {
   EXPECT_EQ(v.health.frames_missing, 1u);
   ASSERT_TRUE(v.ieee952_summary.has_value());
   EXPECT_EQ(v.ieee952_summary->seq, 7);
+}
+
+TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
+  // docs/protocol.md 2.2. A node announcing version 3 (its clock page, in report 0 of the 4-report
+  // slow cycle, comes after the 2 + 2 x 8 fast frames and the sampling page) is decoded no further: the frames after
+  // its clock page and of its next reports are counted as not decoded and change no value. When it
+  // announces version 2 again, a new session starts.
+  Feed feed;
+  std::vector<DecoderEvent> events;
+  feed.decoder = Decoder([&](DecoderEvent e, const NodeView&, std::uint8_t) { events.push_back(e); });
+  for (std::uint8_t s = 0; s < 4; ++s) feed.frames(report(5, s, 8, 1000 + s * 100));
+  const float adev_before = feed.node(5).taus[0].adev.dev;
+  const std::uint64_t frames_before = feed.node(5).health.frames;
+  std::size_t sent = 0;
+  for (std::uint8_t s = 4; s < 8; ++s) {
+    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, 3);
+    // Tau 0's ADEV (position 2) differs in every report, so that a decoded frame would show.
+    EXPECT_EQ(encode(TauDevMsg{s, 0, DevKind::adev, 10.0f + s, 100.0, NoiseType::white_fm, true}, 5, frames[2]),
+              ProtocolError::none);
+    frames.back().data[0] |= 0xE0;  // a frame this decoder would reject: not its business either
+    sent += frames.size();
+    feed.frames(frames);
+  }
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.unknown_version, 3);
+  EXPECT_EQ(std::count(events.begin(), events.end(), DecoderEvent::unknown_version), 1);
+  const std::size_t before_clock = 19;  // report 4's frames before its clock page
+  EXPECT_EQ(v.health.frames, frames_before + before_clock);
+  EXPECT_EQ(v.health.not_decoded, sent - before_clock);
+  EXPECT_EQ(v.health.restarts, 0u);
+  EXPECT_NE(adev_before, 14.0f);
+  EXPECT_EQ(v.taus[0].adev.dev, 14.0f);  // report 4's, before its clock page; none of 5 .. 7's
+  EXPECT_TRUE(v.health.rejected.empty());
+  for (std::uint8_t s = 8; s < 13; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 2000));
+  feed.decoder.flush();
+  const NodeView& w = feed.node(5);
+  EXPECT_EQ(w.unknown_version, 0);
+  EXPECT_EQ(w.health.restarts, 1u);
+  EXPECT_EQ(w.schedule_version(), 2);
+  EXPECT_EQ(w.taus[0].adev.dev, 1.0f);
 }
 
 TEST(Decoder, MissingFramesAndLostReportsAreCounted) {
