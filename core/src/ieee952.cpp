@@ -323,72 +323,72 @@ double ieee952_avar(const std::array<double, 5>& p, double tau) {
          p[4] * p[4] * tau * tau / 2;
 }
 
-Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
-                       std::span<double> workspace, PairSumCache* cache) {
-  Ieee952Fit out;
-  out.curve = curve;
-  Problem pr;
-  pr.tau0 = setup.tau0_s;
-  pr.n_phase = setup.n_phase;
-  pr.spread = setup.model_spread;
-  for (const FitPoint& p : points) {
-    const bool wanted = curve == FitCurve::both || (curve == FitCurve::avar) == (p.stat == Stat::avar);
-    if (!wanted || (p.stat != Stat::avar && p.stat != Stat::mvar) || p.n == 0 || !(p.variance > 0) || pr.n >= 128)
-      continue;
-    if (unbroken_grid(p.stat, p.m, p.stride, setup.n_phase).n == 0) continue;
-    pr.point[pr.n++] = &p;
-  }
-  // At m = 1 the modified Allan estimate is the Allan one, term for term: keep it once.
-  if (curve == FitCurve::both) {
-    bool avar_at_1 = false;
-    for (std::size_t i = 0; i < pr.n; ++i) avar_at_1 |= pr.point[i]->m == 1 && pr.point[i]->stat == Stat::avar;
-    std::size_t kept = 0;
-    for (std::size_t i = 0; i < pr.n; ++i)
-      if (!(avar_at_1 && pr.point[i]->m == 1 && pr.point[i]->stat == Stat::mvar)) pr.point[kept++] = pr.point[i];
-    pr.n = kept;
-  }
-  if (workspace.size() < ieee952_workspace_doubles(pr.n) || !(setup.tau0_s > 0)) return out;
+namespace {
 
-  // Quantization: with the white level known (counts), a quantization-dominated point far below it
-  // means a periodic pattern.
-  const double qw2 = setup.white_quantization * setup.white_quantization;
-  std::array<bool, terms> free{true, true, true, true, true};
-  std::array<double, terms> fixed{};
-  if (qw2 > 0) {
-    for (std::size_t i = 0; i < pr.n; ++i) {
-      const FitPoint& p = *pr.point[i];
-      const double white = qw2 * design(p.stat, p.m, setup.tau0_s)[0];
-      if (white < 0.5 * p.variance) continue;
-      const double edf = exact_edf(2, unbroken_grid(p.stat, p.m, p.stride, setup.n_phase)) *
-                         static_cast<double>(p.n) /
-                         static_cast<double>(unbroken_grid(p.stat, p.m, p.stride, setup.n_phase).n);
-      const double sd = white * std::sqrt(2 / edf);
-      if (p.variance < white - 3 * sd && p.variance < 0.98 * white) out.quantization_white = false;
+// Leaves out every point whose white-quantization part is quantization_left_out or more of it, and
+// holds Q at the white level: the quantization is not white.
+void leave_out_quantization(Problem& pr, double qw2, std::array<bool, terms>& free, std::array<double, terms>& fixed,
+                            Ieee952Fit& out) {
+  out.quantization_white = false;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    const FitPoint& p = *pr.point[i];
+    const double white = qw2 * design(p.stat, p.m, pr.tau0)[0];
+    if (white >= quantization_left_out * p.variance) {
+      double& below = out.excluded_below_tau_s[p.stat == Stat::avar ? 0 : 1];
+      const double next_octave = 2 * static_cast<double>(p.m) * pr.tau0;
+      if (next_octave > below) below = next_octave;
+      continue;
     }
-    if (!out.quantization_white) {
-      std::size_t kept = 0;
-      for (std::size_t i = 0; i < pr.n; ++i) {
-        const FitPoint& p = *pr.point[i];
-        const double white = qw2 * design(p.stat, p.m, setup.tau0_s)[0];
-        if (white >= quantization_left_out * p.variance) {
-          double& below = out.excluded_below_tau_s[p.stat == Stat::avar ? 0 : 1];
-          const double next_octave = 2 * static_cast<double>(p.m) * setup.tau0_s;
-          if (next_octave > below) below = next_octave;
-          continue;
-        }
-        pr.point[kept++] = pr.point[i];
-      }
-      pr.n = kept;
-      free[0] = false;
-      fixed[0] = qw2;
-    }
+    pr.point[kept++] = pr.point[i];
   }
+  pr.n = kept;
+  free[0] = false;
+  fixed[0] = qw2;
+}
+
+// Before the fit: a point the white quantization alone would dominate lies far below it (three
+// standard deviations and 2 %). Only a pattern can do that: other noise adds.
+bool below_white_quantization(const Problem& pr, double qw2) {
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    const FitPoint& p = *pr.point[i];
+    const double white = qw2 * design(p.stat, p.m, pr.tau0)[0];
+    if (white < 0.5 * p.variance) continue;
+    const TermGrid grid = unbroken_grid(p.stat, p.m, p.stride, pr.n_phase);
+    const double edf = exact_edf(2, grid) * static_cast<double>(p.n) / static_cast<double>(grid.n);
+    const double sd = white * std::sqrt(2 / edf);
+    if (p.variance < white - 3 * sd && p.variance < 0.98 * white) return true;
+  }
+  return false;
+}
+
+// After the fit: a point the fitted Q dominates departs from the model, either way, by three of its
+// standard deviations and 2 %. With Q free, white angle noise beyond quantization is in the model,
+// so the 1/tau^2 shape itself fails there: a pattern (a rate a little above a pulse per sample
+// quantizes into one as well), a dither, or anything else no IEEE-952 term describes.
+bool quantization_departs(const Problem& pr, const Solution& sol) {
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    const double* x = pr.row(i);
+    double model = 0;
+    for (std::size_t t = 0; t < terms; ++t) model += sol.theta[t] * x[t];
+    if (!(sol.theta[0] * x[0] >= 0.5 * model)) continue;
+    const double gap = std::fabs(x[5] - model);
+    if (gap > 3 * std::sqrt(x[6]) && gap > 0.02 * model) return true;
+  }
+  return false;
+}
+
+// The fit of the points in pr: their pair sums, first weights, then the exact covariance until
+// the parameters settle. Fills out's status, chi2 and parameters; leaves the solution in `sol`.
+void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms>& free,
+                const std::array<double, terms>& fixed, std::span<double> workspace, PairSumCache* cache,
+                Ieee952Fit& out, Solution& sol) {
   out.points = pr.n;
   std::size_t n_free = 0;
   for (bool f : free) n_free += f;
   if (pr.n <= n_free || pr.n == 0) {
     out.status = FitStatus::too_few_points;
-    return out;
+    return;
   }
   pr.pair = workspace.data();
   pr.sigma = pr.pair + pr.n * (pr.n + 1) / 2 * 14;
@@ -429,16 +429,16 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
   }
   if (!cholesky(pr.sigma, pr.n)) {
     out.status = FitStatus::singular;
-    return out;
+    return;
   }
-  Solution sol = solve(pr, free, fixed);
+  sol = solve(pr, free, fixed);
   // Then the exact covariance under the current parameters, until they settle.
   for (int iteration = 0; iteration < 12; ++iteration) {
     covariance_of_points(pr, sol.theta);
     for (std::size_t i = 0; i < pr.n; ++i) pr.row(i)[6] = pr.sigma[i * pr.n + i];
     if (!factor(pr)) {
       out.status = FitStatus::singular;
-      return out;
+      return;
     }
     const Solution next = solve(pr, free, fixed);
     double change = 0;
@@ -458,6 +458,7 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
   out.status = rejected(out.chi2, out.dof) ? FitStatus::rejected : FitStatus::ok;
   for (std::size_t t = 0; t < terms; ++t) {
     Ieee952Parameter& p = out.p[t];
+    p = Ieee952Parameter{};
     p.fitted = sol.active[t];
     const double theta = sol.theta[t];
     p.value = theta > 0 ? std::sqrt(theta) : 0.0;
@@ -473,6 +474,48 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
         if (u != t && sol.theta[u] * pr.row(i)[u] > mine) largest = false;
       p.resolved = largest;
     }
+  }
+}
+
+}  // namespace
+
+Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
+                       std::span<double> workspace, PairSumCache* cache) {
+  Ieee952Fit out;
+  out.curve = curve;
+  Problem pr;
+  pr.tau0 = setup.tau0_s;
+  pr.n_phase = setup.n_phase;
+  pr.spread = setup.model_spread;
+  for (const FitPoint& p : points) {
+    const bool wanted = curve == FitCurve::both || (curve == FitCurve::avar) == (p.stat == Stat::avar);
+    if (!wanted || (p.stat != Stat::avar && p.stat != Stat::mvar) || p.n == 0 || !(p.variance > 0) || pr.n >= 128)
+      continue;
+    if (unbroken_grid(p.stat, p.m, p.stride, setup.n_phase).n == 0) continue;
+    pr.point[pr.n++] = &p;
+  }
+  // At m = 1 the modified Allan estimate is the Allan one, term for term: keep it once.
+  if (curve == FitCurve::both) {
+    bool avar_at_1 = false;
+    for (std::size_t i = 0; i < pr.n; ++i) avar_at_1 |= pr.point[i]->m == 1 && pr.point[i]->stat == Stat::avar;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < pr.n; ++i)
+      if (!(avar_at_1 && pr.point[i]->m == 1 && pr.point[i]->stat == Stat::mvar)) pr.point[kept++] = pr.point[i];
+    pr.n = kept;
+  }
+  if (workspace.size() < ieee952_workspace_doubles(pr.n) || !(setup.tau0_s > 0)) return out;
+
+  // Quantization, where its white level is known (counts): tested before the fit and after it.
+  const double qw2 = setup.white_quantization * setup.white_quantization;
+  std::array<bool, terms> free{true, true, true, true, true};
+  std::array<double, terms> fixed{};
+  if (qw2 > 0 && below_white_quantization(pr, qw2)) leave_out_quantization(pr, qw2, free, fixed, out);
+  Solution sol;
+  fit_points(pr, setup, free, fixed, workspace, cache, out, sol);
+  if (qw2 > 0 && out.quantization_white && out.status != FitStatus::too_few_points &&
+      out.status != FitStatus::singular && quantization_departs(pr, sol)) {
+    leave_out_quantization(pr, qw2, free, fixed, out);
+    fit_points(pr, setup, free, fixed, workspace, cache, out, sol);
   }
   return out;
 }

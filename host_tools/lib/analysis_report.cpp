@@ -157,8 +157,9 @@ std::string format_table(const Report& r) {
   for (const CurveFit& f : r.fits) {
     fmt::format_to(to, "# {}\n", fit_summary(f));
     if (!f.fit.quantization_white)
-      fmt::format_to(to, "#   quantization is not white (a periodic pattern: a rate below one pulse per sample without "
-                         "dither): points it reaches left out ({}), Q held at pulse weight / sqrt(12)\n",
+      fmt::format_to(to, "#   quantization is not white (the short taus do not follow white quantization: a steady rate "
+                         "makes a periodic pattern without dither): points it reaches left out ({}), Q held at "
+                         "pulse weight / sqrt(12)\n",
                      excluded_text(f.fit));
     if (f.fit.status == FitStatus::too_few_points || f.fit.status == FitStatus::singular) continue;
     for (std::size_t i = 0; i < 5; ++i) {

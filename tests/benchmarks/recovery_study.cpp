@@ -91,7 +91,7 @@ Examples:
   const double p1 = resolved_present ? static_cast<double>(within1) / static_cast<double>(resolved_present) : 0;
   const double p2 = resolved_present ? static_cast<double>(within2) / static_cast<double>(resolved_present) : 0;
   const double pf = absent ? static_cast<double>(false_resolved) / static_cast<double>(absent) : 0;
-  fmt::format_to(to, "| pooled over the scenarios | runs | share (%) | standard error (points) | target |\n");
+  fmt::format_to(to, "| pooled over the scenarios | terms | share (%) | standard error (points) | target |\n");
   fmt::format_to(to, "|---|---:|---:|---:|---|\n");
   fmt::format_to(to, "| resolved terms within 1 stated sigma of the truth | {} | {} | {} | 68 +- 5 |\n", resolved_present,
                  share(within1, resolved_present), error_of(p1, resolved_present));

@@ -2,7 +2,8 @@
 // must give their parameters back), and Monte Carlo with points drawn from the multivariate normal
 // distribution of the model's own covariance (noise_model.hpp, computed here by pair_sums()
 // independently of the fit): the stated uncertainties must then cover the truth about 68 % of the
-// time, and chi2/dof average 1. The quantization rule against a curve with a known periodic deficit.
+// time, and chi2/dof average 1. The quantization rules against curves with a known periodic deficit
+// or departure.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -186,6 +187,27 @@ TEST(Ieee952, PeriodicQuantizationIsDetectedAndItsTausLeftOut) {
   EXPECT_TRUE(white.quantization_white);
   EXPECT_EQ(white.excluded_below_tau_s[0], 0.0);
   EXPECT_EQ(white.excluded_below_tau_s[1], 0.0);
+}
+
+TEST(Ieee952, APatternAboveTheWhiteLevelIsFoundAfterTheFit) {
+  // A pattern that never falls below the white level alone: AVAR 1.37 x the model at m = 1 and 0.86 x
+  // at m = 2 (ADEV +17 % and -7 %, what 1.5 pulses per sample gave in docs/metrology.md), with
+  // white angle noise beyond quantization (Q = 1.5 Q_w) so that the test before the fit passes.
+  // Oracle: the truth's N, from the taus quantization leaves alone; without the departure nothing
+  // is left out and Q is fitted (1.5 Q_w back).
+  const double qw = truth[0] / 1.5;
+  auto pts = exact_points(truth);
+  for (FitPoint& pt : pts) {
+    if (pt.m == 1) pt.variance *= 1.37;
+    if (pt.m == 2) pt.variance *= 0.86;
+  }
+  const Ieee952Fit f = fit(pts, FitCurve::both, qw);
+  EXPECT_FALSE(f.quantization_white);
+  EXPECT_FALSE(f.p[0].fitted);
+  EXPECT_NEAR(f.p[1].value / truth[1], 1.0, 0.01);
+  const Ieee952Fit white = fit(exact_points(truth), FitCurve::both, qw);
+  EXPECT_TRUE(white.quantization_white);
+  EXPECT_NEAR(white.p[0].value / truth[0], 1.0, 1e-3);
 }
 
 TEST(Ieee952, AModelThatDoesNotDescribeTheCurveIsRejected) {

@@ -41,6 +41,13 @@ std::vector<Scenario> standard_scenarios() {
              o.arw_deg_per_sqrt_h = 0.01;
              o.rrw_deg_per_h_sqrt_h = 0.1;
            }),
+      // The rate random walk without the whitener: 1.5 pulses per sample still quantize
+      // into a pattern, one the fit can only see after fitting.
+      make("ARW + rate random walk, periodic quantization", 4, 0.1,
+           [](SimOptions& o) {
+             o.arw_deg_per_sqrt_h = 0.01;
+             o.rrw_deg_per_h_sqrt_h = 0.1;
+           }),
       make("ARW + rate ramp", 4, 0.1,
            [](SimOptions& o) {
              o.white_angle_arcsec = 1;

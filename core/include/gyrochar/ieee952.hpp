@@ -31,11 +31,14 @@
 // above zero, and it is the largest of the five contributions at one of the taus used at least.
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
-// A constant rate below one pulse per sample without dither makes a periodic pattern instead, whose
-// Allan variance at some short taus falls well below the white level 3 Q_w^2 / tau^2. Where a point
-// dominated by quantization falls that far (three standard deviations and 2 %), quantization is
-// declared not white: every point with a quantization share of 1 % or more is left out, and Q is
-// held at Q_w (not fitted) for the rest.
+// A steady rate without dither (and with too little random angle per sample to spread it) makes a
+// periodic pattern instead, whose Allan variance at short taus swings above and below the white
+// level 3 Q_w^2 / tau^2. Quantization is declared not white when, before the fit, a point the
+// white level alone would dominate lies below it, or when, after the fit (Q free: white angle
+// noise beyond quantization is in the model), a point the fitted Q dominates departs from the
+// model either way; both by three standard deviations and 2 %. Then every point with a
+// quantization share of 1 % or more is left out, Q is held at Q_w (not fitted) and the rest is
+// fitted again.
 #include <array>
 #include <cstddef>
 #include <cstdint>
