@@ -321,7 +321,7 @@ class Characterizer {
     const double b = hi - x;
     const double lo = (x - (hi - b)) - (run_.line_x0 + b);
     if (k == 1) run_.line_slope = hi;
-    push(std::fma(-static_cast<double>(k), run_.line_slope, hi) + lo);
+    push(static_cast<X>(std::fma(-static_cast<double>(k), run_.line_slope, hi) + lo));
   }
 
   /// Adds the next increment of phase: a pulse count per tau0 (CountArith) or frequency * tau0
