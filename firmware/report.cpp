@@ -58,6 +58,12 @@ ReportWorkspace::ReportWorkspace(unsigned octaves)
       entries_(std::size_t{octaves} * octaves * 4 * 2 + 64),
       cache_(entries_) {}
 
+bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau0_s) {
+  if (last_fit_samples == 0 || samples < last_fit_samples) return true;
+  const auto grown = static_cast<double>(samples - last_fit_samples);
+  return grown >= 0.25 * static_cast<double>(last_fit_samples) || grown * tau0_s >= refit_after_s;
+}
+
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
                   std::uint64_t uptime_ms, const FaultCounters& f, ReportWorkspace& work, ReportContent& out) {
   using namespace protocol;
@@ -91,13 +97,17 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   out.config = {seq, s.config_hash, s.report_period_ms};
   // The recommended fit of both curves, in arcsec and seconds; quantization's white level is the
   // pulse weight over sqrt(12). Only for the reports that carry the Ieee952 frames (one in
-  // protocol::slow_cycle_reports): the others keep the last fit, which they do not send.
+  // protocol::slow_cycle_reports), and only when refit_due(); otherwise they repeat the last fit.
   bool carries_fit = false;
   for (std::size_t k = 0; k < report_frame_count(seq, taus) && !carries_fit; ++k)
     carries_fit = report_slot(seq, taus, k).slot == Slot::ieee952;
   if (!carries_fit) return;
-  const FitSetup setup{s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)};
-  const Ieee952Fit fit = fit_ieee952(std::span(points.data(), n_points), setup, FitCurve::both, work.fit(), &work.cache());
+  if (refit_due(samples, work.last_fit_samples, s.tau0_s)) {
+    const FitSetup setup{s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)};
+    work.last_fit = fit_ieee952(std::span(points.data(), n_points), setup, FitCurve::both, work.fit(), &work.cache());
+    work.last_fit_samples = samples;
+  }
+  const Ieee952Fit& fit = work.last_fit;
   // A term in the model goes out with its value and uncertainty, resolved or not (an upper-bound
   // reading); Resolved also needs an accepted fit. A term left out or held fixed goes out as zeros.
   for (std::size_t k = 0; k < 5; ++k) {

@@ -56,20 +56,31 @@ struct ReportContent {
   Ieee952Fit fit;  // the fit the IEEE-952 frames were made from (for logs and tests)
 };
 
-/// What build_report() works in, allocated once for `octaves` taus: the IEEE-952 fit's workspace
-/// and the cache of the covariance sums behind the EDFs, the noise identification and the fit
-/// (noise_model.hpp: computed once per pair of taus, then O(1) per report as the run grows).
+/// What build_report() works in, allocated once for `octaves` taus: the IEEE-952 fit's workspace,
+/// the last fit, and the cache of the covariance sums behind the EDFs, the noise identification
+/// and the fit (noise_model.hpp: computed once per pair of taus, then O(1) per report as the run
+/// grows).
 class ReportWorkspace {
  public:
   explicit ReportWorkspace(unsigned octaves);
   std::span<double> fit() { return fit_; }
   PairSumCache& cache() { return cache_; }
+  /// The last fit and the number of samples it was made from (0: none yet).
+  Ieee952Fit last_fit;
+  std::uint64_t last_fit_samples = 0;
 
  private:
   std::vector<double> fit_;
   std::vector<PairSumCache::Entry> entries_;
   PairSumCache cache_;
 };
+
+/// When a report that carries the IEEE-952 frames fits again: once the run has grown by a quarter
+/// since the last fit, or by `refit_after_s` of samples. In between the frames repeat the last
+/// fit: a fit on a young run is the report's dearest part (the covariance of every pair of its
+/// points, before the cache's sums turn linear), and it changes slowly as the run grows.
+inline constexpr double refit_after_s = 900.0;
+bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau0_s);
 
 /// Fills `out` for report `seq` from the characterizer's current state: the deviations, EDFs and
 /// noise types of every report, and the IEEE-952 fit for the reports that carry its frames (the

@@ -161,5 +161,49 @@ TEST(ReportEndToEnd, PeriodicQuantizationReachesTheDecoderAsTheBoardsFitSaysIt) 
   expect_decoded_fit_is_the_boards(v, content.fit, s.tau0_s);
 }
 
+TEST(ReportSchedule, RefitWhenTheRunHasGrownByAQuarterOrByFifteenMinutes) {
+  // Oracle: the rule as report.hpp states it, worked by hand.
+  EXPECT_TRUE(firmware::refit_due(1000, 0, 0.01));      // no fit yet
+  EXPECT_FALSE(firmware::refit_due(1249, 1000, 0.01));  // grown 24.9 %
+  EXPECT_TRUE(firmware::refit_due(1250, 1000, 0.01));   // grown 25 %
+  EXPECT_FALSE(firmware::refit_due(1'089'999, 1'000'000, 0.01));  // 899.99 s more, 9 %
+  EXPECT_TRUE(firmware::refit_due(1'090'000, 1'000'000, 0.01));   // 900 s more
+  EXPECT_TRUE(firmware::refit_due(10, 1000, 0.01));     // fewer samples than the fit: a new run
+}
+
+TEST(ReportSchedule, ReportsBetweenRefitsRepeatTheLastFitWithTheirOwnSeq) {
+  GyroParameters g;
+  g.tau0_s = 0.01;
+  g.pulse_weight_rad = units::arcsec;
+  g.n_rad_sqrt_s = 0.003 * units::deg_per_sqrt_h;
+  GyroSimulator sim(g);
+  firmware::ReportSettings s;
+  s.tau0_s = g.tau0_s;
+  s.octaves = 12;
+  auto board = std::make_unique<firmware::BoardCharacterizer>();
+  ASSERT_TRUE(firmware::configure(*board, s));
+  firmware::ReportContent content;
+  firmware::ReportWorkspace workspace(s.octaves);
+  // Three slow cycles: 40 000 samples before the first, 1000 more per report in the second (the run
+  // grows by 10 %: the fit is repeated), 40 000 more per report in the third (a new fit).
+  std::vector<std::uint64_t> fitted_from;
+  for (std::uint8_t seq = 0; seq < 12; ++seq) {
+    const int add = seq < 4 ? 10000 : seq < 8 ? 1000 : 40000;
+    for (int k = 0; k < add; ++k) board->add_increment(static_cast<std::int32_t>(sim.next_count()));
+    firmware::build_report(*board, s, seq, 1000u * (seq + 1), {}, workspace, content);
+    bool carries = false;
+    for (std::size_t k = 0; k < protocol::report_frame_count(seq, board->tau_count()); ++k)
+      carries |= protocol::report_slot(seq, board->tau_count(), k).slot == protocol::Slot::ieee952;
+    if (!carries) continue;
+    EXPECT_EQ(content.ieee952_summary.seq, seq);
+    for (const auto& term : content.ieee952) EXPECT_EQ(term.seq, seq);
+    fitted_from.push_back(workspace.last_fit_samples);
+    EXPECT_EQ(content.ieee952_summary.points, workspace.last_fit.points);
+  }
+  ASSERT_EQ(fitted_from.size(), 3u);  // one report of each slow cycle carries the fit
+  EXPECT_EQ(fitted_from[1], fitted_from[0]);  // repeated
+  EXPECT_GT(fitted_from[2], fitted_from[1]);  // fitted again
+}
+
 }  // namespace
 }  // namespace gyrochar
