@@ -53,9 +53,9 @@ const char* restore_reason(RestoreStatus s) {
 
 }  // namespace
 
-Board::Board(const Config& config, BoardIo io)
+Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
     : config_(config), io_(io), can_counter_(static_cast<std::uint8_t>(config.counter_node)),
-      checkpoint_file_(config.checkpoint_path), report_work_(config.octaves) {
+      checkpoint_file_(config.checkpoint_path), report_work_(config.octaves, fit_mode) {
   settings_.tau0_s = config.tau0_s;
   settings_.pulse_weight_arcsec = config.pulse_weight_arcsec;
   settings_.stride_factor = config.stride_factor;

@@ -27,8 +27,9 @@ struct BoardIo {
 
 class Board final : public hal::CountSink {
  public:
-  /// Throws std::invalid_argument for settings the estimator cannot hold.
-  Board(const Config& config, BoardIo io);
+  /// Throws std::invalid_argument for settings the estimator cannot hold. gyrochard fits in the
+  /// background (fit_worker.hpp); the host simulation and the tests inline, to repeat exactly.
+  Board(const Config& config, BoardIo io, FitMode fit_mode = FitMode::inline_fit);
   ~Board();
   Board(const Board&) = delete;
   Board& operator=(const Board&) = delete;

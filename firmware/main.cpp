@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
   }
   std::unique_ptr<firmware::Board> board;
   try {
-    board = std::make_unique<firmware::Board>(config, firmware::BoardIo{*can, source.get(), clock, *timer, stop_fd});
+    board = std::make_unique<firmware::Board>(config, firmware::BoardIo{*can, source.get(), clock, *timer, stop_fd},
+                                                   firmware::FitMode::background);
   } catch (const std::exception& e) {
     return fail(exit_config, "configuration", e.what());
   }

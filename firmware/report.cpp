@@ -51,12 +51,10 @@ protocol::Ieee952SummaryMsg ieee952_summary(const Ieee952Fit& fit, std::uint8_t 
 
 }  // namespace
 
-ReportWorkspace::ReportWorkspace(unsigned octaves)
-    : fit_(ieee952_workspace_doubles(2 * octaves)),
-      // Every pair of the fit's points (both curves of every tau): a table less than half full
-      // keeps the probes short.
-      entries_(std::size_t{octaves} * octaves * 4 * 2 + 64),
-      cache_(entries_) {}
+ReportWorkspace::ReportWorkspace(unsigned octaves, FitMode fit_mode)
+    : entries_(std::size_t{octaves} * 16 + 64),  // a few pairs per tau, the table less than half full
+      cache_(entries_),
+      fitter_(octaves, fit_mode) {}
 
 bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau0_s) {
   if (last_fit_samples == 0 || samples < last_fit_samples) return true;
@@ -97,17 +95,16 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   out.config = {seq, s.config_hash, s.report_period_ms};
   // The recommended fit of both curves, in arcsec and seconds; quantization's white level is the
   // pulse weight over sqrt(12). Only for the reports that carry the Ieee952 frames (one in
-  // protocol::slow_cycle_reports), and only when refit_due(); otherwise they repeat the last fit.
+  // protocol::slow_cycle_reports); they ask for a new fit when refit_due() and send the latest.
   bool carries_fit = false;
   for (std::size_t k = 0; k < report_frame_count(seq, taus) && !carries_fit; ++k)
     carries_fit = report_slot(seq, taus, k).slot == Slot::ieee952;
   if (!carries_fit) return;
-  if (refit_due(samples, work.last_fit_samples, s.tau0_s)) {
-    const FitSetup setup{s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)};
-    work.last_fit = fit_ieee952(std::span(points.data(), n_points), setup, FitCurve::both, work.fit(), &work.cache());
-    work.last_fit_samples = samples;
-  }
-  const Ieee952Fit& fit = work.last_fit;
+  if (refit_due(samples, work.fitter().requested_samples(), s.tau0_s))
+    work.fitter().request(std::span(points.data(), n_points),
+                          {s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)}, samples);
+  const FitWorker::Result latest = work.fitter().latest();
+  const Ieee952Fit& fit = latest.fit;
   // A term in the model goes out with its value and uncertainty, resolved or not (an upper-bound
   // reading); Resolved also needs an accepted fit. A term left out or held fixed goes out as zeros.
   for (std::size_t k = 0; k < 5; ++k) {
@@ -119,6 +116,7 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   }
   out.ieee952_summary = ieee952_summary(fit, seq, s.tau0_s);
   out.fit = fit;
+  out.fit_samples = latest.samples;
 }
 
 protocol::Message report_message(const ReportContent& c, std::size_t k) {

@@ -12,6 +12,7 @@
 #include "gyrochar/characterizer.hpp"
 #include "gyrochar/ieee952.hpp"
 #include "gyrochar/protocol.hpp"
+#include "fit_worker.hpp"
 
 namespace gyrochar::firmware {
 
@@ -54,31 +55,29 @@ struct ReportContent {
   std::array<protocol::Ieee952Msg, 5> ieee952{};
   protocol::Ieee952SummaryMsg ieee952_summary;
   Ieee952Fit fit;  // the fit the IEEE-952 frames were made from (for logs and tests)
+  std::uint64_t fit_samples = 0;  // the samples it was made from (0: none yet)
 };
 
-/// What build_report() works in, allocated once for `octaves` taus: the IEEE-952 fit's workspace,
-/// the last fit, and the cache of the covariance sums behind the EDFs, the noise identification
-/// and the fit (noise_model.hpp: computed once per pair of taus, then O(1) per report as the run
-/// grows).
+/// What build_report() works in, allocated once for `octaves` taus: the cache of the covariance
+/// sums behind the EDFs and the noise identification (noise_model.hpp: computed once per tau, then
+/// O(1) per report as the run grows), and the IEEE-952 fit (fit_worker.hpp: inline or beside the
+/// report loop, with its own cache).
 class ReportWorkspace {
  public:
-  explicit ReportWorkspace(unsigned octaves);
-  std::span<double> fit() { return fit_; }
+  explicit ReportWorkspace(unsigned octaves, FitMode fit_mode = FitMode::inline_fit);
   PairSumCache& cache() { return cache_; }
-  /// The last fit and the number of samples it was made from (0: none yet).
-  Ieee952Fit last_fit;
-  std::uint64_t last_fit_samples = 0;
+  FitWorker& fitter() { return fitter_; }
 
  private:
-  std::vector<double> fit_;
   std::vector<PairSumCache::Entry> entries_;
   PairSumCache cache_;
+  FitWorker fitter_;
 };
+static_assert(2 * max_octaves <= FitWorker::max_points);
 
-/// When a report that carries the IEEE-952 frames fits again: once the run has grown by a quarter
-/// since the last fit, or by `refit_after_s` of samples. In between the frames repeat the last
-/// fit: a fit on a young run is the report's dearest part (the covariance of every pair of its
-/// points, before the cache's sums turn linear), and it changes slowly as the run grows.
+/// When a report that carries the IEEE-952 frames asks for a new fit: once the run has grown by a
+/// quarter since the points of the last fit, or by `refit_after_s` of samples. In between the
+/// frames repeat the latest fit: it changes slowly as the run grows.
 inline constexpr double refit_after_s = 900.0;
 bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau0_s);
 
