@@ -47,7 +47,7 @@ cmake --build build/perf --target coverage_study recovery_study >/dev/null
 mkdir -p "$(dirname "$csv")"
 
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-if [ -n "$(git status --porcelain -- core host_tools/lib tests/support tests/benchmarks 2>/dev/null)" ]; then
+if [ -n "$(git status --porcelain -- core host_tools/common host_tools/analyze host_tools/sim tests/support tests/benchmarks 2>/dev/null)" ]; then
   commit="$commit with uncommitted changes to the engine or the studies"
 fi
 machine="$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), g++ $(g++ -dumpversion), Release build"

@@ -1,7 +1,7 @@
 // gyrochar-analyze: Allan-family deviations of a recorded file, with EDF, confidence intervals,
 // noise identification and the IEEE-952 fit, computed by the same streaming core as the board.
 // This file is the command line: options, the read passes, progress and exit codes. The engine is
-// host_tools/lib/analysis.*, the output formats host_tools/lib/analysis_report.*.
+// host_tools/analyze/analysis.*, the output formats host_tools/analyze/analysis_report.*.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <unistd.h>

@@ -4,7 +4,7 @@
 // how often the interval holds the true deviation. Used by tests/benchmarks/coverage_study.cpp
 // (the full study, docs/metrology.md) and tests/host/test_coverage.cpp (a small, fast version).
 //
-// Every use of the engine's API (host_tools/lib/analysis.hpp) is in run_engine(), and every true
+// Every use of the engine's API (host_tools/analyze/analysis.hpp) is in run_engine(), and every true
 // value comes from true_variance(): the engine is being rewritten, and only these two functions
 // know how it is called and what it is compared with.
 #include <array>

@@ -22,7 +22,7 @@
 
 namespace gyrochar {
 
-// TODO(units.hpp): take these factors from host_tools/lib/units.hpp once it lands.
+// TODO(units.hpp): take these factors from host_tools/common/units.hpp once it lands.
 /// Size in rad of an angle unit: rad, mrad, urad, deg, arcsec; empty for anything else. O(1).
 std::optional<double> angle_unit_rad(std::string_view unit);
 
