@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -61,7 +62,8 @@ Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
   settings_.stride_factor = config.stride_factor;
   settings_.octaves = config.octaves;
   settings_.source = input_source(config.source);
-  settings_.report_period_ms = static_cast<std::uint16_t>(config.report_period_s * 1000.0);
+  // validate() keeps the period within the protocol's 100..2000 ms: the field cannot wrap.
+  settings_.report_period_ms = static_cast<std::uint16_t>(std::lround(config.report_period_s * 1000.0));
   settings_.config_hash = hash_settings(settings_);
   if (!configure(characterizer_, settings_)) throw std::invalid_argument("estimator settings out of range");
   checkpoint_buffer_.resize(characterizer_.checkpoint_size());
@@ -74,7 +76,7 @@ Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
   // frames always come through.
   const hal::CanFilter counter_frames{protocol::counter_input_id | config.counter_node, 0x1FFFFFFF};
   if (!io.can.set_filters(io.source ? std::span<const hal::CanFilter>{} : std::span(&counter_frames, 1)))
-    throw std::invalid_argument("the CAN interface refused the receive filters");
+    throw std::runtime_error(config.can_interface + ": the CAN interface refused the receive filters");
 
   epoll_ = epoll_create1(EPOLL_CLOEXEC);
   for (const int fd : {io.can.fd(), io.timer.fd(), io.source ? io.source->fd() : -1, io.stop_fd}) {

@@ -21,23 +21,21 @@
 #include "analysis.hpp"
 #include "analysis_report.hpp"
 #include "datafile.hpp"
+#include "hal/exit_codes.hpp"
 
 namespace {
 
 using namespace gyrochar;
 
-constexpr int exit_internal = 1;   // a bug or resource exhaustion
-constexpr int exit_bad_input = 2;  // bad options or data
-constexpr int exit_output = 3;     // the results could not be written
+constexpr const char* program = "gyrochar-analyze";
 
 bool progress_line_open = false;  // a progress line without its newline is on stderr
 
 [[noreturn]] void fail(int code, const std::string& what, const std::string& why) {
   if (progress_line_open) std::fputc('\n', stderr);
-  std::fprintf(stderr, "gyrochar-analyze: %s: %s\n", what.c_str(), why.c_str());
-  std::exit(code);
+  exit_with(code, program, what, why);
 }
-[[noreturn]] void bad(const std::string& what, const std::string& why) { fail(exit_bad_input, what, why); }
+[[noreturn]] void bad(const std::string& what, const std::string& why) { fail(exit_code::bad_input, what, why); }
 
 constexpr const char* footer = R"(Data type and units (the type is required: for a gyro "frequency" is rate and "phase" is angle):
   --type phase   phase samples: --unit s (clock phase, the default; deviations as fractional
@@ -73,8 +71,7 @@ Examples:
   gyrochar-analyze --type phase --unit deg --tau0 0.01 --column 2 --stats oadev,mdev angle.csv
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
 
-Exit codes: 0 success; 1 internal error; 2 bad options or data; 3 the output could not be written.
-Errors go to stderr as 'gyrochar-analyze: what: why'; data goes to stdout.)";
+)";
 
 std::vector<std::string> split(const std::string& text, char separator) {
   std::vector<std::string> items;
@@ -177,7 +174,7 @@ int main(int argc, char** argv) {
   CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV of a recorded file, with EDF,\n"
                "confidence intervals, noise identification and the IEEE-952 gyro fit; streams any length.",
                "gyrochar-analyze"};
-  app.footer(footer);
+  app.footer(std::string(footer) + exit_code::help);
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
   std::string format = "table", fit_text;
@@ -204,7 +201,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return finish(program, app.exit(e));
   } catch (const CLI::ParseError& e) {
     bad("options", std::string(e.what()) + " (see --help)");
   }
@@ -345,10 +342,9 @@ int main(int argc, char** argv) {
     const std::string text = format == "json" ? to_json(report).dump(2) + "\n"
                              : format == "csv" ? format_csv(report)
                                                : format_table(report);
-    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
-      fail(exit_output, "output", std::strerror(errno));
+    std::fwrite(text.data(), 1, text.size(), stdout);
   } catch (const std::exception& e) {
-    fail(exit_internal, "internal error", e.what());
+    fail(exit_code::internal, "internal error", e.what());
   }
-  return 0;
+  return finish(program, exit_code::ok);
 }
