@@ -1,5 +1,7 @@
 #include "analysis.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -14,6 +16,24 @@
 #include "gyrochar/characterizer.hpp"
 
 namespace gyrochar {
+
+namespace {
+
+// Why estimate `e` is not a finite number, for an error message. The variance is the sum of the
+// squared differences over tau0^2 (phase data) or over 1 (frequency data), TDEV's times tau^2 / 3.
+std::string non_finite_reason(const Estimate& e, const TauSums& sums, double tau0_s) {
+  const std::string where = fmt::format("{} at tau = {:g} s (m = {})", name(e.stat), e.tau_s, e.m);
+  for (const double v : sums.variance)
+    if (!std::isfinite(v))
+      return where + ": the squared differences of the values overflow a double (largest 1.8e308): the values "
+                     "are too large; scale them";
+  if (!std::isnormal(tau0_s * tau0_s) || !std::isnormal(e.tau_s * e.tau_s))
+    return where + fmt::format(": tau0^2 = ({:g} s)^2 is outside the range of a double: tau0 is too {}", tau0_s,
+                               tau0_s < 1 ? "small" : "large");
+  return where + fmt::format(": the squared differences divided by tau0^2 = ({:g} s)^2 overflow a double", tau0_s);
+}
+
+}  // namespace
 
 const char* name(DataType t) {
   switch (t) {
@@ -148,6 +168,7 @@ class Engine final : public EngineBase {
         const NoiseId& id = stat_of(stat) == Stat::hvar ? noise3[i] : noise2[i];
         const Estimate e = estimate(sums[i], a.n_phase, stat, id, options);
         if (e.n == 0) continue;
+        if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
         AnalysisRow row;
         row.stat = stat;
         row.m = e.m;

@@ -102,6 +102,9 @@ class Analyzer {
   /// finite or not a valid count, std::range_error when the accumulated count passes 2^63 pulses.
   void add(double value);
   /// Results so far; may be called at any time. O(taus x stats) plus the EDF, allocates the rows.
+  /// Throws std::range_error naming the statistic, the tau and the cause when a deviation is not
+  /// a finite number (values whose squared differences overflow a double, a tau0 whose square
+  /// leaves a double's range): such a result is never returned.
   Analysis result() const;
 
  private:

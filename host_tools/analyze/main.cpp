@@ -99,6 +99,7 @@ std::vector<DevStat> parse_stats(const std::string& text) {
   for (const std::string& item : split(text, ',')) {
     const auto s = parse_dev_stat(item);
     if (!s) bad("--stats", "unknown statistic '" + item + "' (adev, oadev, mdev, tdev, hdev, ohdev)");
+    if (std::find(stats.begin(), stats.end(), *s) != stats.end()) bad("--stats", "'" + item + "' is asked twice");
     stats.push_back(*s);
   }
   if (stats.empty()) bad("--stats", "empty list");
@@ -328,7 +329,13 @@ int main(int argc, char** argv) {
     } catch (const DataFileError& e) {
       bad_data(path, e);
     }
-    const Analysis a = analyzer->result();
+    const Analysis a = [&] {
+      try {
+        return analyzer->result();
+      } catch (const std::range_error& e) {  // a deviation that is not a finite number, and why
+        bad(source, e.what());
+      }
+    }();
     if (a.n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
     if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
 
@@ -337,6 +344,25 @@ int main(int argc, char** argv) {
       fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0);
     Analysis displayed = a;
     std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
+    // A tau asked for by number but too long for the data has no row: say so. (The octave,
+    // decade and all lists stop where the data end by design.)
+    const bool taus_listed = taus_text != "octave" && taus_text != "decade" && taus_text != "all";
+    for (const std::uint64_t m : taus_listed ? o.m_list : std::vector<std::uint64_t>{}) {
+      std::string missing;
+      for (const DevStat stat : shown)
+        if (std::none_of(displayed.rows.begin(), displayed.rows.end(),
+                         [&](const AnalysisRow& r) { return r.stat == stat && r.m == m; }))
+          missing += (missing.empty() ? "" : ", ") + std::string(name(stat));
+      if (!missing.empty())
+        print_error(program, "note",
+                    fmt::format("m = {} (tau = {:g} s) left out of {}: {} phase points are too few for a term", m,
+                                static_cast<double>(m) * o.tau0_s, missing, a.n_phase));
+    }
+    for (const AnalysisRow& r : displayed.rows)  // the output unit must not take a value out of range
+      if (!std::isfinite(r.dev * units.factor()) || (r.ci.valid && !std::isfinite(r.ci.high * units.factor())))
+        bad(source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) overflows a double",
+                                name(r.stat), r.tau_s, r.m, r.ci.valid ? r.ci.high : r.dev, units.factor(),
+                                units.unit(r.stat)));
     Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt};
     if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);
     const std::string text = format == "json" ? to_json(report).dump(2) + "\n"

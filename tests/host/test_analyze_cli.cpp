@@ -118,6 +118,34 @@ TEST(AnalyzeCli, BadInputsGetExitCodeTwoAndAReason) {
   expect_bad_input("--type phase --tau0 1 " + dir, "directory");
 }
 
+// A deviation that is not a finite number is an error naming the statistic, the tau and the cause,
+// wherever it arises after reading: never inf, nan or null in the output.
+TEST(AnalyzeCli, NonFiniteResultsAreErrorsWithTheirCause) {
+  std::string huge;
+  for (int i = 0; i < 8; ++i) huge += i % 2 ? "-1e308\n" : "1e308\n";
+  expect_bad_input("--type phase --tau0 1 " + file_with("huge.txt", huge),
+                   "oadev at tau = 1 s (m = 1): the squared differences of the values overflow a double");
+  expect_bad_input("--type phase --tau0 1e-200 --format json " + good_phase(),
+                   "oadev at tau = 1e-200 s (m = 1): tau0^2 = (1e-200 s)^2 is outside the range of a double: tau0 is too small");
+  // Finite deviations, but the output unit takes them out of range (1e308 arcsec pulses in deg/h).
+  expect_bad_input("--type counts --pulse-weight 1e308arcsec --tau0 1 " + file_with("c.txt", "100\n-100\n100\n-100\n100\n"),
+                   "oadev at tau = 1 s (m = 1): ");
+}
+
+TEST(AnalyzeCli, EachStatisticOnceAndListedTausTooLongForTheDataGetANote) {
+  expect_bad_input("--type phase --tau0 1 --stats oadev,oadev " + good_phase(), "--stats: 'oadev' is asked twice");
+  // 200 phase points: oadev needs 2m + 1 (m = 90 fits), mdev 3m + 1 (m = 90 does not), m = 1000 neither.
+  const Outcome r = run("--type phase --tau0 1 --taus 1,90,1000 --format csv " + good_phase());
+  EXPECT_EQ(r.code, exit_code::ok) << r.err;
+  EXPECT_EQ(r.err,
+            "gyrochar-analyze: note: m = 90 (tau = 90 s) left out of mdev: 200 phase points are too few for a term\n"
+            "gyrochar-analyze: note: m = 1000 (tau = 1000 s) left out of oadev, mdev: 200 phase points are too few for a "
+            "term\n");
+  EXPECT_NE(r.out.find("\noadev,90,"), std::string::npos) << r.out;
+  // Generated lists stop where the data end: no note.
+  EXPECT_EQ(run("--type phase --tau0 1 " + good_phase()).err, "");
+}
+
 TEST(AnalyzeCli, HelpHasExamplesAndExitCodes) {
   const Outcome r = run("--help");
   EXPECT_EQ(r.code, 0);
