@@ -12,19 +12,9 @@ namespace gyrochar {
 
 namespace {
 
-constexpr double deg_rad = std::numbers::pi / 180.0;
-
-// IEEE-952 parameters Q, N, B, K, R: name, unit and size of the unit in SI.
-struct FitUnit {
-  const char* name;
-  const char* unit;
-  double si;
-};
-constexpr FitUnit gyro_fit_units[5] = {{"Q", "arcsec", deg_rad / 3600.0},
-                                       {"N", "deg/sqrt(h)", deg_rad / 60.0},
-                                       {"B", "deg/h", deg_rad / 3600.0},
-                                       {"K", "deg/h/sqrt(h)", deg_rad / (3600.0 * 60.0)},
-                                       {"R", "deg/h/h", deg_rad / (3600.0 * 3600.0)}};
+// IEEE-952 parameters Q, N, B, K, R: letter, unit and size of the unit in SI.
+using FitUnit = units::Ieee952Unit;
+constexpr const FitUnit* gyro_fit_units = units::ieee952.data();
 constexpr FitUnit clock_fit_units[5] = {{"Q", "s", 1}, {"N", "s^0.5", 1}, {"B", "1", 1}, {"K", "s^-0.5", 1}, {"R", "1/s", 1}};
 
 const FitUnit* fit_units(const ReportUnits& u) { return u.gyro ? gyro_fit_units : clock_fit_units; }
@@ -71,22 +61,6 @@ std::string fit_summary(const CurveFit& f) {
 
 }  // namespace
 
-std::optional<double> angle_unit_rad(std::string_view unit) {
-  if (unit == "rad") return 1.0;
-  if (unit == "mrad") return 1e-3;
-  if (unit == "urad") return 1e-6;
-  if (unit == "deg") return deg_rad;
-  if (unit == "arcsec") return deg_rad / 3600.0;
-  return std::nullopt;
-}
-
-std::optional<RateUnit> rate_unit(std::string_view unit) {
-  if (unit == "deg/h") return RateUnit{"deg/h", deg_rad / 3600.0, "arcsec"};
-  if (unit == "deg/s") return RateUnit{"deg/s", deg_rad, "deg"};
-  if (unit == "rad/s") return RateUnit{"rad/s", 1.0, "rad"};
-  return std::nullopt;
-}
-
 std::string ReportUnits::unit(DevStat s) const {
   if (gyro) return s == DevStat::tdev ? rate.angle : rate.name;
   return s == DevStat::tdev ? "s" : "1";
@@ -120,7 +94,7 @@ std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, Dat
     const auto t = parse_sim_truth_line(line);
     if (!t) continue;
     const auto same = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::fabs(b); };
-    if (!same(t->options.tau0_s, tau0_s) || !same(t->options.pulse_arcsec * deg_rad / 3600.0, pulse_weight_rad))
+    if (!same(t->options.tau0_s, tau0_s) || !same(t->options.pulse_arcsec * units::arcsec, pulse_weight_rad))
       return std::nullopt;
     return t->truth;
   }
@@ -166,15 +140,15 @@ std::string format_table(const Report& r) {
       const FitUnit& fu = fit_units(u)[i];
       const Ieee952Parameter& p = f.fit.p[i];
       if (!p.fitted && !(i == 0 && !f.fit.quantization_white)) {
-        fmt::format_to(to, "#   {} not in the model (the fit is better without it){}\n", fu.name,
-                       r.truth ? fmt::format("   simulated {:.4g} {}", truth_values(*r.truth)[i] / fu.si, fu.unit) : "");
+        fmt::format_to(to, "#   {} not in the model (the fit is better without it){}\n", fu.letter,
+                       r.truth ? fmt::format("   simulated {:.4g} {}", truth_values(*r.truth)[i] / fu.si, fu.name) : "");
         continue;
       }
       const std::string truth = r.truth ? fmt::format("   simulated {:.4g}", truth_values(*r.truth)[i] / fu.si) : "";
       if (!p.fitted)
-        fmt::format_to(to, "#   {} = {:.4g} {}  (held, not fitted){}\n", fu.name, p.value / fu.si, fu.unit, truth);
+        fmt::format_to(to, "#   {} = {:.4g} {}  (held, not fitted){}\n", fu.letter, p.value / fu.si, fu.name, truth);
       else
-        fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}{}\n", fu.name, p.value / fu.si, p.uncertainty / fu.si, fu.unit,
+        fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}{}\n", fu.letter, p.value / fu.si, p.uncertainty / fu.si, fu.name,
                        p.resolved ? "" : "  (not resolved)", truth);
     }
   }
@@ -244,8 +218,8 @@ nlohmann::json to_json(const Report& r) {
       for (std::size_t i = 0; i < 5; ++i) {
         const FitUnit& fu = fit_units(u)[i];
         const Ieee952Parameter& p = fit.p[i];
-        one[fu.name] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"fitted", p.fitted},
-                        {"resolved", p.resolved}, {"unit", fu.unit}};
+        one[fu.letter] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"fitted", p.fitted},
+                        {"resolved", p.resolved}, {"unit", fu.name}};
       }
       fits.push_back(std::move(one));
     }
@@ -255,7 +229,7 @@ nlohmann::json to_json(const Report& r) {
     json truth = {{"quantization_white", r.truth->quantization_white}};
     for (std::size_t i = 0; i < 5; ++i) {
       const FitUnit& fu = fit_units(u)[i];
-      truth[fu.name] = {{"value", truth_values(*r.truth)[i] / fu.si}, {"unit", fu.unit}};
+      truth[fu.letter] = {{"value", truth_values(*r.truth)[i] / fu.si}, {"unit", fu.name}};
     }
     j["simulated"] = std::move(truth);
   }

@@ -19,20 +19,9 @@
 #include "analysis.hpp"
 #include "gyrochar/ieee952.hpp"
 #include "sim_truth.hpp"
+#include "units.hpp"
 
 namespace gyrochar {
-
-// TODO(units.hpp): take these factors from host_tools/common/units.hpp once it lands.
-/// Size in rad of an angle unit: rad, mrad, urad, deg, arcsec; empty for anything else. O(1).
-std::optional<double> angle_unit_rad(std::string_view unit);
-
-struct RateUnit {
-  const char* name = "rad/s";
-  double rad_per_s = 1.0;     // size of the unit
-  const char* angle = "rad";  // the unit times 1 s, for TDEV
-};
-/// A rate unit: deg/h, deg/s, rad/s; empty for anything else. O(1).
-std::optional<RateUnit> rate_unit(std::string_view unit);
 
 struct ReportUnits {
   bool gyro = false;           // angle/rate data (else clock data)

@@ -16,10 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "decode_session.hpp"
-#include "hal/linux/socketcan.hpp"
-#include "decode_plot.hpp"
 #include "hal/exit_codes.hpp"
+#include "hal/linux/socketcan.hpp"
+#include "plot.hpp"
+#include "session.hpp"
+#include "view.hpp"
 
 namespace {
 
@@ -89,7 +90,7 @@ NodeFilter parse_nodes(const std::vector<std::string>& texts) {
 // Everything the main loop does besides decoding: the live view, the periodic plot, the end.
 class Presenter {
  public:
-  Presenter(const Options& o, View view, RateUnit rate_unit, Session& session)
+  Presenter(const Options& o, View view, DisplayRate rate_unit, Session& session)
       : options_(o), view_(view), rate_unit_(rate_unit), session_(session), tty_(isatty(STDOUT_FILENO) == 1) {}
 
   void malformed(const std::string& where, std::uint64_t line, const std::string& why) {
@@ -153,7 +154,7 @@ class Presenter {
 
   const Options& options_;
   View view_;
-  RateUnit rate_unit_;
+  DisplayRate rate_unit_;
   Session& session_;
   bool tty_;
   double last_view_s_ = -1e300;
@@ -291,8 +292,9 @@ int main(int argc, char** argv) {
   }
   if (o.log.empty() == o.interface.empty())
     fail(exit_code::bad_input, "options", "give either a LOG or --interface (see --help)");
-  const auto rate_unit = parse_rate_unit(o.rate_unit);
-  if (!rate_unit) fail(exit_code::bad_input, "--rate-unit", "'" + o.rate_unit + "' is not deg/h, deg/s, rad/s or native");
+  const DisplayRate rate_unit = gyrochar::rate_unit(o.rate_unit);
+  if (!rate_unit && o.rate_unit != "native")
+    fail(exit_code::bad_input, "--rate-unit", "'" + o.rate_unit + "' is not deg/h, deg/s, rad/s or native");
   if (!(o.confidence > 0 && o.confidence < 1)) fail(exit_code::bad_input, "--confidence", "must be in (0, 1)");
   if (!(o.duration_s >= 0)) fail(exit_code::bad_input, "--duration", "must be >= 0");
   if (!(o.plot_every_s >= 0)) fail(exit_code::bad_input, "--plot-every", "must be >= 0");
@@ -314,7 +316,7 @@ int main(int argc, char** argv) {
   }
 
   SessionOptions s;
-  s.rate_unit = *rate_unit;
+  s.rate_unit = rate_unit;
   s.confidence = o.confidence;
   s.shown = parse_nodes(o.nodes);
   s.csv = o.csv.empty() ? nullptr : open_output(o.csv);
@@ -323,7 +325,7 @@ int main(int argc, char** argv) {
   int code = exit_code::ok;
   {
     Session session(s);
-    Presenter presenter(o, view, *rate_unit, session);
+    Presenter presenter(o, view, rate_unit, session);
     code = o.interface.empty() ? decode_log(o, session, presenter) : decode_live(o, session, presenter);
   }
   for (const auto& [file, path] : {std::pair{s.csv, o.csv}, std::pair{s.jsonl, o.jsonl}})

@@ -20,8 +20,9 @@
 
 #include "board.hpp"
 #include "candump.hpp"
-#include "decode_plot.hpp"
-#include "decode_session.hpp"
+#include "plot.hpp"
+#include "session.hpp"
+#include "view.hpp"
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
 #include "hal/exit_codes.hpp"
@@ -195,10 +196,7 @@ int main(int argc, char** argv) {
     }
   }
   // The decoder's end-of-run summary, under this program's name.
-  std::string summary = decoding::format_summary(session.decoder(), session.input(), so.shown);
-  for (std::size_t at = 0; (at = summary.find("gyrochar-decode: ", at)) != std::string::npos; at += 15)
-    summary.replace(at, 17, "gyrochar-demo: ");
-  std::fputs(summary.c_str(), stderr);
+  std::fputs(decoding::format_summary(session.decoder(), session.input(), so.shown, program).c_str(), stderr);
   std::fprintf(stderr, "gyrochar-demo: %.1f gyro hours, %u nodes, %llu frames on the bus%s%s%s%s\n", hours, nodes,
                static_cast<unsigned long long>(bus.frames_on_bus()), csv_path.empty() ? "" : "; CSV ", csv_path.c_str(),
                plot_prefix.empty() ? "" : ", plot ", plot_prefix.empty() ? "" : (plot_prefix + ".svg/.png").c_str());
