@@ -2,9 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
+#include <filesystem>
 #include <iterator>
 #include <numbers>
 
@@ -234,6 +236,80 @@ nlohmann::json to_json(const Report& r) {
     j["simulated"] = std::move(truth);
   }
   return j;
+}
+
+namespace {
+
+// Stable32's name of a statistic and its column line.
+struct Stable32Stat {
+  const char* sigma_type;
+  const char* columns;
+};
+Stable32Stat stable32_stat(DevStat s) {
+  constexpr const char* allan = "#  AF        Tau        #    Alpha  Min Sigma      Sigma         Max Sigma";
+  constexpr const char* hadamard = "#  AF        Tau         #    Alpha  Min Sigma   Hadamard Sig     Max Sigma";
+  switch (s) {
+    case DevStat::adev: return {"Allan", allan};
+    case DevStat::oadev: return {"Overlapping Allan", allan};
+    case DevStat::mdev: return {"Modified Allan", "#  AF        Tau         #    Alpha  Min Sigma     Mod Sigma      Max Sigma"};
+    case DevStat::tdev: return {"Time", "#  AF        Tau         #    Alpha  Min Sigma    Time Sigma      Max Sigma"};
+    case DevStat::hdev: return {"Hadamard", hadamard};
+    case DevStat::ohdev: return {"Overlapping Hadamard", hadamard};
+  }
+  return {"?", allan};
+}
+
+}  // namespace
+
+std::string format_stable32(const Report& r) {
+  const Analysis& a = r.analysis;
+  const ReportUnits& u = r.units;
+  const double k = u.factor();
+  std::vector<DevStat> stats;  // in the order of the rows
+  for (const AnalysisRow& row : a.rows)
+    if (std::find(stats.begin(), stats.end(), row.stat) == stats.end()) stats.push_back(row.stat);
+  std::string s;
+  auto to = std::back_inserter(s);
+  for (const DevStat stat : stats) {
+    const Stable32Stat names = stable32_stat(stat);
+    if (!s.empty()) s += '\n';
+    fmt::format_to(to, "# STATISTICS FOR FILE: {}\n", std::filesystem::path(r.source).filename().string());
+    fmt::format_to(to, "# {} Data Points 1 thru {} of {}\n", r.type == DataType::phase ? "Phase" : "Frequency",
+                   r.range.count, r.range.count);
+    fmt::format_to(to, "# Maximum = {:e}\n# Minimum = {:e}\n# Average = {:e}\n", r.range.max, r.range.min, r.range.mean());
+    fmt::format_to(to, "# Sigma Type: {}\n# Confidence Factor = {:.3f}\n# Deadtime T/Tau = 1.000000\n", names.sigma_type,
+                   r.confidence);
+    if (u.gyro) fmt::format_to(to, "# Units: {}\n", u.unit(stat));
+    fmt::format_to(to, "#\n{}\n", names.columns);
+    for (const AnalysisRow& row : a.rows) {
+      if (row.stat != stat) continue;
+      fmt::format_to(to, "{:5d}{:13.4e}{:9d}{:6d}{:13.4e}{:14.4e}{:15.4e}\n", row.m, row.tau_s, row.n,
+                     row.alpha.value_or(0), row.ci.valid ? row.ci.low * k : 0.0, row.dev * k,
+                     row.ci.valid ? row.ci.high * k : 0.0);
+    }
+  }
+  return s;
+}
+
+std::optional<std::string> kalibr_yaml(const Report& r, std::string& why) {
+  if (!r.units.gyro) {
+    why = "needs gyro data: counts, or --unit with an angle or a rate";
+    return std::nullopt;
+  }
+  const auto both = std::find_if(r.fits.begin(), r.fits.end(), [](const CurveFit& f) { return f.curve == FitCurve::both; });
+  if (both == r.fits.end()) {
+    why = "needs the IEEE-952 fit (--fit ieee952)";
+    return std::nullopt;
+  }
+  if (!both->fit.ok()) {
+    why = fmt::format("the IEEE-952 fit of both curves is {}: no noise parameters to give", name(both->fit.status));
+    return std::nullopt;
+  }
+  const auto term = [&](std::size_t k) {
+    const Ieee952Parameter& p = both->fit.p[k];
+    return KalibrTerm{p.value, p.value > 0 ? p.uncertainty / p.value : 0.0, p.fitted, p.resolved};
+  };
+  return kalibr_imu_yaml(term(1), term(3), 1.0 / r.tau0_s, fmt::format("{} ({})", r.source, r.units.input), why);
 }
 
 }  // namespace gyrochar

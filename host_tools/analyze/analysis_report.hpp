@@ -19,6 +19,7 @@
 #include "analysis.hpp"
 #include "gyrochar/ieee952.hpp"
 #include "sim_truth.hpp"
+#include "kalibr.hpp"
 #include "units.hpp"
 
 namespace gyrochar {
@@ -55,6 +56,19 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
 std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, DataType type, double tau0_s,
                                      double pulse_weight_rad);
 
+/// The smallest, largest and mean value read (Stable32's header). add() is O(1).
+struct DataRange {
+  double min = 0.0, max = 0.0, sum = 0.0;
+  std::uint64_t count = 0;
+  void add(double v) {
+    min = count == 0 || v < min ? v : min;
+    max = count == 0 || v > max ? v : max;
+    sum += v;
+    ++count;
+  }
+  double mean() const { return count ? sum / static_cast<double>(count) : 0.0; }
+};
+
 /// Everything a report shows. Refers to (does not own) the analysis.
 struct Report {
   const Analysis& analysis;
@@ -64,6 +78,8 @@ struct Report {
   ReportUnits units;
   std::vector<CurveFit> fits;
   std::optional<Ieee952Truth> truth;  // a simulation's truth, shown beside the fits
+  std::string source;                 // the input's name, for Stable32's header
+  DataRange range;                    // the values read (after --nominal-hz), for Stable32's header
 };
 
 /// Aligned table for people: a header line (data, units, stride factor, confidence), one line per
@@ -77,5 +93,16 @@ std::string format_csv(const Report& r);
 /// "ci_low", "ci_high", "unit", "stride"}], "units", "stride_factor", "confidence", "fit" (only
 /// with fits)}; null where not available. O(rows).
 nlohmann::json to_json(const Report& r);
+/// Stable32's result table, one block per statistic (in the order asked), each as Stable32 writes
+/// it: the header ("# STATISTICS FOR FILE:", data points, maximum, minimum, average of the values,
+/// "# Sigma Type: Overlapping Allan", confidence factor, dead time, the column line) and rows
+/// "AF Tau # Alpha MinSigma Sigma MaxSigma" in its column widths (5, 13, 9, 6, 13, 14, 15;
+/// %.4e). Gyro data add one "# Units:" line (Stable32 files are fractional frequency); a row
+/// without an interval has 0 bounds and one without identified noise alpha 0, as in Stable32.
+/// Blocks are separated by a blank line. O(rows).
+std::string format_stable32(const Report& r);
+/// The Kalibr imu.yaml (kalibr.hpp) of the fit of both curves; nothing, and why, when the data
+/// are not gyro data, the fit was not made or was rejected, or N or K is not in its model. O(1).
+std::optional<std::string> kalibr_yaml(const Report& r, std::string& why);
 
 }  // namespace gyrochar

@@ -47,6 +47,11 @@ constexpr const char* footer = R"(Data type and units (the type is required: for
   Gyro data (angle, rate, counts) come out in --rate-unit (TDEV in deg/h -> arcsec, deg/s -> deg,
   rad/s -> rad); IEEE-952 parameters in Q arcsec, N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h/h.
 
+Formats: table (people), csv, json, stable32 (Stable32's result table: AF Tau # Alpha MinSigma
+Sigma MaxSigma, one block per statistic; values in the output unit). --kalibr FILE also writes the
+IEEE-952 fit's N and K as the gyroscope part of a Kalibr imu.yaml (N in rad/s/sqrt(Hz) = rad/s^0.5,
+K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill).
+
 Input: one value per line, or --column C of lines split by blanks, commas or semicolons; '#'
 starts a comment; gzip is recognized by content; '-' reads standard input.
 
@@ -69,6 +74,8 @@ Examples:
   gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec --rate-unit deg/h \
                    --fit ieee952 --format json run.txt.gz
   gyrochar-analyze --type phase --unit deg --tau0 0.01 --column 2 --stats oadev,mdev angle.csv
+  gyrochar-analyze --type phase --tau0 1 --stats oadev,mdev --format stable32 PHASE.DAT
+  gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --kalibr imu.yaml run.txt
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
 
 )";
@@ -178,7 +185,7 @@ int main(int argc, char** argv) {
   app.footer(std::string(footer) + exit_code::help);
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
-  std::string format = "table", fit_text;
+  std::string format = "table", fit_text, kalibr_path;
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
   unsigned column = 1;
   bool progress = false;
@@ -197,7 +204,10 @@ int main(int argc, char** argv) {
   app.add_option("--confidence", confidence, "confidence level of the intervals")->capture_default_str();
   app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
   app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
-  app.add_option("--format", format, "table, csv or json")->capture_default_str();
+  app.add_option("--format", format, "table, csv, json or stable32 (Stable32's result table, one per statistic)")
+      ->capture_default_str();
+  app.add_option("--kalibr", kalibr_path, "with --fit ieee952 on gyro data: also write N and K as a Kalibr imu.yaml")
+      ->option_text("FILE");
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
     app.parse(argc, argv);
@@ -233,8 +243,10 @@ int main(int argc, char** argv) {
         bad("--alpha", "must be auto or an integer from -4 to 2");
       o.alpha = a;
     }
-    if (format != "table" && format != "csv" && format != "json") bad("--format", "must be table, csv or json");
+    if (format != "table" && format != "csv" && format != "json" && format != "stable32")
+      bad("--format", "must be table, csv, json or stable32");
     if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
+    if (!kalibr_path.empty() && fit_text.empty()) bad("--kalibr", "needs --fit ieee952 (the file holds fitted terms)");
     // The fit uses both curves, whatever the table shows: compute them, show what was asked.
     const std::vector<DevStat> shown = o.stats;
     if (!fit_text.empty())
@@ -277,6 +289,8 @@ int main(int argc, char** argv) {
         bad("--unit", "freq is in 1 (fractional), Hz or a rate unit (deg/h, deg/s, rad/s), not '" + value_unit + "'");
       }
     }
+    if (!kalibr_path.empty() && !units.gyro)
+      bad("--kalibr", "needs gyro data: counts, or --unit with an angle or a rate");
     if (units.gyro) {
       const auto rate = rate_unit(rate_text);
       if (!rate) bad("--rate-unit", "unknown unit '" + rate_text + "' (deg/h, deg/s, rad/s)");
@@ -313,11 +327,13 @@ int main(int argc, char** argv) {
       bad("--taus", e.what());
     }
     std::vector<std::string> header;
+    DataRange range;
     try {
       DataFile file(path, column);
       Progress p(show_progress, "analyzing", file);
       for (double v = 0; file.next(v);) {
         if (nominal_hz > 0) v = (v - nominal_hz) / nominal_hz;
+        range.add(v);
         try {
           analyzer->add(v);
         } catch (const std::exception& e) {  // invalid_argument (a bad count), range_error
@@ -363,12 +379,26 @@ int main(int argc, char** argv) {
         bad(source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) overflows a double",
                                 name(r.stat), r.tau_s, r.m, r.ci.valid ? r.ci.high : r.dev, units.factor(),
                                 units.unit(r.stat)));
-    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt};
+    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt, source, range};
     if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);
-    const std::string text = format == "json" ? to_json(report).dump(2) + "\n"
-                             : format == "csv" ? format_csv(report)
-                                               : format_table(report);
+    std::string yaml;  // made before anything is written: a refusal loses no output
+    if (!kalibr_path.empty()) {
+      std::string why;
+      const auto text = kalibr_yaml(report, why);
+      if (!text) bad("--kalibr", why);
+      yaml = *text;
+    }
+    const std::string text = format == "json"       ? to_json(report).dump(2) + "\n"
+                             : format == "csv"      ? format_csv(report)
+                             : format == "stable32" ? format_stable32(report)
+                                                    : format_table(report);
     std::fwrite(text.data(), 1, text.size(), stdout);
+    if (!kalibr_path.empty()) {
+      std::FILE* f = std::fopen(kalibr_path.c_str(), "w");
+      if (f == nullptr) fail(exit_code::output_failed, kalibr_path, std::strerror(errno));
+      std::fputs(yaml.c_str(), f);
+      if (!close_output(f, program, kalibr_path)) return finish(program, exit_code::output_failed);
+    }
   } catch (const std::exception& e) {
     fail(exit_code::internal, "internal error", e.what());
   }

@@ -1,5 +1,7 @@
 #include "display_units.hpp"
 
+#include <fmt/format.h>
+
 namespace gyrochar::decoding {
 
 using namespace protocol;
@@ -35,6 +37,32 @@ Units units_for(const NodeView& node, const DisplayRate& choice) {
     u.ieee[k] = *si_per_wire / units::ieee952[k].si;
   }
   return u;
+}
+
+std::optional<std::string> kalibr_yaml(const NodeView& node, std::string& why) {
+  const std::optional<double> to_wire = wire_per_si(node);
+  if (!to_wire) {
+    why = node.scale ? "the node reports pulses: no angle to give Kalibr" : "the node's angle unit has not arrived";
+    return std::nullopt;
+  }
+  if (!node.sampling) {
+    why = "the node's tau0 has not arrived";
+    return std::nullopt;
+  }
+  if (node.ieee952_summary && node.ieee952_summary->status != Ieee952Status::ok) {
+    why = fmt::format("the node's IEEE-952 fit is {}: no noise parameters to give", name(node.ieee952_summary->status));
+    return std::nullopt;
+  }
+  const auto term = [&](Ieee952Term t) {
+    const Ieee952View& v = node.ieee952[static_cast<std::size_t>(t)];
+    return KalibrTerm{static_cast<double>(v.value) / *to_wire, static_cast<double>(v.rel_uncertainty), v.in_model(),
+                      v.resolved};
+  };
+  return kalibr_imu_yaml(term(Ieee952Term::angle_random_walk), term(Ieee952Term::rate_random_walk),
+                         static_cast<double>(1.0f / node.sampling->tau0_s),  // the wire carries tau0 as a float32
+                         fmt::format("node 0x{:02X} (session {}, {} samples)", node.address, node.session,
+                                     node.status.sample_count),
+                         why);
 }
 
 }  // namespace gyrochar::decoding

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "decoder.hpp"
+#include "kalibr.hpp"
 #include "units.hpp"
 
 namespace gyrochar::decoding {
@@ -33,5 +34,10 @@ Units units_for(const NodeView& node, const DisplayRate& choice);
 /// Wire value (the node's angle unit) per SI value (rad): the same factor for every IEEE-952 term,
 /// whose other dimensions are seconds on both sides. Nothing for pulses or an unknown unit. O(1).
 std::optional<double> wire_per_si(const NodeView& node);
+
+/// The node's N and K as a Kalibr imu.yaml (kalibr.hpp), converted from its angle unit to SI, at
+/// the rate 1 / tau0. Nothing, and why, when the node reports pulses or its angle unit or tau0 has
+/// not arrived, its fit was not made or was rejected, or N or K is not in the fitted model. O(1).
+std::optional<std::string> kalibr_yaml(const NodeView& node, std::string& why);
 
 }  // namespace gyrochar::decoding

@@ -53,7 +53,7 @@ enum class View { live, final, none };
 struct Options {
   std::string log;        // candump log path or "-"
   std::string interface;  // live SocketCAN interface
-  std::string csv, jsonl, plot;
+  std::string csv, jsonl, plot, kalibr;
   double plot_every_s = 0.0;
   std::string view;
   std::string rate_unit = "deg/h";
@@ -124,6 +124,7 @@ class Presenter {
     session_.finish();
     int code = exit_code::ok;
     if (!options_.plot.empty() && !plot()) code = exit_code::output_failed;
+    if (const int k = options_.kalibr.empty() ? exit_code::ok : kalibr(); code == exit_code::ok) code = k;
     if (view_ != View::none) show();
     std::fputs(format_summary(session_.decoder(), session_.input(), session_.options().shown).c_str(), stderr);
     return code;
@@ -136,6 +137,36 @@ class Presenter {
     if (view_ == View::live && tty_) std::fputs("\033[H\033[J", stdout);  // home, clear screen
     std::fputs(text.c_str(), stdout);
     std::fflush(stdout);
+  }
+
+  // The Kalibr imu.yaml of the one node shown: exit code.
+  int kalibr() {
+    const NodeView* node = nullptr;
+    std::string seen;
+    int count = 0;
+    for (const auto& [address, v] : session_.decoder().nodes()) {
+      if (!session_.options().shown[address]) continue;
+      seen += fmt::format("{}0x{:02X}", seen.empty() ? "" : ", ", address);
+      node = &v;
+      ++count;
+    }
+    if (count != 1) {
+      print_error(program, "--kalibr", seen.empty() ? "no node seen" : "nodes " + seen + " seen: choose one with --node");
+      return exit_code::bad_input;
+    }
+    std::string why;
+    const auto yaml = kalibr_yaml(*node, why);
+    if (!yaml) {
+      print_error(program, "--kalibr", why);
+      return exit_code::bad_input;
+    }
+    std::FILE* f = std::fopen(options_.kalibr.c_str(), "w");
+    if (f == nullptr) {
+      print_error(program, options_.kalibr, std::strerror(errno));
+      return exit_code::output_failed;
+    }
+    std::fputs(yaml->c_str(), f);
+    return close_output(f, program, options_.kalibr) ? exit_code::ok : exit_code::output_failed;
   }
 
   bool plot() {
@@ -258,6 +289,7 @@ int main(int argc, char** argv) {
       "  gyrochar-decode --interface can0 --csv run.csv --jsonl run.jsonl --plot run --plot-every 60\n"
       "  gyrochar-decode capture.log --view none --csv capture.csv --plot capture\n"
       "  gyrochar-decode capture.log --node 0x10 --rate-unit deg/s --view final\n"
+      "  gyrochar-decode --interface can0 --node 0x10 --duration 86400 --kalibr imu.yaml\n"
       "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
       "Malformed lines and rejected frames are counted and reported, not fatal; a log that is missing,\n"
       "unreadable, empty or without any candump line is bad input.\n" +
@@ -269,6 +301,8 @@ int main(int argc, char** argv) {
   app.add_option("--jsonl", o.jsonl, "write the same rows, per-report status and events as JSON lines")
       ->option_text("FILE");
   app.add_option("--plot", o.plot, "write PREFIX.svg and PREFIX.png at the end")->option_text("PREFIX");
+  app.add_option("--kalibr", o.kalibr, "write the node's N and K as a Kalibr imu.yaml at the end (one node: --node)")
+      ->option_text("FILE");
   app.add_option("--plot-every", o.plot_every_s, "also rewrite the plot every S seconds (decoder time)")
       ->option_text("S");
   app.add_option("--view", o.view,

@@ -10,11 +10,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
 #include <string>
+#include <vector>
 
 #include "hal/exit_codes.hpp"
 
@@ -144,6 +148,73 @@ TEST(AnalyzeCli, EachStatisticOnceAndListedTausTooLongForTheDataGetANote) {
   EXPECT_NE(r.out.find("\noadev,90,"), std::string::npos) << r.out;
   // Generated lists stop where the data end: no note.
   EXPECT_EQ(run("--type phase --tau0 1 " + good_phase()).err, "");
+}
+
+// --kalibr writes the recommended fit's N and K in SI: the JSON's N [deg/sqrt(h)] times
+// (pi/180) / 60 and K [deg/h/sqrt(h)] times (pi/180) / 3600 / 60 (closed forms, kalibr.hpp).
+TEST(AnalyzeCli, KalibrYamlHoldsTheFitsNAndKInSI) {
+  const std::string counts = temp("sim_counts.txt"), yaml = temp("imu.yaml");
+  ASSERT_EQ(std::system((GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim --duration 2000 --tau0 0.01 --arw 0.003 "
+                         "--rrw 0.5 --white-angle 2 --seed 3 --out " + counts).c_str()), 0);
+  const Outcome r = run("--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --format json --kalibr " + yaml +
+                        " " + counts);
+  ASSERT_EQ(r.code, exit_code::ok) << r.err;
+  const auto fit = nlohmann::json::parse(r.out)["fit"][0];
+  ASSERT_EQ(fit["curve"], "both");
+  std::ifstream in(yaml);
+  std::map<std::string, double> keys;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#' && line.rfind("rostopic", 0) != 0)
+      keys[line.substr(0, line.find(':'))] = std::stod(line.substr(line.find(':') + 1));
+  const double pi = 3.14159265358979323846;
+  EXPECT_NEAR(keys.at("gyroscope_noise_density") / (fit["N"]["value"].get<double>() * pi / 180 / 60), 1.0, 1e-12);
+  EXPECT_NEAR(keys.at("gyroscope_random_walk") / (fit["K"]["value"].get<double>() * pi / 180 / 3600 / 60), 1.0, 1e-12);
+  EXPECT_EQ(keys.at("update_rate"), 100.0);
+
+  expect_bad_input("--type counts --tau0 0.01 --pulse-weight 1arcsec --kalibr " + yaml + " " + counts,
+                   "--kalibr: needs --fit ieee952");
+  expect_bad_input("--type phase --tau0 1 --fit ieee952 --kalibr " + yaml + " " + good_phase(),
+                   "--kalibr: needs gyro data");
+}
+
+// --format stable32 against the layout of Stable32's own file for PHASE.DAT (../shared/refdata):
+// the same header lines but the file's name, the same column line, every row in the same columns
+// with AF, Tau and # equal, Sigma within Stable32's 5 printed digits. (Min/Max Sigma: gyrochar's
+// intervals use the exact EDF, Stable32's Greenhall's approximation: within 5 % here.)
+TEST(AnalyzeCli, Stable32TablesHaveStable32sLayout) {
+  for (const std::string stat : {"oadev", "mdev"}) {
+    const Outcome r = run("--type phase --tau0 1 --alpha 0 --format stable32 --stats " + stat + " " GYROCHAR_REFDATA
+                          "/phasedat/PHASE.DAT");
+    ASSERT_EQ(r.code, exit_code::ok) << r.err;
+    std::ifstream ref(GYROCHAR_REFDATA "/phasedat/phase_dat_" + stat + "_octave.txt");
+    std::vector<std::string> want, got;
+    for (std::string line; std::getline(ref, line);) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      if (!want.empty() || line.rfind("# STATISTICS", 0) == 0) want.push_back(line);  // from the header on
+    }
+    std::istringstream out(r.out);
+    for (std::string line; std::getline(out, line);) got.push_back(line);
+    ASSERT_GE(got.size(), 10u);
+    EXPECT_EQ(got[0], "# STATISTICS FOR FILE: PHASE.DAT");
+    for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(got[i], want[i]) << stat << " header line " << i;
+    std::size_t compared = 0;
+    for (std::size_t i = 10; i < want.size(); ++i) {
+      const auto row = std::find_if(got.begin() + 10, got.end(), [&](const std::string& g) { return g.substr(0, 5) == want[i].substr(0, 5); });
+      if (row == got.end()) continue;
+      ++compared;
+      ASSERT_EQ(row->size(), want[i].size()) << *row << "\n" << want[i];
+      for (std::size_t c = 0; c < row->size(); ++c)  // fields end in the same columns
+        EXPECT_EQ((*row)[c] == ' ', want[i][c] == ' ') << stat << ": column " << c << "\n" << *row << "\n" << want[i];
+      EXPECT_EQ(row->substr(0, 33), want[i].substr(0, 33)) << "AF, Tau, #, Alpha";
+      std::istringstream g(*row), w(want[i]);
+      double gv[7], wv[7];
+      for (int k = 0; k < 7; ++k) g >> gv[k], w >> wv[k];
+      EXPECT_NEAR(gv[5] / wv[5], 1.0, 1e-4) << *row;
+      EXPECT_NEAR(gv[4] / wv[4], 1.0, 0.05) << *row;
+      EXPECT_NEAR(gv[6] / wv[6], 1.0, 0.05) << *row;
+    }
+    EXPECT_GE(compared, 8u) << stat;
+  }
 }
 
 TEST(AnalyzeCli, HelpHasExamplesAndExitCodes) {

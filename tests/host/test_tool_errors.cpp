@@ -112,6 +112,20 @@ TEST(ToolErrors, EveryToolChecksItsStandardOutput) {
   }
 }
 
+// The decoder's Kalibr file describes one node with an accepted fit; anything else is refused.
+TEST(ToolErrors, DecoderKalibrNeedsOneNodeWithAFit) {
+  const std::string log = temp("kalibr_demo.log"), yaml = temp("imu.yaml");
+  ASSERT_EQ(run(bin + "gyrochar-demo --hours 0.01 --plot '' --csv '' --candump " + log).code, exit_code::ok);
+  const Outcome two = run(bin + "gyrochar-decode " + log + " --view none --kalibr " + yaml);
+  EXPECT_EQ(two.code, exit_code::bad_input) << two.err;
+  EXPECT_NE(two.err.find("gyrochar-decode: --kalibr: nodes 0x10, 0x11 seen: choose one with --node\n"), std::string::npos)
+      << two.err;
+  // 36 s of gyro time: too short for a fit of N and K.
+  const Outcome young = run(bin + "gyrochar-decode " + log + " --view none --node 0x10 --kalibr " + yaml);
+  EXPECT_EQ(young.code, exit_code::bad_input) << young.err;
+  EXPECT_NE(young.err.find("gyrochar-decode: --kalibr: "), std::string::npos) << young.err;
+}
+
 TEST(ToolErrors, EveryHelpAndTheReadmeStateTheSameExitCodes) {
   for (const std::string program : {"gyrochar-analyze", "gyrochar-decode", "gyrochar-sim", "gyrochar-demo"}) {
     const Outcome r = run(bin + program + " --help");
