@@ -164,20 +164,56 @@ TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uin
   TheoBiasRatio out;
   out.defined = last + 1;
   out.exact = count == last + 1 && stride_factor == 0;
-  auto stride = [&](std::uint64_t m) { return stride_factor == 0 || m < stride_factor ? 1 : m / stride_factor; };
   double sum = 0.0;
   for (std::uint64_t j = 0; j < count; ++j) {
     // Evenly spread over 0..last, first and last included.
     const std::uint64_t i = count == last + 1 ? j : (j * last + (count - 1) / 2) / (count - 1);
     const std::uint64_t mt = 12 + 4 * i, ma = 9 + 3 * i;
-    const TotalVariance t = theo1(x, mt, tau0_s, stride(mt));
-    const TotalVariance a = oavar(x, ma, tau0_s, stride(ma));
+    const TotalVariance t = theo1(x, mt, tau0_s, theo1_stride(mt, N, stride_factor));
+    const TotalVariance a = oavar(x, ma, tau0_s, stride_factor == 0 || ma <= stride_factor ? 1 : ma / stride_factor);
     if (t.n == 0 || a.n == 0 || !(t.var > 0)) return {};
     sum += a.var / t.var;
   }
   out.ratio = sum / as_double(count);
   out.taus = count;
   return out;
+}
+
+std::span<double> block_sums(std::span<const double> x, std::uint64_t block, std::span<double> out) {
+  if (block == 0 || out.size() < x.size() / block) return {};
+  const Index b = as_index(block), count = x.size() / b;
+  for (Index k = 0; k < count; ++k) {
+    double sum = 0.0;
+    for (Index t = 0; t < b; ++t) sum += x[k * b + t];
+    out[k] = sum;
+  }
+  return out.first(count);
+}
+
+std::uint64_t theo_bias_taus(std::uint64_t n_phase, std::uint32_t S) {
+  if (n_phase < 24) return 0;
+  const std::uint64_t all = n_phase / 6 - 2;
+  if (S == 0) return all;
+  double cost = 0.0;
+  for (std::uint64_t i = 0; i < all; ++i) cost += total_exact_cost(true, 12 + 4 * i, n_phase);
+  return cost <= total_exact_budget ? all : (all < 64 ? all : 64);
+}
+
+double total_exact_cost(bool theo, std::uint64_t m, std::uint64_t n_phase) {
+  if (theo) return m < n_phase ? as_double(n_phase - m) * as_double(m / 2) : 0.0;
+  return 3 * m <= n_phase ? as_double(n_phase - 3 * m + 1) * 15.0 * as_double(m) : 0.0;
+}
+
+std::uint64_t total_block(std::uint64_t m, std::uint64_t n_phase, std::uint32_t S) {
+  if (S == 0 || m <= S || total_exact_cost(false, m, n_phase) <= total_exact_budget) return 1;
+  std::uint64_t b = 1;
+  while (2 * b <= m / S && m % (4 * b) == 0) b *= 2;  // 2b divides m with m / (2b) even
+  return b;
+}
+
+std::uint64_t theo1_stride(std::uint64_t m, std::uint64_t n_phase, std::uint32_t S) {
+  if (S == 0 || m <= S || total_exact_cost(true, m, n_phase) <= total_exact_budget) return 1;
+  return m / S;
 }
 
 std::uint64_t theoh_switch(std::uint64_t n_phase) {

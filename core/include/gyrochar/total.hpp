@@ -97,8 +97,8 @@ struct TheoBiasRatio {
 };
 
 /// TheoBR's bias ratio of phase x (N >= 24, so that n >= 1). With stride_factor S = 0 every
-/// estimate is exact; otherwise Theo1 at m and AVAR at 0.75 m use sub-sequence strides m / S and
-/// 0.75 m / S (at least 1). At most `ratio_taus` (>= 2) of the n + 1 taus, evenly spread (all when
+/// estimate is exact; otherwise Theo1 at m uses theo1_stride() and AVAR at 0.75 m the stride
+/// 0.75 m / S (1 when 0.75 m <= S). At most `ratio_taus` (>= 2) of the n + 1 taus, evenly spread (all when
 /// ratio_taus >= n + 1). O(taus N S) when decimated, O(N^3) exact; no allocation.
 TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
                               std::uint64_t ratio_taus);
@@ -106,6 +106,31 @@ TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uin
 /// TheoH's switch point k in samples: the largest power of two at or below (N - 1) / 10 (at least 1).
 /// AVAR rows below it (m < k), TheoBR rows at 0.75 m >= k.
 std::uint64_t theoh_switch(std::uint64_t n_phase);
+
+/// Sums of x over consecutive blocks of `block` samples (the record MTOTVAR's decimated variant
+/// reads): floor(N / block) of them written to the front of `out` (which must hold them), that part
+/// returned; an empty span when out is too small or block is 0. O(N).
+std::span<double> block_sums(std::span<const double> x, std::uint64_t block, std::span<double> out);
+
+// The estimator the offline analysis runs: the exact one where it costs at most
+// total_exact_budget operations (about a tenth of a second), the decimated one with stride
+// factor S otherwise (S = 0: always exact).
+inline constexpr double total_exact_budget = 67108864.0;  // 2^26
+
+/// Operations of the exact MTOTVAR/HTOTVAR (15 m per sub-sequence) or Theo1 ((N - m) m / 2) at m.
+double total_exact_cost(bool theo, std::uint64_t m, std::uint64_t n_phase);
+
+/// Block (MTOTVAR, HTOTVAR) at averaging factor m: 1 (exact) when the exact cost fits the budget,
+/// m <= S or S = 0; otherwise the largest power of two b <= m / S that divides m with m / b even
+/// (1 when there is none: an odd m is always exact). O(log m).
+std::uint64_t total_block(std::uint64_t m, std::uint64_t n_phase, std::uint32_t S);
+/// Sub-sequence stride of Theo1 (and of TheoBR's estimates) at m: 1 where exact as above,
+/// otherwise m / S. O(1).
+std::uint64_t theo1_stride(std::uint64_t m, std::uint64_t n_phase, std::uint32_t S);
+
+/// How many of TheoBR's n + 1 taus the analysis averages: all when S = 0 or when exact Theo1 at
+/// every one fits total_exact_budget, otherwise 64. 0 when N < 24. O(N).
+std::uint64_t theo_bias_taus(std::uint64_t n_phase, std::uint32_t S);
 
 /// Stable32's bias corrections: the expected ratio of a total variance to the Allan-family variance
 /// it stands for, which Stable32 divides out where alpha is known (1 where no correction applies).
