@@ -41,24 +41,37 @@ t = time.perf_counter(); f(x, rate=1.0, data_type="phase", taus=[float(m)]); pri
 ' "$file" "$1" "$2" 2>/dev/null || echo timeout
 }
 
+# Work of one tau in allantools' loops (its time is about proportional): MTOTDEV 6m terms for each
+# of N - 3m + 1 sub-sequences, Theo1 m/2 terms for each of N - m starts.
+work() { awk -v s="$1" -v m="$2" -v n=100000 'BEGIN { print (s == "mtotdev") ? (n - 3*m + 1) * 6 * m : (n - m) * m / 2 }'; }
+
 table() {  # stat first_m last_m
-  local stat=$1 m=$2 last=$3 stopped="" sum_peer=0 sum_exact=0 sum_plan=0 bound=""
+  local stat=$1 m=$2 last=$3 stopped="" peer_sum=0 both_exact=0 both_plan=0 all_exact=0 all_plan=0 per_term="" rest=0
   echo "| m | allantools (s) | gyrochar exact (s) | gyrochar plan S = 16 (s) | allantools / exact |"
   echo "|---:|---:|---:|---:|---:|"
   while [ "$m" -le "$last" ]; do
-    local e p a
+    local e p a ratio="-"
     e=$(seconds "$ours_exact" "$stat" "$m"); p=$(seconds "$ours_plan" "$stat" "$m")
     if [ -n "$stopped" ]; then a="not run"; else a=$(peer "$stat" "$m"); fi
-    if [ "$a" = timeout ]; then a="> $limit"; stopped=1; bound=">= "; sum_peer=$(awk -v s="$sum_peer" -v l="$limit" 'BEGIN{print s + l}')
-    elif [ "$a" != "not run" ]; then sum_peer=$(awk -v s="$sum_peer" -v a="$a" 'BEGIN{print s + a}'); fi
-    sum_exact=$(awk -v s="$sum_exact" -v a="$e" 'BEGIN{print s + a}'); sum_plan=$(awk -v s="$sum_plan" -v a="$p" 'BEGIN{print s + a}')
-    local ratio="-"
-    case "$a" in "> "*|"not run") ;; *) ratio=$(awk -v a="$a" -v e="$e" 'BEGIN{printf "%.0f", a / e}') ;; esac
+    all_exact=$(awk -v s="$all_exact" -v a="$e" 'BEGIN{print s + a}'); all_plan=$(awk -v s="$all_plan" -v a="$p" 'BEGIN{print s + a}')
+    case "$a" in
+      timeout|"not run")
+        [ "$a" = timeout ] && a="> $limit"
+        stopped=1
+        rest=$(awk -v r="$rest" -v w="$(work "$stat" "$m")" 'BEGIN{print r + w}') ;;
+      *)
+        peer_sum=$(awk -v s="$peer_sum" -v a="$a" 'BEGIN{print s + a}')
+        both_exact=$(awk -v s="$both_exact" -v a="$e" 'BEGIN{print s + a}'); both_plan=$(awk -v s="$both_plan" -v a="$p" 'BEGIN{print s + a}')
+        per_term=$(awk -v a="$a" -v w="$(work "$stat" "$m")" 'BEGIN{print a / w}')
+        ratio=$(awk -v a="$a" -v e="$e" 'BEGIN{printf "%.0f", a / e}') ;;
+    esac
     printf "| %s | %s | %.4f | %.4f | %s |\n" "$m" "$a" "$e" "$p" "$ratio"
     m=$((m * 2))
   done
-  printf "| all | %s%.1f | %.3f | %.3f | %s%.0f (plan: %s%.0f) |\n" "$bound" "$sum_peer" "$sum_exact" "$sum_plan" \
-    "$bound" "$(awk -v a="$sum_peer" -v e="$sum_exact" 'BEGIN{print a / e}')" "$bound" "$(awk -v a="$sum_peer" -v e="$sum_plan" 'BEGIN{print a / e}')"
+  echo
+  awk -v a="$peer_sum" -v e="$both_exact" -v p="$both_plan" 'BEGIN{printf "Taus both ran: allantools %.1f s, gyrochar exact %.3f s (%.0fx faster), plan %.3f s (%.0fx).\n", a, e, a / e, p, a / p}'
+  awk -v a="$peer_sum" -v r="$rest" -v c="$per_term" -v e="$all_exact" -v p="$all_plan" 'BEGIN{t = a + r * c;
+    printf "Every octave tau: gyrochar exact %.2f s, plan %.3f s; allantools extrapolated from its time per term at the last tau it finished: %.0f s (%.1f h), %.0fx the exact, %.0fx the plan.\n", e, p, t, t / 3600, t / e, t / p}'
 }
 
 section=$(mktemp)
