@@ -169,7 +169,7 @@ TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uin
     // Evenly spread over 0..last, first and last included.
     const std::uint64_t i = count == last + 1 ? j : (j * last + (count - 1) / 2) / (count - 1);
     const std::uint64_t mt = 12 + 4 * i, ma = 9 + 3 * i;
-    const TotalVariance t = theo1(x, mt, tau0_s, theo1_stride(mt, N, stride_factor));
+    const TotalVariance t = theo1(x, mt, tau0_s, stride_factor == 0 || mt <= stride_factor ? 1 : mt / stride_factor);
     const TotalVariance a = oavar(x, ma, tau0_s, stride_factor == 0 || ma <= stride_factor ? 1 : ma / stride_factor);
     if (t.n == 0 || a.n == 0 || !(t.var > 0)) return {};
     sum += a.var / t.var;

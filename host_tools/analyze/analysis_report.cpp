@@ -88,8 +88,9 @@ std::optional<RateUnit> rate_unit(std::string_view unit) {
 }
 
 std::string ReportUnits::unit(DevStat s) const {
-  if (gyro) return s == DevStat::tdev ? rate.angle : rate.name;
-  return s == DevStat::tdev ? "s" : "1";
+  const bool time = s == DevStat::tdev || s == DevStat::ttotdev;  // in phase units
+  if (gyro) return time ? rate.angle : rate.name;
+  return time ? "s" : "1";
 }
 
 std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,

@@ -71,6 +71,7 @@ Examples:
   gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec --rate-unit deg/h \
                    --fit ieee952 --format json run.txt.gz
   gyrochar-analyze --type phase --unit deg --tau0 0.01 --column 2 --stats oadev,mdev angle.csv
+  gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --stats oadev,totdev,theoh run120h.txt
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
 
 Exit codes: 0 success; 1 internal error; 2 bad options or data; 3 the output could not be written.
@@ -101,7 +102,9 @@ std::vector<DevStat> parse_stats(const std::string& text) {
   std::vector<DevStat> stats;
   for (const std::string& item : split(text, ',')) {
     const auto s = parse_dev_stat(item);
-    if (!s) bad("--stats", "unknown statistic '" + item + "' (adev, oadev, mdev, tdev, hdev, ohdev)");
+    if (!s)
+      bad("--stats", "unknown statistic '" + item +
+                         "' (adev, oadev, mdev, tdev, hdev, ohdev, totdev, mtotdev, ttotdev, htotdev, theo1, theoh)");
     stats.push_back(*s);
   }
   if (stats.empty()) bad("--stats", "empty list");
@@ -174,8 +177,9 @@ std::uint64_t count_values(const std::string& path, unsigned column, bool progre
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV of a recorded file, with EDF,\n"
-               "confidence intervals, noise identification and the IEEE-952 gyro fit; streams any length.",
+  CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV (streamed, any length) and TOTDEV,\n"
+               "MTOTDEV, TTOTDEV, HTOTDEV, Theo1, TheoH (held in memory) of a recorded file, with EDF,\n"
+               "confidence intervals, noise identification and the IEEE-952 gyro fit.",
                "gyrochar-analyze"};
   app.footer(footer);
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
@@ -194,8 +198,13 @@ int main(int argc, char** argv) {
   app.add_option("--nominal-hz", nominal_hz, "freq values are in Hz around this nominal frequency");
   app.add_option("--column", column, "column holding the values (1-based)")->capture_default_str();
   app.add_option("--taus", taus_text, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
-  app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev")->capture_default_str();
+  app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh")
+      ->capture_default_str();
   app.add_option("--stride-factor", stride_text, "S, a power of two, or full")->capture_default_str();
+  std::string total_stride_text = "16";
+  app.add_option("--total-stride-factor", total_stride_text,
+                 "S of the decimated total/Theo estimators (a power of two from 2 to 2^20), or exact")
+      ->capture_default_str();
   app.add_option("--confidence", confidence, "confidence level of the intervals")->capture_default_str();
   app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
   app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
@@ -227,6 +236,15 @@ int main(int argc, char** argv) {
       if (ec != std::errc() || end != stride_text.data() + stride_text.size() || o.stride_factor < 2 ||
           (o.stride_factor & (o.stride_factor - 1)) != 0 || o.stride_factor > (1u << 24))
         bad("--stride-factor", "must be a power of two from 2 to 2^24, or full");
+    }
+    if (total_stride_text == "exact") {
+      o.total_stride_factor = 0;
+    } else {
+      const auto [end, ec] =
+          std::from_chars(total_stride_text.data(), total_stride_text.data() + total_stride_text.size(), o.total_stride_factor);
+      if (ec != std::errc() || end != total_stride_text.data() + total_stride_text.size() || o.total_stride_factor < 2 ||
+          (o.total_stride_factor & (o.total_stride_factor - 1)) != 0 || o.total_stride_factor > (1u << 20))
+        bad("--total-stride-factor", "must be a power of two from 2 to 2^20, or exact");
     }
     if (alpha_text != "auto") {
       int a = 0;
@@ -306,6 +324,8 @@ int main(int argc, char** argv) {
       o.m_list = parse_tau_list(taus_text);
     }
     if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
+    const bool lists = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
+    o.theo_m_list = theo_taus(lists ? taus_text : "list", o.m_list, n_phase);
 
     // Pass 2: the analysis.
     std::unique_ptr<Analyzer> analyzer;

@@ -97,8 +97,9 @@ struct TheoBiasRatio {
 };
 
 /// TheoBR's bias ratio of phase x (N >= 24, so that n >= 1). With stride_factor S = 0 every
-/// estimate is exact; otherwise Theo1 at m uses theo1_stride() and AVAR at 0.75 m the stride
-/// 0.75 m / S (1 when 0.75 m <= S). At most `ratio_taus` (>= 2) of the n + 1 taus, evenly spread (all when
+/// estimate is exact; otherwise Theo1 at m and AVAR at 0.75 m use the sub-sequence strides m / S
+/// and 0.75 m / S (1 below S): the ratio averages many taus, each need not be exact. At most
+/// `ratio_taus` (>= 2) of the n + 1 taus, evenly spread (all when
 /// ratio_taus >= n + 1). O(taus N S) when decimated, O(N^3) exact; no allocation.
 TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
                               std::uint64_t ratio_taus);
