@@ -115,6 +115,7 @@ struct EngineBase {
   virtual ~EngineBase() = default;
   virtual void add(double value) = 0;
   virtual Analysis result(const AnalysisOptions& o) const = 0;
+  virtual PhaseRecord record(const AnalysisOptions& o) const = 0;
 };
 
 // The characterizer of one arithmetic over heap storage, and its read-out into rows.
@@ -188,7 +189,7 @@ class Engine final : public EngineBase {
       }
     };
     std::vector<AnalysisRow> allan;  // what the total family leans on (total_analysis.hpp)
-    if (keep_record_)
+    if (std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); }))
       for (const DevStat s : {DevStat::oadev, DevStat::mdev, DevStat::ohdev}) rows_of(s, allan);
     for (const DevStat stat : o.stats) {
       if (!is_total(stat)) {
@@ -199,6 +200,10 @@ class Engine final : public EngineBase {
       a.rows.insert(a.rows.end(), total.begin(), total.end());
     }
     return a;
+  }
+
+  PhaseRecord record(const AnalysisOptions& o) const override {
+    return {record_, type_ == DataType::freq ? o.tau0_s : 1.0};
   }
 
  private:
@@ -250,7 +255,7 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   for (std::size_t i = 1; i < o.theo_m_list.size(); ++i)
     if (o.theo_m_list[i] <= o.theo_m_list[i - 1]) throw std::invalid_argument("Theo1 averaging factors must increase");
   impl_->options = o;
-  const bool keep_record = std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
+  const bool keep_record = o.keep_record || std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
   if (o.type == DataType::counts)
     impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record);
   else
@@ -262,5 +267,7 @@ Analyzer::~Analyzer() = default;
 void Analyzer::add(double value) { impl_->engine->add(value); }
 
 Analysis Analyzer::result() const { return impl_->engine->result(impl_->options); }
+
+PhaseRecord Analyzer::record() const { return impl_->engine->record(impl_->options); }
 
 }  // namespace gyrochar

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,7 @@ struct AnalysisOptions {
   // hold the record (8 bytes a phase point).
   std::vector<std::uint64_t> theo_m_list;  // averaging factors of Theo1 and TheoBR (even), increasing
   std::uint32_t total_stride_factor = 16;  // S of their decimated estimators; 0: always exact
+  bool keep_record = false;                // hold the record without a total statistic (fits)
 };
 
 struct AnalysisRow {
@@ -87,6 +89,14 @@ struct AnalysisRow {
   double edf = 0.0;             // EDF of this estimator; 0: not available
   double skew_dof = 0.0;        // skewness of its distribution (confidence.hpp); 0: plain chi-squared
   Interval ci;                  // same unit as dev
+};
+
+/// The phase record the analyzer holds for the total family: points in the engine's representation
+/// (phase relative to the first point; for freq and counts the running sum of the values) and the
+/// factor that makes them phase units (tau0 for frequency data, else 1). Empty when not held.
+struct PhaseRecord {
+  std::span<const double> phase;
+  double phase_scale = 1.0;
 };
 
 struct Analysis {
@@ -113,6 +123,9 @@ class Analyzer {
   void add(double value);
   /// Results so far; may be called at any time. O(taus x stats) plus the EDF, allocates the rows.
   Analysis result() const;
+  /// The record held for the total family (empty unless a total statistic or keep_record was
+  /// asked for); valid until the next add(). O(1).
+  PhaseRecord record() const;
 
  private:
   struct Impl;

@@ -65,6 +65,18 @@ Taus (averaging factors m, tau = m tau0) and memory:
   2^16 are strided, their terms m/2^16 points apart, and their EDF is that of the strided
   estimator. adev and hdev are Stable32's non-overlapped estimators at any tau.
 
+The total and Theo family (docs/total.md): totdev, mtotdev, ttotdev, htotdev, theo1, theoh need the
+whole record, which the analyzer then holds (8 bytes a value, plus 4 for mtotdev). Theo1 and
+TheoBR rows carry m as their averaging factor at tau = 0.75 m tau0 (m even, from 10 up to N - 1:
+octave 16, 32, ...; decade 10, 20, 40, ...); theoh is overlapping ADEV below its switch point (the
+largest octave at or below 10 % of the record) and TheoBR from there on. Each estimate is exact
+where that costs at most 2^26 operations at its tau and decimated beyond (blocks or sub-sequences
+every m/S samples, S from --total-stride-factor, 16 by default; 'exact' never decimates): the
+stride column says which. Where the noise is identified the deviations carry Stable32's bias
+corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and the EDF is NIST
+SP 1065's for the statistic. --fit-long-tau totdev or theoh lets the IEEE-952 fit take TOTDEV or
+TheoBR points in place of OADEV at long tau, where they have more degrees of freedom.
+
 Examples:
   gyrochar-analyze --type phase --tau0 1 --stats adev,oadev,mdev,tdev PHASE.DAT
   gyrochar-analyze --type freq --tau0 1 --nominal-hz 10e6 --taus all --stats mdev ocxo.txt
@@ -72,6 +84,7 @@ Examples:
                    --fit ieee952 --format json run.txt.gz
   gyrochar-analyze --type phase --unit deg --tau0 0.01 --column 2 --stats oadev,mdev angle.csv
   gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --stats oadev,totdev,theoh run120h.txt
+  gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 --fit-long-tau totdev run120h.txt
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
 
 Exit codes: 0 success; 1 internal error; 2 bad options or data; 3 the output could not be written.
@@ -208,6 +221,10 @@ int main(int argc, char** argv) {
   app.add_option("--confidence", confidence, "confidence level of the intervals")->capture_default_str();
   app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
   app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
+  std::string long_tau_text = "oadev";
+  app.add_option("--fit-long-tau", long_tau_text,
+                 "the fit's Allan curve at long tau: oadev, totdev or theoh (docs/metrology.md)")
+      ->capture_default_str();
   app.add_option("--format", format, "table, csv or json")->capture_default_str();
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
@@ -255,6 +272,12 @@ int main(int argc, char** argv) {
     }
     if (format != "table" && format != "csv" && format != "json") bad("--format", "must be table, csv or json");
     if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
+    LongTau long_tau = LongTau::oadev;
+    if (long_tau_text == "totdev") long_tau = LongTau::totdev;
+    else if (long_tau_text == "theoh") long_tau = LongTau::theoh;
+    else if (long_tau_text != "oadev") bad("--fit-long-tau", "must be oadev, totdev or theoh, not '" + long_tau_text + "'");
+    if (long_tau != LongTau::oadev && fit_text.empty()) bad("--fit-long-tau", "only applies with --fit ieee952");
+    o.keep_record = long_tau != LongTau::oadev;
     // The fit uses both curves, whatever the table shows: compute them, show what was asked.
     const std::vector<DevStat> shown = o.stats;
     if (!fit_text.empty())
@@ -357,7 +380,8 @@ int main(int argc, char** argv) {
 
     std::vector<CurveFit> fits;
     if (!fit_text.empty())
-      fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0);
+      fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
+                        long_tau, analyzer->record());
     Analysis displayed = a;
     std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
     Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt};

@@ -92,6 +92,8 @@ TEST(AnalyzeCli, BadInputsGetExitCodeTwoAndAReason) {
   expect_bad_input("--type phase --tau0 1 --stats adev,foo " + good, "foo");
   expect_bad_input("--type phase --tau0 1 --stride-factor 6 " + good, "--stride-factor");
   expect_bad_input("--type phase --tau0 1 --stats totdev --total-stride-factor 3 " + good, "--total-stride-factor");
+  expect_bad_input("--type phase --tau0 1 --fit-long-tau totdev " + good, "--fit-long-tau");  // needs --fit
+  expect_bad_input("--type phase --tau0 1 --fit ieee952 --fit-long-tau theo2 " + good, "--fit-long-tau");
   expect_bad_input("--type phase --tau0 1 --alpha 5 " + good, "--alpha");
   expect_bad_input("--type phase --tau0 1 --confidence 1.5 " + good, "--confidence");
   expect_bad_input("--type phase --tau0 1 --taus 4,2 " + good, "--taus");
@@ -267,6 +269,19 @@ TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
   EXPECT_NE(table.out.find("IEEE-952 fit of both curves (recommended)"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("IEEE-952 fit of the Allan curve alone"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("deg/sqrt(h)"), std::string::npos) << table.out;
+  // With TOTDEV or TheoH at long tau (docs/metrology.md): the same closed form, and the fit says
+  // what its Allan curve was made of.
+  for (const char* input : {"totdev", "theoh"}) {
+    const Outcome t = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 --format json "
+                          "--fit-long-tau " + std::string(input) + " " + temp("white.txt"));
+    ASSERT_EQ(t.code, 0) << t.err;
+    const auto k = nlohmann::json::parse(t.out);
+    EXPECT_EQ(k["fit"][0]["long_tau"], input);
+    EXPECT_EQ(k["fit"][2]["long_tau"], "oadev");  // the modified Allan curve alone has no Allan points
+    const auto& n = k["fit"][0]["N"];
+    ASSERT_TRUE(n["resolved"].get<bool>()) << input;
+    EXPECT_NEAR(n["value"].get<double>(), n_true, 3 * n["uncertainty"].get<double>()) << input;
+  }
 }
 
 TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {

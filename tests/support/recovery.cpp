@@ -1,7 +1,6 @@
 #include "support/recovery.hpp"
 
 #include <atomic>
-#include <bit>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -10,8 +9,6 @@
 
 #include "analysis.hpp"
 #include "analysis_report.hpp"
-#include "gyrochar/greenhall_edf.hpp"
-#include "gyrochar/total.hpp"
 
 namespace gyrochar::test_support {
 
@@ -27,63 +24,6 @@ Scenario long_run(const char* name, double hours) {
   s.sim.rrw_deg_per_h_sqrt_h = 0.05;
   s.sim.ramp_deg_per_h2 = 0.01;
   return s;
-}
-
-// The octave points of both curves in SI units, as fit_curves() takes them.
-std::vector<FitPoint> curve_points(const Analysis& a, const ReportUnits& units) {
-  std::vector<FitPoint> points;
-  for (const AnalysisRow& r : a.rows)
-    if ((r.stat == DevStat::oadev || r.stat == DevStat::mdev) && std::has_single_bit(r.m)) {
-      const double v = r.dev * units.phase_unit_si;
-      points.push_back({r.stat == DevStat::oadev ? Stat::avar : Stat::mvar, r.m, r.stride, r.n, v * v, r.edf});
-    }
-  return points;
-}
-
-const AnalysisRow* oadev_row(const Analysis& a, std::uint64_t m) {  // the row at m, or the last before it
-  const AnalysisRow* found = nullptr;
-  for (const AnalysisRow& r : a.rows)
-    if (r.stat == DevStat::oadev && r.m <= m) found = &r;
-  return found;
-}
-
-// The Allan curve's long taus from the total family (recovery.hpp). x: the run's phase in pulses;
-// unit: one pulse in rad. Points keep the Allan geometry and carry variance_scale = the Allan
-// estimate's EDF over their own (both SP 1065 / Greenhall's formulas for the identified alpha).
-void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& a, const std::vector<double>& x,
-                  double tau0, double unit) {
-  const double N = static_cast<double>(x.size());
-  auto allan_edf = [&](int alpha, std::uint64_t m) {
-    const double md = static_cast<double>(m);
-    return edf_greenhall({alpha, 2, md, false, md, N});
-  };
-  if (input == LongTau::totdev) {
-    for (FitPoint& p : points) {
-      const AnalysisRow* r = p.stat == Stat::avar ? oadev_row(a, p.m) : nullptr;
-      if (r == nullptr) continue;
-      const int alpha = r->edf_alpha;
-      const double md = static_cast<double>(p.m), edf = edf_totvar(alpha, N, md), edf_a = allan_edf(alpha, p.m);
-      if (!(edf > edf_a && edf_a > 0)) continue;
-      p.variance = totvar(x, p.m, tau0).var / totvar_bias(alpha, N, md) * unit * unit;
-      p.edf = edf;
-      p.variance_scale = edf_a / edf;
-    }
-    return;
-  }
-  if (input != LongTau::theoh) return;
-  const std::uint64_t k = theoh_switch(x.size());
-  std::erase_if(points, [&](const FitPoint& p) { return p.stat == Stat::avar && p.m >= k; });
-  constexpr std::uint32_t S = 16;
-  const double ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(x.size(), S)).ratio;
-  for (std::uint64_t mt = 2 * k; 2 * (3 * mt / 4) + 1 <= x.size(); mt *= 2) {
-    const std::uint64_t m = 3 * mt / 4;  // tau = 0.75 mt tau0: the Allan geometry at m
-    const AnalysisRow* r = oadev_row(a, m);
-    if (r == nullptr || !(ratio > 0)) break;
-    const double edf = edf_theo1(r->edf_alpha, N, static_cast<double>(mt)), edf_a = allan_edf(r->edf_alpha, m);
-    if (!(edf > 0 && edf_a > 0)) continue;
-    const double var = theo1(x, mt, tau0, theo1_stride(mt, x.size(), S)).var * ratio * unit * unit;
-    points.push_back({Stat::avar, m, 1, x.size() - 2 * m, var, edf, edf_a / edf});
-  }
 }
 
 }  // namespace
@@ -153,28 +93,23 @@ Recovery recover(const SimOptions& sim, bool long_tau) {
   const auto n = static_cast<std::uint64_t>(std::llround(sim.duration_s / sim.tau0_s));
   o.m_list = octave_taus(n + 1);
   o.stats = {DevStat::oadev, DevStat::mdev};
+  o.keep_record = long_tau;  // the total family's record, for the long-tau fits
   Analyzer analyzer(o);
-  std::vector<double> phase;  // pulses, for the total family
-  if (long_tau) phase.reserve(n + 1), phase.push_back(0.0);
-  for (std::uint64_t k = 0; k < n; ++k) {
-    const auto c = static_cast<double>(gyro.next_count());
-    analyzer.add(c);
-    if (long_tau) phase.push_back(phase.back() + c);
-  }
+  for (std::uint64_t k = 0; k < n; ++k) analyzer.add(static_cast<double>(gyro.next_count()));
   ReportUnits units;
   units.gyro = true;
   units.phase_unit_si = sim.pulse_arcsec * units::arcsec;
   const Analysis analysis = analyzer.result();
   const double qw = units.phase_unit_si / std::sqrt(12.0);
-  Recovery out{{fit_curves(analysis, units, sim.tau0_s, qw).at(0).fit}, ieee952_truth(sim)};
-  if (!long_tau) return out;
-  for (const LongTau input : {LongTau::totdev, LongTau::theoh}) {
-    std::vector<FitPoint> points = curve_points(analysis, units);
-    use_long_tau(points, input, analysis, phase, sim.tau0_s, units.phase_unit_si);
+  // The recommended fit of both curves, once per input (fit_curves() would make all three).
+  auto fit = [&](LongTau input) {
+    const std::vector<FitPoint> points = fit_points(analysis, units, sim.tau0_s, input, analyzer.record());
     std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
-    out.fits[static_cast<std::size_t>(input)] =
-        fit_ieee952(points, {sim.tau0_s, analysis.n_phase, qw}, FitCurve::both, workspace);
-  }
+    return fit_ieee952(points, {sim.tau0_s, analysis.n_phase, qw}, FitCurve::both, workspace);
+  };
+  Recovery out{{fit(LongTau::oadev)}, ieee952_truth(sim)};
+  if (!long_tau) return out;
+  for (const LongTau input : {LongTau::totdev, LongTau::theoh}) out.fits[static_cast<std::size_t>(input)] = fit(input);
   return out;
 }
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "gyrochar/ieee952.hpp"
+#include "analysis_report.hpp"
 #include "sim_truth.hpp"
 
 namespace gyrochar::test_support {
@@ -31,8 +32,7 @@ struct Scenario {
   bool long_tau = false;  // also fit with TOTDEV and with TheoH at long tau
 };
 
-/// What the Allan curve of a fit is made of at long tau.
-enum class LongTau : std::uint8_t { oadev, totdev, theoh };
+/// Names of the fits by LongTau (analysis_report.hpp) in the study's tables.
 inline constexpr std::array<const char*, 3> long_tau_names{"OADEV", "TOTDEV", "TheoH"};
 
 /// The grid of docs/metrology.md: quantization made white by a random dither residue and left
