@@ -32,6 +32,8 @@ if [ "$job" = test ]; then
              python3-canmatrix python3-can clang libclang-rt-14-dev)
   # The QEMU bench (toolchain/bench/build.sh adds the kernel headers of the kernel it boots).
   packages+=(qemu-system-x86 busybox-static cpio can-utils)
+  # The peer the benchmarks run beside (toolchain/total_benchmarks.sh: allantools needs these).
+  packages+=(python3-numpy python3-scipy)
 fi
 
 missing=()
