@@ -126,7 +126,11 @@ Examples:
     fmt::format_to(to, "\n");
     if (!c.long_tau) continue;
     fmt::format_to(to, "The same runs fitted with the Allan curve's long taus from the total family (docs/total.md): "
-                       "statistics over the runs where the term is resolved.\n\n");
+                       "statistics over the runs where the term is resolved.");
+    for (std::size_t in = 0; in < c.by_long_tau.size(); ++in)
+      fmt::format_to(to, " {}: {} of {} fits ok, mean chi2/dof {:.2f}.", long_tau_names[in], c.long_tau_ok[in], c.runs,
+                     c.long_tau_chi2[in]);
+    fmt::format_to(to, "\n\n");
     fmt::format_to(to, "| term | long taus from | resolved (%) | within 1 sigma (%) | within 2 sigma (%) | mean stated sigma / truth | rms error / truth |\n");
     fmt::format_to(to, "|---|---|---:|---:|---:|---:|---:|\n");
     for (std::size_t k = 2; k < 5; ++k)

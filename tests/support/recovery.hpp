@@ -11,7 +11,7 @@
 // OADEV on the Allan curve (docs/total.md, docs/metrology.md): TOTDEV, bias-corrected, wherever
 // SP 1065's EDF for it exceeds the OADEV estimate's; and TheoH: OADEV below its switch point k,
 // TheoBR points (Theo1 times the data's bias ratio) from tau = 1.5 k on, as far as an Allan
-// geometry exists (tau <= T/2). The modified Allan curve is the same in all three fits.
+// geometry exists (tau <= T/2). These scenarios fit the Allan curve alone (recovery.cpp says why).
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -38,7 +38,8 @@ inline constexpr std::array<const char*, 3> long_tau_names{"OADEV", "TOTDEV", "T
 /// The grid of docs/metrology.md: quantization made white by a random dither residue and left
 /// periodic (no dither), angle random walk, bias instability, rate random walk and rate ramp in
 /// the combinations of the issue's reports and a complete RLG; then one long-run gyro (every term
-/// but Q dominating somewhere, the ramp only after 17 h) over 24 h and 120 h, with long_tau set.
+/// but Q dominating somewhere, the ramp only after 17 h) over 24 h and 120 h, and the same gyro
+/// without the ramp over 24 h, with long_tau set.
 std::vector<Scenario> standard_scenarios();
 
 /// One run: the fits (by LongTau; only OADEV's unless long_tau) and the truth (SI units).
@@ -75,6 +76,8 @@ struct RecoveryCell {
   std::array<TermTally, 5> terms{};                              // Q N B K R, the OADEV fit
   bool long_tau = false;
   std::array<std::array<TermTally, 5>, 3> by_long_tau{};         // long_tau: every fit by LongTau
+  std::array<std::size_t, 3> long_tau_ok{};                      // ... its fits with status ok
+  std::array<double, 3> long_tau_chi2{};                         // ... their mean chi2/dof
 };
 
 struct RecoverySettings {
