@@ -41,14 +41,28 @@ struct ReportUnits {
 struct CurveFit {
   FitCurve curve = FitCurve::both;
   Ieee952Fit fit;  // parameters in SI: Q rad (s), N rad/s^0.5, B rad/s, K rad/s^1.5, R rad/s^2
+  int long_tau = 0;  // the LongTau (below) its Allan curve was made of at long tau (0: OADEV alone)
 };
 
+/// What the Allan curve of a fit is made of at long tau (docs/metrology.md, "Long taus"): OADEV
+/// alone; TOTDEV (bias-corrected) wherever SP 1065's EDF for it exceeds OADEV's; or TheoH: OADEV
+/// below its switch point k, TheoBR points at tau = 1.5 k, 3 k, ... up to T/2.
+enum class LongTau : std::uint8_t { oadev, totdev, theoh };
+/// "oadev", "totdev", "theoh": a static string.
+const char* name(LongTau l);
+
 /// Fits the oadev and mdev rows of the analysis (one point per octave, m = 2^k), with the points
-/// in SI units. white_quantization_si: the white-quantization level Q_w = pulse weight / sqrt(12)
-/// in rad for counts, 0 otherwise. O(points^2) covariance sums, allocates the workspace; empty
-/// when the analysis has neither curve. A fit that fails says why in its status.
+/// in SI units; with long_tau totdev or theoh, the record (Analyzer::record()) gives total-family
+/// points in place of OADEV at long tau (an empty record: OADEV alone). white_quantization_si:
+/// the white-quantization level Q_w = pulse weight / sqrt(12) in rad for counts, 0 otherwise.
+/// O(points^2) covariance sums, allocates the workspace; empty when the analysis has neither
+/// curve. A fit that fails says why in its status.
 std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
-                                 double white_quantization_si);
+                                 double white_quantization_si, LongTau long_tau = LongTau::oadev,
+                                 const PhaseRecord& record = {});
+/// The points fit_curves() fits (SI units), for a single fit_ieee952() of one curve. Allocates.
+std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s,
+                                 LongTau long_tau = LongTau::oadev, const PhaseRecord& record = {});
 
 /// The truth a simulated input carries (gyrochar-sim's header, sim_truth.hpp), shown beside the
 /// fitted terms when the data are counts with the simulator's own tau0 and pulse weight.

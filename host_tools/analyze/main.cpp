@@ -68,6 +68,18 @@ Taus (averaging factors m, tau = m tau0) and memory:
   2^16 are strided, their terms m/2^16 points apart, and their EDF is that of the strided
   estimator. adev and hdev are Stable32's non-overlapped estimators at any tau.
 
+The total and Theo family (docs/total.md): totdev, mtotdev, ttotdev, htotdev, theo1, theoh need the
+whole record, which the analyzer then holds (8 bytes a value, plus 4 for mtotdev). Theo1 and
+TheoBR rows carry m as their averaging factor at tau = 0.75 m tau0 (m even, from 10 up to N - 1:
+octave 16, 32, ...; decade 10, 20, 40, ...); theoh is overlapping ADEV below its switch point (the
+largest octave at or below 10 % of the record) and TheoBR from there on. Each estimate is exact
+where that costs at most 2^26 operations at its tau and decimated beyond (blocks or sub-sequences
+every m/S samples, S from --total-stride-factor, 16 by default; 'exact' never decimates): the
+stride column says which. Where the noise is identified the deviations carry Stable32's bias
+corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and the EDF is NIST
+SP 1065's for the statistic. --fit-long-tau totdev or theoh lets the IEEE-952 fit take TOTDEV or
+TheoBR points in place of OADEV at long tau, where they have more degrees of freedom.
+
 Examples:
   gyrochar-analyze --type phase --tau0 1 --stats adev,oadev,mdev,tdev PHASE.DAT
   gyrochar-analyze --type freq --tau0 1 --nominal-hz 10e6 --taus all --stats mdev ocxo.txt
@@ -76,6 +88,8 @@ Examples:
   gyrochar-analyze --type phase --unit deg --tau0 0.01 --column 2 --stats oadev,mdev angle.csv
   gyrochar-analyze --type phase --tau0 1 --stats oadev,mdev --format stable32 PHASE.DAT
   gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --kalibr imu.yaml run.txt
+  gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --stats oadev,totdev,theoh run120h.txt
+  gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 --fit-long-tau totdev run120h.txt
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
 
 )";
@@ -105,7 +119,9 @@ std::vector<DevStat> parse_stats(const std::string& text) {
   std::vector<DevStat> stats;
   for (const std::string& item : split(text, ',')) {
     const auto s = parse_dev_stat(item);
-    if (!s) bad("--stats", "unknown statistic '" + item + "' (adev, oadev, mdev, tdev, hdev, ohdev)");
+    if (!s)
+      bad("--stats", "unknown statistic '" + item +
+                         "' (adev, oadev, mdev, tdev, hdev, ohdev, totdev, mtotdev, ttotdev, htotdev, theo1, theoh)");
     if (std::find(stats.begin(), stats.end(), *s) != stats.end()) bad("--stats", "'" + item + "' is asked twice");
     stats.push_back(*s);
   }
@@ -179,8 +195,9 @@ std::uint64_t count_values(const std::string& path, unsigned column, bool progre
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV of a recorded file, with EDF,\n"
-               "confidence intervals, noise identification and the IEEE-952 gyro fit; streams any length.",
+  CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV (streamed, any length) and TOTDEV,\n"
+               "MTOTDEV, TTOTDEV, HTOTDEV, Theo1, TheoH (held in memory) of a recorded file, with EDF,\n"
+               "confidence intervals, noise identification and the IEEE-952 gyro fit.",
                "gyrochar-analyze"};
   app.footer(std::string(footer) + exit_code::help);
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
@@ -199,11 +216,20 @@ int main(int argc, char** argv) {
   app.add_option("--nominal-hz", nominal_hz, "freq values are in Hz around this nominal frequency");
   app.add_option("--column", column, "column holding the values (1-based)")->capture_default_str();
   app.add_option("--taus", taus_text, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
-  app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev")->capture_default_str();
+  app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh")
+      ->capture_default_str();
   app.add_option("--stride-factor", stride_text, "S, a power of two, or full")->capture_default_str();
+  std::string total_stride_text = "16";
+  app.add_option("--total-stride-factor", total_stride_text,
+                 "S of the decimated total/Theo estimators (a power of two from 2 to 2^20), or exact")
+      ->capture_default_str();
   app.add_option("--confidence", confidence, "confidence level of the intervals")->capture_default_str();
   app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
   app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
+  std::string long_tau_text = "oadev";
+  app.add_option("--fit-long-tau", long_tau_text,
+                 "the fit's Allan curve at long tau: oadev, totdev or theoh (docs/metrology.md)")
+      ->capture_default_str();
   app.add_option("--format", format, "table, csv, json or stable32 (Stable32's result table, one per statistic)")
       ->capture_default_str();
   app.add_option("--kalibr", kalibr_path, "with --fit ieee952 on gyro data: also write N and K as a Kalibr imu.yaml")
@@ -236,6 +262,15 @@ int main(int argc, char** argv) {
           (o.stride_factor & (o.stride_factor - 1)) != 0 || o.stride_factor > (1u << 24))
         bad("--stride-factor", "must be a power of two from 2 to 2^24, or full");
     }
+    if (total_stride_text == "exact") {
+      o.total_stride_factor = 0;
+    } else {
+      const auto [end, ec] =
+          std::from_chars(total_stride_text.data(), total_stride_text.data() + total_stride_text.size(), o.total_stride_factor);
+      if (ec != std::errc() || end != total_stride_text.data() + total_stride_text.size() || o.total_stride_factor < 2 ||
+          (o.total_stride_factor & (o.total_stride_factor - 1)) != 0 || o.total_stride_factor > (1u << 20))
+        bad("--total-stride-factor", "must be a power of two from 2 to 2^20, or exact");
+    }
     if (alpha_text != "auto") {
       int a = 0;
       const auto [end, ec] = std::from_chars(alpha_text.data(), alpha_text.data() + alpha_text.size(), a);
@@ -247,6 +282,12 @@ int main(int argc, char** argv) {
       bad("--format", "must be table, csv, json or stable32");
     if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
     if (!kalibr_path.empty() && fit_text.empty()) bad("--kalibr", "needs --fit ieee952 (the file holds fitted terms)");
+    LongTau long_tau = LongTau::oadev;
+    if (long_tau_text == "totdev") long_tau = LongTau::totdev;
+    else if (long_tau_text == "theoh") long_tau = LongTau::theoh;
+    else if (long_tau_text != "oadev") bad("--fit-long-tau", "must be oadev, totdev or theoh, not '" + long_tau_text + "'");
+    if (long_tau != LongTau::oadev && fit_text.empty()) bad("--fit-long-tau", "only applies with --fit ieee952");
+    o.keep_record = long_tau != LongTau::oadev;
     // The fit uses both curves, whatever the table shows: compute them, show what was asked.
     const std::vector<DevStat> shown = o.stats;
     if (!fit_text.empty())
@@ -318,6 +359,8 @@ int main(int argc, char** argv) {
       o.m_list = parse_tau_list(taus_text);
     }
     if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
+    const bool lists = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
+    o.theo_m_list = theo_taus(lists ? taus_text : "list", o.m_list, n_phase);
 
     // Pass 2: the analysis.
     std::unique_ptr<Analyzer> analyzer;
@@ -357,7 +400,8 @@ int main(int argc, char** argv) {
 
     std::vector<CurveFit> fits;
     if (!fit_text.empty())
-      fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0);
+      fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
+                        long_tau, analyzer->record());
     Analysis displayed = a;
     std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
     // A tau asked for by number but too long for the data has no row: say so. (The octave,

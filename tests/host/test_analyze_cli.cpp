@@ -22,6 +22,8 @@
 
 #include "hal/exit_codes.hpp"
 
+#include "gyrochar/total.hpp"
+
 namespace {
 
 using namespace gyrochar;
@@ -96,6 +98,9 @@ TEST(AnalyzeCli, BadInputsGetExitCodeTwoAndAReason) {
   expect_bad_input("--type phase --tau0 1 /nonexistent/file.txt", "No such file");
   expect_bad_input("--type phase --tau0 1 --stats adev,foo " + good, "foo");
   expect_bad_input("--type phase --tau0 1 --stride-factor 6 " + good, "--stride-factor");
+  expect_bad_input("--type phase --tau0 1 --stats totdev --total-stride-factor 3 " + good, "--total-stride-factor");
+  expect_bad_input("--type phase --tau0 1 --fit-long-tau totdev " + good, "--fit-long-tau");  // needs --fit
+  expect_bad_input("--type phase --tau0 1 --fit ieee952 --fit-long-tau theo2 " + good, "--fit-long-tau");
   expect_bad_input("--type phase --tau0 1 --alpha 5 " + good, "--alpha");
   expect_bad_input("--type phase --tau0 1 --confidence 1.5 " + good, "--confidence");
   expect_bad_input("--type phase --tau0 1 --taus 4,2 " + good, "--taus");
@@ -224,6 +229,52 @@ TEST(AnalyzeCli, HelpHasExamplesAndExitCodes) {
     EXPECT_NE(r.out.find(part), std::string::npos) << part;
 }
 
+TEST(AnalyzeCli, TotalFamilyInEveryFormat) {
+  // 20000 counts of white rate noise (white FM): every statistic of the family gives rows in the
+  // table, CSV and JSON. Oracles: white FM's TOTDEV, MTOTDEV and Theo1 follow ADEV's 1/sqrt(tau)
+  // shape (SP 1065: all of them estimate it, Theo1 at tau = 0.75 m tau0) and their unbiased
+  // expectation at m = 1 is 2 pulses / 1 ms = ADEV; ttotdev is in the angle unit.
+  std::string s;
+  for (const int c : white_rate_counts()) s += std::to_string(c) + "\n";
+  const std::string path = file_with("white_total.txt", s);
+  const std::string args = "--type counts --tau0 0.001 --pulse-weight 1arcsec --rate-unit deg/h "
+                           "--stats oadev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh ";
+  const Outcome table = run(args + path);
+  ASSERT_EQ(table.code, 0) << table.err;
+  for (const char* stat : {"\ntotdev ", "\nmtotdev ", "\nttotdev ", "\nhtotdev ", "\ntheo1 ", "\ntheoh "})
+    EXPECT_NE(table.out.find(stat), std::string::npos) << stat;
+  const Outcome csv = run(args + "--format csv " + path);
+  ASSERT_EQ(csv.code, 0) << csv.err;
+  EXPECT_NE(csv.out.find("\nttotdev,1,0.001,"), std::string::npos);
+  EXPECT_NE(csv.out.find(",arcsec,"), std::string::npos) << "ttotdev in the angle unit";
+  const Outcome js = run(args + "--format json " + path);
+  ASSERT_EQ(js.code, 0) << js.err;
+  const auto j = nlohmann::json::parse(js.out);
+  std::map<std::string, std::vector<nlohmann::json>> by_stat;
+  for (const auto& row : j["results"]) by_stat[row["stat"]].push_back(row);
+  for (const char* stat : {"totdev", "mtotdev", "ttotdev", "htotdev", "theo1", "theoh"}) EXPECT_GT(by_stat[stat].size(), 5u) << stat;
+  const double adev1 = by_stat["oadev"][0]["dev"];  // deg/h at m = 1
+  EXPECT_NEAR(by_stat["totdev"][0]["dev"].get<double>() / adev1, 1.0, 0.02);
+  for (const auto& row : by_stat["theo1"]) {  // 1/sqrt(tau) from ADEV at m = 1, within 25 % (EDF >= 30 here)
+    const double want = adev1 / std::sqrt(row["tau"].get<double>() / 0.001);
+    if (row["edf"].get<double>() > 30) {
+      EXPECT_NEAR(row["dev"].get<double>() / want, 1.0, 0.25) << row["m"];
+    }
+    EXPECT_DOUBLE_EQ(row["tau"].get<double>(), 0.75 * row["m"].get<double>() * 0.001);
+  }
+  // Each row says which estimator made it: the plan of core/total.hpp (its own test), exact below
+  // 2^26 operations (mtotdev and htotdev to m = 128 here, theo1 at every m), blocks of m/16 beyond.
+  for (const auto& [stat, rows] : by_stat)
+    for (const auto& row : rows) {
+      const std::uint64_t m = row["m"];
+      const std::uint64_t want = stat == "mtotdev" || stat == "ttotdev" || stat == "htotdev" ? gyrochar::total_block(m, 20001, 16)
+                                 : stat == "theo1" || (stat == "theoh" && row["tau"] != m * 0.001) ? gyrochar::theo1_stride(m, 20001, 16)
+                                                                                                   : 1;
+      EXPECT_EQ(row["stride"].get<std::uint64_t>(), want) << stat << " m=" << m;
+    }
+  EXPECT_EQ(by_stat["mtotdev"].back()["stride"], 256) << "m = 4096: blocks of 256";
+}
+
 TEST(AnalyzeCli, UnwritableOutputIsOutputFailed) {
   const Outcome r = run("--type phase --tau0 1 " + good_phase() + " > /dev/full");
   EXPECT_EQ(r.code, exit_code::output_failed) << r.err;
@@ -320,6 +371,19 @@ TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
   EXPECT_NE(table.out.find("IEEE-952 fit of both curves (recommended)"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("IEEE-952 fit of the Allan curve alone"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("deg/sqrt(h)"), std::string::npos) << table.out;
+  // With TOTDEV or TheoH at long tau (docs/metrology.md): the same closed form, and the fit says
+  // what its Allan curve was made of.
+  for (const char* input : {"totdev", "theoh"}) {
+    const Outcome t = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 --format json "
+                          "--fit-long-tau " + std::string(input) + " " + temp("white.txt"));
+    ASSERT_EQ(t.code, 0) << t.err;
+    const auto k = nlohmann::json::parse(t.out);
+    EXPECT_EQ(k["fit"][0]["long_tau"], input);
+    EXPECT_EQ(k["fit"][2]["long_tau"], "oadev");  // the modified Allan curve alone has no Allan points
+    const auto& n = k["fit"][0]["N"];
+    ASSERT_TRUE(n["resolved"].get<bool>()) << input;
+    EXPECT_NEAR(n["value"].get<double>(), n_true, 3 * n["uncertainty"].get<double>()) << input;
+  }
 }
 
 TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
