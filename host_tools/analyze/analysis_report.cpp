@@ -333,6 +333,12 @@ Stable32Stat stable32_stat(DevStat s) {
     case DevStat::tdev: return {"Time", "#  AF        Tau         #    Alpha  Min Sigma    Time Sigma      Max Sigma"};
     case DevStat::hdev: return {"Hadamard", hadamard};
     case DevStat::ohdev: return {"Overlapping Hadamard", hadamard};
+    case DevStat::totdev: return {"Total", "#  AF        Tau         #    Alpha  Min Sigma    Total Sigma     Max Sigma"};
+    case DevStat::mtotdev: return {"Modified Total", "# AF          Tau        #     Alpha  Min Sigma     Mod Totdev      Max Sigma"};
+    case DevStat::ttotdev: return {"Time Total", "#AF          Tau       #      Alpha  Min Sigma    Time Totdev    Max Sigma"};
+    case DevStat::htotdev: return {"Hadamard Total", hadamard};
+    case DevStat::theo1: return {"Th\u00eao1", "#  AF   Th\u00eao1 Tau   Th\u00eao1 #    Alpha   Min Th\u00eao1    Th\u00eao1    Max Th\u00eao1"};
+    case DevStat::theoh: return {"Th\u00eaoH", "#  AF   Th\u00eaoH Tau   Th\u00eaoH #    Alpha   Min Th\u00eaoH    Th\u00eaoH    Max Th\u00eaoH"};
   }
   return {"?", allan};
 }
