@@ -195,7 +195,7 @@ int main(int argc, char** argv) {
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
   std::string format = "table", fit_text, kalibr_path;
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
-  unsigned column = 1;
+  unsigned column = 0;  // 0: the reader chooses
   bool progress = false;
   app.add_option("file", path, "data file (plain or gzip), '-' for standard input")->required();
   app.add_option("--type", type_text, "phase, freq or counts")->required();
@@ -205,7 +205,7 @@ int main(int argc, char** argv) {
   app.add_option("--pulse-unit", pulse_unit, "unit of --pulse-weight when it has none")->capture_default_str();
   app.add_option("--rate-unit", rate_text, "output unit of gyro data: deg/h, deg/s, rad/s")->capture_default_str();
   app.add_option("--nominal-hz", nominal_hz, "freq values are in Hz around this nominal frequency");
-  app.add_option("--column", column, "column holding the values (1-based)")->capture_default_str();
+  app.add_option("--column", column, "column holding the values (1-based; default: the only one, or the value of time,value)");
   app.add_option("--taus", taus_text, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
   app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev")->capture_default_str();
   app.add_option("--stride-factor", stride_text, "S, a power of two, or full")->capture_default_str();
@@ -234,7 +234,7 @@ int main(int argc, char** argv) {
     else bad("--type", "must be phase, freq or counts, not '" + type_text + "'");
     if (!(tau0_s > 0) || !std::isfinite(tau0_s)) bad("--tau0", "must be a positive number of seconds");
     o.tau0_s = tau0_s;
-    if (column == 0) bad("--column", "columns are numbered from 1");
+    if (app.count("--column") && column == 0) bad("--column", "columns are numbered from 1");
     if (!(confidence > 0 && confidence < 1)) bad("--confidence", "must be between 0 and 1");
     o.confidence = confidence;
     o.stats = parse_stats(stats_text);
@@ -333,7 +333,8 @@ int main(int argc, char** argv) {
     } catch (const DataFileError& e) {
       bad_data(source, e);
     }
-    if (o.stride_factor == 0) o.stride_factor = full_stride_factor(n_phase);
+    // full: every tau up to N/4 fully overlapped; for --taus all every m up to N/2 (all of them).
+    if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus_text == "all" ? 2 * n_phase : n_phase);
     const std::uint32_t s = o.stride_factor;
     std::vector<std::uint64_t> not_formed;  // decade taus the stride factor cannot form
     const bool generated = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
