@@ -1,13 +1,18 @@
 #!/usr/bin/env python3
 """The analyzer's job done with allantools, for toolchain/benchmarks.sh: load a counts file (one
-integer per line, '#' comments), then the deviations at the given taus. Prints one line
-'allantools: load S s, STAT S s, ..., total S s, taus K' (wall times of this process's steps),
-or, when a step fails (memory), the steps done and the error.
+integer per line, '#' comments), then the deviations at the given taus. Prints, step by step on
+one line, 'allantools: load S s, STAT S s (K taus), ..., total S s' (wall times of each step), so
+that a run stopped by a time limit shows how far it got; a step that runs out of memory ends the
+line with the error.
 
     allantools_job.py PEERS_DIR FILE TAU0 STATS TAUS     e.g. ... run.txt 0.01 oadev,mdev,ohdev octave
 """
 import sys
 import time
+
+
+def say(text):
+    print(text, end="", flush=True)
 
 
 def main():
@@ -16,8 +21,8 @@ def main():
     import numpy as np
     import allantools
 
-    steps = []
     start = time.perf_counter()
+    say("allantools:")
     try:
         t = time.perf_counter()
         counts = np.loadtxt(path, comments="#", dtype=np.float64)
@@ -25,18 +30,14 @@ def main():
         # formed once here, so allantools does not convert the frequency data again for each stat.
         phase = np.concatenate(([0.0], np.cumsum(counts)))
         del counts
-        steps.append(f"load {time.perf_counter() - t:.3f} s")
-        n_taus = 0
+        say(f" load {time.perf_counter() - t:.2f} s")
         for stat in stats.split(","):
             t = time.perf_counter()
             result = getattr(allantools, stat)(phase, rate=1.0 / tau0, data_type="phase", taus=taus)
-            n_taus = max(n_taus, len(result[0]))
-            steps.append(f"{stat} {time.perf_counter() - t:.3f} s")
-        steps.append(f"total {time.perf_counter() - start:.3f} s")
-        steps.append(f"taus {n_taus}")
-    except MemoryError as e:
-        steps.append(f"failed after {time.perf_counter() - start:.1f} s: MemoryError {e}")
-    print("allantools: " + ", ".join(steps))
+            say(f", {stat} {time.perf_counter() - t:.2f} s ({len(result[0])} taus)")
+        say(f", total {time.perf_counter() - start:.2f} s\n")
+    except MemoryError:
+        say(f", out of memory after {time.perf_counter() - start:.1f} s\n")
 
 
 if __name__ == "__main__":
