@@ -36,7 +36,7 @@ counts_file() {
 measure() {
   local limit=$1 out=$2; shift 2
   if timeout "$limit" /usr/bin/time -f "%e %U %S %M" -o "$data/time.txt" "$@" > "$out" 2>/dev/null; then
-    awk '{printf "%.2f %.2f %d", $1, $2 + $3, $4 / 1024}' "$data/time.txt"
+    awk '{printf "%.2f %.2f %d\n", $1, $2 + $3, $4 / 1024}' "$data/time.txt"
   else
     echo "- - -"
   fi
@@ -69,13 +69,13 @@ side_by_side() {
 analyzer_sections() {
 echo "## The analyzer's reader (Google Benchmark)"
 echo
-echo "\`build/perf/tests/bench_datafile\`: 4 10^6 values from the page cache, bytes of text per CPU"
+echo "\`build/perf/tests/bench_datafile\`: 4 000 000 values from the page cache, bytes of text per CPU"
 echo "second: counts of four digits (integer fast path), the same gzip'd (zlib's inflate in the loop;"
 echo "libdeflate, measured below, is faster but cannot stream), phase values as %.9e (std::from_chars)."
 echo
-echo '\`\`\`'
+echo '```'
 (cd "$data" && ../tests/bench_datafile --benchmark_min_time=1 2>/dev/null | grep -E "^(Benchmark|Read|-)")
-echo '\`\`\`'
+echo '```'
 f=$(counts_file 10000000)
 [ -f "$f.gz" ] || gzip -kf "$f"
 if command -v libdeflate-gunzip >/dev/null; then
@@ -97,7 +97,7 @@ echo "and ohdev on it). Process wall time, CPU time (user + sys) and peak RSS; t
 echo "time over gyrochar-analyze's. The default stride factor is full: every tau up to N/4 fully"
 echo "overlapped, as allantools. The machine is shared: CPU times are the steadier figures."
 echo
-echo "| samples | file | gyrochar-analyze | gyrochar-analyze | allantools | ratio |"
+echo "| samples | file | options | gyrochar-analyze | allantools | ratio |"
 echo "|---|---|---|---|---|---|"
 side_by_side 10000000 1800 "" octave
 side_by_side 10000000 1800 "--stride-factor 8" octave
@@ -106,7 +106,7 @@ side_by_side 100000000 3600 "--stride-factor 8" octave
 echo
 echo "Every m (\`--taus all\`, Stable32's \"all tau\"; allantools' taus=\"all\"), at most 10 minutes each:"
 echo
-echo "| samples | file | gyrochar-analyze | gyrochar-analyze | allantools | ratio |"
+echo "| samples | file | options | gyrochar-analyze | allantools | ratio |"
 echo "|---|---|---|---|---|---|"
 side_by_side 10000 600 "--taus all" all
 side_by_side 100000 600 "--taus all" all

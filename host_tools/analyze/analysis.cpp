@@ -174,19 +174,23 @@ class Engine final : public EngineBase {
     std::vector<TauSums> sums(taus);
     take_sums(characterizer_, sums);
     std::vector<NoiseId> noise2(taus), noise3(taus);
+    // The identification and the EDF need the same covariance sums of each tau's Allan and
+    // modified Allan grids: computed once (two grids a tau, the table half full at most).
+    std::vector<PairSumCache::Entry> entries(4 * taus + 16);
+    PairSumCache cache(entries);
     const bool frequency_input = type_ == DataType::freq;
     if (o.alpha) {
       std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
       std::fill(noise3.begin(), noise3.end(), given_noise(*o.alpha));
     } else {
-      identify_noise(sums, a.n_phase, 2, frequency_input, noise2);
-      identify_noise(sums, a.n_phase, 3, frequency_input, noise3);
+      identify_noise(sums, a.n_phase, 2, frequency_input, noise2, &cache);
+      identify_noise(sums, a.n_phase, 3, frequency_input, noise3, &cache);
     }
     const EstimateOptions options{o.tau0_s, type_ == DataType::freq ? o.tau0_s : 1.0, o.edf};
     for (const DevStat stat : o.stats) {
       for (std::size_t i = 0; i < taus; ++i) {
         const NoiseId& id = stat_of(stat) == Stat::hvar ? noise3[i] : noise2[i];
-        const Estimate e = estimate(sums[i], a.n_phase, stat, id, options);
+        const Estimate e = estimate(sums[i], a.n_phase, stat, id, options, &cache);
         if (e.n == 0) continue;
         if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
         AnalysisRow row;
