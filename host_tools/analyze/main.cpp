@@ -59,13 +59,14 @@ Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' 
 plain or gzip (recognized by content), '-' for standard input; read once. Every data line has as
 many fields as the first. Without --column a table of two columns whose first one increases
 (time, value) is read from column 2, and stderr says so; other tables need --column. A comma
-between digits must be a column separator: decimal commas are refused, never half read.
+between two digits beside another separator is a decimal comma, refused; with no other separator
+it is ambiguous and needs --column. A number is never half read.
 
 Taus (averaging factors m, tau = m tau0) and memory:
   octave        1, 2, 4, ... while a term fits
   decade        1, 2, 4, 10, 20, 40, ... (Stable32's decade)
-  all           every m up to N/2 that the stride factor can form (keeps the values in memory,
-                and time grows as N min(N, S): meant for files up to about 10^6 values)
+  all           every m up to N/2 that the stride factor can form (keeps the values in memory;
+                the EDF of every tau makes it O(N^2): 10^4 values take seconds, 10^5 too long)
   1,10,100      a list of m (strictly increasing)
   The taus are sized from the file's length (an upper bound: rows the data does not reach are
   left out) and cover any length on standard input. --stride-factor full (the default) makes
