@@ -45,6 +45,7 @@
 #include <cstring>
 #include <span>
 
+#include "gyrochar/block_kernel.hpp"
 #include "gyrochar/crc32.hpp"
 #include "gyrochar/noise_id.hpp"
 #include "gyrochar/stat.hpp"
@@ -283,9 +284,7 @@ class Characterizer {
     }
     ring_levels_ = max_level + 1;
     fast_count_ = 0;
-    while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0 &&
-           (!Arith::exact || taus_[fast_count_].result.m <= fast_m_max))
-      ++fast_count_;
+    while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0) ++fast_count_;
     if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.size()) return ConfigureStatus::history_too_small;
     restart();
     return ConfigureStatus::ok;
@@ -306,6 +305,7 @@ class Characterizer {
     }
     run_ = RunState{};
     run_.steady_from = 3u * stride_;
+    staged_count_ = 0;
   }
 
   /// Adds the next phase point (floating phase data). O(S) amortized; no allocation; never fails.
@@ -321,7 +321,7 @@ class Characterizer {
     const double b = hi - x;
     const double lo = (x - (hi - b)) - (run_.line_x0 + b);
     if (k == 1) run_.line_slope = hi;
-    push(static_cast<X>(std::fma(-static_cast<double>(k), run_.line_slope, hi) + lo));
+    stage(static_cast<X>(std::fma(-static_cast<double>(k), run_.line_slope, hi) + lo));
   }
 
   /// Adds the next increment of phase: a pulse count per tau0 (CountArith) or frequency * tau0
@@ -331,7 +331,7 @@ class Characterizer {
   /// new segment starts from 0 and phase_overflowed() turns true.
   void add_increment(typename Arith::Increment dx) {
     ++run_.increments;
-    if (run_.next_e == run_.segment_start) push(run_.x);
+    if (phase_points() == run_.segment_start) stage(run_.x);
     if constexpr (!Arith::exact) {
       if (run_.increments == 1) run_.first_increment = dx;
       run_.x += dx - run_.first_increment;
@@ -340,11 +340,13 @@ class Characterizer {
         run_.phase_overflow = true;
         mark_gap();
         run_.x = 0;
-        push(run_.x);
+        stage(run_.x);
         run_.x = dx;
       }
+      if (dx < run_.increment_min) run_.increment_min = dx;
+      if (dx > run_.increment_max) run_.increment_max = dx;
     }
-    push(run_.x);
+    stage(run_.x);
   }
 
   /// The block API: add_increment() for each value of `block`, in order. O(S) amortized per value.
@@ -356,6 +358,9 @@ class Characterizer {
   /// Starts a new segment at the next phase point: no term and no difference of a decimated series
   /// will span the break. O(taus).
   void mark_gap() {
+    flush();
+    run_.increment_min = RunState{}.increment_min;
+    run_.increment_max = RunState{}.increment_max;
     run_.segment_start = run_.next_e;
     run_.steady_from = run_.segment_start + 3u * stride_;
     run_.p_segment_start = run_.p;
@@ -372,7 +377,7 @@ class Characterizer {
   // (atomically: firmware/checkpoint.hpp).
 
   static constexpr std::uint32_t checkpoint_magic = 0x43525947;  // "GYRC"
-  static constexpr std::uint16_t checkpoint_version = 2;
+  static constexpr std::uint16_t checkpoint_version = 3;
 
   /// Bytes save() writes for the current configuration. O(1).
   std::size_t checkpoint_size() const {
@@ -384,6 +389,7 @@ class Characterizer {
   /// O(history + taus), no allocation, does not disturb accumulation.
   std::size_t save(std::span<std::byte> out) const {
     if (out.size() < checkpoint_size()) return 0;
+    flush();
     std::byte* p = out.data();
     const Header h = header();
     p = put(p, &h, sizeof h);
@@ -422,6 +428,7 @@ class Characterizer {
       p = get(p, &m, sizeof m);
       if (m != taus_[i].result.m) return RestoreStatus::config_mismatch;
     }
+    staged_count_ = 0;  // the restored state replaces the points not yet processed
     p = get(p, &run_, sizeof run_);
     p = get(p, history_.data(), used_history() * sizeof(Entry));
     get(p, taus_.data(), ntaus_ * sizeof(TauState));
@@ -435,7 +442,7 @@ class Characterizer {
   /// True once the accumulated pulse count passed 2^63 (CountArith); a gap was inserted there.
   bool phase_overflowed() const { return run_.phase_overflow; }
   /// Phase points added so far (over all segments).
-  std::uint64_t phase_points() const { return run_.next_e; }
+  std::uint64_t phase_points() const { return run_.next_e + staged_count_; }
   /// Increments added so far (samples of counts or frequency; 0 for phase input).
   std::uint64_t increments() const { return run_.increments; }
   /// Gaps marked so far (restores and phase overflows included).
@@ -445,12 +452,16 @@ class Characterizer {
   std::uint32_t tag() const { return tag_; }
   /// Sums of tau i (0 <= i < tau_count()), valid at any time.
   Result result(std::size_t i) const {
+    flush();
     Result r = taus_[i].result;
     r.sum_overflow = (taus_[i].sticky >> 63) != 0;
     return r;
   }
   /// The lag-1 autocorrelation sums of tau i's decimated series.
-  const NoiseIdAccumulator& noise(std::size_t i) const { return taus_[i].noise; }
+  const NoiseIdAccumulator& noise(std::size_t i) const {
+    flush();
+    return taus_[i].noise;
+  }
 
  private:
   struct Header {
@@ -481,31 +492,184 @@ class Characterizer {
     return p + n;
   }
 
+  // Staging. Points wait in staged_ until a block is full or the state is read, then go through
+  // the block kernel (counts, steady state) or one by one through push(). Read-outs are const and
+  // process the staged points first: nothing observable changes, but two threads must not read
+  // at once. A characterizer defined const never has staged points, so nothing is written then.
+  void stage(X x) {
+    staged_[staged_count_++] = x;
+    if (staged_count_ == block_points) flush();
+  }
+  void flush() const { const_cast<Characterizer*>(this)->process_staged(); }
+  void process_staged() {
+    const std::size_t n = staged_count_;
+    if (n == 0) return;
+    staged_count_ = 0;
+    std::size_t i = 0;
+    if constexpr (Arith::exact) {
+      while (i < n && run_.next_e < run_.steady_from) push(staged_[i++]);
+      if (i < n) push_block(&staged_[i], n - i);
+    } else {
+      while (i < n) push(staged_[i++]);
+    }
+  }
+
+  // One phase point through every level that runs at it.
   void push(X x) {
     const std::uint64_t e = run_.next_e++;
     run_.p = Arith::add_prefix(run_.p, x);
     const Entry current{x, run_.p};
-    // Levels 0 .. countr_zero(e) run at e; their ring heads move on by one slot.
+    const unsigned fired = advance_heads(e);
+    if (e == 0) {  // point 0 is a multiple of every m
+      for (std::size_t i = 0; i < ntaus_; ++i) decimate(taus_[i], x);
+    }
+    std::size_t i = 0;
+    if constexpr (!Arith::exact) {
+      if (e >= run_.steady_from) {
+        for (; i < fast_count_; ++i) {
+          fast_terms(taus_[i], current);
+          if (--taus_[i].countdown == 0) decimate(taus_[i], x);
+        }
+      }
+    }
+    later_levels(i, e, fired, current);
+    insert(e, current);
+  }
+
+  // Levels 0 .. countr_zero(e) run at e; their ring heads move on by one slot. Returns how many.
+  unsigned advance_heads(std::uint64_t e) {
     const unsigned fired = e == 0 ? 0 : static_cast<unsigned>(std::countr_zero(e)) + 1;
     const unsigned moved = fired < ring_levels_ ? fired : ring_levels_;
     for (unsigned ring = 0; ring < moved; ++ring) {
       if (++run_.head[ring] == ring_size(ring)) run_.head[ring] = 0;
     }
-    if (e == 0) {  // point 0 is a multiple of every m
-      for (std::size_t i = 0; i < ntaus_; ++i) decimate(taus_[i], x);
-    }
-    std::size_t i = 0;
-    if (e >= run_.steady_from) {
-      for (; i < fast_count_; ++i) {
-        fast_terms(taus_[i], current);
-        if (--taus_[i].countdown == 0) decimate(taus_[i], x);
-      }
-    }
-    for (; i < ntaus_ && taus_[i].level < fired; ++i) {
+    return fired;
+  }
+
+  // Terms and decimation of the taus from index `first` on whose level runs at e.
+  void later_levels(std::size_t first, std::uint64_t e, unsigned fired, const Entry& current) {
+    for (std::size_t i = first; i < ntaus_ && taus_[i].level < fired; ++i) {
       form_terms(taus_[i], e, current);
-      if (--taus_[i].countdown == 0) decimate(taus_[i], x);
+      if (--taus_[i].countdown == 0) decimate(taus_[i], current.x);
     }
-    insert(e, current);
+  }
+
+  // ---------------------------------------------------------------------------------------------
+  // The block kernel (counts, steady state: the points' level-0 history lies in this segment).
+  // The level-0 taus (m <= S) take the whole block at once, tau by tau, in block_terms(); the
+  // history and the higher levels then take the points one by one, as push() does. Level 0 reads
+  // only ring 0 as it was before the block, so the order of the two passes does not matter.
+  void push_block(const X* x, std::size_t n)
+    requires(Arith::exact)
+  {
+    std::array<std::uint64_t, block_points> p_lo, p_hi;
+    Int128 p = run_.p;
+    for (std::size_t j = 0; j < n; ++j) {
+      p = Arith::add_prefix(p, x[j]);
+      p_lo[j] = p.lo;
+      p_hi[j] = p.hi;
+    }
+    const Block b{run_.next_e, n, x, p_lo.data(), p_hi.data()};
+    for (std::size_t i = 0; i < fast_count_; ++i) level0_block(taus_[i], b);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::uint64_t e = run_.next_e++;
+      run_.p = {p_lo[j], p_hi[j]};
+      const Entry current{x[j], run_.p};
+      later_levels(fast_count_, e, advance_heads(e), current);
+      insert(e, current);
+    }
+  }
+
+  struct Block {
+    std::uint64_t e0;  // index of the first point
+    std::size_t n;
+    const X* x;
+    const std::uint64_t* p_lo;
+    const std::uint64_t* p_hi;
+    // Point e0 + j - age, from the block or from ring 0 (ages up to 3S before e0).
+    Entry at(const Characterizer& c, std::size_t j, std::uint64_t age) const
+      requires(Arith::exact)
+    {
+      if (j >= age) return {x[j - age], Int128{p_lo[j - age], p_hi[j - age]}};
+      return c.history_[(e0 + j - age) % (3u * c.stride_)];
+    }
+  };
+
+  // The block's terms of one level-0 tau, and its decimated points.
+  void level0_block(TauState& t, const Block& b)
+    requires(Arith::exact)
+  {
+    const std::uint64_t m = t.result.m;
+    // The terms fit in int64 when 2 m^2 (largest increment - smallest) < 2^63 (|a| <= m span,
+    // |h| <= 2 m span, |t| <= m^2 span), always for m <= 2^15 since increments are int32.
+    const std::uint64_t span = run_.increment_max >= run_.increment_min
+                                   ? static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min)
+                                   : 0;
+    if (span > (~std::uint64_t{0} >> 1) / (2 * m * m)) {
+      for (std::size_t j = 0; j < b.n; ++j) {  // the checked path, point by point
+        const Entry now = b.at(*this, j, 0);
+        checked_terms(t, now, b.at(*this, j, m), b.at(*this, j, 2 * m), b.at(*this, j, 3 * m));
+        if (--t.countdown == 0) decimate(t, now.x);
+      }
+      return;
+    }
+    std::array<std::int64_t, block_points> x1, x2, x3, a, h, mt;
+    std::array<std::uint64_t, block_points> p1, p2, p3;
+    gather(b, m, x1.data(), p1.data());
+    gather(b, 2 * m, x2.data(), p2.data());
+    gather(b, 3 * m, x3.data(), p3.data());
+    const BlockTerms terms = block_terms(b.n, b.x, x1.data(), x2.data(), x3.data(), b.p_lo, p1.data(), p2.data(),
+                                         p3.data(), a.data(), h.data(), mt.data());
+    Result& r = t.result;
+    t.sticky |= add_block(r.sum[0], terms.avar, a.data(), b.n) | add_block(r.sum[1], terms.mvar, mt.data(), b.n) |
+                add_block(r.sum[2], terms.hvar, h.data(), b.n);
+    r.n[0] += b.n;
+    r.n[1] += b.n;
+    r.n[2] += b.n;
+    // The decimated series: its terms are the overlapping ones at the multiples of m.
+    if (t.countdown > b.n) {
+      t.countdown -= b.n;
+      return;
+    }
+    std::size_t j = t.countdown - 1;
+    for (;; j += m) {
+      t.sticky |= Arith::accumulate(r.sum[static_cast<std::size_t>(SumKind::avar_nonoverlapped)], a[j]) |
+                  Arith::accumulate(r.sum[static_cast<std::size_t>(SumKind::hvar_nonoverlapped)], h[j]);
+      ++r.n[static_cast<std::size_t>(SumKind::avar_nonoverlapped)];
+      ++r.n[static_cast<std::size_t>(SumKind::hvar_nonoverlapped)];
+      t.noise.add(static_cast<double>(b.x[j]));
+      if (j + m >= b.n) break;
+    }
+    t.decimated = {b.x[j], x1[j], x2[j]};
+    t.decimated_count = 3;
+    t.countdown = m - (b.n - 1 - j);
+  }
+
+  // x and the low word of P at age `age` of each point of the block.
+  void gather(const Block& b, std::uint64_t age, std::int64_t* x, std::uint64_t* p) const
+    requires(Arith::exact)
+  {
+    const std::size_t from_history = age < b.n ? static_cast<std::size_t>(age) : b.n;
+    const std::uint32_t size = 3u * stride_;
+    std::uint32_t slot = static_cast<std::uint32_t>((b.e0 - age) % size);
+    for (std::size_t j = 0; j < from_history; ++j) {
+      x[j] = history_[slot].x;
+      p[j] = history_[slot].p.lo;
+      if (++slot == size) slot = 0;
+    }
+    for (std::size_t j = from_history; j < b.n; ++j) {
+      x[j] = b.x[j - age];
+      p[j] = b.p_lo[j - age];
+    }
+  }
+
+  // Adds a block's squares to a 128-bit sum: the 64-bit partial sum when it is exact, else the
+  // terms one by one. Returns the sum's high word (for the sticky overflow bit).
+  static std::uint64_t add_block(UInt128& sum, const BlockSquares& s, const std::int64_t* terms, std::size_t n) {
+    if (squares_exact(s, n)) return add_high_word(sum, UInt128{s.sum, 0});
+    std::uint64_t high = 0;
+    for (std::size_t j = 0; j < n; ++j) high |= add_high_word(sum, square(terms[j]));
+    return high;
   }
 
   // A point of the decimated series x[k m]: the non-overlapped second and third differences, and
@@ -555,7 +719,7 @@ class Characterizer {
     const Entry& e1 = at(t, 0);
     const Entry& e2 = at(t, 1);
     Result& r = t.result;
-    X a{}, h{};
+    X a{};
     if (span < 3 * m) {
       // Only the AVAR term fits; MVAR may still use P just before the segment start.
       if (!Arith::x_term2(now.x, e1.x, e2.x, a)) {
@@ -567,7 +731,13 @@ class Characterizer {
       if (span + 1 == 3 * m) mvar_term(t, now.p, e1.p, e2.p, run_.p_segment_start);
       return;
     }
-    const Entry& e3 = at(t, 2);
+    checked_terms(t, now, e1, e2, at(t, 2));
+  }
+
+  // The three terms at a point whose points of ages m, 2m, 3m lie in its segment, each checked.
+  void checked_terms(TauState& t, const Entry& now, const Entry& e1, const Entry& e2, const Entry& e3) {
+    Result& r = t.result;
+    X a{}, h{};
     if (!Arith::x_terms(now.x, e1.x, e2.x, e3.x, a, h)) {
       ++r.out_of_range;
     } else {
@@ -626,14 +796,16 @@ class Characterizer {
   std::uint32_t stride_ = 8;
   std::uint32_t tag_ = 0;
   unsigned ring_levels_ = 1;
-  std::size_t fast_count_ = 0;  // leading taus that take fast_terms() in the steady state
-  static constexpr std::uint64_t fast_m_max = std::uint64_t{1} << 15;
+  std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
+  static constexpr std::size_t block_points = 64;  // staged points per block
+  std::array<X, block_points> staged_{};
+  std::size_t staged_count_ = 0;
 
   // Everything that changes while data flows (with history_ and the tau states: the checkpoint).
   struct RunState {
     std::uint64_t next_e = 0;         // index of the next phase point
     std::uint64_t segment_start = 0;  // index of the current segment's first point
-    std::uint64_t steady_from = 0;    // from here on fast_terms() applies
+    std::uint64_t steady_from = 0;    // from here on level 0 has its whole history in the segment
     std::uint64_t increments = 0;     // add_increment() calls
     std::uint64_t gaps = 0;
     decltype(Entry{}.p) p{};          // P of the next point
@@ -643,6 +815,8 @@ class Characterizer {
     std::uint64_t line_points = 0;    // FloatArith phase input: the reference line
     double line_x0 = 0, line_slope = 0;
     bool phase_overflow = false;
+    // CountArith: the smallest and largest increment of this segment (they bound the terms).
+    std::int32_t increment_min = INT32_MAX, increment_max = INT32_MIN;
     std::array<std::uint32_t, 64> head{};  // head[l]: slot of (e >> l) in ring l
   };
   RunState run_;

@@ -1,22 +1,18 @@
 #pragma once
 // Power-law noise identification primitives (W. J. Riley and C. A. Greenhall, "Power law noise
 // identification using the lag 1 autocorrelation", 2004; NIST SP 1065 section 5.6). Streaming:
-// only running sums of a decimated series are kept (about 330 bytes per tau); no heap, no clock.
+// only running sums of a decimated series are kept (about 300 bytes per tau); no heap, no clock.
 // estimates.hpp combines them over the taus of a curve.
 #include <cstdint>
 
 namespace gyrochar {
 
-/// Lag-1 autocorrelation of a series from running sums, values shifted by the first one.
+/// Lag-1 autocorrelation of a series from running sums, values shifted by the first one: the
+/// read-out of one difference order of a NoiseIdAccumulator.
 struct Lag1Sums {
   std::uint64_t n = 0, pairs = 0;
   double shift = 0, sum = 0, sum_sq = 0;            // of v = z - shift (shift: the first value)
   double sum_lag = 0, sum_left = 0, sum_right = 0;  // over adjacent pairs (v_i, v_i+1)
-  double last = 0;
-  bool linked = false;                              // the next value pairs with `last`
-  void add(double z);
-  /// The next value starts a new segment (no pair spans a gap).
-  void unlink() { linked = false; }
   /// r1 = sum (z_i - mean)(z_{i+1} - mean) / sum (z_i - mean)^2; 0 with fewer than 3 values.
   double r1() const;
   /// Standard (n-1) variance of the values; 0 with fewer than 2.
@@ -24,19 +20,56 @@ struct Lag1Sums {
 };
 
 /// Fed with the decimated phase series z_k = x[k m] (relative to any fixed reference): keeps the
-/// lag-1 sums of the series and of its first, second and third differences.
+/// lag-1 sums of the series and of its first, second and third differences. The four orders
+/// advance in lockstep, one lane each of small vectors, so that a value costs a handful of vector
+/// operations; every lane performs exactly the operations, in the order, of a scalar running sum.
 class NoiseIdAccumulator {
  public:
-  void add(double z);
+  /// Adds the next value. O(1), no allocation.
+  void add(double z) {
+    if (have_ == 3 && linked_[3]) {  // steady state: every order has a previous value
+      Lanes v{z, 0, 0, 0};
+      v[1] = v[0] - raw_[0];
+      v[2] = v[1] - raw_[1];
+      v[3] = v[2] - raw_[2];
+      raw_ = v;
+      const Lanes u = v - shift_;
+      sum_lag_ += last_ * u;
+      sum_left_ += last_;
+      sum_right_ += u;
+      sum_ += u;
+      sum_sq_ += u * u;
+      last_ = u;
+      for (int d = 0; d < 4; ++d) {
+        ++n_[d];
+        ++pairs_[d];
+      }
+      return;
+    }
+    add_ramp(z);
+  }
   /// A gap: the next value starts a new segment; no difference or pair spans it.
-  void reset_segment();
-  std::uint64_t points() const { return order_[0].n; }
-  const Lag1Sums& order(int d) const { return order_[d]; }
+  void reset_segment() {
+    have_ = 0;
+    for (bool& l : linked_) l = false;
+  }
+  std::uint64_t points() const { return n_[0]; }
+  /// The sums of difference order d (0..3).
+  Lag1Sums order(int d) const {
+    return {n_[d], pairs_[d], shift_[d], sum_[d], sum_sq_[d], sum_lag_[d], sum_left_[d], sum_right_[d]};
+  }
 
  private:
-  Lag1Sums order_[4];
-  double last_[3] = {0, 0, 0};  // last value of orders 0..2 in this segment
-  int have_ = 0;                // values of this segment seen so far (capped at 3)
+  // Generic vectors (GCC and Clang): SIMD where the target has it, scalar code elsewhere.
+  using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
+  void add_ramp(double z);  // the first values of a segment, order by order
+  Lanes shift_{}, sum_{}, sum_sq_{}, sum_lag_{}, sum_left_{}, sum_right_{};
+  Lanes last_{};  // last shifted value of each order in this segment
+  Lanes raw_{};   // last unshifted value of orders 0..2 in this segment (the differences' base)
+  std::uint64_t n_[4] = {0, 0, 0, 0};
+  std::uint64_t pairs_[4] = {0, 0, 0, 0};
+  bool linked_[4] = {false, false, false, false};  // order d's next value pairs with last_[d]
+  int have_ = 0;  // values of this segment seen so far (capped at 3)
 };
 
 /// The lag-1 rule: difference the series (from order dmin) until delta = r1 / (1 + r1) < 0.25 or
