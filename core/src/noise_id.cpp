@@ -30,9 +30,9 @@ void NoiseIdAccumulator::add_ramp(double z) {
     const double u = v[d] - shift_[d];
     if (linked_[d]) {
       sum_lag_[d] += last_[d] * u;
-      sum_left_[d] += last_[d];
-      sum_right_[d] += u;
       ++pairs_[d];
+    } else {
+      firsts_[d] += u;
     }
     sum_[d] += u;
     sum_sq_[d] += u * u;

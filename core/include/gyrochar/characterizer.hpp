@@ -559,33 +559,58 @@ class Characterizer {
   // The level-0 taus (m <= S) take the whole block at once, tau by tau, in block_terms(); the
   // history and the higher levels then take the points one by one, as push() does. Level 0 reads
   // only ring 0 as it was before the block, so the order of the two passes does not matter.
+  // Working memory on the stack: about 5 KiB.
   void push_block(const X* x, std::size_t n)
     requires(Arith::exact)
   {
-    std::array<std::uint64_t, block_points> p_lo, p_hi;
+    // The window: the last `depth` points before the block (from ring 0), then the block.
+    const std::uint32_t ring0 = 3u * stride_;
+    const std::size_t depth = ring0 < window_depth ? ring0 : window_depth;
+    std::array<std::int64_t, window_depth + block_points> wx;
+    std::array<std::uint64_t, window_depth + block_points> wp;
+    std::array<std::uint64_t, block_points> p_hi;
+    std::uint32_t slot = static_cast<std::uint32_t>((run_.next_e - depth) % ring0);
+    for (std::size_t j = 0; j < depth; ++j) {
+      wx[j] = history_[slot].x;
+      wp[j] = history_[slot].p.lo;
+      if (++slot == ring0) slot = 0;
+    }
     Int128 p = run_.p;
     for (std::size_t j = 0; j < n; ++j) {
       p = Arith::add_prefix(p, x[j]);
-      p_lo[j] = p.lo;
+      wx[depth + j] = x[j];
+      wp[depth + j] = p.lo;
       p_hi[j] = p.hi;
     }
-    const Block b{run_.next_e, n, x, p_lo.data(), p_hi.data()};
+    const Block b{run_.next_e, n, x, &wp[depth], p_hi.data(), &wx[depth], depth};
     for (std::size_t i = 0; i < fast_count_; ++i) level0_block(taus_[i], b);
+    // The history and the higher levels, point by point. Odd points only enter ring 0.
+    const bool later = fast_count_ < ntaus_;
     for (std::size_t j = 0; j < n; ++j) {
       const std::uint64_t e = run_.next_e++;
-      run_.p = {p_lo[j], p_hi[j]};
+      run_.p = {wp[depth + j], p_hi[j]};
       const Entry current{x[j], run_.p};
-      later_levels(fast_count_, e, advance_heads(e), current);
+      if (e & 1) {
+        if (++run_.head[0] == ring0) run_.head[0] = 0;
+        history_[run_.head[0]] = current;
+        continue;
+      }
+      const unsigned fired = advance_heads(e);
+      if (later && taus_[fast_count_].level < fired) later_levels(fast_count_, e, fired, current);
       insert(e, current);
     }
   }
+
+  static constexpr std::size_t window_depth = 96;  // points before a block copied next to it
 
   struct Block {
     std::uint64_t e0;  // index of the first point
     std::size_t n;
     const X* x;
-    const std::uint64_t* p_lo;
+    const std::uint64_t* p_lo;  // low words of P (window: valid back to index -depth)
     const std::uint64_t* p_hi;
+    const std::int64_t* wx;     // x in the window (valid back to index -depth)
+    std::size_t depth;
     // Point e0 + j - age, from the block or from ring 0 (ages up to 3S before e0).
     Entry at(const Characterizer& c, std::size_t j, std::uint64_t age) const
       requires(Arith::exact)
@@ -613,33 +638,56 @@ class Characterizer {
       }
       return;
     }
-    std::array<std::int64_t, block_points> x1, x2, x3, a, h, mt;
-    std::array<std::uint64_t, block_points> p1, p2, p3;
-    gather(b, m, x1.data(), p1.data());
-    gather(b, 2 * m, x2.data(), p2.data());
-    gather(b, 3 * m, x3.data(), p3.data());
-    const BlockTerms terms = block_terms(b.n, b.x, x1.data(), x2.data(), x3.data(), b.p_lo, p1.data(), p2.data(),
-                                         p3.data(), a.data(), h.data(), mt.data());
+    // The points at ages m, 2m, 3m: in the window, or gathered from ring 0.
+    std::array<std::int64_t, block_points> gx1, gx2, gx3, a, h, mt;
+    std::array<std::uint64_t, block_points> gp1, gp2, gp3;
+    const std::int64_t *x1 = gx1.data(), *x2 = gx2.data(), *x3 = gx3.data();
+    const std::uint64_t *p1 = gp1.data(), *p2 = gp2.data(), *p3 = gp3.data();
+    if (3 * m <= b.depth) {
+      x1 = b.wx - m, x2 = b.wx - 2 * m, x3 = b.wx - 3 * m;
+      p1 = b.p_lo - m, p2 = b.p_lo - 2 * m, p3 = b.p_lo - 3 * m;
+    } else {
+      gather(b, m, gx1.data(), gp1.data());
+      gather(b, 2 * m, gx2.data(), gp2.data());
+      gather(b, 3 * m, gx3.data(), gp3.data());
+    }
+    const BlockTerms terms = block_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data(), mt.data());
     Result& r = t.result;
     t.sticky |= add_block(r.sum[0], terms.avar, a.data(), b.n) | add_block(r.sum[1], terms.mvar, mt.data(), b.n) |
                 add_block(r.sum[2], terms.hvar, h.data(), b.n);
     r.n[0] += b.n;
     r.n[1] += b.n;
     r.n[2] += b.n;
-    // The decimated series: its terms are the overlapping ones at the multiples of m.
+    // The decimated series: its terms are the overlapping ones at the multiples of m, so the
+    // block's bound covers their squares too.
     if (t.countdown > b.n) {
       t.countdown -= b.n;
       return;
     }
-    std::size_t j = t.countdown - 1;
+    const std::size_t first = static_cast<std::size_t>(t.countdown - 1);
+    std::size_t count = 0, j = first;
+    BlockSquares da{terms.avar.magnitude_bits, 0}, dh{terms.hvar.magnitude_bits, 0};
     for (;; j += m) {
-      t.sticky |= Arith::accumulate(r.sum[static_cast<std::size_t>(SumKind::avar_nonoverlapped)], a[j]) |
-                  Arith::accumulate(r.sum[static_cast<std::size_t>(SumKind::hvar_nonoverlapped)], h[j]);
-      ++r.n[static_cast<std::size_t>(SumKind::avar_nonoverlapped)];
-      ++r.n[static_cast<std::size_t>(SumKind::hvar_nonoverlapped)];
-      t.noise.add(static_cast<double>(b.x[j]));
+      da.sum += static_cast<std::uint64_t>(a[j]) * static_cast<std::uint64_t>(a[j]);
+      dh.sum += static_cast<std::uint64_t>(h[j]) * static_cast<std::uint64_t>(h[j]);
+      ++count;
       if (j + m >= b.n) break;
     }
+    const auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
+    const auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
+    if (squares_exact(da, b.n)) {
+      t.sticky |= add_high_word(r.sum[avar_d], UInt128{da.sum, 0});
+    } else {
+      for (std::size_t k = first; k <= j; k += m) t.sticky |= Arith::accumulate(r.sum[avar_d], a[k]);
+    }
+    if (squares_exact(dh, b.n)) {
+      t.sticky |= add_high_word(r.sum[hvar_d], UInt128{dh.sum, 0});
+    } else {
+      for (std::size_t k = first; k <= j; k += m) t.sticky |= Arith::accumulate(r.sum[hvar_d], h[k]);
+    }
+    r.n[avar_d] += count;
+    r.n[hvar_d] += count;
+    t.noise.add(b.x + first, count, m);
     t.decimated = {b.x[j], x1[j], x2[j]};
     t.decimated_count = 3;
     t.countdown = m - (b.n - 1 - j);

@@ -3,6 +3,7 @@
 // identification using the lag 1 autocorrelation", 2004; NIST SP 1065 section 5.6). Streaming:
 // only running sums of a decimated series are kept (about 300 bytes per tau); no heap, no clock.
 // estimates.hpp combines them over the taus of a curve.
+#include <cstddef>
 #include <cstdint>
 
 namespace gyrochar {
@@ -27,47 +28,69 @@ class NoiseIdAccumulator {
  public:
   /// Adds the next value. O(1), no allocation.
   void add(double z) {
-    if (have_ == 3 && linked_[3]) {  // steady state: every order has a previous value
-      Lanes v{z, 0, 0, 0};
-      v[1] = v[0] - raw_[0];
-      v[2] = v[1] - raw_[1];
-      v[3] = v[2] - raw_[2];
-      raw_ = v;
-      const Lanes u = v - shift_;
-      sum_lag_ += last_ * u;
-      sum_left_ += last_;
-      sum_right_ += u;
-      sum_ += u;
-      sum_sq_ += u * u;
-      last_ = u;
-      for (int d = 0; d < 4; ++d) {
-        ++n_[d];
-        ++pairs_[d];
-      }
-      return;
+    if (have_ == 3 && linked_[3]) {
+      add_steady(&z, 1, 1);
+    } else {
+      add_ramp(z);
     }
-    add_ramp(z);
+  }
+  /// Adds z[0], z[step], ..., z[(count-1) step] (integer phase points), as add() would one by one.
+  /// O(count), no allocation.
+  void add(const std::int64_t* z, std::size_t count, std::size_t step) {
+    std::size_t k = 0;
+    for (; k < count && !(have_ == 3 && linked_[3]); ++k) add_ramp(static_cast<double>(z[k * step]));
+    add_steady(z + k * step, count - k, step);
   }
   /// A gap: the next value starts a new segment; no difference or pair spans it.
   void reset_segment() {
     have_ = 0;
-    for (bool& l : linked_) l = false;
+    for (int d = 0; d < 4; ++d) {
+      if (linked_[d]) lasts_[d] += last_[d];
+      linked_[d] = false;
+    }
   }
   std::uint64_t points() const { return n_[0]; }
   /// The sums of difference order d (0..3).
   Lag1Sums order(int d) const {
-    return {n_[d], pairs_[d], shift_[d], sum_[d], sum_sq_[d], sum_lag_[d], sum_left_[d], sum_right_[d]};
+    // Every value but the last of each segment is a left one; every value but the first, a right one.
+    const double left = sum_[d] - lasts_[d] - (linked_[d] ? last_[d] : 0.0);
+    return {n_[d], pairs_[d], shift_[d], sum_[d], sum_sq_[d], sum_lag_[d], left, sum_[d] - firsts_[d]};
   }
 
  private:
   // Generic vectors (GCC and Clang): SIMD where the target has it, scalar code elsewhere.
   using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
   void add_ramp(double z);  // the first values of a segment, order by order
-  Lanes shift_{}, sum_{}, sum_sq_{}, sum_lag_{}, sum_left_{}, sum_right_{};
+  // Every order has a previous value in this segment: the four advance together.
+  template <class T>
+  void add_steady(const T* z, std::size_t count, std::size_t step) {
+    Lanes last = last_, sum = sum_, sum_sq = sum_sq_, sum_lag = sum_lag_;
+    const Lanes shift = shift_;
+    double r0 = raw_[0], r1 = raw_[1], r2 = raw_[2];
+    for (std::size_t k = 0; k < count; ++k) {
+      const double d0 = static_cast<double>(z[k * step]);
+      const double d1 = d0 - r0;
+      const double d2 = d1 - r1;
+      const double d3 = d2 - r2;
+      r0 = d0, r1 = d1, r2 = d2;
+      const Lanes u = Lanes{d0, d1, d2, d3} - shift;
+      sum_lag += last * u;
+      sum += u;
+      sum_sq += u * u;
+      last = u;
+    }
+    raw_ = Lanes{r0, r1, r2, 0};
+    last_ = last, sum_ = sum, sum_sq_ = sum_sq, sum_lag_ = sum_lag;
+    n_ += count;
+    pairs_ += count;
+  }
+  using Counts = std::uint64_t __attribute__((vector_size(4 * sizeof(std::uint64_t))));
+  Lanes shift_{}, sum_{}, sum_sq_{}, sum_lag_{};
+  Lanes firsts_{}, lasts_{};  // sums of the first and of the last value of each (closed) segment
   Lanes last_{};  // last shifted value of each order in this segment
   Lanes raw_{};   // last unshifted value of orders 0..2 in this segment (the differences' base)
-  std::uint64_t n_[4] = {0, 0, 0, 0};
-  std::uint64_t pairs_[4] = {0, 0, 0, 0};
+  Counts n_{};
+  Counts pairs_{};
   bool linked_[4] = {false, false, false, false};  // order d's next value pairs with last_[d]
   int have_ = 0;  // values of this segment seen so far (capped at 3)
 };
