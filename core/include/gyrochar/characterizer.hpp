@@ -498,7 +498,8 @@ class Characterizer {
   // at once. A characterizer defined const never has staged points, so nothing is written then.
   void stage(X x) {
     staged_[staged_count_++] = x;
-    if (staged_count_ == block_points) flush();
+    // Blocks end on multiples of block_points, so the next one starts on one (higher_levels()).
+    if (((run_.next_e + staged_count_) & (block_points - 1)) == 0) flush();
   }
   void flush() const { const_cast<Characterizer*>(this)->process_staged(); }
   void process_staged() {
@@ -560,6 +561,24 @@ class Characterizer {
   // history and the higher levels then take the points one by one, as push() does. Level 0 reads
   // only ring 0 as it was before the block, so the order of the two passes does not matter.
   // Working memory on the stack: about 5 KiB.
+  struct Block {
+    std::uint64_t e0;  // index of the first point
+    std::size_t n;
+    const X* x;
+    const std::uint64_t* p_lo;  // low words of P (window: valid back to index -depth)
+    const std::uint64_t* p_hi;
+    const std::int64_t* wx;     // x in the window (valid back to index -depth)
+    std::size_t depth;
+    unsigned level;             // the points are the multiples of 2^level: tau m has lag m >> level
+    // Point e0 + j - age, from the block or from ring 0 (ages up to 3S before e0).
+    Entry at(const Characterizer& c, std::size_t j, std::uint64_t age) const
+      requires(Arith::exact)
+    {
+      if (j >= age) return {x[j - age], Int128{p_lo[j - age], p_hi[j - age]}};
+      return c.history_[(e0 + j - age) % (3u * c.stride_)];
+    }
+  };
+
   void push_block(const X* x, std::size_t n)
     requires(Arith::exact)
   {
@@ -582,10 +601,11 @@ class Characterizer {
       wp[depth + j] = p.lo;
       p_hi[j] = p.hi;
     }
-    const Block b{run_.next_e, n, x, &wp[depth], p_hi.data(), &wx[depth], depth};
+    const Block b{run_.next_e, n, x, &wp[depth], p_hi.data(), &wx[depth], depth, 0};
     for (std::size_t i = 0; i < fast_count_; ++i) level0_block(taus_[i], b);
-    // The history and the higher levels, point by point. Odd points only enter ring 0.
-    const bool later = fast_count_ < ntaus_;
+    const std::size_t done = depth == ring0 ? higher_levels(b, wx.data(), wp.data()) : fast_count_;
+    // The history and the remaining levels, point by point. Odd points only enter ring 0.
+    const bool later = done < ntaus_;
     for (std::size_t j = 0; j < n; ++j) {
       const std::uint64_t e = run_.next_e++;
       run_.p = {wp[depth + j], p_hi[j]};
@@ -596,41 +616,76 @@ class Characterizer {
         continue;
       }
       const unsigned fired = advance_heads(e);
-      if (later && taus_[fast_count_].level < fired) later_levels(fast_count_, e, fired, current);
+      if (later && taus_[done].level < fired) later_levels(done, e, fired, current);
       insert(e, current);
     }
   }
 
   static constexpr std::size_t window_depth = 96;  // points before a block copied next to it
 
-  struct Block {
-    std::uint64_t e0;  // index of the first point
-    std::size_t n;
-    const X* x;
-    const std::uint64_t* p_lo;  // low words of P (window: valid back to index -depth)
-    const std::uint64_t* p_hi;
-    const std::int64_t* wx;     // x in the window (valid back to index -depth)
-    std::size_t depth;
-    // Point e0 + j - age, from the block or from ring 0 (ages up to 3S before e0).
-    Entry at(const Characterizer& c, std::size_t j, std::uint64_t age) const
-      requires(Arith::exact)
-    {
-      if (j >= age) return {x[j - age], Int128{p_lo[j - age], p_hi[j - age]}};
-      return c.history_[(e0 + j - age) % (3u * c.stride_)];
-    }
-  };
-
-  // The block's terms of one level-0 tau, and its decimated points.
-  void level0_block(TauState& t, const Block& b)
+  // Levels 1, 2, ... of a block that starts at a multiple of block_points, with 3S <= window_depth:
+  // the points of level L (the multiples of 2^L) form a series in which a tau r 2^L of that level
+  // is a level-0 tau of lag r, so the same kernel takes them, over a window of the series' last 3S
+  // points (the younger half from level L-1's window, the older half from ring L) and the block's
+  // points of level L. Stops at the first level not yet steady in this segment or whose terms are
+  // not proved to fit. Returns how many taus (a prefix of the list) the kernel took.
+  std::size_t higher_levels(const Block& level0, const std::int64_t* x_prev, const std::uint64_t* p_prev)
     requires(Arith::exact)
   {
-    const std::uint64_t m = t.result.m;
-    // The terms fit in int64 when 2 m^2 (largest increment - smallest) < 2^63 (|a| <= m span,
-    // |h| <= 2 m span, |t| <= m^2 span), always for m <= 2^15 since increments are int32.
+    std::size_t done = fast_count_;
+    const std::uint64_t e0 = level0.e0;
+    const std::size_t depth = 3u * stride_;
+    if (e0 % block_points != 0) return done;
+    std::array<std::array<std::int64_t, window_depth + block_points>, 2> x_buf;
+    std::array<std::array<std::uint64_t, window_depth + block_points>, 2> p_buf;
+    std::size_t n = level0.n;
+    for (unsigned level = 1; (std::size_t{1} << level) <= block_points && level < ring_levels_; ++level) {
+      if (done == ntaus_ || taus_[done].level != level || e0 < run_.segment_start + (std::uint64_t{depth} << level))
+        return done;
+      std::int64_t* x_next = x_buf[level % 2].data();
+      std::uint64_t* p_next = p_buf[level % 2].data();
+      const std::size_t half = depth / 2;
+      const std::uint32_t ring = 3u * stride_ / 2;
+      std::uint32_t slot = static_cast<std::uint32_t>(((e0 >> level) - depth) % ring);
+      const std::size_t base = ring_offset(level);
+      for (std::size_t i = 0; i < half; ++i) {  // ages (3S 2^(L-1), 3S 2^L]: ring L
+        x_next[i] = history_[base + slot].x;
+        p_next[i] = history_[base + slot].p.lo;
+        if (++slot == ring) slot = 0;
+      }
+      n = (n + 1) / 2;
+      for (std::size_t i = half; i < depth + n; ++i) {  // younger ones and the block: every other one
+        x_next[i] = x_prev[2 * i - depth];
+        p_next[i] = p_prev[2 * i - depth];
+      }
+      const Block b{e0, n, x_next + depth, p_next + depth, nullptr, x_next + depth, depth, level};
+      for (; done < ntaus_ && taus_[done].level == level; ++done) {
+        if (!terms_fit(taus_[done].result.m)) return done;
+        level0_block(taus_[done], b);
+      }
+      x_prev = x_next;
+      p_prev = p_next;
+    }
+    return done;
+  }
+
+
+  // The block's terms of one level-0 tau, and its decimated points.
+  // The terms of tau m fit in int64 when 2 m^2 (largest increment - smallest) < 2^63 (|a| <= m
+  // span, |h| <= 2 m span, |t| <= m^2 span), always for m <= 2^15 since increments are int32.
+  bool terms_fit(std::uint64_t m) const {
+    if (m > (std::uint64_t{1} << 31)) return false;
     const std::uint64_t span = run_.increment_max >= run_.increment_min
                                    ? static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min)
                                    : 0;
-    if (span > (~std::uint64_t{0} >> 1) / (2 * m * m)) {
+    return span <= (~std::uint64_t{0} >> 1) / (2 * m * m);
+  }
+
+  void level0_block(TauState& t, const Block& b)
+    requires(Arith::exact)
+  {
+    const std::uint64_t m = t.result.m >> b.level;  // the lag in the block's series
+    if (!terms_fit(t.result.m)) {  // level 0 only (higher_levels() checks first)
       for (std::size_t j = 0; j < b.n; ++j) {  // the checked path, point by point
         const Entry now = b.at(*this, j, 0);
         checked_terms(t, now, b.at(*this, j, m), b.at(*this, j, 2 * m), b.at(*this, j, 3 * m));
@@ -845,7 +900,7 @@ class Characterizer {
   std::uint32_t tag_ = 0;
   unsigned ring_levels_ = 1;
   std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
-  static constexpr std::size_t block_points = 64;  // staged points per block
+  static constexpr std::size_t block_points = 64;  // staged points per block (a power of two)
   std::array<X, block_points> staged_{};
   std::size_t staged_count_ = 0;
 

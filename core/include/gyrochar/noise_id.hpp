@@ -39,7 +39,7 @@ class NoiseIdAccumulator {
   void add(const std::int64_t* z, std::size_t count, std::size_t step) {
     std::size_t k = 0;
     for (; k < count && !(have_ == 3 && linked_[3]); ++k) add_ramp(static_cast<double>(z[k * step]));
-    add_steady(z + k * step, count - k, step);
+    if (k < count) add_run(z + k * step, count - k, step);
   }
   /// A gap: the next value starts a new segment; no difference or pair spans it.
   void reset_segment() {
@@ -58,9 +58,11 @@ class NoiseIdAccumulator {
   }
 
  private:
-  // Generic vectors (GCC and Clang): SIMD where the target has it, scalar code elsewhere.
-  using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
+  // Generic vectors (GCC and Clang): SIMD where the target has it, scalar code elsewhere. The
+  // alignment is explicit: the AVX2 clone of add_run() must agree with the baseline on it.
+  using Lanes = double __attribute__((vector_size(4 * sizeof(double)), aligned(4 * sizeof(double))));
   void add_ramp(double z);  // the first values of a segment, order by order
+  void add_run(const std::int64_t* z, std::size_t count, std::size_t step);  // add_steady(), SIMD-compiled
   // Every order has a previous value in this segment: the four advance together.
   template <class T>
   void add_steady(const T* z, std::size_t count, std::size_t step) {
@@ -84,7 +86,7 @@ class NoiseIdAccumulator {
     n_ += count;
     pairs_ += count;
   }
-  using Counts = std::uint64_t __attribute__((vector_size(4 * sizeof(std::uint64_t))));
+  using Counts = std::uint64_t __attribute__((vector_size(4 * sizeof(std::uint64_t)), aligned(4 * sizeof(std::uint64_t))));
   Lanes shift_{}, sum_{}, sum_sq_{}, sum_lag_{};
   Lanes firsts_{}, lasts_{};  // sums of the first and of the last value of each (closed) segment
   Lanes last_{};  // last shifted value of each order in this segment
