@@ -575,7 +575,7 @@ class Characterizer {
       requires(Arith::exact)
     {
       if (j >= age) return {x[j - age], Int128{p_lo[j - age], p_hi[j - age]}};
-      return c.history_[(e0 + j - age) % (3u * c.stride_)];
+      return c.history_[static_cast<std::size_t>((e0 + j - age) % (3u * c.stride_))];
     }
   };
 
@@ -684,7 +684,7 @@ class Characterizer {
   void level0_block(TauState& t, const Block& b)
     requires(Arith::exact)
   {
-    const std::uint64_t m = t.result.m >> b.level;  // the lag in the block's series
+    const auto m = static_cast<std::size_t>(t.result.m >> b.level);  // the lag in the block's series (<= S)
     if (!terms_fit(t.result.m)) {  // level 0 only (higher_levels() checks first)
       for (std::size_t j = 0; j < b.n; ++j) {  // the checked path, point by point
         const Entry now = b.at(*this, j, 0);
