@@ -137,7 +137,7 @@ echo
 rate() { awk -v b="$1" '$1 == b { for (i = 1; i <= NF; ++i) if ($i ~ /^items_per_second=/) { sub(/items_per_second=/, "", $i); print $i } }' "$data/pyramid.txt"; }
 met() { awk -v v="$1" -v t="$2" -v dir="$3" 'BEGIN { ok = dir == "max" ? v + 0 <= t + 0 : v + 0 >= t + 0; print ok ? "met" : "**missed**" }'; }
 block=$(rate Block/8/10000000 | tr -d M/s)
-state_bytes=$(echo "$state" | awk '{print $3}')
+state_bytes=$(echo "$state" | sed 's/.*) = \([0-9]*\) bytes.*/\1/')
 echo "## Against the targets"
 echo
 echo "Core (issue 11), one run on this machine:"
