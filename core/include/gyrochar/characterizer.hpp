@@ -64,6 +64,7 @@ struct CountArith {
   using X = std::int64_t;
   using Sum = UInt128;
   using Increment = std::int32_t;  // pulses per tau0: the exactness bounds rely on |c| < 2^31
+  using NoiseSums = IntegerNoiseIdAccumulator;  // the decimated phase is integer: exact sums
   static constexpr bool exact = true;
 
   static constexpr Int128 add_prefix(Int128 p, std::int64_t x) { return p + widen(x); }
@@ -110,6 +111,7 @@ struct FloatArith {
   using X = double;
   using Sum = double;
   using Increment = double;
+  using NoiseSums = NoiseIdAccumulator;
   static constexpr bool exact = false;
 
   static constexpr Prefix add_prefix(Prefix a, double b) {  // Knuth two-sum, then renormalize
@@ -240,7 +242,7 @@ class Characterizer {
     std::uint64_t countdown = 0;            // runs of this level until the next multiple of m
     std::array<X, 3> decimated{};           // the last three decimated points of this segment
     std::uint8_t decimated_count = 0;       // how many of them are valid (0..3)
-    NoiseIdAccumulator noise;               // lag-1 autocorrelation sums
+    typename Arith::NoiseSums noise;        // lag-1 autocorrelation sums
   };
 
   /// Binds the characterizer to storage owned by the caller, which must outlive it. No allocation.
@@ -301,7 +303,7 @@ class Characterizer {
       t.sticky = 0;
       t.countdown = 0;
       t.decimated_count = 0;
-      t.noise = NoiseIdAccumulator{};
+      t.noise = typename Arith::NoiseSums{};
     }
     run_ = RunState{};
     run_.steady_from = 3u * stride_;
@@ -377,7 +379,7 @@ class Characterizer {
   // (atomically: firmware/checkpoint.hpp).
 
   static constexpr std::uint32_t checkpoint_magic = 0x43525947;  // "GYRC"
-  static constexpr std::uint16_t checkpoint_version = 3;
+  static constexpr std::uint16_t checkpoint_version = 4;
 
   /// Bytes save() writes for the current configuration. O(1).
   std::size_t checkpoint_size() const {
@@ -458,7 +460,7 @@ class Characterizer {
     return r;
   }
   /// The lag-1 autocorrelation sums of tau i's decimated series.
-  const NoiseIdAccumulator& noise(std::size_t i) const {
+  const typename Arith::NoiseSums& noise(std::size_t i) const {
     flush();
     return taus_[i].noise;
   }
@@ -681,6 +683,14 @@ class Characterizer {
     return span <= (~std::uint64_t{0} >> 1) / (2 * m * m);
   }
 
+  // A bound on |x[e] - x[e-m]| (m increments) in this segment, 0 when it does not fit in 62 bits.
+  std::uint64_t step_bound(std::uint64_t m) const {
+    const std::int64_t lo = run_.increment_min, hi = run_.increment_max;
+    if (hi < lo || m > (std::uint64_t{1} << 31)) return 0;
+    const auto largest = static_cast<std::uint64_t>(-lo > hi ? -lo : hi);
+    return m * largest;
+  }
+
   void level0_block(TauState& t, const Block& b)
     requires(Arith::exact)
   {
@@ -742,7 +752,7 @@ class Characterizer {
     }
     r.n[avar_d] += count;
     r.n[hvar_d] += count;
-    t.noise.add(b.x + first, count, m);
+    t.noise.add(b.x + first, count, m, step_bound(t.result.m));
     t.decimated = {b.x[j], x1[j], x2[j]};
     t.decimated_count = 3;
     t.countdown = m - (b.n - 1 - j);
@@ -791,7 +801,7 @@ class Characterizer {
     }
     t.decimated = {x, t.decimated[0], t.decimated[1]};
     if (t.decimated_count < 3) ++t.decimated_count;
-    t.noise.add(static_cast<double>(x));
+    t.noise.add(x);
   }
 
   // Steady state of a ring-0 tau (m <= S, whole history inside the segment). For counts, the input

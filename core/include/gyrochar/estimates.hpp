@@ -71,14 +71,15 @@ constexpr SumKind sum_kind(DevStat s) {
 constexpr Stat stat_of(DevStat s) { return stat_of(sum_kind(s)); }
 
 /// The sums of one tau in floating point. variance[k] is in (x step / tau0)^2 (variance() with
-/// tau0 = 1 and unit 1). `noise` points into the characterizer, which must outlive it.
+/// tau0 = 1 and unit 1); `noise` summarizes the lag-1 sums of the decimated series (when has_noise).
 struct TauSums {
   std::uint64_t m = 0;
   std::uint64_t stride = 1;
   std::array<double, sum_kinds> variance{};
   std::array<std::uint64_t, sum_kinds> n{};
   bool clean = true;  // no term out of range, no sum overflow
-  const NoiseIdAccumulator* noise = nullptr;
+  bool has_noise = false;
+  Lag1Summary noise;
 };
 
 /// Fills out[0 .. tau_count) from the characterizer. O(taus), no allocation.
@@ -92,7 +93,8 @@ void take_sums(const Characterizer<Arith>& c, std::span<TauSums> out) {
     t.n = r.n;
     for (std::size_t k = 0; k < sum_kinds; ++k) t.variance[k] = variance(r, static_cast<SumKind>(k), 1.0);
     t.clean = r.out_of_range == 0 && !r.sum_overflow;
-    t.noise = &c.noise(i);
+    t.has_noise = true;
+    t.noise = summarize(c.noise(i));
   }
 }
 
