@@ -49,6 +49,9 @@ std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t t
           m = Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.25f, 0.1, v2};
         }
         break;
+      case Slot::window: m = WindowMsg{seq, 1, false, 0, 0}; break;  // no window taus here
+      case Slot::window_length: m = WindowLengthMsg{seq, 4}; break;
+      case Slot::window_dev: m = WindowDevMsg{seq, s.index, 0, 0.0, 0.0}; break;
     }
     CanFrame f;
     EXPECT_EQ(encode(m, node, f), ProtocolError::none);
@@ -89,7 +92,7 @@ TEST(Decoder, CompleteReportsCarryEveryValue) {
   Ieee952SummaryMsg want = fit_summary;
   want.seq = v.ieee952_summary->seq;
   EXPECT_EQ(*v.ieee952_summary, want);
-  EXPECT_EQ(v.schedule_version(), 2);
+  EXPECT_EQ(v.schedule_version(), version);
 }
 
 TEST(Decoder, VersionOneNodeHasNoSummaryAndMissesNothing) {
@@ -127,10 +130,10 @@ TEST(Decoder, VersionTwoNodeJoinedLateMissesNothingAndItsLostSummaryCounts) {
 }
 
 TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
-  // docs/protocol.md 2.2. A node announcing version 3 (its clock page, in report 0 of the 4-report
+  // docs/protocol.md 2.2. A node announcing version 4 (its clock page, in report 0 of the 4-report
   // slow cycle, comes after the 2 + 2 x 8 fast frames and the sampling page) is decoded no further: the frames after
   // its clock page and of its next reports are counted as not decoded and change no value. When it
-  // announces version 2 again, a new session starts.
+  // announces version 3 (this decoder's) again, a new session starts.
   Feed feed;
   std::vector<DecoderEvent> events;
   feed.decoder = Decoder([&](DecoderEvent e, const NodeView&, std::uint8_t) { events.push_back(e); });
@@ -139,7 +142,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
   const std::uint64_t frames_before = feed.node(5).health.frames;
   std::size_t sent = 0;
   for (std::uint8_t s = 4; s < 8; ++s) {
-    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, 3);
+    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, 4);
     // Tau 0's ADEV (position 2) differs in every report, so that a decoded frame would show.
     EXPECT_EQ(encode(TauDevMsg{s, 0, DevKind::adev, 10.0f + s, 100.0, NoiseType::white_fm, true}, 5, frames[2]),
               ProtocolError::none);
@@ -148,7 +151,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
     feed.frames(frames);
   }
   const NodeView& v = feed.node(5);
-  EXPECT_EQ(v.unknown_version, 3);
+  EXPECT_EQ(v.unknown_version, 4);
   EXPECT_EQ(std::count(events.begin(), events.end(), DecoderEvent::unknown_version), 1);
   const std::size_t before_clock = 19;  // report 4's frames before its clock page
   EXPECT_EQ(v.health.frames, frames_before + before_clock);
@@ -162,7 +165,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
   const NodeView& w = feed.node(5);
   EXPECT_EQ(w.unknown_version, 0);
   EXPECT_EQ(w.health.restarts, 1u);
-  EXPECT_EQ(w.schedule_version(), 2);
+  EXPECT_EQ(w.schedule_version(), 3);
   EXPECT_EQ(w.taus[0].adev.dev, 1.0f);
 }
 
