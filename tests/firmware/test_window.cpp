@@ -38,6 +38,16 @@ std::unique_ptr<WindowPyramid> direct(const std::vector<std::int32_t>& c, std::s
   return p;
 }
 
+constexpr std::uint64_t length = 1000;  // samples per window in these tests: 8 window taus
+const unsigned taus = window_taus(32, length);
+
+/// A window of `length` samples over `taus` taus, S = 8, checkpoint tag `tag`.
+std::unique_ptr<DynamicWindow> window(std::uint32_t tag = 0) {
+  auto w = std::make_unique<DynamicWindow>();
+  EXPECT_TRUE(w->configure(8, tag, taus, length));
+  return w;
+}
+
 void expect_curve(const WindowCurve& w, const WindowPyramid& oracle) {
   ASSERT_TRUE(w.complete);
   for (std::size_t i = 0; i < oracle.tau_count(); ++i) {
@@ -58,11 +68,8 @@ TEST(Window, TausReachAQuarterOfTheWindow) {
 }
 
 TEST(Window, EachWindowIsItsSamplesCutOutIntoARunOfTheirOwn) {
-  constexpr std::uint64_t length = 1000;
-  const unsigned taus = window_taus(32, length);
   const auto c = counts(3500);
-  auto w = std::make_unique<DynamicWindow>();
-  ASSERT_TRUE(w->configure(8, 0, taus, length));
+  auto w = window();
   EXPECT_FALSE(w->latest().complete);
   for (std::size_t k = 0; k < c.size(); ++k) {
     w->add(c[k]);
@@ -78,11 +85,8 @@ TEST(Window, EachWindowIsItsSamplesCutOutIntoARunOfTheirOwn) {
 }
 
 TEST(Window, AGapBreaksTheWindowAsItBreaksTheRun) {
-  constexpr std::uint64_t length = 1000;
-  const unsigned taus = window_taus(32, length);
   const auto c = counts(2000, 5);
-  auto w = std::make_unique<DynamicWindow>();
-  ASSERT_TRUE(w->configure(8, 0, taus, length));
+  auto w = window();
   for (std::size_t k = 0; k < c.size(); ++k) {
     if (k == 1300) w->mark_gap();
     w->add(c[k]);
@@ -102,17 +106,13 @@ TEST(Window, ConfigurationsBeyondItsCapacityAreRefused) {
 }
 
 TEST(Window, ACheckpointCarriesTheWindowOnAfterAGap) {
-  constexpr std::uint64_t length = 1000;
-  const unsigned taus = window_taus(32, length);
   const auto c = counts(2500, 9);
-  auto a = std::make_unique<DynamicWindow>();
-  ASSERT_TRUE(a->configure(8, 77, taus, length));
+  auto a = window(77);
   for (std::size_t k = 0; k < 1600; ++k) a->add(c[k]);
   std::vector<std::byte> bytes(a->checkpoint_size());
   ASSERT_EQ(a->save(bytes), bytes.size());
 
-  auto b = std::make_unique<DynamicWindow>();
-  ASSERT_TRUE(b->configure(8, 77, taus, length));
+  auto b = window(77);
   ASSERT_EQ(b->restore(bytes), RestoreStatus::ok);
   EXPECT_EQ(b->latest().window, 0u);
   expect_curve(b->latest(), *direct(c, 0, 1000, taus));
@@ -122,21 +122,16 @@ TEST(Window, ACheckpointCarriesTheWindowOnAfterAGap) {
   expect_curve(b->latest(), *direct(c, 1000, 2000, taus, {1600}));
 
   // Refused, and nothing changes: truncated, corrupted (in either part), another tag.
-  auto fresh = [&](std::uint32_t tag) {
-    auto w = std::make_unique<DynamicWindow>();
-    EXPECT_TRUE(w->configure(8, tag, taus, length));
-    return w;
-  };
-  EXPECT_EQ(fresh(77)->restore(std::span(bytes).first(bytes.size() - 1)), RestoreStatus::truncated);
+  EXPECT_EQ(window(77)->restore(std::span(bytes).first(bytes.size() - 1)), RestoreStatus::truncated);
   for (const std::size_t where : {std::size_t{100}, bytes.size() - 8}) {
     std::vector<std::byte> bad = bytes;
     bad[where] ^= std::byte{0x40};
-    auto w = fresh(77);
+    auto w = window(77);
     EXPECT_EQ(w->restore(bad), RestoreStatus::corrupted) << where;
     EXPECT_FALSE(w->latest().complete);
     EXPECT_EQ(w->samples_in_window(), 0u);
   }
-  EXPECT_EQ(fresh(78)->restore(bytes), RestoreStatus::config_mismatch);
+  EXPECT_EQ(window(78)->restore(bytes), RestoreStatus::config_mismatch);
 }
 
 }  // namespace
