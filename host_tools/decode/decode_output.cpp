@@ -191,6 +191,44 @@ void tau_rows(const NodeView& node, const ReportTracker::Report& report, const U
   }
 }
 
+namespace {
+
+DevCell window_cell(double dev, bool received, double rate) {
+  DevCell c;
+  if (!received) return c;
+  c.status = dev > 0 ? DevCell::Status::ok : DevCell::Status::invalid;
+  c.value = dev * rate;
+  return c;
+}
+
+}  // namespace
+
+void window_rows(const NodeView& node, const WindowView& w, double time_s, std::uint8_t seq, const Units& units,
+                 std::vector<WindowRow>& out) {
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  for (std::size_t i = 0; i < w.adev.size() && i < max_taus; ++i) {
+    WindowRow r;
+    r.time_s = time_s;
+    r.node = node.address;
+    r.session = node.session;
+    r.seq = seq;
+    r.window = w.window;
+    r.length = node.window_length;
+    if (tau0_s > 0 && node.window_length != 0) {
+      const double length_s = static_cast<double>(node.window_length) * tau0_s;
+      r.start_s = static_cast<double>(w.window) * length_s;
+      r.end_s = r.start_s + length_s;
+    }
+    r.gaps = w.gaps;
+    r.tau_index = static_cast<std::uint8_t>(i);
+    r.m = node.taus[i].m;
+    r.tau_s = node.tau_s(i);
+    r.adev = window_cell(w.adev[i], w.received[i], units.rate);
+    r.mdev = window_cell(w.mdev[i], w.received[i], units.rate);
+    out.push_back(r);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // CSV
 
@@ -201,20 +239,43 @@ CsvWriter::CsvWriter(std::FILE* out, double confidence) : out_(out), confidence_
       "mdev,mdev_low,mdev_high,mdev_edf,mdev_noise,mdev_status,"
       "rate_unit,ci_level,session,"
       "fit_status,fit_chi2_per_dof,fit_points,fit_quantization_white,"
-      "fit_avar_excluded_below_tau_s,fit_mvar_excluded_below_tau_s\n",
+      "fit_avar_excluded_below_tau_s,fit_mvar_excluded_below_tau_s,"
+      "type,window,window_start_s,window_end_s,window_gaps\n",
       out_);
 }
 
-void CsvWriter::row(const TauRow& r, const Units& units) {
+template <class T>
+void CsvWriter::field(bool known, T value) {
+  if (known) fmt::format_to(fmt::appender(line_), FMT_COMPILE("{}"), value);
+  line_.push_back(',');
+}
+
+void CsvWriter::begin(double time_s, std::uint8_t node, std::uint8_t seq, std::uint8_t tau_index, std::uint64_t m,
+                      double tau_s) {
   line_.clear();
+  fmt::format_to(fmt::appender(line_), FMT_COMPILE("{:.6f},{},{},{},"), time_s, node, seq, tau_index);
+  field(m != 0, m);
+  field(tau_s > 0, static_cast<float>(tau_s));  // tau0 is a float32 on the wire
+}
+
+void CsvWriter::row(const WindowRow& r, const Units& units) {
+  begin(r.time_s, r.node, r.seq, r.tau_index, r.m, r.tau_s);
   const auto out = fmt::appender(line_);
-  const auto field = [&](bool known, auto value) {
-    if (known) fmt::format_to(out, FMT_COMPILE("{}"), value);
-    line_.push_back(',');
-  };
-  fmt::format_to(out, FMT_COMPILE("{:.6f},{},{},{},"), r.time_s, r.node, r.seq, r.tau_index);
-  field(r.m != 0, r.m);
-  field(r.tau_s > 0, static_cast<float>(r.tau_s));  // tau0 is a float32 on the wire
+  line_.push_back(',');  // n: a window's terms are not sent
+  for (const DevCell* c : {&r.adev, &r.mdev}) {
+    field(c->status == DevCell::Status::ok, c->value);
+    fmt::format_to(out, FMT_COMPILE(",,,,{},"), name(c->status));  // no interval, EDF or noise type
+  }
+  fmt::format_to(out, FMT_COMPILE("{},,{},,,,,,,window,{},"), units.rate_name, r.session, r.window);
+  field(r.end_s > 0, r.start_s);
+  field(r.end_s > 0, r.end_s);
+  fmt::format_to(out, FMT_COMPILE("{}\n"), r.gaps);
+  std::fwrite(line_.data(), 1, line_.size(), out_);
+}
+
+void CsvWriter::row(const TauRow& r, const Units& units) {
+  begin(r.time_s, r.node, r.seq, r.tau_index, r.m, r.tau_s);
+  const auto out = fmt::appender(line_);
   field(r.n != 0, r.n);
   for (const DevCell* c : {&r.adev, &r.mdev}) {
     field(c->status == DevCell::Status::ok, c->value);
@@ -231,8 +292,8 @@ void CsvWriter::row(const TauRow& r, const Units& units) {
   field(fit, fit ? r.fit->points : 0u);
   field(fit, fit && r.fit->quantization_white ? "true" : "false");
   field(r.fit_excluded_below_tau_s[0].has_value(), r.fit_excluded_below_tau_s[0].value_or(0.0));
-  if (r.fit_excluded_below_tau_s[1]) fmt::format_to(out, FMT_COMPILE("{}"), *r.fit_excluded_below_tau_s[1]);
-  line_.push_back('\n');
+  field(r.fit_excluded_below_tau_s[1].has_value(), r.fit_excluded_below_tau_s[1].value_or(0.0));
+  fmt::format_to(out, FMT_COMPILE("tau,,,,\n"));
   std::fwrite(line_.data(), 1, line_.size(), out_);
 }
 
@@ -258,6 +319,7 @@ Json health_json(const LinkHealth& h) {
               {"offline_events", h.offline_events},
               {"duplicates", h.duplicates},
               {"not_decoded", h.not_decoded},
+              {"window_frames_unplaced", h.window_frames_unplaced},
               {"rejected", rejected}};
 }
 
@@ -277,11 +339,21 @@ const char* name(DecoderEvent e) {
       return "duplicate";
     case DecoderEvent::unknown_version:
       return "unknown_version";
+    case DecoderEvent::window_complete:
+      return "window_complete";
   }
   return "invalid";
 }
 
 }  // namespace
+
+template <class T>
+void JsonlWriter::member(const char* key, bool known, T value) {
+  if (known)
+    fmt::format_to(fmt::appender(line_), FMT_COMPILE(",\"{}\":{}"), key, value);
+  else
+    fmt::format_to(fmt::appender(line_), FMT_COMPILE(",\"{}\":null"), key);
+}
 
 // The tau rows are the bulk of a recording: written with fmt, not built as JSON objects (5x faster).
 // Every string in them is an enumeration or unit name (plain ASCII, nothing to escape) and every
@@ -289,12 +361,6 @@ const char* name(DecoderEvent e) {
 void JsonlWriter::row(const TauRow& r, const Units& units) {
   line_.clear();
   const auto out = fmt::appender(line_);
-  const auto member = [&](const char* key, bool known, auto value) {
-    if (known)
-      fmt::format_to(out, FMT_COMPILE(",\"{}\":{}"), key, value);
-    else
-      fmt::format_to(out, FMT_COMPILE(",\"{}\":null"), key);
-  };
   fmt::format_to(
       out, FMT_COMPILE("{{\"type\":\"tau\",\"time_s\":{:.6f},\"node\":{},\"session\":{},\"seq\":{},\"tau_index\":{}"),
       r.time_s, r.node, r.session, r.seq, r.tau_index);
@@ -312,6 +378,29 @@ void JsonlWriter::row(const TauRow& r, const Units& units) {
       fmt::format_to(out, FMT_COMPILE(",\"noise\":\"{}\"}}"), name(c->noise));
     else
       fmt::format_to(out, FMT_COMPILE(",\"noise\":null}}"));
+  }
+  fmt::format_to(out, FMT_COMPILE("}}\n"));
+  std::fwrite(line_.data(), 1, line_.size(), out_);
+}
+
+void JsonlWriter::row(const WindowRow& r, const Units& units) {
+  line_.clear();
+  const auto out = fmt::appender(line_);
+  fmt::format_to(out,
+                 FMT_COMPILE("{{\"type\":\"window\",\"time_s\":{:.6f},\"node\":{},\"session\":{},\"seq\":{},"
+                             "\"window\":{},\"window_gaps\":{}"),
+                 r.time_s, r.node, r.session, r.seq, r.window, r.gaps);
+  member("window_length", r.length != 0, r.length);
+  member("window_start_s", r.end_s > 0, r.start_s);
+  member("window_end_s", r.end_s > 0, r.end_s);
+  fmt::format_to(out, FMT_COMPILE(",\"tau_index\":{}"), r.tau_index);
+  member("m", r.m != 0, r.m);
+  member("tau_s", r.tau_s > 0, static_cast<float>(r.tau_s));
+  fmt::format_to(out, FMT_COMPILE(",\"rate_unit\":\"{}\""), units.rate_name);
+  for (const auto& [key, c] : {std::pair{"adev", &r.adev}, std::pair{"mdev", &r.mdev}}) {
+    fmt::format_to(out, FMT_COMPILE(",\"{}\":{{\"status\":\"{}\""), key, name(c->status));
+    member("value", c->status == DevCell::Status::ok, c->value);
+    line_.push_back('}');
   }
   fmt::format_to(out, FMT_COMPILE("}}\n"));
   std::fwrite(line_.data(), 1, line_.size(), out_);
@@ -418,10 +507,12 @@ std::string rejected_text(const LinkHealth& h) {
 std::string health_text(const LinkHealth& h) {
   return fmt::format(
       "frames {}; reports {} complete, {} incomplete, {} lost; frames missing {}; restarts {}; "
-      "offline {}; duplicates {}; rejected {}{}",
+      "offline {}; duplicates {}; rejected {}{}{}",
       h.frames, h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing, h.restarts,
       h.offline_events, h.duplicates, rejected_text(h),
-      h.not_decoded ? fmt::format("; not decoded {} (unknown protocol version)", h.not_decoded) : "");
+      h.not_decoded ? fmt::format("; not decoded {} (unknown protocol version)", h.not_decoded) : "",
+      h.window_frames_unplaced ? fmt::format("; window frames without their window page {}", h.window_frames_unplaced)
+                               : "");
 }
 
 std::string input_text(const Decoder& decoder, const InputCounters& in) {
@@ -494,6 +585,28 @@ void ieee952_view(std::string& s, const NodeView& v, const Units& u, const TrueT
   }
 }
 
+/// The dynamic Allan deviation's line: the window, and the latest window's ADEV at each window tau.
+void window_view(std::string& s, const NodeView& v, const Units& u) {
+  if (v.window_taus == 0) return;
+  auto out = std::back_inserter(s);
+  const double length_s = v.sampling ? static_cast<double>(v.window_length) * static_cast<double>(v.sampling->tau0_s) : 0.0;
+  fmt::format_to(out, "  dynamic ADEV: {} window taus, ", v.window_taus);
+  if (length_s > 0)
+    fmt::format_to(out, "windows of {:.4g} s", length_s);
+  else
+    s += "window length not received yet";
+  std::size_t complete = 0;
+  for (const auto& [k, w] : v.windows) complete += w.complete() ? 1 : 0;
+  fmt::format_to(out, "; {} windows received, {} complete", v.windows.size(), complete);
+  if (!v.windows.empty()) {
+    const WindowView& w = v.windows.rbegin()->second;
+    fmt::format_to(out, "; window {}{} [{}]:", w.window, w.gaps ? fmt::format(" ({} gaps)", w.gaps) : "", u.rate_name);
+    for (std::size_t i = 0; i < w.adev.size(); ++i)
+      s += w.received[i] && w.adev[i] > 0 ? fmt::format(" {:.3e}", w.adev[i] * u.rate) : " -";
+  }
+  s += '\n';
+}
+
 void node_view(std::string& s, const NodeView& v, RateUnit rate_unit, ConfidenceIntervals& intervals,
                const TrueTerms* truth) {
   const Units u = units_for(v, rate_unit);
@@ -536,6 +649,7 @@ void node_view(std::string& s, const NodeView& v, RateUnit rate_unit, Confidence
                    dev_text(t.mdev, u.rate, intervals), edf, noise);
   }
   ieee952_view(s, v, u, truth);
+  window_view(s, v, u);
 }
 
 }  // namespace
@@ -591,11 +705,40 @@ double model_adev(const std::array<double, 5>& qnbkr, double tau_s, double rate)
 
 }  // namespace
 
+namespace {
+
+// The heat map of the node's window curves: a column per window, a row per window tau (while tau0,
+// the window length or a window tau's m is unknown: no columns yet).
+HeatMap window_heat_map(const NodeView& node, const Units& u) {
+  HeatMap h;
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  const double length_s = static_cast<double>(node.window_length) * tau0_s;
+  h.title = length_s > 0 ? fmt::format("node 0x{:02X}, session {}: dynamic ADEV, windows of {:.4g} s", node.address,
+                                       node.session, length_s)
+                         : fmt::format("node 0x{:02X}, session {}: dynamic ADEV", node.address, node.session);
+  h.value_name = "ADEV";
+  h.unit = u.rate_name;
+  for (std::size_t i = 0; i < node.window_taus; ++i) {
+    if (!(node.tau_s(i) > 0)) return h;
+    h.tau_s.push_back(node.tau_s(i));
+  }
+  if (!(length_s > 0)) return h;
+  for (const auto& [k, w] : node.windows) {
+    HeatMap::Column c{static_cast<double>(k) * length_s, static_cast<double>(k + 1) * length_s, {}};
+    for (std::size_t i = 0; i < w.adev.size(); ++i) c.value.push_back(w.received[i] ? w.adev[i] * u.rate : 0.0);
+    h.columns.push_back(std::move(c));
+  }
+  return h;
+}
+
+}  // namespace
+
 NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals& intervals, const TrueTerms* truth) {
   const Units u = units_for(node, rate_unit);
   NodePlot p;
   p.title = fmt::format("node 0x{:02X}, session {}", node.address, node.session);
   p.rate_name = u.rate_name;
+  if (node.window_taus != 0) p.dynamic = window_heat_map(node, u);
   double lo = INFINITY, hi = 0.0;
   for (std::size_t i = 0; i < node.status.tau_count && i < max_taus; ++i) {
     const double tau = node.tau_s(i);

@@ -26,6 +26,7 @@
 
 #include "confidence.hpp"
 #include "decoder.hpp"
+#include "heat_map.hpp"
 
 namespace gyrochar::decoding {
 
@@ -150,6 +151,30 @@ struct TauRow {
 void tau_rows(const NodeView& node, const ReportTracker::Report& report, const Units& units,
               ConfidenceIntervals& intervals, std::vector<TauRow>& out);
 
+/// One window tau of one window of the node's dynamic Allan deviation (protocol version 3), in
+/// display units, written once, when the window's last frame arrives. No interval travels with a
+/// window curve (docs/protocol.md 2.5).
+struct WindowRow {
+  double time_s = 0.0;  // time of the frame that completed the window
+  std::uint8_t node = 0;
+  std::uint32_t session = 0;
+  std::uint8_t seq = 0;  // the report that carried that frame
+  std::uint32_t window = 0;
+  std::uint64_t length = 0;          // samples per window, 0 while unknown
+  double start_s = 0.0, end_s = 0.0;  // the window in the node's run: k L tau0, (k+1) L tau0; 0, 0
+                                      // while tau0 or L is unknown
+  std::uint32_t gaps = 0;
+  std::uint8_t tau_index = 0;
+  std::uint64_t m = 0;  // 0 while unknown
+  double tau_s = 0.0;   // 0 while unknown
+  DevCell adev, mdev;   // ok or invalid (the node had no estimate), without interval
+};
+
+/// The window's rows of `node` (one per window tau), at time `time_s`. Appends to `out`.
+/// O(window taus).
+void window_rows(const NodeView& node, const WindowView& window, double time_s, std::uint8_t seq, const Units& units,
+                 std::vector<WindowRow>& out);
+
 // ---------------------------------------------------------------------------------------------
 // What came in
 
@@ -172,34 +197,42 @@ using NodeFilter = std::bitset<256>;
 // Each call writes whole lines; O(size of the line); no allocation once the line buffer has grown
 // (the JSON report, event and summary records are built with nlohmann::json and do allocate).
 
-/// CSV, one row per tau per closed report, header first. Empty fields for unknown values.
+/// CSV, one row per tau per closed report, header first. Empty fields for unknown values. The
+/// window rows of the dynamic Allan deviation share the columns and fill the window_ ones; the
+/// column `type` tells them apart (tau, window).
 class CsvWriter {
  public:
   /// Writes the header. `confidence` is the level of the intervals (column ci_level).
   CsvWriter(std::FILE* out, double confidence);
   void row(const TauRow& r, const Units& units);
+  void row(const WindowRow& r, const Units& units);
 
  private:
+  template <class T>
+  void field(bool known, T value);  // the value (or nothing) and a comma
+  void begin(double time_s, std::uint8_t node, std::uint8_t seq, std::uint8_t tau_index, std::uint64_t m, double tau_s);
   std::FILE* out_;
   double confidence_;
   fmt::memory_buffer line_;
 };
 
 /// JSON lines, one object per line, told apart by "type": "tau" (the CSV row but its fit_ columns),
-/// "report" (one per closed report: status, node faults, link health, metadata, IEEE-952 terms and
-/// the fit's summary), "event" (restart,
-/// offline, online, duplicate) and "summary" (once, at the end: input counters and every node's
-/// link health).
+/// "window" (a window row), "report" (one per closed report: status, node faults, link health,
+/// metadata, IEEE-952 terms and the fit's summary), "event" (restart, offline, online, duplicate)
+/// and "summary" (once, at the end: input counters and every node's link health).
 class JsonlWriter {
  public:
   /// `confidence` is the level of the intervals ("ci_level").
   JsonlWriter(std::FILE* out, double confidence) : out_(out), confidence_(confidence) {}
   void row(const TauRow& r, const Units& units);
+  void row(const WindowRow& r, const Units& units);
   void report(double time_s, const NodeView& node, std::uint8_t seq, const Units& units);
   void event(double time_s, DecoderEvent e, const NodeView& node);
   void summary(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown);
 
  private:
+  template <class T>
+  void member(const char* key, bool known, T value);  // ,"key":value (or null) into line_
   void line(const std::string& text);
   std::FILE* out_;
   double confidence_;
@@ -248,6 +281,8 @@ struct NodePlot {
   std::vector<ReadOffPoint> read_offs;
   double tau_min_s = 0.0, tau_max_s = 0.0;  // the tau axis: the points' range widened by 2 on each
                                             // side (0, 0 when there are no points)
+  std::optional<HeatMap> dynamic;           // the window curves' ADEV (protocol version 3): a node
+                                            // with window taus has one, empty until a window comes
 };
 
 /// The plot of one node. Each resolved IEEE-952 term is drawn as the ADEV of its own AVAR term
@@ -258,7 +293,9 @@ struct NodePlot {
 /// pulse weight / sqrt(12) where the node held it there (quantization not white). A fit the node
 /// rejected, or could not make, draws no model line and says so in `notes`. With `truth` (SI), its
 /// model is drawn too (`truth`, the same closed form). Lines span the tau axis; read-off points
-/// outside it are left out. O(taus + line points); allocates.
+/// outside it are left out. A node with window taus also gets the heat map of its windows' ADEV
+/// (`dynamic`: one column per window, placed at its samples times tau0). O(taus + line points +
+/// windows x window taus); allocates.
 NodePlot plot_data(const NodeView& node, RateUnit rate_unit, ConfidenceIntervals& intervals,
                    const TrueTerms* truth = nullptr);
 
