@@ -122,6 +122,7 @@ std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, Dat
     const auto same = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::fabs(b); };
     if (!same(t->options.tau0_s, tau0_s) || !same(t->options.pulse_arcsec * deg_rad / 3600.0, pulse_weight_rad))
       return std::nullopt;
+    if (!t->options.segments.empty()) return std::nullopt;  // the gyro changed: no one truth for the run
     return t->truth;
   }
   return std::nullopt;

@@ -61,8 +61,8 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
                                  double white_quantization_si);
 
 /// The truth a simulated input carries (gyrochar-sim's header, sim_truth.hpp), shown beside the
-/// fitted terms when the data are counts with the simulator's own tau0 and pulse weight.
-/// Nothing otherwise. O(header lines).
+/// fitted terms when the data are counts with the simulator's own tau0 and pulse weight, and the
+/// simulated gyro did not change during the run (no segments). Nothing otherwise. O(header lines).
 std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, DataType type, double tau0_s,
                                      double pulse_weight_rad);
 
