@@ -21,6 +21,8 @@
 #include "analysis.hpp"
 #include "analysis_report.hpp"
 #include "datafile.hpp"
+#include "dynamic.hpp"
+#include "heat_map.hpp"
 
 namespace {
 
@@ -65,6 +67,13 @@ Taus (averaging factors m, tau = m tau0) and memory:
   2^16 are strided, their terms m/2^16 points apart, and their EDF is that of the strided
   estimator. adev and hdev are Stable32's non-overlapped estimators at any tau.
 
+Dynamic Allan deviation (--dynamic WINDOW[,STEP], in seconds; STEP defaults to WINDOW): the
+  statistics of every window of WINDOW/tau0 values, one starting every STEP/tau0 values, each as
+  if its values were a file of their own, at the taus with 4 m <= the window's values (--taus
+  chooses among them). Output: the tau x time surface (table, CSV or JSON); --plot PREFIX also
+  draws it as heat maps, one per statistic, in PREFIX.svg and PREFIX.png. Values after the last
+  complete window are counted, not analysed.
+
 Examples:
   gyrochar-analyze --type phase --tau0 1 --stats adev,oadev,mdev,tdev PHASE.DAT
   gyrochar-analyze --type freq --tau0 1 --nominal-hz 10e6 --taus all --stats mdev ocxo.txt
@@ -72,6 +81,8 @@ Examples:
                    --fit ieee952 --format json run.txt.gz
   gyrochar-analyze --type phase --unit deg --tau0 0.01 --column 2 --stats oadev,mdev angle.csv
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
+  gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1arcsec --dynamic 600,60 --format csv \
+                   --plot warmup run.txt > surface.csv
 
 Exit codes: 0 success; 1 internal error; 2 bad options or data; 3 the output could not be written.
 Errors go to stderr as 'gyrochar-analyze: what: why'; data goes to stdout.)";
@@ -171,6 +182,77 @@ std::uint64_t count_values(const std::string& path, unsigned column, bool progre
   }
 }
 
+// --dynamic WINDOW[,STEP]: one pass over the file, the surface on stdout, the heat maps to --plot.
+int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::string& dynamic_text,
+                    const std::string& taus_text, const std::string& path, unsigned column, double nominal_hz,
+                    const std::string& format, const std::string& plot_prefix, bool show_progress) {
+  const std::vector<std::string> parts = split(dynamic_text, ',');
+  double window_s = 0, step_s = 0;
+  const auto seconds = [](const std::string& t, double& v) {
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    return ec == std::errc() && end == t.data() + t.size() && v > 0 && std::isfinite(v);
+  };
+  if (parts.empty() || parts.size() > 2 || !seconds(parts[0], window_s) || (parts.size() == 2 && !seconds(parts[1], step_s)))
+    bad("--dynamic", "'" + dynamic_text + "' is not WINDOW or WINDOW,STEP in positive seconds");
+  if (parts.size() == 1) step_s = window_s;
+  const double window_values = std::round(window_s / o.tau0_s), step_values = std::round(step_s / o.tau0_s);
+  if (window_values < 4 || window_values > 1e15)
+    bad("--dynamic", fmt::format("a window of {} s holds {} values of tau0: at least 4 are needed", window_s, window_values));
+  if (step_values < 1) bad("--dynamic", fmt::format("a step of {} s is shorter than tau0", step_s));
+  const auto window = static_cast<std::uint64_t>(window_values), step = static_cast<std::uint64_t>(step_values);
+  // The windows' taus: --taus over the phase points of one window, those with 4 m <= its values.
+  const std::uint64_t window_phase = o.type == DataType::phase ? window : window + 1;
+  std::vector<std::uint64_t> m_list = taus_text == "octave"   ? octave_taus(window_phase)
+                                      : taus_text == "decade" ? decade_taus(window_phase)
+                                      : taus_text == "all"
+                                          ? all_taus(window_phase, resolve_stride_factor(o.stride_factor, window_phase / 2))
+                                          : parse_tau_list(taus_text);
+  const std::size_t asked = m_list.size();
+  m_list = window_taus(m_list, window);
+  if (m_list.empty()) bad("--taus", fmt::format("no tau with 4 m <= the window's {} values", window));
+  if (m_list.size() != asked && taus_text != "octave" && taus_text != "decade" && taus_text != "all")
+    bad("--taus", fmt::format("averaging factors above {} do not fit a quarter of the window", window / 4));
+  o.m_list = m_list;
+
+  std::unique_ptr<DynamicAnalyzer> analyzer;
+  try {
+    analyzer = std::make_unique<DynamicAnalyzer>(o, window, step);
+  } catch (const std::invalid_argument& e) {
+    bad("--dynamic", e.what());
+  }
+  const std::string source = path == "-" ? "standard input" : path;
+  std::vector<WindowAnalysis> windows;
+  try {
+    DataFile file(path, column);
+    Progress p(show_progress, "analyzing windows", file);
+    for (double v = 0; file.next(v);) {
+      if (nominal_hz > 0) v = (v - nominal_hz) / nominal_hz;
+      try {
+        analyzer->add(v);
+      } catch (const std::exception& e) {
+        bad(source, fmt::format("line {}: {}", file.line(), e.what()));
+      }
+      for (WindowAnalysis& w : analyzer->take_completed()) windows.push_back(std::move(w));
+      p.value();
+    }
+  } catch (const DataFileError& e) {
+    bad_data(path, e);
+  }
+  if (windows.empty())
+    bad(source, fmt::format("{} values are fewer than one window of {} values", analyzer->values(), window));
+  const DynamicReport report{windows, o.type, o.tau0_s, o.confidence, units, window, step, analyzer->values(), o.stats};
+  const std::string text = format == "json" ? dynamic_to_json(report).dump(2) + "\n"
+                           : format == "csv" ? format_dynamic_csv(report)
+                                             : format_dynamic_table(report);
+  if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
+    fail(exit_output, "output", std::strerror(errno));
+  if (!plot_prefix.empty()) {
+    std::string why;
+    if (!write_heat_maps(plot_prefix, dynamic_heat_maps(report), why)) fail(exit_output, "--plot", why);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -180,7 +262,7 @@ int main(int argc, char** argv) {
   app.footer(footer);
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
-  std::string format = "table", fit_text;
+  std::string format = "table", fit_text, dynamic_text, plot_prefix;
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
   unsigned column = 1;
   bool progress = false;
@@ -200,6 +282,10 @@ int main(int argc, char** argv) {
   app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
   app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
   app.add_option("--format", format, "table, csv or json")->capture_default_str();
+  app.add_option("--dynamic", dynamic_text, "dynamic Allan deviation: windows of WINDOW s, one every STEP s")
+      ->option_text("WINDOW[,STEP]");
+  app.add_option("--plot", plot_prefix, "with --dynamic: draw the heat maps to PREFIX.svg and PREFIX.png")
+      ->option_text("PREFIX");
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
     app.parse(argc, argv);
@@ -236,6 +322,9 @@ int main(int argc, char** argv) {
       o.alpha = a;
     }
     if (format != "table" && format != "csv" && format != "json") bad("--format", "must be table, csv or json");
+    if (!plot_prefix.empty()) {
+      if (const std::string missing = plot_devices_missing(); !missing.empty()) bad("--plot", missing);
+    }
     if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
     // The fit uses both curves, whatever the table shows: compute them, show what was asked.
     const std::vector<DevStat> shown = o.stats;
@@ -287,9 +376,16 @@ int main(int argc, char** argv) {
       bad("--rate-unit", "only applies to gyro data (counts, or --unit with an angle or a rate)");
     }
 
-    // Pass 1 (regular files only): the number of values, so the taus fit the data.
     const bool show_progress = progress || isatty(STDERR_FILENO);
     const std::string source = path == "-" ? "standard input" : path;
+    if (!plot_prefix.empty() && dynamic_text.empty()) bad("--plot", "draws the heat maps of --dynamic only");
+    if (!dynamic_text.empty()) {
+      if (!fit_text.empty()) bad("--fit", "fits the whole run's curves: not with --dynamic");
+      return analyze_dynamic(o, units, dynamic_text, taus_text, path, column, nominal_hz, format, plot_prefix,
+                             show_progress);
+    }
+
+    // Pass 1 (regular files only): the number of values, so the taus fit the data.
     std::uint64_t n_phase = 0;  // unknown
     if (is_regular_file(path)) {
       const std::uint64_t n_values = count_values(path, column, show_progress);

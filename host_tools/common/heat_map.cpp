@@ -10,7 +10,7 @@
 namespace gyrochar {
 namespace {
 
-enum Colour : PLINT { background, ink };
+enum Colour : PLINT { ink = 1 };  // colour map 0: heat_map_palette()
 
 // Character heights relative to PLplot's default, as gyrochar-decode's curve panels.
 constexpr PLFLT text_scale = 0.55;
@@ -60,7 +60,7 @@ void draw_heat_map(plstream& pls, const HeatMap& map) {
   const double t_lo = map.columns.front().start_s, t_hi = map.columns.back().end_s;
   const TimeUnit unit = time_unit(t_hi - t_lo);
 
-  pls.vpor(0.08, 0.80, 0.10, 0.92);  // the colour bar, outside on the right, gets the rest
+  pls.vpor(0.08, 0.80, 0.10, 0.92);  // the colour bar gets the right
   pls.wind(t_lo / unit.s, t_hi / unit.s, edge.front(), edge.back());
   pls.scmap1n(256);
   pls.scmap1l(true, static_cast<PLINT>(at.size()), at.data(), red.data(), green.data(), blue.data());
@@ -79,19 +79,19 @@ void draw_heat_map(plstream& pls, const HeatMap& map) {
   pls.lab(fmt::format("time since the start of the run [{}]", unit.name).c_str(), "averaging time #gt [s]",
           map.title.c_str());
 
-  const std::string label = fmt::format("log#d10#u {} [{}]", map.value_name, map.unit);
-  const char* labels[] = {label.c_str()};
-  PLINT label_opts[] = {PL_COLORBAR_LABEL_RIGHT};
-  const char* axis_opts[] = {"bcvtm"};
-  PLFLT ticks[] = {0.0};
-  PLINT sub_ticks[] = {0};
-  PLINT n_values[] = {2};
-  const PLFLT range[] = {lo, hi};
-  const PLFLT* values[] = {range};
-  PLFLT width = 0, height = 0;
-  pls.colorbar(&width, &height, PL_COLORBAR_GRADIENT, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE, 0.03, 0.0, 0.03, 0.82,
-               background, ink, 1, 0.0, 1.0, ink, 1.0, 1, label_opts, labels, 1, axis_opts, ticks, sub_ticks, n_values,
-               values);
+  // The colour bar beside the map: its own viewport, log10 of the value upwards.
+  pls.vpor(0.84, 0.86, 0.10, 0.92);
+  pls.wind(0, 1, lo, hi);
+  constexpr int slices = 128;
+  for (int k = 0; k < slices; ++k) {
+    const double a = lo + (hi - lo) * k / slices, b = lo + (hi - lo) * (k + 1) / slices;
+    pls.col1((k + 0.5) / slices);
+    const std::array<PLFLT, 4> x{0, 1, 1, 0}, y{a, a, b, b};
+    pls.fill(4, x.data(), y.data());
+  }
+  pls.col0(ink);
+  pls.box("bc", 0, 0, "bcmstv", 0, 0);
+  pls.mtex("r", 5.0, 0.5, 0.5, fmt::format("log#d10#u {} [{}]", map.value_name, map.unit).c_str());
 }
 
 bool write_heat_maps(const std::string& prefix, const std::vector<HeatMap>& maps, std::string& why) {

@@ -134,9 +134,8 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
           }
           v.window_taus = msg.tau_count;
           relayout_if_schedule_changed(v, a);
-          v.current_window.reset();
+          v.window_page = msg;
           if (msg.complete) {
-            v.current_window = msg.window;
             WindowView& w = v.windows[msg.window];
             w.window = msg.window;
             w.gaps = msg.gaps;
@@ -158,8 +157,11 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
 
 void Decoder::accept_window_dev(NodeView& v, Assembly& a, const WindowDevMsg& msg) {
   // The frame belongs to the window its cycle's window page named; WindowMod16 says whether it is
-  // that one (the page may have been lost, and the node moved on to another window).
-  const auto current = v.current_window ? v.windows.find(*v.current_window) : v.windows.end();
+  // that one (the page may have been lost, and the node moved on to another window). While the
+  // node has no completed window its frames carry nothing.
+  if (v.window_page && !v.window_page->complete && msg.adev_angle_per_s == 0 && msg.mdev_angle_per_s == 0) return;
+  const std::optional<std::uint32_t> k = v.current_window();
+  const auto current = k ? v.windows.find(*k) : v.windows.end();
   if (current == v.windows.end() || (current->first & 15u) != msg.window || msg.tau_index >= v.window_taus) {
     ++v.health.window_frames_unplaced;
     return;

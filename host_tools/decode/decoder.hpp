@@ -95,9 +95,13 @@ struct NodeView {
   /// Every window received in this session, by number: the columns of the heat map. A window is
   /// added when a window page names it and filled as its window tau frames arrive.
   std::map<std::uint32_t, WindowView> windows;
-  /// The window the frames of the current slow cycle describe (its window page's); empty before
-  /// one, and while the node has no completed window.
-  std::optional<std::uint32_t> current_window;
+  /// The latest window page: the window the frames of the current slow cycle describe (none while
+  /// the node has no completed window); empty until one arrives in this session.
+  std::optional<protocol::WindowMsg> window_page;
+  /// The window the window tau frames now arriving belong to, if any.
+  std::optional<std::uint32_t> current_window() const {
+    return window_page && window_page->complete ? std::optional<std::uint32_t>(window_page->window) : std::nullopt;
+  }
   LinkHealth health;
   /// Non-zero: the ProtocolVersion the node announced, newer than this decoder's; its frames are no
   /// longer decoded (counted in health.not_decoded) until it announces a known version again.
@@ -120,7 +124,7 @@ struct NodeView {
   }
 };
 
-/// window_complete: the last window tau of `node.current_window` arrived (once per window).
+/// window_complete: the last window tau of `node.current_window()` arrived (once per window).
 enum class DecoderEvent {
   report_closed,
   restart,

@@ -5,7 +5,8 @@
 // follows every node, shows its table as the run goes, and leaves a CSV and an ADEV/MDEV plot.
 // Hours of gyro time pass in seconds. The demo knows each gyro's true IEEE-952 parameters
 // (sim_truth.hpp, the simulator's own options): the view shows them beside every node's fitted
-// terms, and the plot draws the true model beside the fitted one.
+// terms, and the plot draws the true model beside the fitted one. Each board also keeps the
+// dynamic Allan deviation over --window minutes, which the plot draws as a heat map per node.
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
@@ -49,8 +50,9 @@ int main(int argc, char** argv) {
                "on a virtual clock.",
                "gyrochar-demo"};
   app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n"
+             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n"
              "Exit codes: 0 success, 1 an output could not be written, 2 bad options.");
-  double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30;
+  double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30, window_min = 30;
   unsigned nodes = 2, octaves = 20;
   std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo", candump_path;
   app.add_option("--hours", hours, "gyro hours to simulate")->capture_default_str();
@@ -58,6 +60,8 @@ int main(int argc, char** argv) {
   app.add_option("--tau0", tau0, "sample interval in seconds")->capture_default_str();
   app.add_option("--octaves", octaves, "octave taus per node (1..40)")->capture_default_str();
   app.add_option("--loss", loss, "probability that a frame is lost on the bus")->capture_default_str();
+  app.add_option("--window", window_min, "gyro minutes per window of the dynamic Allan deviation (0: none)")
+      ->capture_default_str();
   app.add_option("--view-every", view_every_min, "show the table every N gyro minutes (0: only at the end)")
       ->capture_default_str();
   app.add_option("--csv", csv_path, "decoded reports as CSV (one row per node, report and tau)")->capture_default_str();
@@ -73,8 +77,9 @@ int main(int argc, char** argv) {
     return exit_usage;
   }
   if (!(hours > 0) || !(tau0 > 0) || nodes < 1 || nodes > 8 || !(loss >= 0 && loss < 1) || octaves < 1 ||
-      octaves > 40 || !(view_every_min >= 0)) {
-    std::fprintf(stderr, "gyrochar-demo: options: hours, tau0 > 0; nodes 1..8; loss in [0, 1); octaves 1..40\n");
+      octaves > 40 || !(view_every_min >= 0) || !(window_min == 0 || window_min >= 4.0 / 60)) {
+    std::fprintf(stderr, "gyrochar-demo: options: hours, tau0 > 0; nodes 1..8; loss in [0, 1); octaves 1..40; "
+                         "window 0 or at least 4 s\n");
     return exit_usage;
   }
   if (!plot_prefix.empty()) {
@@ -108,6 +113,7 @@ int main(int argc, char** argv) {
     c.tau0_s = tau0;
     c.octaves = octaves;
     c.report_period_s = 1.0;
+    c.window_s = window_min * 60;
     // 1 arcsec pulses at the earth rate with 2 arcsec of white angle noise (so the quantization is
     // white), ARW 0.002, 0.003, ... deg/sqrt(h), bias instability 0.01 deg/h, RRW 0.03 deg/h/sqrt(h).
     SimOptions o;
