@@ -182,6 +182,30 @@ std::uint64_t count_values(const std::string& path, unsigned column, bool progre
   }
 }
 
+// Reads every value of the file (Hz around --nominal-hz made fractional) into `add`; a value `add`
+// refuses (invalid_argument: a bad count; range_error) is bad data at its line. Returns the
+// file's header lines.
+template <class Add>
+std::vector<std::string> read_values(const std::string& path, unsigned column, double nominal_hz, bool progress,
+                                     const char* stage, Add add) {
+  try {
+    DataFile file(path, column);
+    Progress p(progress, stage, file);
+    for (double v = 0; file.next(v);) {
+      if (nominal_hz > 0) v = (v - nominal_hz) / nominal_hz;
+      try {
+        add(v);
+      } catch (const std::exception& e) {
+        bad(path == "-" ? "standard input" : path, fmt::format("line {}: {}", file.line(), e.what()));
+      }
+      p.value();
+    }
+    return file.header();
+  } catch (const DataFileError& e) {
+    bad_data(path, e);
+  }
+}
+
 // --dynamic WINDOW[,STEP]: one pass over the file, the surface on stdout, the heat maps to --plot.
 int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::string& dynamic_text,
                     const std::string& taus_text, const std::string& path, unsigned column, double nominal_hz,
@@ -222,22 +246,10 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
   }
   const std::string source = path == "-" ? "standard input" : path;
   std::vector<WindowAnalysis> windows;
-  try {
-    DataFile file(path, column);
-    Progress p(show_progress, "analyzing windows", file);
-    for (double v = 0; file.next(v);) {
-      if (nominal_hz > 0) v = (v - nominal_hz) / nominal_hz;
-      try {
-        analyzer->add(v);
-      } catch (const std::exception& e) {
-        bad(source, fmt::format("line {}: {}", file.line(), e.what()));
-      }
-      for (WindowAnalysis& w : analyzer->take_completed()) windows.push_back(std::move(w));
-      p.value();
-    }
-  } catch (const DataFileError& e) {
-    bad_data(path, e);
-  }
+  read_values(path, column, nominal_hz, show_progress, "analyzing windows", [&](double v) {
+    analyzer->add(v);
+    for (WindowAnalysis& w : analyzer->take_completed()) windows.push_back(std::move(w));
+  });
   if (windows.empty())
     bad(source, fmt::format("{} values are fewer than one window of {} values", analyzer->values(), window));
   const DynamicReport report{windows, o.type, o.tau0_s, o.confidence, units, window, step, analyzer->values(), o.stats};
@@ -410,23 +422,8 @@ int main(int argc, char** argv) {
     } catch (const std::invalid_argument& e) {
       bad("--taus", e.what());
     }
-    std::vector<std::string> header;
-    try {
-      DataFile file(path, column);
-      Progress p(show_progress, "analyzing", file);
-      for (double v = 0; file.next(v);) {
-        if (nominal_hz > 0) v = (v - nominal_hz) / nominal_hz;
-        try {
-          analyzer->add(v);
-        } catch (const std::exception& e) {  // invalid_argument (a bad count), range_error
-          bad(source, fmt::format("line {}: {}", file.line(), e.what()));
-        }
-        p.value();
-      }
-      header = file.header();
-    } catch (const DataFileError& e) {
-      bad_data(path, e);
-    }
+    const std::vector<std::string> header =
+        read_values(path, column, nominal_hz, show_progress, "analyzing", [&](double v) { analyzer->add(v); });
     const Analysis a = analyzer->result();
     if (a.n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
     if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
