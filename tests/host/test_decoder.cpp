@@ -17,14 +17,17 @@ const Ieee952SummaryMsg fit_summary{0, Ieee952Status::ok, 0.93f, 24, true, {0, 0
 
 // The frames of report `seq` of a node with `taus` taus, values derived from (seq, tau), speaking
 // protocol version `protocol_version` (1: no summary page, no Fitted flag; B is fitted but not
-// resolved in version 2, and goes out as zeros in version 1).
+// resolved in version 2, and goes out as zeros in version 1). With `window_taus` (version 3) the
+// window frames describe window `window`, its ADEV at window tau i 1 + i + window, MDEV half that.
 std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t taus, std::uint64_t samples,
                              std::uint64_t uptime_ms = 0, std::uint32_t hash = 7,
-                             std::uint8_t protocol_version = version) {
+                             std::uint8_t protocol_version = version, std::uint8_t window_taus = 0,
+                             std::uint32_t window = 0) {
   std::vector<CanFrame> frames;
   const bool v2 = protocol_version >= 2;
-  for (std::size_t k = 0; k < report_frame_count(seq, taus, protocol_version); ++k) {
-    const ReportSlot s = report_slot(seq, taus, k, protocol_version);
+  const auto window_dev = [&](std::size_t i) { return 1.0 + static_cast<double>(i + window); };
+  for (std::size_t k = 0; k < report_frame_count(seq, taus, protocol_version, window_taus); ++k) {
+    const ReportSlot s = report_slot(seq, taus, k, protocol_version, window_taus);
     Message m;
     switch (s.slot) {
       case Slot::status: m = StatusMsg{seq, NodeState::running, taus, samples}; break;
@@ -49,9 +52,12 @@ std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t t
           m = Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.25f, 0.1, v2};
         }
         break;
-      case Slot::window: m = WindowMsg{seq, 1, false, 0, 0}; break;  // no window taus here
-      case Slot::window_length: m = WindowLengthMsg{seq, 4}; break;
-      case Slot::window_dev: m = WindowDevMsg{seq, s.index, 0, 0.0, 0.0}; break;
+      case Slot::window: m = WindowMsg{seq, window_taus, true, window, 0}; break;
+      case Slot::window_length: m = WindowLengthMsg{seq, 1000}; break;
+      case Slot::window_dev:
+        m = WindowDevMsg{seq, s.index, static_cast<std::uint8_t>(window % 16), window_dev(s.index),
+                         window_dev(s.index) / 2};
+        break;
     }
     CanFrame f;
     EXPECT_EQ(encode(m, node, f), ProtocolError::none);
@@ -291,6 +297,73 @@ TEST(Decoder, BadFramesAreCountedNeverFatal) {
   EXPECT_EQ(v.health.rejected.at(ProtocolError::reserved_bits), 1u);
   EXPECT_EQ(feed.decoder.other_frames(), 1u);
   EXPECT_EQ(v.health.duplicates, 1u);
+}
+
+// --- the window curves (protocol version 3) ----------------------------------------------------
+
+TEST(Decoder, WindowCurvesAreKeptPerWindowAndCountedAsExpectedFrames) {
+  // A node with 8 taus and 5 window taus: window 3 for two slow cycles, then window 4. Oracle: the
+  // values the frames carry, and the schedule (report_slot with the window taus).
+  Feed feed;
+  std::vector<std::uint32_t> completed;
+  feed.decoder = Decoder([&](DecoderEvent e, const NodeView& v, std::uint8_t) {
+    if (e == DecoderEvent::window_complete) completed.push_back(*v.current_window());
+  });
+  for (std::uint8_t s = 0; s < 12; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, s < 8 ? 3 : 4));
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.window_taus, 5u);
+  EXPECT_EQ(v.window_length, 1000u);
+  EXPECT_EQ(v.health.frames_missing, 0u);
+  EXPECT_EQ(v.health.reports_complete, 12u);
+  EXPECT_EQ(v.health.window_frames_unplaced, 0u);
+  EXPECT_EQ(completed, (std::vector<std::uint32_t>{3, 4})) << "once per window, though sent in two cycles";
+  ASSERT_EQ(v.windows.size(), 2u);
+  for (const std::uint32_t k : {3u, 4u}) {
+    const WindowView& w = v.windows.at(k);
+    ASSERT_TRUE(w.complete());
+    for (std::size_t i = 0; i < 5; ++i) {
+      EXPECT_NEAR(w.adev[i], 1.0 + static_cast<double>(i + k), 2.2e-5 * w.adev[i]);
+      EXPECT_NEAR(w.mdev[i], w.adev[i] / 2, 2.2e-5 * w.adev[i]);
+    }
+  }
+}
+
+TEST(Decoder, WindowFramesWithoutTheirPageAreNotTakenForAnotherWindow) {
+  // Window 3, then window 4 whose window page is lost: its frames (WindowMod16 = 4) are counted as
+  // unplaced, never stored as window 3's; the next cycle's page brings window 4.
+  Feed feed;
+  for (std::uint8_t s = 0; s < 4; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, 3));
+  for (std::uint8_t s = 4; s < 8; ++s) {
+    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, 4);
+    if (s == 4) {
+      const auto page = std::find_if(frames.begin(), frames.end(), [](const CanFrame& f) {
+        const Decoded d = decode(f);
+        return std::holds_alternative<WindowMsg>(d.message);
+      });
+      ASSERT_NE(page, frames.end());
+      frames.erase(page);
+    }
+    feed.frames(frames);
+  }
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.window_frames_unplaced, 5u);
+  EXPECT_EQ(v.windows.count(4), 0u);
+  EXPECT_NEAR(v.windows.at(3).adev[0], 4.0, 1e-4) << "window 3 keeps its own values";
+  for (std::uint8_t s = 8; s < 12; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, 4));
+  ASSERT_EQ(v.windows.count(4), 1u);
+  EXPECT_TRUE(v.windows.at(4).complete());
+}
+
+TEST(Decoder, AChangedWindowTauCountEndsTheSession) {
+  Feed feed;
+  for (std::uint8_t s = 0; s < 4; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, 3));
+  for (std::uint8_t s = 4; s < 8; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 6, 3));
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.restarts, 1u);
+  EXPECT_EQ(v.window_taus, 6u);
+  ASSERT_EQ(v.windows.size(), 1u);
+  EXPECT_EQ(v.windows.at(3).adev.size(), 6u) << "the new session's window";
 }
 
 }  // namespace
