@@ -3,6 +3,7 @@
 // the program itself writes. Oracles: the options given (round trip), the closed-form truth
 // Q = sqrt(q^2 + pulse^2 / 12) in arcsec and the identity of N, B, K, R in the fit's units.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -244,6 +245,36 @@ TEST(SimSegments, TheOptionReadsTimeAndChanges) {
   o = doubling();
   o.segments[1].white_angle_arcsec = -1;
   EXPECT_TRUE(check_parameters(o));
+}
+
+TEST(SimSegments, TheProgramWritesItsSegmentsAndTheirCounts) {
+  // Oracle: SimRun of the same options (the program's own loop) gives the counts it writes.
+  const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_sim_segments.txt";
+  const std::string sim = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim";
+  ASSERT_EQ(std::system((sim + " --duration 20 --arw 0.002 --segment 10:arw=0.004 --segment 15:rate=-20,white-angle=0.5"
+                              ",rrw=0.1 --out " + out).c_str()),
+            0);
+  std::ifstream in(out);
+  std::string first, second;
+  std::getline(in, first);
+  std::getline(in, second);
+  EXPECT_NE(first.find("; from 10 s: arw 0.004; from 15 s: rate -20 white-angle 0.5 rrw 0.1"), std::string::npos)
+      << first;
+  const auto t = parse_sim_truth_line(second);
+  ASSERT_TRUE(t) << second;
+  expect_same_options(t->options, doubling());
+  SimRun run(doubling());
+  long long count = 0;
+  std::uint64_t k = 0;
+  for (; in >> count; ++k) ASSERT_EQ(count, run.next_count()) << k;
+  EXPECT_EQ(k, run.samples());
+  std::remove(out.c_str());
+  const std::string err = ::testing::TempDir() + std::to_string(getpid()) + "_sim_segments.err";
+  EXPECT_EQ(WEXITSTATUS(std::system((sim + " --duration 20 --segment 25:arw=1 > /dev/null 2> " + err).c_str())), 2);
+  std::ifstream e(err);
+  const std::string why{std::istreambuf_iterator<char>(e), {}};
+  EXPECT_EQ(why.rfind("gyrochar-sim: --segment: ", 0), 0u) << why;
+  std::remove(err.c_str());
 }
 
 TEST(SimSegments, ARunChangesAtItsSegmentAndNowhereElse) {
