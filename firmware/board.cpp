@@ -68,7 +68,8 @@ Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
   settings_.stride_factor = config.stride_factor;
   settings_.octaves = config.octaves;
   settings_.source = input_source(config.source);
-  settings_.report_period_ms = static_cast<std::uint16_t>(config.report_period_s * 1000.0);
+  // validate() keeps the period within the protocol's 100..2000 ms: the field cannot wrap.
+  settings_.report_period_ms = static_cast<std::uint16_t>(std::lround(config.report_period_s * 1000.0));
   if (config.window_s > 0) {
     settings_.window_length = static_cast<std::uint64_t>(std::llround(config.window_s / config.tau0_s));
     settings_.window_taus = window_taus(config.octaves, settings_.window_length);
@@ -88,7 +89,7 @@ Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
   // frames always come through.
   const hal::CanFilter counter_frames{protocol::counter_input_id | config.counter_node, 0x1FFFFFFF};
   if (!io.can.set_filters(io.source ? std::span<const hal::CanFilter>{} : std::span(&counter_frames, 1)))
-    throw std::invalid_argument("the CAN interface refused the receive filters");
+    throw std::runtime_error(config.can_interface + ": the CAN interface refused the receive filters");
 
   epoll_ = epoll_create1(EPOLL_CLOEXEC);
   for (const int fd : {io.can.fd(), io.timer.fd(), io.source ? io.source->fd() : -1, io.stop_fd}) {

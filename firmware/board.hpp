@@ -28,7 +28,8 @@ struct BoardIo {
 
 class Board final : public hal::CountSink {
  public:
-  /// Throws std::invalid_argument for settings the estimator cannot hold. gyrochard fits in the
+  /// Throws std::invalid_argument for settings the estimator cannot hold (validate() refuses them
+  /// first), std::runtime_error when the CAN interface refuses the receive filters. gyrochard fits in the
   /// background (fit_worker.hpp); the host simulation and the tests inline, to repeat exactly.
   Board(const Config& config, BoardIo io, FitMode fit_mode = FitMode::inline_fit);
   ~Board();

@@ -1,7 +1,7 @@
 #pragma once
-// gyrochard's configuration: a file (INI/TOML key = value, CLI11's format) plus command-line
-// overrides. Every key is also a long option (--tau0 0.001). Invalid values are reported with the
-// key's name; nothing is started.
+// gyrochard's configuration: a file of `key = value` lines plus command-line overrides. Every key
+// is also a long option (--tau0 0.001). Invalid values are reported with the key's name (and the
+// file and line when they came from the file); nothing is started.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -36,10 +36,13 @@ struct Config {
   bool verbose = false;
 };
 
-/// A configuration problem: which key and why (shown as "gyrochard: <key>: <why>").
+/// A configuration problem: where the value came from ("FILE:LINE" for the configuration file,
+/// empty for the command line or a default), which key and why; shown as
+/// "gyrochard: [FILE:LINE: ]<key>: <why>".
 struct ConfigError {
   std::string key;
   std::string why;
+  std::string where = {};
 };
 
 /// Outcome of parsing: a configuration, a request to exit with a message already printed
@@ -50,10 +53,20 @@ struct ParseResult {
   bool exit_now = false;
 };
 
-/// Parses argv (and the file named by --config, if any). Never throws; prints help on request.
+/// Parses argv and the file named by --config, if any; the command line overrides the file.
+/// The file holds `key = value` lines ('#' starts a comment, blank lines are skipped, a value may
+/// be in double quotes); a line without '=', an unknown or repeated key, or a value of the wrong
+/// type is an error naming the file and line. Then validate(). Never throws; prints help and
+/// version on request. Reads the file once; allocates.
 ParseResult parse_config(int argc, const char* const* argv);
 
-/// Checks ranges and combinations; returns the first problem found.
+/// Checks ranges and combinations (the report period within the protocol's 100 ms .. 2 s);
+/// returns the first problem found. Pure: O(1), touches nothing outside `config`.
 std::optional<ConfigError> validate(const Config& config);
+
+/// Checks what the configuration needs from the file system, before any hardware is opened:
+/// the checkpoint's directory exists and is writable, and an existing checkpoint is a regular
+/// file this process can read and replace. Returns the first problem found. A few system calls.
+std::optional<ConfigError> check_files(const Config& config);
 
 }  // namespace gyrochar::firmware

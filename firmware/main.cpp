@@ -1,7 +1,9 @@
 // gyrochard: the board program. The composition root: the only place that picks backends. It reads
 // the configuration, opens the Linux backends (SocketCAN, the configured count source, timerfd),
 // resumes from the checkpoint, and runs the board's event loop until SIGTERM or SIGINT, when it
-// writes a last checkpoint. Exit codes: 0 clean stop, 2 invalid configuration, 3 hardware missing.
+// writes a last checkpoint. The whole configuration (and the checkpoint's directory) is checked
+// before any hardware is opened, so an invalid configuration exits 2 even without the hardware;
+// then missing hardware exits 3 naming the device (hal/exit_codes.hpp).
 #include <sys/signalfd.h>
 #include <unistd.h>
 
@@ -12,6 +14,7 @@
 
 #include "board.hpp"
 #include "config.hpp"
+#include "hal/exit_codes.hpp"
 #include "hal/linux/gpio_quadrature.hpp"
 #include "hal/linux/gpio_strobe.hpp"
 #include "hal/linux/socketcan.hpp"
@@ -21,12 +24,17 @@ namespace {
 
 using namespace gyrochar;
 
-constexpr int exit_config = 2;
-constexpr int exit_hardware = 3;
+constexpr const char* program = "gyrochard";
 
-int fail(int code, const std::string& key, const std::string& why) {
-  std::fprintf(stderr, "gyrochard: %s: %s\n", key.c_str(), why.c_str());
-  return code;
+int config_error(const firmware::ConfigError& e) {
+  print_error(program, e.where.empty() ? e.key : e.where + ": " + e.key, e.why);
+  return exit_code::bad_input;
+}
+
+// The HAL's messages name the device first ("can0: No such device").
+int no_hardware(const std::exception& e) {
+  print_error(program, e.what());
+  return exit_code::no_hardware;
 }
 
 // The configured count source; nullptr for CounterInput frames (they arrive on the CAN bus).
@@ -58,9 +66,10 @@ std::unique_ptr<hal::CountSource> open_source(const firmware::Config& c, std::ui
 
 int main(int argc, char** argv) {
   const firmware::ParseResult parsed = firmware::parse_config(argc, argv);
-  if (parsed.exit_now) return 0;
-  if (parsed.error) return fail(exit_config, parsed.error->key, parsed.error->why);
+  if (parsed.exit_now) return finish(program, exit_code::ok);
+  if (parsed.error) return config_error(*parsed.error);
   const firmware::Config& config = *parsed.config;
+  if (const auto problem = firmware::check_files(config)) return config_error(*problem);
 
   // Signals become a readable descriptor for the loop.
   sigset_t signals;
@@ -74,27 +83,18 @@ int main(int argc, char** argv) {
   std::unique_ptr<hal::SocketCan> can;
   std::unique_ptr<hal::CountSource> source;
   std::unique_ptr<hal::TimerFd> timer;
-  try {
-    source = open_source(config, clock.now_ns());
-  } catch (const std::exception& e) {
-    return fail(exit_hardware, "source", e.what());
-  }
-  try {
-    can = std::make_unique<hal::SocketCan>(config.can_interface);
-  } catch (const std::exception& e) {
-    return fail(exit_hardware, "can-interface", e.what());
-  }
-  try {
-    timer = std::make_unique<hal::TimerFd>();
-  } catch (const std::exception& e) {
-    return fail(exit_hardware, "timer", e.what());
-  }
   std::unique_ptr<firmware::Board> board;
   try {
+    source = open_source(config, clock.now_ns());
+    can = std::make_unique<hal::SocketCan>(config.can_interface);
+    timer = std::make_unique<hal::TimerFd>();
     board = std::make_unique<firmware::Board>(config, firmware::BoardIo{*can, source.get(), clock, *timer, stop_fd},
-                                                   firmware::FitMode::background);
+                                              firmware::FitMode::background);
+  } catch (const std::invalid_argument& e) {  // settings validate() passed: a bug
+    print_error(program, "internal error", e.what());
+    return exit_code::internal;
   } catch (const std::exception& e) {
-    return fail(exit_config, "configuration", e.what());
+    return no_hardware(e);
   }
   std::fprintf(stderr, "<6>gyrochard: %s\n", board->resume().c_str());
   std::fprintf(stderr, "<6>gyrochard: running: node %u on %s, tau0 %g s, %u octaves, stride factor %u\n",

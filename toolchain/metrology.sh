@@ -3,7 +3,8 @@
 # BENCHMARKS.md): how often the offline engine's 68.3 % confidence intervals hold the true deviation
 # (tests/benchmarks/coverage_study.cpp), and how well the IEEE-952 fit recovers simulated gyros
 # (tests/benchmarks/recovery_study.cpp). Only the text between each block's markers is replaced.
-#   toolchain/metrology.sh                       both studies, full size (about 15 minutes on 2 cores)
+#   toolchain/metrology.sh                       both studies, full size (about 50 minutes on 2 cores,
+#                                                35 of them the long-run recovery scenarios)
 #   toolchain/metrology.sh --only coverage       one of them (coverage or recovery)
 #   toolchain/metrology.sh --runs 100            a quick look (the tables say how many runs)
 #   toolchain/metrology.sh --csv coverage.csv    where the coverage CSV goes (default build/perf/data/coverage.csv)

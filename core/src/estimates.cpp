@@ -16,6 +16,12 @@ const char* name(DevStat s) {
     case DevStat::tdev: return "tdev";
     case DevStat::hdev: return "hdev";
     case DevStat::ohdev: return "ohdev";
+    case DevStat::totdev: return "totdev";
+    case DevStat::mtotdev: return "mtotdev";
+    case DevStat::ttotdev: return "ttotdev";
+    case DevStat::htotdev: return "htotdev";
+    case DevStat::theo1: return "theo1";
+    case DevStat::theoh: return "theoh";
   }
   return "?";
 }

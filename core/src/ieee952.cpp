@@ -178,6 +178,7 @@ void covariance_of_points(const Problem& pr, const std::array<double, terms>& th
       const double share = std::sqrt(static_cast<double>(ga.n) / na * static_cast<double>(gb.n) / nb);
       v *= share / (static_cast<double>(ga.n) * static_cast<double>(gb.n) * normalization(a.stat, a.m, pr.tau0) *
                     normalization(b.stat, b.m, pr.tau0));
+      v *= std::sqrt(a.variance_scale * b.variance_scale);  // a total-family estimate in an Allan point's place
       if (i == j) v += pr.spread * pr.spread * a.variance * a.variance;
       pr.sigma[i * pr.n + j] = v;
       pr.sigma[j * pr.n + i] = v;
@@ -356,7 +357,7 @@ bool below_white_quantization(const Problem& pr, double qw2) {
     if (white < 0.5 * p.variance) continue;
     const TermGrid grid = unbroken_grid(p.stat, p.m, p.stride, pr.n_phase);
     const double edf = exact_edf(2, grid) * static_cast<double>(p.n) / static_cast<double>(grid.n);
-    const double sd = white * std::sqrt(2 / edf);
+    const double sd = white * std::sqrt(2 * p.variance_scale / edf);
     if (p.variance < white - 3 * sd && p.variance < 0.98 * white) return true;
   }
   return false;

@@ -543,14 +543,14 @@ Decoded decode(const CanFrame& frame) {
   };
   if (frame.error) return fail(ProtocolError::error_frame);
   if (!frame.extended) return fail(ProtocolError::not_extended);
-  if (frame.fd) return fail(ProtocolError::fd_frame);
   const std::uint32_t base = frame.id & ~std::uint32_t{0xFF};
   const bool known = frame.id <= id_mask && (base == status_id || base == tau_stats_id ||
                                              base == metadata_id || base == ieee952_id ||
                                              base == window_id || base == counter_input_id);
   if (!known) return fail(ProtocolError::unknown_id);
-  out.node = u8(frame.id & 0xFFu);
+  out.node = u8(frame.id & 0xFFu);  // set before any later refusal: the frame is counted against its node
   if (out.node > max_node_address) return fail(ProtocolError::bad_address);
+  if (frame.fd) return fail(ProtocolError::fd_frame);
   const std::uint8_t len = base == counter_input_id ? counter_input_len : report_len;
   if (frame.len != len) return fail(ProtocolError::wrong_length);
   switch (base) {

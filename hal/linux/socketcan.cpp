@@ -36,7 +36,7 @@ SocketCan::SocketCan(const std::string& interface) : name_(interface) {
   if (interface.empty() || interface.size() >= IFNAMSIZ)
     throw std::runtime_error(interface + ": not a valid interface name");
   fd_ = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
-  if (fd_ < 0) throw std::runtime_error(std::string("cannot open a CAN socket: ") + std::strerror(errno));
+  if (fd_ < 0) throw std::runtime_error(interface + ": cannot open a CAN socket: " + std::strerror(errno));
   ifindex_ = interface_index(fd_, interface);
   if (ifindex_ == 0) {
     const int e = errno;

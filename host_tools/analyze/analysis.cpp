@@ -1,5 +1,7 @@
 #include "analysis.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -12,8 +14,27 @@
 #include <type_traits>
 
 #include "gyrochar/characterizer.hpp"
+#include "total_analysis.hpp"
 
 namespace gyrochar {
+
+namespace {
+
+// Why estimate `e` is not a finite number, for an error message. The variance is the sum of the
+// squared differences over tau0^2 (phase data) or over 1 (frequency data), TDEV's times tau^2 / 3.
+std::string non_finite_reason(const Estimate& e, const TauSums& sums, double tau0_s) {
+  const std::string where = fmt::format("{} at tau = {:g} s (m = {})", name(e.stat), e.tau_s, e.m);
+  for (const double v : sums.variance)
+    if (!std::isfinite(v))
+      return where + ": the squared differences of the values overflow a double (largest 1.8e308): the values "
+                     "are too large; scale them";
+  if (!std::isnormal(tau0_s * tau0_s) || !std::isnormal(e.tau_s * e.tau_s))
+    return where + fmt::format(": tau0^2 = ({:g} s)^2 is outside the range of a double: tau0 is too {}", tau0_s,
+                               tau0_s < 1 ? "small" : "large");
+  return where + fmt::format(": the squared differences divided by tau0^2 = ({:g} s)^2 overflow a double", tau0_s);
+}
+
+}  // namespace
 
 const char* name(DataType t) {
   switch (t) {
@@ -25,8 +46,9 @@ const char* name(DataType t) {
 }
 
 std::optional<DevStat> parse_dev_stat(const std::string& text) {
-  for (const DevStat s : all_dev_stats)
-    if (text == name(s)) return s;
+  for (const auto& list : {all_dev_stats, total_dev_stats})
+    for (const DevStat s : list)
+      if (text == name(s)) return s;
   return std::nullopt;
 }
 
@@ -67,6 +89,25 @@ std::vector<std::uint64_t> all_taus(std::uint64_t n_phase, std::uint32_t stride_
   return m;
 }
 
+std::vector<std::uint64_t> theo_taus(const std::string& rule, const std::vector<std::uint64_t>& m_list,
+                                     std::uint64_t n_phase) {
+  const std::uint64_t last = n_phase == 0 ? std::uint64_t{1} << 40 : n_phase - 1;
+  std::vector<std::uint64_t> m;
+  if (rule == "all") {
+    for (std::uint64_t v = 10; v <= last; v += 2) m.push_back(v);
+    return m;
+  }
+  for (const std::uint64_t v : m_list)
+    if (v >= 10 && v % 2 == 0 && v <= last) m.push_back(v);
+  if (rule == "octave")
+    for (std::uint64_t v = m.empty() ? 16 : 2 * m.back(); v <= last; v *= 2) m.push_back(v);
+  if (rule == "decade")
+    for (std::uint64_t decade = 10; decade <= last; decade *= 10)
+      for (const std::uint64_t step : {1, 2, 4})
+        if (decade * step <= last && (m.empty() || decade * step > m.back())) m.push_back(decade * step);
+  return m;
+}
+
 namespace {
 
 // Zero-filled storage from calloc, whose pages the system maps on first write: the pyramid's
@@ -94,6 +135,7 @@ struct EngineBase {
   virtual ~EngineBase() = default;
   virtual void add(double value) = 0;
   virtual Analysis result(const AnalysisOptions& o) const = 0;
+  virtual PhaseRecord record(const AnalysisOptions& o) const = 0;
 };
 
 // The characterizer of one arithmetic over heap storage, and its read-out into rows.
@@ -102,9 +144,9 @@ class Engine final : public EngineBase {
   using Entry = typename Arith::Entry;
 
  public:
-  Engine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list)
-      : type_(type), history_(history_entries(stride_factor, m_list.back())), states_(m_list.size()),
-        characterizer_(history_, states_) {
+  Engine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list, bool keep_record)
+      : type_(type), keep_record_(keep_record), history_(history_entries(stride_factor, m_list.back())),
+        states_(m_list.size()), characterizer_(history_, states_) {
     if (!history_.data()) throw std::bad_alloc();
     if (characterizer_.configure({stride_factor, 0}, m_list) != ConfigureStatus::ok)
       throw std::invalid_argument("the taus do not fit the stride factor");
@@ -116,12 +158,14 @@ class Engine final : public EngineBase {
         throw std::invalid_argument("a count must be an integer of magnitude below 2^31");
       characterizer_.add_increment(static_cast<std::int32_t>(value));
       if (characterizer_.phase_overflowed()) throw std::range_error("the accumulated count passed 2^63 pulses");
+      keep(value);
     } else {
       if (!std::isfinite(value)) throw std::invalid_argument("not a finite number");
       if (type_ == DataType::phase)
         characterizer_.add_phase_point(value);
       else
         characterizer_.add_increment(value);  // frequency: phase in units of y tau0
+      keep(value);
     }
   }
 
@@ -143,11 +187,12 @@ class Engine final : public EngineBase {
       identify_noise(sums, a.n_phase, 3, frequency_input, noise3);
     }
     const EstimateOptions options{o.tau0_s, type_ == DataType::freq ? o.tau0_s : 1.0, o.edf};
-    for (const DevStat stat : o.stats) {
+    auto rows_of = [&](DevStat stat, std::vector<AnalysisRow>& out) {
       for (std::size_t i = 0; i < taus; ++i) {
         const NoiseId& id = stat_of(stat) == Stat::hvar ? noise3[i] : noise2[i];
         const Estimate e = estimate(sums[i], a.n_phase, stat, id, options);
         if (e.n == 0) continue;
+        if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
         AnalysisRow row;
         row.stat = stat;
         row.m = e.m;
@@ -161,14 +206,45 @@ class Engine final : public EngineBase {
         row.edf = e.edf;
         row.skew_dof = o.edf == EdfModel::exact ? e.skew_dof : 0.0;  // Greenhall's: Stable32's plain intervals
         if (e.edf > 0) row.ci = confidence_interval(row.dev, row.edf, o.confidence, row.skew_dof);
-        a.rows.push_back(row);
+        out.push_back(row);
       }
+    };
+    std::vector<AnalysisRow> allan;  // what the total family leans on (total_analysis.hpp)
+    if (std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); }))
+      for (const DevStat s : {DevStat::oadev, DevStat::mdev, DevStat::ohdev}) rows_of(s, allan);
+    for (const DevStat stat : o.stats) {
+      if (!is_total(stat)) {
+        rows_of(stat, a.rows);
+        continue;
+      }
+      const auto total = total_rows(stat, record_, options.unit, o, allan);
+      a.rows.insert(a.rows.end(), total.begin(), total.end());
     }
     return a;
   }
 
+  PhaseRecord record(const AnalysisOptions& o) const override {
+    return {record_, type_ == DataType::freq ? o.tau0_s : 1.0};
+  }
+
  private:
+  // The record for the total family, in the characterizer's phase representation: phase relative
+  // to the first point (the statistics ignore a constant), or the running sum of the increments.
+  void keep(double value) {
+    if (!keep_record_) return;
+    if (type_ == DataType::phase) {
+      if (record_.empty()) first_ = value;
+      record_.push_back(value - first_);
+    } else {
+      if (record_.empty()) record_.push_back(0.0);
+      record_.push_back(record_.back() + value);
+    }
+  }
+
   DataType type_;
+  bool keep_record_;
+  double first_ = 0.0;
+  std::vector<double> record_;
   ZeroedArray<Entry> history_;
   std::vector<typename Characterizer<Arith>::TauState> states_;
   Characterizer<Arith> characterizer_;
@@ -197,11 +273,14 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
     if (!tau_representable(m, s))
       throw std::invalid_argument("averaging factor " + std::to_string(m) + " cannot be formed with stride factor " +
                                   std::to_string(s) + ": above S it must be a multiple of its stride (m/S rounded up to a power of two)");
+  for (std::size_t i = 1; i < o.theo_m_list.size(); ++i)
+    if (o.theo_m_list[i] <= o.theo_m_list[i - 1]) throw std::invalid_argument("Theo1 averaging factors must increase");
   impl_->options = o;
+  const bool keep_record = o.keep_record || std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
   if (o.type == DataType::counts)
-    impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list);
+    impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record);
   else
-    impl_->engine = std::make_unique<Engine<FloatArith>>(o.type, s, o.m_list);
+    impl_->engine = std::make_unique<Engine<FloatArith>>(o.type, s, o.m_list, keep_record);
 }
 
 Analyzer::~Analyzer() = default;
@@ -209,5 +288,7 @@ Analyzer::~Analyzer() = default;
 void Analyzer::add(double value) { impl_->engine->add(value); }
 
 Analysis Analyzer::result() const { return impl_->engine->result(impl_->options); }
+
+PhaseRecord Analyzer::record() const { return impl_->engine->record(impl_->options); }
 
 }  // namespace gyrochar

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,11 @@ bool tau_representable(std::uint64_t m, std::uint32_t stride_factor);
 std::vector<std::uint64_t> octave_taus(std::uint64_t n_phase);
 /// Decade averaging factors as Stable32: 1, 2, 4, 10, 20, 40, 100, ... up to n_phase / 2.
 std::vector<std::uint64_t> decade_taus(std::uint64_t n_phase);
+/// Averaging factors of Theo1 and TheoBR (tau = 0.75 m tau0) for a tau list of the Allan family:
+/// its even factors from 10 on, continued by its own rule (octave: doubling; decade: 1, 2, 4 per
+/// decade) up to n_phase - 1 (2^40 when n_phase is 0, unknown); "all": every even m from 10 to
+/// n_phase - 1. O(list).
+std::vector<std::uint64_t> theo_taus(const std::string& rule, const std::vector<std::uint64_t>& m_list, std::uint64_t n_phase);
 /// Every averaging factor up to n_phase / 2 that stride factor S can form (every m when
 /// n_phase / 2 <= S). The list has O(min(n_phase, S log n_phase)) entries.
 std::vector<std::uint64_t> all_taus(std::uint64_t n_phase, std::uint32_t stride_factor);
@@ -62,21 +68,35 @@ struct AnalysisOptions {
   double confidence = 0.682689492137086;
   std::optional<int> alpha;             // noise exponent for the EDF; empty: identified per tau
   EdfModel edf = EdfModel::exact;       // greenhall: Stable32's approximation (comparisons)
+  // The total and Theo family (total_analysis.hpp): asked for in `stats`, they make the analyzer
+  // hold the record (8 bytes a phase point).
+  std::vector<std::uint64_t> theo_m_list;  // averaging factors of Theo1 and TheoBR (even), increasing
+  std::uint32_t total_stride_factor = 16;  // S of their decimated estimators; 0: always exact
+  bool keep_record = false;                // hold the record without a total statistic (fits)
 };
 
 struct AnalysisRow {
   DevStat stat = DevStat::oadev;
   std::uint64_t m = 0;
-  double tau_s = 0.0;
+  double tau_s = 0.0;           // m tau0 (Theo1, TheoBR: 0.75 m tau0)
   std::uint64_t n = 0;          // terms in the estimate (Stable32's "#")
-  double dev = 0.0;             // deviation: phase unit per second (TDEV: phase unit)
+  double dev = 0.0;             // deviation: phase unit per second (TDEV, TTOTDEV: phase unit)
   std::optional<int> alpha;     // identified (or given) noise exponent; empty: not identified
   NoiseId noise;                // the identification: plausible range and method
   int edf_alpha = 0;            // the alpha whose EDF was used (the smallest of the plausible)
-  std::uint64_t stride = 1;     // terms every `stride` phase points (m for adev and hdev)
+  std::uint64_t stride = 1;     // terms every `stride` phase points (m for adev and hdev); total
+                                // family: 1 exact, else the decimated estimator's block or stride
   double edf = 0.0;             // EDF of this estimator; 0: not available
   double skew_dof = 0.0;        // skewness of its distribution (confidence.hpp); 0: plain chi-squared
   Interval ci;                  // same unit as dev
+};
+
+/// The phase record the analyzer holds for the total family: points in the engine's representation
+/// (phase relative to the first point; for freq and counts the running sum of the values) and the
+/// factor that makes them phase units (tau0 for frequency data, else 1). Empty when not held.
+struct PhaseRecord {
+  std::span<const double> phase;
+  double phase_scale = 1.0;
 };
 
 struct Analysis {
@@ -102,7 +122,13 @@ class Analyzer {
   /// finite or not a valid count, std::range_error when the accumulated count passes 2^63 pulses.
   void add(double value);
   /// Results so far; may be called at any time. O(taus x stats) plus the EDF, allocates the rows.
+  /// Throws std::range_error naming the statistic, the tau and the cause when a deviation is not
+  /// a finite number (values whose squared differences overflow a double, a tau0 whose square
+  /// leaves a double's range): such a result is never returned.
   Analysis result() const;
+  /// The record held for the total family (empty unless a total statistic or keep_record was
+  /// asked for); valid until the next add(). O(1).
+  PhaseRecord record() const;
 
  private:
   struct Impl;

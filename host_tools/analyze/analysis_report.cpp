@@ -2,29 +2,24 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
+#include <filesystem>
 #include <iterator>
 #include <numbers>
+
+#include "gyrochar/greenhall_edf.hpp"
+#include "gyrochar/total.hpp"
 
 namespace gyrochar {
 
 namespace {
 
-constexpr double deg_rad = std::numbers::pi / 180.0;
-
-// IEEE-952 parameters Q, N, B, K, R: name, unit and size of the unit in SI.
-struct FitUnit {
-  const char* name;
-  const char* unit;
-  double si;
-};
-constexpr FitUnit gyro_fit_units[5] = {{"Q", "arcsec", deg_rad / 3600.0},
-                                       {"N", "deg/sqrt(h)", deg_rad / 60.0},
-                                       {"B", "deg/h", deg_rad / 3600.0},
-                                       {"K", "deg/h/sqrt(h)", deg_rad / (3600.0 * 60.0)},
-                                       {"R", "deg/h/h", deg_rad / (3600.0 * 3600.0)}};
+// IEEE-952 parameters Q, N, B, K, R: letter, unit and size of the unit in SI.
+using FitUnit = units::Ieee952Unit;
+constexpr const FitUnit* gyro_fit_units = units::ieee952.data();
 constexpr FitUnit clock_fit_units[5] = {{"Q", "s", 1}, {"N", "s^0.5", 1}, {"B", "1", 1}, {"K", "s^-0.5", 1}, {"R", "1/s", 1}};
 
 const FitUnit* fit_units(const ReportUnits& u) { return u.gyro ? gyro_fit_units : clock_fit_units; }
@@ -60,7 +55,11 @@ std::string excluded_text(const Ieee952Fit& fit) {
 
 std::string fit_summary(const CurveFit& f) {
   const Ieee952Fit& fit = f.fit;
-  std::string s = fmt::format("IEEE-952 fit of {}: {} points", curve_title(f.curve), fit.points);
+  std::string s = fmt::format("IEEE-952 fit of {}{}: {} points", curve_title(f.curve),
+                              f.long_tau != 0
+                                  ? fmt::format(", long taus from {}", name(static_cast<LongTau>(f.long_tau)))
+                                  : std::string(),
+                              fit.points);
   if (fit.status == FitStatus::too_few_points || fit.status == FitStatus::singular)
     return s + fmt::format(": not identified ({})", name(fit.status));
   s += fmt::format(", chi2/dof {:.3g} on {} dof", fit.chi2_per_dof(), fit.dof);
@@ -71,35 +70,88 @@ std::string fit_summary(const CurveFit& f) {
 
 }  // namespace
 
-std::optional<double> angle_unit_rad(std::string_view unit) {
-  if (unit == "rad") return 1.0;
-  if (unit == "mrad") return 1e-3;
-  if (unit == "urad") return 1e-6;
-  if (unit == "deg") return deg_rad;
-  if (unit == "arcsec") return deg_rad / 3600.0;
-  return std::nullopt;
-}
-
-std::optional<RateUnit> rate_unit(std::string_view unit) {
-  if (unit == "deg/h") return RateUnit{"deg/h", deg_rad / 3600.0, "arcsec"};
-  if (unit == "deg/s") return RateUnit{"deg/s", deg_rad, "deg"};
-  if (unit == "rad/s") return RateUnit{"rad/s", 1.0, "rad"};
-  return std::nullopt;
-}
-
 std::string ReportUnits::unit(DevStat s) const {
-  if (gyro) return s == DevStat::tdev ? rate.angle : rate.name;
-  return s == DevStat::tdev ? "s" : "1";
+  const bool time = s == DevStat::tdev || s == DevStat::ttotdev;  // in phase units
+  if (gyro) return time ? rate.angle : rate.name;
+  return time ? "s" : "1";
 }
 
-std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
-                                 double white_quantization_si) {
+const char* name(LongTau l) {
+  switch (l) {
+    case LongTau::oadev: return "oadev";
+    case LongTau::totdev: return "totdev";
+    case LongTau::theoh: return "theoh";
+  }
+  return "?";
+}
+
+namespace {
+
+const AnalysisRow* oadev_row(const Analysis& a, std::uint64_t m) {  // the row at m, or the last before it
+  const AnalysisRow* found = nullptr;
+  for (const AnalysisRow& r : a.rows)
+    if (r.stat == DevStat::oadev && r.m <= m) found = &r;
+  return found;
+}
+
+// The Allan curve's long taus from the total family (LongTau; docs/metrology.md says why so). x:
+// the phase in engine units; unit: one of them in SI. Points keep the Allan geometry and carry
+// variance_scale = the Allan estimate's EDF over their own (Greenhall's and SP 1065's formulas for
+// the identified alpha).
+void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& a, std::span<const double> x,
+                  double tau0, double unit) {
+  const double N = static_cast<double>(x.size());
+  auto allan_edf = [&](int alpha, std::uint64_t m) {
+    const double md = static_cast<double>(m);
+    return edf_greenhall({alpha, 2, md, false, md, N});
+  };
+  if (input == LongTau::totdev) {
+    for (FitPoint& p : points) {
+      const AnalysisRow* r = p.stat == Stat::avar ? oadev_row(a, p.m) : nullptr;
+      if (r == nullptr || !r->alpha) continue;
+      const int alpha = *r->alpha;
+      const double md = static_cast<double>(p.m), edf = edf_totvar(alpha, N, md), edf_a = allan_edf(alpha, p.m);
+      if (!(edf > edf_a && edf_a > 0)) continue;
+      p.variance = totvar(x, p.m, tau0).var / totvar_bias(alpha, N, md) * unit * unit;
+      p.edf = edf;
+      p.variance_scale = edf_a / edf;
+    }
+    return;
+  }
+  const std::uint64_t k = theoh_switch(x.size());
+  std::erase_if(points, [&](const FitPoint& p) { return p.stat == Stat::avar && p.m >= k; });
+  constexpr std::uint32_t S = 16;
+  const double ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(x.size(), S)).ratio;
+  if (!(ratio > 0)) return;
+  for (std::uint64_t mt = 2 * k; 2 * (3 * mt / 4) + 1 <= x.size(); mt *= 2) {
+    const std::uint64_t m = 3 * mt / 4;  // tau = 0.75 mt tau0: the Allan geometry at m
+    const AnalysisRow* r = oadev_row(a, m);
+    if (r == nullptr || !r->alpha) continue;
+    const double edf = edf_theo1(*r->alpha, N, static_cast<double>(mt)), edf_a = allan_edf(*r->alpha, m);
+    if (!(edf > 0 && edf_a > 0)) continue;
+    const double var = theo1(x, mt, tau0, theo1_stride(mt, x.size(), S)).var * ratio * unit * unit;
+    points.push_back({Stat::avar, m, 1, x.size() - 2 * m, var, edf, edf_a / edf});
+  }
+}
+
+}  // namespace
+
+std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s, LongTau long_tau,
+                                 const PhaseRecord& record) {
   std::vector<FitPoint> points;
   for (const AnalysisRow& r : a.rows) {
     if ((r.stat != DevStat::oadev && r.stat != DevStat::mdev) || !std::has_single_bit(r.m)) continue;
     const double dev_si = r.dev * units.phase_unit_si;
     points.push_back({r.stat == DevStat::oadev ? Stat::avar : Stat::mvar, r.m, r.stride, r.n, dev_si * dev_si, r.edf});
   }
+  if (long_tau != LongTau::oadev && !record.phase.empty())
+    use_long_tau(points, long_tau, a, record.phase, tau0_s, units.phase_unit_si * record.phase_scale);
+  return points;
+}
+
+std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
+                                 double white_quantization_si, LongTau long_tau, const PhaseRecord& record) {
+  const std::vector<FitPoint> points = fit_points(a, units, tau0_s, long_tau, record);
   std::vector<CurveFit> fits;
   if (points.empty()) return fits;
   std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
@@ -108,8 +160,9 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
   PairSumCache cache(entries);
   const FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
+  const int used = long_tau != LongTau::oadev && !record.phase.empty() ? static_cast<int>(long_tau) : 0;
   for (const FitCurve curve : {FitCurve::both, FitCurve::avar, FitCurve::mvar})
-    fits.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache)});
+    fits.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache), curve == FitCurve::mvar ? 0 : used});
   return fits;
 }
 
@@ -120,7 +173,7 @@ std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, Dat
     const auto t = parse_sim_truth_line(line);
     if (!t) continue;
     const auto same = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::fabs(b); };
-    if (!same(t->options.tau0_s, tau0_s) || !same(t->options.pulse_arcsec * deg_rad / 3600.0, pulse_weight_rad))
+    if (!same(t->options.tau0_s, tau0_s) || !same(t->options.pulse_arcsec * units::arcsec, pulse_weight_rad))
       return std::nullopt;
     if (!t->options.segments.empty()) return std::nullopt;  // the gyro changed: no one truth for the run
     return t->truth;
@@ -167,15 +220,15 @@ std::string format_table(const Report& r) {
       const FitUnit& fu = fit_units(u)[i];
       const Ieee952Parameter& p = f.fit.p[i];
       if (!p.fitted && !(i == 0 && !f.fit.quantization_white)) {
-        fmt::format_to(to, "#   {} not in the model (the fit is better without it){}\n", fu.name,
-                       r.truth ? fmt::format("   simulated {:.4g} {}", truth_values(*r.truth)[i] / fu.si, fu.unit) : "");
+        fmt::format_to(to, "#   {} not in the model (the fit is better without it){}\n", fu.letter,
+                       r.truth ? fmt::format("   simulated {:.4g} {}", truth_values(*r.truth)[i] / fu.si, fu.name) : "");
         continue;
       }
       const std::string truth = r.truth ? fmt::format("   simulated {:.4g}", truth_values(*r.truth)[i] / fu.si) : "";
       if (!p.fitted)
-        fmt::format_to(to, "#   {} = {:.4g} {}  (held, not fitted){}\n", fu.name, p.value / fu.si, fu.unit, truth);
+        fmt::format_to(to, "#   {} = {:.4g} {}  (held, not fitted){}\n", fu.letter, p.value / fu.si, fu.name, truth);
       else
-        fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}{}\n", fu.name, p.value / fu.si, p.uncertainty / fu.si, fu.unit,
+        fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}{}\n", fu.letter, p.value / fu.si, p.uncertainty / fu.si, fu.name,
                        p.resolved ? "" : "  (not resolved)", truth);
     }
   }
@@ -237,6 +290,7 @@ nlohmann::json to_json(const Report& r) {
     for (const CurveFit& f : r.fits) {
       const Ieee952Fit& fit = f.fit;
       json one = {{"curve", name(f.curve)},
+                  {"long_tau", name(static_cast<LongTau>(f.long_tau))},
                   {"recommended", f.curve == FitCurve::both},
                   {"status", name(fit.status)},
                   {"ok", fit.ok()},
@@ -251,8 +305,8 @@ nlohmann::json to_json(const Report& r) {
       for (std::size_t i = 0; i < 5; ++i) {
         const FitUnit& fu = fit_units(u)[i];
         const Ieee952Parameter& p = fit.p[i];
-        one[fu.name] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"fitted", p.fitted},
-                        {"resolved", p.resolved}, {"unit", fu.unit}};
+        one[fu.letter] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"fitted", p.fitted},
+                        {"resolved", p.resolved}, {"unit", fu.name}};
       }
       fits.push_back(std::move(one));
     }
@@ -262,11 +316,91 @@ nlohmann::json to_json(const Report& r) {
     json truth = {{"quantization_white", r.truth->quantization_white}};
     for (std::size_t i = 0; i < 5; ++i) {
       const FitUnit& fu = fit_units(u)[i];
-      truth[fu.name] = {{"value", truth_values(*r.truth)[i] / fu.si}, {"unit", fu.unit}};
+      truth[fu.letter] = {{"value", truth_values(*r.truth)[i] / fu.si}, {"unit", fu.name}};
     }
     j["simulated"] = std::move(truth);
   }
   return j;
+}
+
+namespace {
+
+// Stable32's name of a statistic and its column line.
+struct Stable32Stat {
+  const char* sigma_type;
+  const char* columns;
+};
+Stable32Stat stable32_stat(DevStat s) {
+  constexpr const char* allan = "#  AF        Tau        #    Alpha  Min Sigma      Sigma         Max Sigma";
+  constexpr const char* hadamard = "#  AF        Tau         #    Alpha  Min Sigma   Hadamard Sig     Max Sigma";
+  switch (s) {
+    case DevStat::adev: return {"Allan", allan};
+    case DevStat::oadev: return {"Overlapping Allan", allan};
+    case DevStat::mdev: return {"Modified Allan", "#  AF        Tau         #    Alpha  Min Sigma     Mod Sigma      Max Sigma"};
+    case DevStat::tdev: return {"Time", "#  AF        Tau         #    Alpha  Min Sigma    Time Sigma      Max Sigma"};
+    case DevStat::hdev: return {"Hadamard", hadamard};
+    case DevStat::ohdev: return {"Overlapping Hadamard", hadamard};
+    case DevStat::totdev: return {"Total", "#  AF        Tau         #    Alpha  Min Sigma    Total Sigma     Max Sigma"};
+    case DevStat::mtotdev: return {"Modified Total", "# AF          Tau        #     Alpha  Min Sigma     Mod Totdev      Max Sigma"};
+    case DevStat::ttotdev: return {"Time Total", "#AF          Tau       #      Alpha  Min Sigma    Time Totdev    Max Sigma"};
+    case DevStat::htotdev: return {"Hadamard Total", hadamard};
+    case DevStat::theo1: return {"Th\u00eao1", "#  AF   Th\u00eao1 Tau   Th\u00eao1 #    Alpha   Min Th\u00eao1    Th\u00eao1    Max Th\u00eao1"};
+    case DevStat::theoh: return {"Th\u00eaoH", "#  AF   Th\u00eaoH Tau   Th\u00eaoH #    Alpha   Min Th\u00eaoH    Th\u00eaoH    Max Th\u00eaoH"};
+  }
+  return {"?", allan};
+}
+
+}  // namespace
+
+std::string format_stable32(const Report& r) {
+  const Analysis& a = r.analysis;
+  const ReportUnits& u = r.units;
+  const double k = u.factor();
+  std::vector<DevStat> stats;  // in the order of the rows
+  for (const AnalysisRow& row : a.rows)
+    if (std::find(stats.begin(), stats.end(), row.stat) == stats.end()) stats.push_back(row.stat);
+  std::string s;
+  auto to = std::back_inserter(s);
+  for (const DevStat stat : stats) {
+    const Stable32Stat names = stable32_stat(stat);
+    if (!s.empty()) s += '\n';
+    fmt::format_to(to, "# STATISTICS FOR FILE: {}\n", std::filesystem::path(r.source).filename().string());
+    fmt::format_to(to, "# {} Data Points 1 thru {} of {}\n", r.type == DataType::phase ? "Phase" : "Frequency",
+                   r.range.count, r.range.count);
+    fmt::format_to(to, "# Maximum = {:e}\n# Minimum = {:e}\n# Average = {:e}\n", r.range.max, r.range.min, r.range.mean());
+    fmt::format_to(to, "# Sigma Type: {}\n# Confidence Factor = {:.3f}\n# Deadtime T/Tau = 1.000000\n", names.sigma_type,
+                   r.confidence);
+    if (u.gyro) fmt::format_to(to, "# Units: {}\n", u.unit(stat));
+    fmt::format_to(to, "#\n{}\n", names.columns);
+    for (const AnalysisRow& row : a.rows) {
+      if (row.stat != stat) continue;
+      fmt::format_to(to, "{:5d}{:13.4e}{:9d}{:6d}{:13.4e}{:14.4e}{:15.4e}\n", row.m, row.tau_s, row.n,
+                     row.alpha.value_or(0), row.ci.valid ? row.ci.low * k : 0.0, row.dev * k,
+                     row.ci.valid ? row.ci.high * k : 0.0);
+    }
+  }
+  return s;
+}
+
+std::optional<std::string> kalibr_yaml(const Report& r, std::string& why) {
+  if (!r.units.gyro) {
+    why = "needs gyro data: counts, or --unit with an angle or a rate";
+    return std::nullopt;
+  }
+  const auto both = std::find_if(r.fits.begin(), r.fits.end(), [](const CurveFit& f) { return f.curve == FitCurve::both; });
+  if (both == r.fits.end()) {
+    why = "needs the IEEE-952 fit (--fit ieee952)";
+    return std::nullopt;
+  }
+  if (!both->fit.ok()) {
+    why = fmt::format("the IEEE-952 fit of both curves is {}: no noise parameters to give", name(both->fit.status));
+    return std::nullopt;
+  }
+  const auto term = [&](std::size_t k) {
+    const Ieee952Parameter& p = both->fit.p[k];
+    return KalibrTerm{p.value, p.value > 0 ? p.uncertainty / p.value : 0.0, p.fitted, p.resolved};
+  };
+  return kalibr_imu_yaml(term(1), term(3), 1.0 / r.tau0_s, fmt::format("{} ({})", r.source, r.units.input), why);
 }
 
 }  // namespace gyrochar

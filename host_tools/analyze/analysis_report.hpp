@@ -19,20 +19,10 @@
 #include "analysis.hpp"
 #include "gyrochar/ieee952.hpp"
 #include "sim_truth.hpp"
+#include "kalibr.hpp"
+#include "units.hpp"
 
 namespace gyrochar {
-
-// TODO(units.hpp): take these factors from host_tools/common/units.hpp once it lands.
-/// Size in rad of an angle unit: rad, mrad, urad, deg, arcsec; empty for anything else. O(1).
-std::optional<double> angle_unit_rad(std::string_view unit);
-
-struct RateUnit {
-  const char* name = "rad/s";
-  double rad_per_s = 1.0;     // size of the unit
-  const char* angle = "rad";  // the unit times 1 s, for TDEV
-};
-/// A rate unit: deg/h, deg/s, rad/s; empty for anything else. O(1).
-std::optional<RateUnit> rate_unit(std::string_view unit);
 
 struct ReportUnits {
   bool gyro = false;           // angle/rate data (else clock data)
@@ -51,20 +41,47 @@ struct ReportUnits {
 struct CurveFit {
   FitCurve curve = FitCurve::both;
   Ieee952Fit fit;  // parameters in SI: Q rad (s), N rad/s^0.5, B rad/s, K rad/s^1.5, R rad/s^2
+  int long_tau = 0;  // the LongTau (below) its Allan curve was made of at long tau (0: OADEV alone)
 };
 
+/// What the Allan curve of a fit is made of at long tau (docs/metrology.md, "Long taus"): OADEV
+/// alone; TOTDEV (bias-corrected) wherever SP 1065's EDF for it exceeds OADEV's; or TheoH: OADEV
+/// below its switch point k, TheoBR points at tau = 1.5 k, 3 k, ... up to T/2.
+enum class LongTau : std::uint8_t { oadev, totdev, theoh };
+/// "oadev", "totdev", "theoh": a static string.
+const char* name(LongTau l);
+
 /// Fits the oadev and mdev rows of the analysis (one point per octave, m = 2^k), with the points
-/// in SI units. white_quantization_si: the white-quantization level Q_w = pulse weight / sqrt(12)
-/// in rad for counts, 0 otherwise. O(points^2) covariance sums, allocates the workspace; empty
-/// when the analysis has neither curve. A fit that fails says why in its status.
+/// in SI units; with long_tau totdev or theoh, the record (Analyzer::record()) gives total-family
+/// points in place of OADEV at long tau (an empty record: OADEV alone). white_quantization_si:
+/// the white-quantization level Q_w = pulse weight / sqrt(12) in rad for counts, 0 otherwise.
+/// O(points^2) covariance sums, allocates the workspace; empty when the analysis has neither
+/// curve. A fit that fails says why in its status.
 std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
-                                 double white_quantization_si);
+                                 double white_quantization_si, LongTau long_tau = LongTau::oadev,
+                                 const PhaseRecord& record = {});
+/// The points fit_curves() fits (SI units), for a single fit_ieee952() of one curve. Allocates.
+std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s,
+                                 LongTau long_tau = LongTau::oadev, const PhaseRecord& record = {});
 
 /// The truth a simulated input carries (gyrochar-sim's header, sim_truth.hpp), shown beside the
 /// fitted terms when the data are counts with the simulator's own tau0 and pulse weight, and the
 /// simulated gyro did not change during the run (no segments). Nothing otherwise. O(header lines).
 std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, DataType type, double tau0_s,
                                      double pulse_weight_rad);
+
+/// The smallest, largest and mean value read (Stable32's header). add() is O(1).
+struct DataRange {
+  double min = 0.0, max = 0.0, sum = 0.0;
+  std::uint64_t count = 0;
+  void add(double v) {
+    min = count == 0 || v < min ? v : min;
+    max = count == 0 || v > max ? v : max;
+    sum += v;
+    ++count;
+  }
+  double mean() const { return count ? sum / static_cast<double>(count) : 0.0; }
+};
 
 /// Everything a report shows. Refers to (does not own) the analysis.
 struct Report {
@@ -75,6 +92,8 @@ struct Report {
   ReportUnits units;
   std::vector<CurveFit> fits;
   std::optional<Ieee952Truth> truth;  // a simulation's truth, shown beside the fits
+  std::string source;                 // the input's name, for Stable32's header
+  DataRange range;                    // the values read (after --nominal-hz), for Stable32's header
 };
 
 /// Aligned table for people: a header line (data, units, stride factor, confidence), one line per
@@ -94,5 +113,16 @@ nlohmann::json to_json(const Report& r);
 /// One element of "results", and the "units" object. O(1).
 nlohmann::json row_json(const AnalysisRow& row, const ReportUnits& units);
 nlohmann::json units_json(const ReportUnits& units);
+/// Stable32's result table, one block per statistic (in the order asked), each as Stable32 writes
+/// it: the header ("# STATISTICS FOR FILE:", data points, maximum, minimum, average of the values,
+/// "# Sigma Type: Overlapping Allan", confidence factor, dead time, the column line) and rows
+/// "AF Tau # Alpha MinSigma Sigma MaxSigma" in its column widths (5, 13, 9, 6, 13, 14, 15;
+/// %.4e). Gyro data add one "# Units:" line (Stable32 files are fractional frequency); a row
+/// without an interval has 0 bounds and one without identified noise alpha 0, as in Stable32.
+/// Blocks are separated by a blank line. O(rows).
+std::string format_stable32(const Report& r);
+/// The Kalibr imu.yaml (kalibr.hpp) of the fit of both curves; nothing, and why, when the data
+/// are not gyro data, the fit was not made or was rejected, or N or K is not in its model. O(1).
+std::optional<std::string> kalibr_yaml(const Report& r, std::string& why);
 
 }  // namespace gyrochar

@@ -23,23 +23,21 @@
 #include "datafile.hpp"
 #include "dynamic.hpp"
 #include "heat_map.hpp"
+#include "hal/exit_codes.hpp"
 
 namespace {
 
 using namespace gyrochar;
 
-constexpr int exit_internal = 1;   // a bug or resource exhaustion
-constexpr int exit_bad_input = 2;  // bad options or data
-constexpr int exit_output = 3;     // the results could not be written
+constexpr const char* program = "gyrochar-analyze";
 
 bool progress_line_open = false;  // a progress line without its newline is on stderr
 
 [[noreturn]] void fail(int code, const std::string& what, const std::string& why) {
   if (progress_line_open) std::fputc('\n', stderr);
-  std::fprintf(stderr, "gyrochar-analyze: %s: %s\n", what.c_str(), why.c_str());
-  std::exit(code);
+  exit_with(code, program, what, why);
 }
-[[noreturn]] void bad(const std::string& what, const std::string& why) { fail(exit_bad_input, what, why); }
+[[noreturn]] void bad(const std::string& what, const std::string& why) { fail(exit_code::bad_input, what, why); }
 
 constexpr const char* footer = R"(Data type and units (the type is required: for a gyro "frequency" is rate and "phase" is angle):
   --type phase   phase samples: --unit s (clock phase, the default; deviations as fractional
@@ -50,6 +48,11 @@ constexpr const char* footer = R"(Data type and units (the type is required: for
                  pulse with its unit: 1.5arcsec, "0.5 urad", or 1.5 with --pulse-unit arcsec
   Gyro data (angle, rate, counts) come out in --rate-unit (TDEV in deg/h -> arcsec, deg/s -> deg,
   rad/s -> rad); IEEE-952 parameters in Q arcsec, N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h/h.
+
+Formats: table (people), csv, json, stable32 (Stable32's result table: AF Tau # Alpha MinSigma
+Sigma MaxSigma, one block per statistic; values in the output unit). --kalibr FILE also writes the
+IEEE-952 fit's N and K as the gyroscope part of a Kalibr imu.yaml (N in rad/s/sqrt(Hz) = rad/s^0.5,
+K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill).
 
 Input: one value per line, or --column C of lines split by blanks, commas or semicolons; '#'
 starts a comment; gzip is recognized by content; '-' reads standard input.
@@ -67,6 +70,18 @@ Taus (averaging factors m, tau = m tau0) and memory:
   2^16 are strided, their terms m/2^16 points apart, and their EDF is that of the strided
   estimator. adev and hdev are Stable32's non-overlapped estimators at any tau.
 
+The total and Theo family (docs/total.md): totdev, mtotdev, ttotdev, htotdev, theo1, theoh need the
+whole record, which the analyzer then holds (8 bytes a value, plus 4 for mtotdev). Theo1 and
+TheoBR rows carry m as their averaging factor at tau = 0.75 m tau0 (m even, from 10 up to N - 1:
+octave 16, 32, ...; decade 10, 20, 40, ...); theoh is overlapping ADEV below its switch point (the
+largest octave at or below 10 % of the record) and TheoBR from there on. Each estimate is exact
+where that costs at most 2^26 operations at its tau and decimated beyond (blocks or sub-sequences
+every m/S samples, S from --total-stride-factor, 16 by default; 'exact' never decimates): the
+stride column says which. Where the noise is identified the deviations carry Stable32's bias
+corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and the EDF is NIST
+SP 1065's for the statistic. --fit-long-tau totdev or theoh lets the IEEE-952 fit take TOTDEV or
+TheoBR points in place of OADEV at long tau, where they have more degrees of freedom.
+
 Dynamic Allan deviation (--dynamic WINDOW[,STEP], in seconds; STEP defaults to WINDOW): the
   statistics of every window of WINDOW/tau0 values, one starting every STEP/tau0 values, each as
   if its values were a file of their own, at the taus with 4 m <= the window's values (--taus
@@ -80,12 +95,15 @@ Examples:
   gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec --rate-unit deg/h \
                    --fit ieee952 --format json run.txt.gz
   gyrochar-analyze --type phase --unit deg --tau0 0.01 --column 2 --stats oadev,mdev angle.csv
+  gyrochar-analyze --type phase --tau0 1 --stats oadev,mdev --format stable32 PHASE.DAT
+  gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --kalibr imu.yaml run.txt
+  gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --stats oadev,totdev,theoh run120h.txt
+  gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 --fit-long-tau totdev run120h.txt
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
   gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1arcsec --dynamic 600,60 --format csv \
                    --plot warmup run.txt > surface.csv
 
-Exit codes: 0 success; 1 internal error; 2 bad options or data; 3 the output could not be written.
-Errors go to stderr as 'gyrochar-analyze: what: why'; data goes to stdout.)";
+)";
 
 std::vector<std::string> split(const std::string& text, char separator) {
   std::vector<std::string> items;
@@ -112,7 +130,10 @@ std::vector<DevStat> parse_stats(const std::string& text) {
   std::vector<DevStat> stats;
   for (const std::string& item : split(text, ',')) {
     const auto s = parse_dev_stat(item);
-    if (!s) bad("--stats", "unknown statistic '" + item + "' (adev, oadev, mdev, tdev, hdev, ohdev)");
+    if (!s)
+      bad("--stats", "unknown statistic '" + item +
+                         "' (adev, oadev, mdev, tdev, hdev, ohdev, totdev, mtotdev, ttotdev, htotdev, theo1, theoh)");
+    if (std::find(stats.begin(), stats.end(), *s) != stats.end()) bad("--stats", "'" + item + "' is asked twice");
     stats.push_back(*s);
   }
   if (stats.empty()) bad("--stats", "empty list");
@@ -256,25 +277,25 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
   const std::string text = format == "json" ? dynamic_to_json(report).dump(2) + "\n"
                            : format == "csv" ? format_dynamic_csv(report)
                                              : format_dynamic_table(report);
-  if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
-    fail(exit_output, "output", std::strerror(errno));
+  std::fwrite(text.data(), 1, text.size(), stdout);
   if (!plot_prefix.empty()) {
     std::string why;
-    if (!write_heat_maps(plot_prefix, dynamic_heat_maps(report), why)) fail(exit_output, "--plot", why);
+    if (!write_heat_maps(plot_prefix, dynamic_heat_maps(report), why)) fail(exit_code::output_failed, "--plot", why);
   }
-  return 0;
+  return finish(program, exit_code::ok);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV of a recorded file, with EDF,\n"
-               "confidence intervals, noise identification and the IEEE-952 gyro fit; streams any length.",
+  CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV (streamed, any length) and TOTDEV,\n"
+               "MTOTDEV, TTOTDEV, HTOTDEV, Theo1, TheoH (held in memory) of a recorded file, with EDF,\n"
+               "confidence intervals, noise identification and the IEEE-952 gyro fit.",
                "gyrochar-analyze"};
-  app.footer(footer);
+  app.footer(std::string(footer) + exit_code::help);
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
-  std::string format = "table", fit_text, dynamic_text, plot_prefix;
+  std::string format = "table", fit_text, kalibr_path, dynamic_text, plot_prefix;
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
   unsigned column = 1;
   bool progress = false;
@@ -288,12 +309,24 @@ int main(int argc, char** argv) {
   app.add_option("--nominal-hz", nominal_hz, "freq values are in Hz around this nominal frequency");
   app.add_option("--column", column, "column holding the values (1-based)")->capture_default_str();
   app.add_option("--taus", taus_text, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
-  app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev")->capture_default_str();
+  app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh")
+      ->capture_default_str();
   app.add_option("--stride-factor", stride_text, "S, a power of two, or full")->capture_default_str();
+  std::string total_stride_text = "16";
+  app.add_option("--total-stride-factor", total_stride_text,
+                 "S of the decimated total/Theo estimators (a power of two from 2 to 2^20), or exact")
+      ->capture_default_str();
   app.add_option("--confidence", confidence, "confidence level of the intervals")->capture_default_str();
   app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
   app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
-  app.add_option("--format", format, "table, csv or json")->capture_default_str();
+  std::string long_tau_text = "oadev";
+  app.add_option("--fit-long-tau", long_tau_text,
+                 "the fit's Allan curve at long tau: oadev, totdev or theoh (docs/metrology.md)")
+      ->capture_default_str();
+  app.add_option("--format", format, "table, csv, json or stable32 (Stable32's result table, one per statistic)")
+      ->capture_default_str();
+  app.add_option("--kalibr", kalibr_path, "with --fit ieee952 on gyro data: also write N and K as a Kalibr imu.yaml")
+      ->option_text("FILE");
   app.add_option("--dynamic", dynamic_text, "dynamic Allan deviation: windows of WINDOW s, one every STEP s")
       ->option_text("WINDOW[,STEP]");
   app.add_option("--plot", plot_prefix, "with --dynamic: draw the heat maps to PREFIX.svg and PREFIX.png")
@@ -302,7 +335,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return finish(program, app.exit(e));
   } catch (const CLI::ParseError& e) {
     bad("options", std::string(e.what()) + " (see --help)");
   }
@@ -326,6 +359,15 @@ int main(int argc, char** argv) {
           (o.stride_factor & (o.stride_factor - 1)) != 0 || o.stride_factor > (1u << 24))
         bad("--stride-factor", "must be a power of two from 2 to 2^24, or full");
     }
+    if (total_stride_text == "exact") {
+      o.total_stride_factor = 0;
+    } else {
+      const auto [end, ec] =
+          std::from_chars(total_stride_text.data(), total_stride_text.data() + total_stride_text.size(), o.total_stride_factor);
+      if (ec != std::errc() || end != total_stride_text.data() + total_stride_text.size() || o.total_stride_factor < 2 ||
+          (o.total_stride_factor & (o.total_stride_factor - 1)) != 0 || o.total_stride_factor > (1u << 20))
+        bad("--total-stride-factor", "must be a power of two from 2 to 2^20, or exact");
+    }
     if (alpha_text != "auto") {
       int a = 0;
       const auto [end, ec] = std::from_chars(alpha_text.data(), alpha_text.data() + alpha_text.size(), a);
@@ -333,11 +375,19 @@ int main(int argc, char** argv) {
         bad("--alpha", "must be auto or an integer from -4 to 2");
       o.alpha = a;
     }
-    if (format != "table" && format != "csv" && format != "json") bad("--format", "must be table, csv or json");
+    if (format != "table" && format != "csv" && format != "json" && format != "stable32")
+      bad("--format", "must be table, csv, json or stable32");
     if (!plot_prefix.empty()) {
       if (const std::string missing = plot_devices_missing(); !missing.empty()) bad("--plot", missing);
     }
     if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
+    if (!kalibr_path.empty() && fit_text.empty()) bad("--kalibr", "needs --fit ieee952 (the file holds fitted terms)");
+    LongTau long_tau = LongTau::oadev;
+    if (long_tau_text == "totdev") long_tau = LongTau::totdev;
+    else if (long_tau_text == "theoh") long_tau = LongTau::theoh;
+    else if (long_tau_text != "oadev") bad("--fit-long-tau", "must be oadev, totdev or theoh, not '" + long_tau_text + "'");
+    if (long_tau != LongTau::oadev && fit_text.empty()) bad("--fit-long-tau", "only applies with --fit ieee952");
+    o.keep_record = long_tau != LongTau::oadev;
     // The fit uses both curves, whatever the table shows: compute them, show what was asked.
     const std::vector<DevStat> shown = o.stats;
     if (!fit_text.empty())
@@ -380,6 +430,8 @@ int main(int argc, char** argv) {
         bad("--unit", "freq is in 1 (fractional), Hz or a rate unit (deg/h, deg/s, rad/s), not '" + value_unit + "'");
       }
     }
+    if (!kalibr_path.empty() && !units.gyro)
+      bad("--kalibr", "needs gyro data: counts, or --unit with an angle or a rate");
     if (units.gyro) {
       const auto rate = rate_unit(rate_text);
       if (!rate) bad("--rate-unit", "unknown unit '" + rate_text + "' (deg/h, deg/s, rad/s)");
@@ -414,6 +466,8 @@ int main(int argc, char** argv) {
       o.m_list = parse_tau_list(taus_text);
     }
     if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
+    const bool lists = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
+    o.theo_m_list = theo_taus(lists ? taus_text : "list", o.m_list, n_phase);
 
     // Pass 2: the analysis.
     std::unique_ptr<Analyzer> analyzer;
@@ -422,26 +476,69 @@ int main(int argc, char** argv) {
     } catch (const std::invalid_argument& e) {
       bad("--taus", e.what());
     }
+    DataRange range;
     const std::vector<std::string> header =
-        read_values(path, column, nominal_hz, show_progress, "analyzing", [&](double v) { analyzer->add(v); });
-    const Analysis a = analyzer->result();
+        read_values(path, column, nominal_hz, show_progress, "analyzing", [&](double v) {
+          range.add(v);
+          analyzer->add(v);
+        });
+    const Analysis a = [&] {
+      try {
+        return analyzer->result();
+      } catch (const std::range_error& e) {  // a deviation that is not a finite number, and why
+        bad(source, e.what());
+      }
+    }();
     if (a.n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
     if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
 
     std::vector<CurveFit> fits;
     if (!fit_text.empty())
-      fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0);
+      fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
+                        long_tau, analyzer->record());
     Analysis displayed = a;
     std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
-    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt};
+    // A tau asked for by number but too long for the data has no row: say so. (The octave,
+    // decade and all lists stop where the data end by design.)
+    const bool taus_listed = taus_text != "octave" && taus_text != "decade" && taus_text != "all";
+    for (const std::uint64_t m : taus_listed ? o.m_list : std::vector<std::uint64_t>{}) {
+      std::string missing;
+      for (const DevStat stat : shown)
+        if (std::none_of(displayed.rows.begin(), displayed.rows.end(),
+                         [&](const AnalysisRow& r) { return r.stat == stat && r.m == m; }))
+          missing += (missing.empty() ? "" : ", ") + std::string(name(stat));
+      if (!missing.empty())
+        print_error(program, "note",
+                    fmt::format("m = {} (tau = {:g} s) left out of {}: {} phase points are too few for a term", m,
+                                static_cast<double>(m) * o.tau0_s, missing, a.n_phase));
+    }
+    for (const AnalysisRow& r : displayed.rows)  // the output unit must not take a value out of range
+      if (!std::isfinite(r.dev * units.factor()) || (r.ci.valid && !std::isfinite(r.ci.high * units.factor())))
+        bad(source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) overflows a double",
+                                name(r.stat), r.tau_s, r.m, r.ci.valid ? r.ci.high : r.dev, units.factor(),
+                                units.unit(r.stat)));
+    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt, source, range};
     if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);
-    const std::string text = format == "json" ? to_json(report).dump(2) + "\n"
-                             : format == "csv" ? format_csv(report)
-                                               : format_table(report);
-    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
-      fail(exit_output, "output", std::strerror(errno));
+    std::string yaml;  // made before anything is written: a refusal loses no output
+    if (!kalibr_path.empty()) {
+      std::string why;
+      const auto text = kalibr_yaml(report, why);
+      if (!text) bad("--kalibr", why);
+      yaml = *text;
+    }
+    const std::string text = format == "json"       ? to_json(report).dump(2) + "\n"
+                             : format == "csv"      ? format_csv(report)
+                             : format == "stable32" ? format_stable32(report)
+                                                    : format_table(report);
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    if (!kalibr_path.empty()) {
+      std::FILE* f = std::fopen(kalibr_path.c_str(), "w");
+      if (f == nullptr) fail(exit_code::output_failed, kalibr_path, std::strerror(errno));
+      std::fputs(yaml.c_str(), f);
+      if (!close_output(f, program, kalibr_path)) return finish(program, exit_code::output_failed);
+    }
   } catch (const std::exception& e) {
-    fail(exit_internal, "internal error", e.what());
+    fail(exit_code::internal, "internal error", e.what());
   }
-  return 0;
+  return finish(program, exit_code::ok);
 }

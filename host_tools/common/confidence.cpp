@@ -27,4 +27,12 @@ Interval confidence_interval(double dev, double edf, double confidence, double s
   return out;
 }
 
+Interval ConfidenceIntervals::operator()(double dev, double edf) {
+  if (!(edf > 0) || !std::isfinite(edf)) return {};
+  auto it = unit_intervals_.find(edf);
+  if (it == unit_intervals_.end()) it = unit_intervals_.emplace(edf, confidence_interval(1.0, edf, confidence_)).first;
+  const Interval& unit = it->second;
+  return unit.valid ? Interval{dev * unit.low, dev * unit.high, true} : Interval{};
+}
+
 }  // namespace gyrochar

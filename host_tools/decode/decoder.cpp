@@ -7,8 +7,23 @@ namespace gyrochar {
 
 using namespace protocol;
 
+const char* name(DecoderEvent e) {
+  switch (e) {
+    case DecoderEvent::report_closed: return "report_closed";
+    case DecoderEvent::restart: return "restart";
+    case DecoderEvent::offline: return "offline";
+    case DecoderEvent::online: return "online";
+    case DecoderEvent::rejected_frame: return "rejected_frame";
+    case DecoderEvent::duplicate: return "duplicate";
+    case DecoderEvent::unknown_version: return "unknown_version";
+    case DecoderEvent::window_complete: return "window_complete";
+  }
+  return "invalid";
+}
+
 void Decoder::feed(const CanFrame& frame, double t_s) {
   tick(t_s);
+  now_s_ = t_s;
   const Decoded d = decode(frame);
   if (d.error == ProtocolError::unknown_id || d.error == ProtocolError::not_extended ||
       d.error == ProtocolError::error_frame || std::holds_alternative<CounterInputMsg>(d.message)) {
@@ -192,11 +207,12 @@ void Decoder::open_report(NodeView& v, Assembly& a, std::uint8_t seq) {
   a.open = true;
   a.seen = true;
   a.seq = seq;
+  a.start_s = now_s_;
   a.lost_at_open = lost;
   a.tau_count = v.have_status ? v.status.tau_count : 0;
   a.version = v.schedule_version();
   a.window_taus = v.window_taus;
-  a.received.fill(false);
+  a.arrived.fill(false);
   layout(a);
 }
 
@@ -212,7 +228,7 @@ void Decoder::relayout_if_schedule_changed(const NodeView& v, Assembly& a) {
 void Decoder::layout(Assembly& a) {
   a.position.fill(-1);
   const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version, a.window_taus);
-  for (std::size_t k = 0; k < frames && k < a.received.size(); ++k) {
+  for (std::size_t k = 0; k < frames && k < a.arrived.size(); ++k) {
     const ReportSlot s = report_slot(a.seq, a.tau_count, k, a.version, a.window_taus);
     a.position[static_cast<std::size_t>(s.slot) * max_taus + s.index] = static_cast<std::int16_t>(k);
   }
@@ -223,7 +239,7 @@ void Decoder::close_report(NodeView& v, Assembly& a) {
   a.open = false;
   const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version, a.window_taus);
   std::uint64_t missing = 0;
-  for (std::size_t k = 0; k < frames && k < a.received.size(); ++k) missing += a.received[k] ? 0 : 1;
+  for (std::size_t k = 0; k < frames && k < a.arrived.size(); ++k) missing += a.arrived[k] ? 0 : 1;
   v.health.frames_missing += missing;
   if (missing == 0) {
     ++v.health.reports_complete;
@@ -255,11 +271,11 @@ void Decoder::restart(NodeView& v, Assembly& a) {
 void Decoder::mark_slot(NodeView& v, Assembly& a, Slot slot, std::uint8_t index) {
   const std::int16_t k = a.position[static_cast<std::size_t>(slot) * max_taus + index];
   if (k < 0) return;  // not expected in this report (e.g. a tau beyond TauCount)
-  if (a.received[static_cast<std::size_t>(k)]) {
+  if (a.arrived[static_cast<std::size_t>(k)]) {
     ++v.health.duplicates;
     emit(DecoderEvent::duplicate, v, a.seq);
   }
-  a.received[static_cast<std::size_t>(k)] = true;
+  a.arrived[static_cast<std::size_t>(k)] = true;
 }
 
 }  // namespace gyrochar

@@ -43,6 +43,8 @@ struct Ieee952View {
   bool fitted = false;         // in the fitted model: value and uncertainty are the fit's even when
                                // not resolved (an upper-bound reading). A version-1 node sends no
                                // Fitted flag: there it is the Resolved flag.
+  /// In the node's model: received and fitted (a version-1 node: resolved).
+  bool in_model() const { return received && (fitted || resolved); }
 };
 
 /// One window of the node's dynamic Allan deviation (protocol version 3): the window k covers the
@@ -135,11 +137,36 @@ enum class DecoderEvent {
   unknown_version,
   window_complete
 };
+/// "report_closed", "restart", ...: the enumerator's name. A static string.
+const char* name(DecoderEvent e);
 
 class Decoder {
  public:
+  /// The report being received from a node: its sequence number, when its first frame came, and
+  /// its slot table (which frames of the report's schedule arrived). Inside a report_closed
+  /// listener, the report just closed.
+  struct Report {
+    bool open = false;
+    bool seen = false;  // a report of this session was opened: `seq` is the last Seq heard, also after offline
+    std::uint8_t seq = 0;
+    double start_s = 0.0;           // time of the report's first frame
+    std::uint8_t lost_at_open = 0;  // reports counted lost when the current report opened
+    std::uint8_t tau_count = 0;
+    std::uint8_t version = 1;  // the schedule's protocol version (NodeView::schedule_version())
+    std::uint8_t window_taus = 0;  // the node's window taus (version 3), 0 while unknown
+    std::array<bool, 512> arrived{};  // by slot position in the report
+    std::array<std::int16_t, protocol::slot_kinds * protocol::max_taus> position{};  // (slot, index) -> position, -1: not in this report
+
+    /// True when the frame of (slot, index) arrived in this report; false for a frame the report's
+    /// schedule does not have. O(1).
+    bool received(protocol::Slot slot, std::uint8_t index) const {
+      const std::int16_t k = position[static_cast<std::size_t>(slot) * protocol::max_taus + index];
+      return k >= 0 && arrived[static_cast<std::size_t>(k)];
+    }
+  };
+
   /// Called for every event; `node` is the view after the event (for report_closed: with the
-  /// closed report's values). May be empty.
+  /// closed report's values, and report(node.address) its slot table). May be empty.
   using Listener = std::function<void(DecoderEvent, const NodeView& node, std::uint8_t seq)>;
   explicit Decoder(Listener listener = {}, double offline_after_s = 3.0)
       : listener_(std::move(listener)), offline_after_s_(offline_after_s) {}
@@ -153,21 +180,16 @@ class Decoder {
   void flush();
 
   const std::map<std::uint8_t, NodeView>& nodes() const { return nodes_; }
+  /// The report of `node` (see Report); nullptr for a node never heard. O(log nodes).
+  const Report* report(std::uint8_t node) const {
+    const auto it = assembly_.find(node);
+    return it == assembly_.end() ? nullptr : &it->second;
+  }
   std::uint64_t other_frames() const { return other_frames_; }
   std::uint64_t rejected_frames() const { return rejected_; }
 
  private:
-  struct Assembly {
-    bool open = false;
-    bool seen = false;  // a report of this session was opened: `seq` is the last Seq heard, also after offline
-    std::uint8_t seq = 0;
-    std::uint8_t lost_at_open = 0;  // reports counted lost when the current report opened
-    std::uint8_t tau_count = 0;
-    std::uint8_t version = 1;  // the schedule's protocol version (NodeView::schedule_version())
-    std::uint8_t window_taus = 0;  // the node's window taus (version 3), 0 while unknown
-    std::array<bool, 512> received{};  // by slot position in the report
-    std::array<std::int16_t, protocol::slot_kinds * protocol::max_taus> position{};  // (slot, index) -> position, -1: not in this report
-  };
+  using Assembly = Report;
   static void layout(Assembly& a);
   static void relayout_if_schedule_changed(const NodeView& v, Assembly& a);
 
@@ -185,6 +207,7 @@ class Decoder {
   double offline_after_s_;
   std::map<std::uint8_t, NodeView> nodes_;
   std::map<std::uint8_t, Assembly> assembly_;  // the report being received, per node
+  double now_s_ = 0.0;                          // time of the frame being fed
   std::uint64_t other_frames_ = 0;
   std::uint64_t rejected_ = 0;
 };

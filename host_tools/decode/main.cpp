@@ -16,24 +16,22 @@
 #include <string>
 #include <vector>
 
-#include "decode_session.hpp"
+#include "hal/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
-#include "decode_plot.hpp"
+#include "plot.hpp"
+#include "session.hpp"
+#include "view.hpp"
 
 namespace {
 
 using namespace gyrochar;
 using namespace gyrochar::decoding;
 
-constexpr int exit_ok = 0;
-constexpr int exit_failure = 1;                   // an output could not be written
-constexpr int exit_bad_input = 2;                 // usage, unreadable input, input without any candump line
-constexpr int exit_no_interface = 3;              // the CAN interface cannot be opened
+constexpr const char* program = "gyrochar-decode";
 constexpr std::uint64_t malformed_reported = 10;  // malformed lines reported one by one, then counted
 
 [[noreturn]] void fail(int code, const std::string& what, const std::string& why) {
-  std::fprintf(stderr, "gyrochar-decode: %s: %s\n", what.c_str(), why.c_str());
-  std::exit(code);
+  exit_with(code, program, what, why);
 }
 
 volatile std::sig_atomic_t stop_requested = 0;
@@ -55,7 +53,7 @@ enum class View { live, final, none };
 struct Options {
   std::string log;        // candump log path or "-"
   std::string interface;  // live SocketCAN interface
-  std::string csv, jsonl, plot;
+  std::string csv, jsonl, plot, kalibr;
   double plot_every_s = 0.0;
   std::string view;
   std::string rate_unit = "deg/h";
@@ -67,7 +65,7 @@ struct Options {
 
 std::FILE* open_output(const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) fail(exit_bad_input, path, std::strerror(errno));
+  if (f == nullptr) fail(exit_code::output_failed, path, std::strerror(errno));
   return f;
 }
 
@@ -83,7 +81,7 @@ NodeFilter parse_nodes(const std::vector<std::string>& texts) {
       used = 0;
     }
     if (used != t.size() || used == 0 || address > protocol::max_node_address)
-      fail(exit_bad_input, "--node", "'" + t + "' is not a node address 0..253 (0x00..0xFD)");
+      fail(exit_code::bad_input, "--node", "'" + t + "' is not a node address 0..253 (0x00..0xFD)");
     shown.set(address);
   }
   return shown;
@@ -92,16 +90,13 @@ NodeFilter parse_nodes(const std::vector<std::string>& texts) {
 // Everything the main loop does besides decoding: the live view, the periodic plot, the end.
 class Presenter {
  public:
-  Presenter(const Options& o, View view, RateUnit rate_unit, Session& session)
+  Presenter(const Options& o, View view, DisplayRate rate_unit, Session& session)
       : options_(o), view_(view), rate_unit_(rate_unit), session_(session), tty_(isatty(STDOUT_FILENO) == 1) {}
 
   void malformed(const std::string& where, std::uint64_t line, const std::string& why) {
     const std::uint64_t count = session_.input().malformed_lines;
-    if (count <= malformed_reported)
-      std::fprintf(stderr, "gyrochar-decode: %s:%llu: malformed line: %s\n", where.c_str(),
-                   static_cast<unsigned long long>(line), why.c_str());
-    if (count == malformed_reported)
-      std::fprintf(stderr, "gyrochar-decode: %s: further malformed lines are only counted\n", where.c_str());
+    if (count <= malformed_reported) print_error(program, fmt::format("{}:{}", where, line), "malformed line: " + why);
+    if (count == malformed_reported) print_error(program, where, "further malformed lines are only counted");
   }
 
   /// Called often: refreshes the view and the plot when due.
@@ -127,8 +122,9 @@ class Presenter {
 
   int finish() {
     session_.finish();
-    int code = exit_ok;
-    if (!options_.plot.empty() && !plot()) code = exit_failure;
+    int code = exit_code::ok;
+    if (!options_.plot.empty() && !plot()) code = exit_code::output_failed;
+    if (const int k = options_.kalibr.empty() ? exit_code::ok : kalibr(); code == exit_code::ok) code = k;
     if (view_ != View::none) show();
     std::fputs(format_summary(session_.decoder(), session_.input(), session_.options().shown).c_str(), stderr);
     return code;
@@ -143,23 +139,53 @@ class Presenter {
     std::fflush(stdout);
   }
 
+  // The Kalibr imu.yaml of the one node shown: exit code.
+  int kalibr() {
+    const NodeView* node = nullptr;
+    std::string seen;
+    int count = 0;
+    for (const auto& [address, v] : session_.decoder().nodes()) {
+      if (!session_.options().shown[address]) continue;
+      seen += fmt::format("{}0x{:02X}", seen.empty() ? "" : ", ", address);
+      node = &v;
+      ++count;
+    }
+    if (count != 1) {
+      print_error(program, "--kalibr", seen.empty() ? "no node seen" : "nodes " + seen + " seen: choose one with --node");
+      return exit_code::bad_input;
+    }
+    std::string why;
+    const auto yaml = kalibr_yaml(*node, why);
+    if (!yaml) {
+      print_error(program, "--kalibr", why);
+      return exit_code::bad_input;
+    }
+    std::FILE* f = std::fopen(options_.kalibr.c_str(), "w");
+    if (f == nullptr) {
+      print_error(program, options_.kalibr, std::strerror(errno));
+      return exit_code::output_failed;
+    }
+    std::fputs(yaml->c_str(), f);
+    return close_output(f, program, options_.kalibr) ? exit_code::ok : exit_code::output_failed;
+  }
+
   bool plot() {
     std::vector<NodePlot> panels;
     for (const auto& [address, node] : session_.decoder().nodes())
       if (session_.options().shown[address]) panels.push_back(plot_data(node, rate_unit_, session_.intervals()));
     if (panels.empty()) {
-      std::fprintf(stderr, "gyrochar-decode: %s: no node to plot\n", options_.plot.c_str());
+      print_error(program, options_.plot, "no node to plot");
       return true;
     }
     std::string why;
     if (write_plot(options_.plot, panels, options_.confidence, why)) return true;
-    std::fprintf(stderr, "gyrochar-decode: plot: %s\n", why.c_str());
+    print_error(program, "plot", why);
     return false;
   }
 
   const Options& options_;
   View view_;
-  RateUnit rate_unit_;
+  DisplayRate rate_unit_;
   Session& session_;
   bool tty_;
   double last_view_s_ = -1e300;
@@ -170,7 +196,7 @@ int decode_log(const Options& o, Session& session, Presenter& presenter) {
   const bool from_stdin = o.log == "-";
   const std::string where = from_stdin ? "stdin" : o.log;
   const int fd = from_stdin ? STDIN_FILENO : ::open(o.log.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail(exit_bad_input, o.log, std::strerror(errno));
+  if (fd < 0) fail(exit_code::bad_input, o.log, std::strerror(errno));
   session.input().source = where;
   LineReader reader(fd);
   std::string_view line;
@@ -192,13 +218,14 @@ int decode_log(const Options& o, Session& session, Presenter& presenter) {
     } else if (r == LineReader::Result::end) {
       break;
     } else {
-      fail(exit_bad_input, where, std::strerror(errno));
+      fail(exit_code::bad_input, where, std::strerror(errno));
     }
   }
   if (!from_stdin) ::close(fd);
   const InputCounters& in = session.input();
-  if (in.lines > 0 && in.malformed_lines == in.lines)
-    fail(exit_bad_input, where, fmt::format("none of its {} lines is a candump log line", in.lines));
+  if (in.lines == 0) fail(exit_code::bad_input, where, "empty: no candump log line");
+  if (in.malformed_lines == in.lines)
+    fail(exit_code::bad_input, where, fmt::format("none of its {} lines is a candump log line", in.lines));
   return presenter.finish();
 }
 
@@ -215,7 +242,7 @@ int decode_live(const Options& o, Session& session, Presenter& presenter) {
   try {
     bus = std::make_unique<hal::SocketCan>(o.interface);
   } catch (const std::exception& e) {
-    fail(exit_no_interface, o.interface, e.what());
+    exit_with(exit_code::no_hardware, program, e.what());  // "can0: why": the interface first
   }
   session.input().source = o.interface;
   const double start_s = wall_s();
@@ -264,10 +291,11 @@ int main(int argc, char** argv) {
       "  gyrochar-decode --interface can0 --csv run.csv --jsonl run.jsonl --plot run --plot-every 60\n"
       "  gyrochar-decode capture.log --view none --csv capture.csv --plot capture\n"
       "  gyrochar-decode capture.log --node 0x10 --rate-unit deg/s --view final\n"
+      "  gyrochar-decode --interface can0 --node 0x10 --duration 86400 --kalibr imu.yaml\n"
       "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
-      "Exit codes: 0 success (malformed lines and rejected frames are counted and reported, not fatal);\n"
-      "1 an output (CSV, JSON lines, plot) could not be written; 2 bad options or bad input (missing or\n"
-      "unreadable file, no candump line at all); 3 the CAN interface is not available.");
+      "Malformed lines and rejected frames are counted and reported, not fatal; a log that is missing,\n"
+      "unreadable, empty or without any candump line is bad input.\n" +
+      std::string(exit_code::help));
   Options o;
   app.add_option("log", o.log, "candump log file, or '-' for stdin")->option_text("LOG");
   app.add_option("-i,--interface", o.interface, "live SocketCAN interface, e.g. can0, vcan0")->option_text("IF");
@@ -275,6 +303,8 @@ int main(int argc, char** argv) {
   app.add_option("--jsonl", o.jsonl, "write the same rows, per-report status and events as JSON lines")
       ->option_text("FILE");
   app.add_option("--plot", o.plot, "write PREFIX.svg and PREFIX.png at the end")->option_text("PREFIX");
+  app.add_option("--kalibr", o.kalibr, "write the node's N and K as a Kalibr imu.yaml at the end (one node: --node)")
+      ->option_text("FILE");
   app.add_option("--plot-every", o.plot_every_s, "also rewrite the plot every S seconds (decoder time)")
       ->option_text("S");
   app.add_option("--view", o.view,
@@ -292,19 +322,20 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return finish(program, app.exit(e));
   } catch (const CLI::ParseError& e) {
-    fail(exit_bad_input, "options", std::string(e.what()) + " (see --help)");
+    fail(exit_code::bad_input, "options", std::string(e.what()) + " (see --help)");
   }
   if (o.log.empty() == o.interface.empty())
-    fail(exit_bad_input, "options", "give either a LOG or --interface (see --help)");
-  const auto rate_unit = parse_rate_unit(o.rate_unit);
-  if (!rate_unit) fail(exit_bad_input, "--rate-unit", "'" + o.rate_unit + "' is not deg/h, deg/s, rad/s or native");
-  if (!(o.confidence > 0 && o.confidence < 1)) fail(exit_bad_input, "--confidence", "must be in (0, 1)");
-  if (!(o.duration_s >= 0)) fail(exit_bad_input, "--duration", "must be >= 0");
-  if (!(o.plot_every_s >= 0)) fail(exit_bad_input, "--plot-every", "must be >= 0");
-  if (o.plot_every_s > 0 && o.plot.empty()) fail(exit_bad_input, "--plot-every", "needs --plot PREFIX");
-  if (!(o.refresh_s > 0)) fail(exit_bad_input, "--refresh", "must be > 0");
+    fail(exit_code::bad_input, "options", "give either a LOG or --interface (see --help)");
+  const DisplayRate rate_unit = gyrochar::rate_unit(o.rate_unit);
+  if (!rate_unit && o.rate_unit != "native")
+    fail(exit_code::bad_input, "--rate-unit", "'" + o.rate_unit + "' is not deg/h, deg/s, rad/s or native");
+  if (!(o.confidence > 0 && o.confidence < 1)) fail(exit_code::bad_input, "--confidence", "must be in (0, 1)");
+  if (!(o.duration_s >= 0)) fail(exit_code::bad_input, "--duration", "must be >= 0");
+  if (!(o.plot_every_s >= 0)) fail(exit_code::bad_input, "--plot-every", "must be >= 0");
+  if (o.plot_every_s > 0 && o.plot.empty()) fail(exit_code::bad_input, "--plot-every", "needs --plot PREFIX");
+  if (!(o.refresh_s > 0)) fail(exit_code::bad_input, "--refresh", "must be > 0");
   View view = isatty(STDOUT_FILENO) ? View::live : View::none;
   if (o.view == "live")
     view = View::live;
@@ -313,33 +344,27 @@ int main(int argc, char** argv) {
   else if (o.view == "none")
     view = View::none;
   else if (!o.view.empty())
-    fail(exit_bad_input, "--view", "'" + o.view + "' is not live, final or none");
+    fail(exit_code::bad_input, "--view", "'" + o.view + "' is not live, final or none");
   if (!o.plot.empty()) {
-    if (const std::string missing = plot_devices_missing(); !missing.empty()) fail(exit_bad_input, "--plot", missing);
+    if (const std::string missing = plot_devices_missing(); !missing.empty()) fail(exit_code::bad_input, "--plot", missing);
     std::fclose(open_output(o.plot + ".svg.part"));  // fail now, not after hours of decoding
     std::remove((o.plot + ".svg.part").c_str());
   }
 
   SessionOptions s;
-  s.rate_unit = *rate_unit;
+  s.rate_unit = rate_unit;
   s.confidence = o.confidence;
   s.shown = parse_nodes(o.nodes);
   s.csv = o.csv.empty() ? nullptr : open_output(o.csv);
   s.jsonl = o.jsonl.empty() ? nullptr : open_output(o.jsonl);
   install_stop_handler();
-  int code = exit_ok;
+  int code = exit_code::ok;
   {
     Session session(s);
-    Presenter presenter(o, view, *rate_unit, session);
+    Presenter presenter(o, view, rate_unit, session);
     code = o.interface.empty() ? decode_log(o, session, presenter) : decode_live(o, session, presenter);
   }
-  for (const auto& [file, path] : {std::pair{s.csv, o.csv}, std::pair{s.jsonl, o.jsonl}}) {
-    if (file == nullptr) continue;
-    const bool failed = std::ferror(file) != 0;
-    if (std::fclose(file) != 0 || failed) {
-      std::fprintf(stderr, "gyrochar-decode: %s: write failed: %s\n", path.c_str(), std::strerror(errno));
-      code = exit_failure;
-    }
-  }
-  return code;
+  for (const auto& [file, path] : {std::pair{s.csv, o.csv}, std::pair{s.jsonl, o.jsonl}})
+    if (!close_output(file, program, path)) code = exit_code::output_failed;
+  return finish(program, code);
 }

@@ -8,19 +8,25 @@
 // terms, and the plot draws the true model beside the fitted one. Each board also keeps the
 // dynamic Allan deviation over --window minutes, which the plot draws as a heat map per node.
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <string>
 #include <memory>
 #include <vector>
 
 #include "board.hpp"
 #include "candump.hpp"
-#include "decode_plot.hpp"
-#include "decode_session.hpp"
+#include "plot.hpp"
+#include "session.hpp"
+#include "view.hpp"
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
+#include "hal/exit_codes.hpp"
 #include "hal/fake/fake_can_bus.hpp"
 #include "hal/fake/fake_clock.hpp"
 #include "hal/fake/fake_count_source.hpp"
@@ -29,7 +35,11 @@ namespace {
 
 using namespace gyrochar;
 
-constexpr int exit_ok = 0, exit_failure = 1, exit_usage = 2;
+constexpr const char* program = "gyrochar-demo";
+
+[[noreturn]] void bad(const std::string& what, const std::string& why) {
+  exit_with(exit_code::bad_input, program, what, why);
+}
 
 // One simulated gyro board on the bus.
 struct Node {
@@ -50,8 +60,8 @@ int main(int argc, char** argv) {
                "on a virtual clock.",
                "gyrochar-demo"};
   app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n"
-             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n"
-             "Exit codes: 0 success, 1 an output could not be written, 2 bad options.");
+             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n\n" +
+             std::string(exit_code::help));
   double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30, window_min = 30;
   unsigned nodes = 2, octaves = 20;
   std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo", candump_path;
@@ -64,41 +74,36 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--view-every", view_every_min, "show the table every N gyro minutes (0: only at the end)")
       ->capture_default_str();
-  app.add_option("--csv", csv_path, "decoded reports as CSV (one row per node, report and tau)")->capture_default_str();
+  app.add_option("--csv", csv_path, "decoded reports as CSV (one row per node, report and tau; empty: none)")->capture_default_str();
   app.add_option("--plot", plot_prefix, "ADEV/MDEV plot written to PREFIX.svg and PREFIX.png (empty: none)")
       ->capture_default_str();
   app.add_option("--candump", candump_path, "also record the bus as a candump log (canplayer replays it)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return finish(program, app.exit(e));
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "gyrochar-demo: options: %s (see --help)\n", e.what());
-    return exit_usage;
+    bad("options", std::string(e.what()) + " (see --help)");
   }
-  if (!(hours > 0) || !(tau0 > 0) || nodes < 1 || nodes > 8 || !(loss >= 0 && loss < 1) || octaves < 1 ||
-      octaves > 40 || !(view_every_min >= 0) || !(window_min == 0 || window_min >= 4.0 / 60)) {
-    std::fprintf(stderr, "gyrochar-demo: options: hours, tau0 > 0; nodes 1..8; loss in [0, 1); octaves 1..40; "
-                         "window 0 or at least 4 s\n");
-    return exit_usage;
-  }
+  // Each rule its own message: the option, what it must be, and what was given.
+  if (!(hours > 0) || !std::isfinite(hours)) bad("--hours", fmt::format("must be a positive number of hours, not {}", hours));
+  if (!(tau0 > 0) || !std::isfinite(tau0)) bad("--tau0", fmt::format("must be a positive number of seconds, not {}", tau0));
+  if (hours * 3600 / tau0 > 1e12) bad("--hours", "more than 10^12 samples per node");
+  if (nodes < 1 || nodes > 8) bad("--nodes", fmt::format("must be 1..8, not {}", nodes));
+  if (octaves < 1 || octaves > 40) bad("--octaves", fmt::format("must be 1..40, not {}", octaves));
+  if (!(loss >= 0 && loss < 1)) bad("--loss", fmt::format("must be a probability in [0, 1), not {}", loss));
+  if (!(view_every_min >= 0) || !std::isfinite(view_every_min))
+    bad("--view-every", fmt::format("must be a number of minutes >= 0, not {}", view_every_min));
+  if (!(window_min == 0 || (window_min >= 4.0 / 60 && std::isfinite(window_min))))
+    bad("--window", fmt::format("must be 0 (none) or at least 4 s of gyro time, not {} min", window_min));
   if (!plot_prefix.empty()) {
-    if (const std::string why = decoding::plot_devices_missing(); !why.empty()) {
-      std::fprintf(stderr, "gyrochar-demo: plot: %s\n", why.c_str());
-      return exit_failure;
-    }
+    if (const std::string why = decoding::plot_devices_missing(); !why.empty()) bad("--plot", why);
   }
-  FILE* csv = std::fopen(csv_path.c_str(), "w");
-  if (csv == nullptr) {
-    std::fprintf(stderr, "gyrochar-demo: %s: cannot write\n", csv_path.c_str());
-    return exit_failure;
-  }
-
+  FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "w");
+  if (!csv_path.empty() && csv == nullptr) exit_with(exit_code::output_failed, program, csv_path, std::strerror(errno));
   FILE* candump = nullptr;
-  if (!candump_path.empty() && (candump = std::fopen(candump_path.c_str(), "w")) == nullptr) {
-    std::fprintf(stderr, "gyrochar-demo: %s: cannot write\n", candump_path.c_str());
-    return exit_failure;
-  }
+  if (!candump_path.empty() && (candump = std::fopen(candump_path.c_str(), "w")) == nullptr)
+    exit_with(exit_code::output_failed, program, candump_path, std::strerror(errno));
 
   hal::FakeClock clock;
   hal::FakeCanBus bus(7);
@@ -125,17 +130,13 @@ int main(int argc, char** argv) {
     o.bias_deg_per_h = 0.01;
     o.rrw_deg_per_h_sqrt_h = 0.03;
     o.seed = 100 + i;
-    if (const auto problem = check_parameters(o)) {
-      std::fprintf(stderr, "gyrochar-demo: options: %s: %s\n", problem->what, problem->why);
-      return exit_usage;
-    }
+    if (const auto problem = check_parameters(o)) bad(problem->what, problem->why);
     const Ieee952Truth t = ieee952_truth(o);
     truth[c.node] = {t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2};
     try {
       gyros.push_back(std::make_unique<Node>(c, gyro_parameters(o), bus, clock));
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "gyrochar-demo: node %u: %s\n", i, e.what());
-      return exit_usage;
+      bad(fmt::format("node {}", i), e.what());
     }
   }
   decoding::SessionOptions so;
@@ -185,15 +186,9 @@ int main(int argc, char** argv) {
   }
   session.finish();
   show();
-  int code = exit_ok;
-  if (candump != nullptr && std::fclose(candump) != 0) {
-    std::fprintf(stderr, "gyrochar-demo: %s: write failed\n", candump_path.c_str());
-    code = exit_failure;
-  }
-  if (std::fclose(csv) != 0) {
-    std::fprintf(stderr, "gyrochar-demo: %s: write failed\n", csv_path.c_str());
-    code = exit_failure;
-  }
+  int code = exit_code::ok;
+  if (!close_output(candump, program, candump_path)) code = exit_code::output_failed;
+  if (!close_output(csv, program, csv_path)) code = exit_code::output_failed;
   if (!plot_prefix.empty()) {
     std::vector<decoding::NodePlot> panels;
     for (const auto& [address, node] : session.decoder().nodes()) {
@@ -203,17 +198,14 @@ int main(int argc, char** argv) {
     }
     std::string why;
     if (!decoding::write_plot(plot_prefix, panels, so.confidence, why)) {
-      std::fprintf(stderr, "gyrochar-demo: plot: %s\n", why.c_str());
-      code = exit_failure;
+      print_error(program, "plot", why);
+      code = exit_code::output_failed;
     }
   }
   // The decoder's end-of-run summary, under this program's name.
-  std::string summary = decoding::format_summary(session.decoder(), session.input(), so.shown);
-  for (std::size_t at = 0; (at = summary.find("gyrochar-decode: ", at)) != std::string::npos; at += 15)
-    summary.replace(at, 17, "gyrochar-demo: ");
-  std::fputs(summary.c_str(), stderr);
-  std::fprintf(stderr, "gyrochar-demo: %.1f gyro hours, %u nodes, %llu frames on the bus; CSV %s%s%s\n", hours, nodes,
-               static_cast<unsigned long long>(bus.frames_on_bus()), csv_path.c_str(),
+  std::fputs(decoding::format_summary(session.decoder(), session.input(), so.shown, program).c_str(), stderr);
+  std::fprintf(stderr, "gyrochar-demo: %.1f gyro hours, %u nodes, %llu frames on the bus%s%s%s%s\n", hours, nodes,
+               static_cast<unsigned long long>(bus.frames_on_bus()), csv_path.empty() ? "" : "; CSV ", csv_path.c_str(),
                plot_prefix.empty() ? "" : ", plot ", plot_prefix.empty() ? "" : (plot_prefix + ".svg/.png").c_str());
-  return code;
+  return finish(program, code);
 }

@@ -32,6 +32,8 @@
 #include <random>
 #include <vector>
 
+#include "units.hpp"  // units:: conversions for the parameters
+
 namespace gyrochar {
 
 /// Top corner of the flicker band times tau0 (0.34 / tau0, below the Nyquist frequency 0.5 / tau0):
@@ -53,15 +55,6 @@ struct GyroParameters {
   std::uint64_t seed = 1;
 };
 
-/// Unit conversions for gyro people (value in the named unit -> SI).
-namespace units {
-inline constexpr double pi = 3.14159265358979323846;
-inline constexpr double arcsec = pi / (180.0 * 3600.0);        // rad
-inline constexpr double deg_per_h = pi / 180.0 / 3600.0;       // rad/s
-inline constexpr double deg_per_sqrt_h = pi / 180.0 / 60.0;    // rad/s^0.5
-inline constexpr double deg_per_h_sqrt_h = pi / 180.0 / 3600.0 / 60.0;  // rad/s^1.5
-inline constexpr double deg_per_h_per_h = pi / 180.0 / 3600.0 / 3600.0;  // rad/s^2
-}  // namespace units
 
 class GyroSimulator {
  public:

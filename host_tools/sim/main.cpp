@@ -18,13 +18,14 @@
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
 #include "gyrochar/protocol.hpp"
+#include "hal/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
 
 namespace {
 
 using namespace gyrochar;
 
-constexpr int exit_no_interface = 4;
+constexpr const char* program = "gyrochar-sim";
 
 // The readout electronics: frame k carries the pulses accumulated over the first k intervals
 // (modulo 2^32) and Seq = k mod 256, sent at start + k tau0 / speed on CLOCK_MONOTONIC. Frame 0
@@ -128,7 +129,7 @@ Examples:
   gyrochar-sim --duration 60 --tau0 0.01 --arw 0.003 --can vcan0 --can-node 128 --speed 4 --out counts.txt
   gyrochar-sim --duration 7200 --arw 0.002 --segment 3600:arw=0.004 > doubling.txt   # N doubles halfway
 
-Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not available.)");
+)" + std::string(exit_code::help));
   SimOptions o;
   std::string out = "-";
   app.add_option("--duration", o.duration_s, "simulated time in seconds")->capture_default_str();
@@ -146,7 +147,17 @@ Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not
   app.add_option("--ramp", o.ramp_deg_per_h2, "rate ramp R in deg/h/h")->capture_default_str();
   app.add_option("--dither", o.dither_arcsec, "dither amplitude in arcsec")->capture_default_str();
   app.add_option("--dither-hz", o.dither_hz, "dither frequency in Hz")->capture_default_str();
-  app.add_option("--seed", o.seed, "random seed (runs are reproducible)")->capture_default_str();
+  // CLI11 would wrap "-1" to 2^64 - 1: only plain decimal digits are a seed.
+  app.add_option("--seed", o.seed, "random seed 0..2^64-1 (runs are reproducible)")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](const std::string& text) {
+            const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+            return digits && (text.size() < 20 || (text.size() == 20 && text <= "18446744073709551615"))
+                       ? std::string()
+                       : "must be an integer 0..2^64-1, not '" + text + "'";
+          },
+          "SEED"));
   std::vector<std::string> segments;
   app.add_option("--segment", segments, "from T seconds on, change parameters: T:NAME=VALUE[,NAME=VALUE...]")
       ->option_text("T:NAME=VALUE");
@@ -162,14 +173,13 @@ Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return finish(program, app.exit(e));
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "gyrochar-sim: options: %s (see --help)\n", e.what());
-    return 2;
+    exit_with(exit_code::bad_input, program, "options", std::string(e.what()) + " (see --help)");
   }
   auto bad = [](const char* what, const char* why) {
-    std::fprintf(stderr, "gyrochar-sim: %s: %s\n", what, why);
-    return 2;
+    print_error(program, what, why);
+    return exit_code::bad_input;
   };
   for (const std::string& text : segments) {
     std::string why;
@@ -189,28 +199,25 @@ Exit codes: 0 success, 2 bad options, 3 cannot write, 4 the CAN interface is not
     try {
       sender = std::make_unique<CounterInputSender>(can_interface, static_cast<std::uint8_t>(can_node), p.tau0_s / speed);
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "gyrochar-sim: --can: %s\n", e.what());
-      return exit_no_interface;
+      exit_with(exit_code::no_hardware, program, e.what());  // "vcan0: why": the interface first
     }
   }
   FILE* f = out.empty() ? nullptr : out == "-" ? stdout : std::fopen(out.c_str(), "w");
-  if (!out.empty() && f == nullptr) {
-    std::fprintf(stderr, "gyrochar-sim: %s: cannot write: %s\n", out.c_str(), std::strerror(errno));
-    return 3;
-  }
+  if (!out.empty() && f == nullptr) exit_with(exit_code::output_failed, program, out, std::strerror(errno));
+  const std::string output_name = out == "-" ? "standard output" : out;
   if (f != nullptr)  // the description, then the machine-readable truth (sim_truth.hpp)
     std::fprintf(f, "%s\n%s\n", format_sim_description_line(o).c_str(), format_sim_truth_line(o).c_str());
   SimRun sim(o);
   if (sender) sender->send_next(0);  // the start: Count 0
   for (std::uint64_t k = 0; k < sim.samples(); ++k) {
     const std::int64_t count = sim.next_count();
-    if (f != nullptr) std::fprintf(f, "%lld\n", static_cast<long long>(count));
+    if (f != nullptr) {
+      std::fprintf(f, "%lld\n", static_cast<long long>(count));
+      if ((k & 0xFFFF) == 0 && std::ferror(f)) break;  // the output is lost: stop now, say so below
+    }
     if (sender) sender->send_next(count);
   }
   if (sender) std::fprintf(stderr, "gyrochar-sim: %s: %s\n", can_interface.c_str(), sender->summary().c_str());
-  if (f != nullptr && f != stdout && std::fclose(f) != 0) {
-    std::fprintf(stderr, "gyrochar-sim: %s: cannot write\n", out.c_str());
-    return 3;
-  }
-  return 0;
+  if (f != nullptr && f != stdout && !close_output(f, program, output_name)) return exit_code::output_failed;
+  return finish(program, exit_code::ok);
 }

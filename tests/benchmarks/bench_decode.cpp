@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "candump.hpp"
-#include "decode_session.hpp"
+#include "session.hpp"
 
 namespace {
 

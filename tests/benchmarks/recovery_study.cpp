@@ -1,7 +1,8 @@
 // recovery_study: how well the IEEE-952 fit recovers simulated gyros (tests/support/recovery.hpp):
 // per scenario and term, how often a term is resolved, how often a resolved term lies within one and
 // two of its stated standard uncertainties of the truth, and how often a term whose truth is zero
-// is called resolved. Markdown on stdout (toolchain/metrology.sh puts it into docs/metrology.md),
+// is called resolved; for the long-run scenarios also how the fits with TOTDEV and TheoH at long
+// tau compare with the one from OADEV alone. Markdown on stdout (toolchain/metrology.sh puts it into docs/metrology.md),
 // progress and the wall time on stderr.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -49,12 +50,16 @@ standard uncertainties; and runs where a term whose truth is zero is resolved ("
 
 Examples:
   recovery_study                 the full study (100 runs per scenario)
-  recovery_study --runs 20       a quick look)");
+  recovery_study --runs 20       a quick look
+  recovery_study --only long-run the long-run scenarios alone)");
   RecoverySettings s;
   app.add_option("--runs", s.runs, "runs per scenario")->capture_default_str()->check(CLI::Range(1, 100000));
   app.add_option("--workers", s.workers, "threads")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--seed", s.seed, "base seed (runs are reproducible)")->capture_default_str();
+  std::string only;
+  app.add_option("--only", only, "run only the scenarios whose name contains this text");
   CLI11_PARSE(app, argc, argv);
+  std::erase_if(s.scenarios, [&](const Scenario& sc) { return sc.name.find(only) == std::string::npos; });
 
   const auto start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
@@ -118,6 +123,26 @@ Examples:
                      present ? share(t.within1, real) : "-", present ? share(t.within2, real) : "-",
                      present ? "-" : share(t.false_resolved, t.runs));
     }
+    fmt::format_to(to, "\n");
+    if (!c.long_tau) continue;
+    fmt::format_to(to, "The same runs fitted with the Allan curve's long taus from the total family (docs/total.md): "
+                       "statistics over the runs where the term is resolved.");
+    for (std::size_t in = 0; in < c.by_long_tau.size(); ++in)
+      fmt::format_to(to, " {}: {} of {} fits ok, mean chi2/dof {:.2f}.", long_tau_names[in], c.long_tau_ok[in], c.runs,
+                     c.long_tau_chi2[in]);
+    fmt::format_to(to, "\n\n");
+    fmt::format_to(to, "| term | long taus from | resolved (%) | within 1 sigma (%) | within 2 sigma (%) | mean stated sigma / truth | rms error / truth |\n");
+    fmt::format_to(to, "|---|---|---:|---:|---:|---:|---:|\n");
+    for (std::size_t k = 2; k < 5; ++k)
+      for (std::size_t in = 0; in < c.by_long_tau.size(); ++in) {
+        const TermTally& t = c.by_long_tau[in][k];
+        const std::size_t real = t.resolved - t.false_resolved;
+        const double n = static_cast<double>(real);
+        fmt::format_to(to, "| {} | {} | {} | {} | {} | {} | {} |\n", term_names[k], long_tau_names[in], share(t.resolved, t.runs),
+                       share(t.within1, real), share(t.within2, real),
+                       real ? fmt::format("{:.3f}", t.sum_relative_uncertainty / n) : "-",
+                       real ? fmt::format("{:.3f}", std::sqrt(t.sum_squared_relative_error / n)) : "-");
+      }
     fmt::format_to(to, "\n");
   }
   if (std::fwrite(out.data(), 1, out.size(), stdout) != out.size() || std::fflush(stdout) != 0) {

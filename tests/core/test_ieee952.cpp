@@ -54,6 +54,25 @@ TEST(Ieee952, ExactCurvesGiveTheirParametersBack) {
   }
 }
 
+TEST(Ieee952, ATotalFamilyPointWeighsWithItsOwnVariance) {
+  // Oracle: with no model spread and exact points (chi2 = 0), the covariance of the points scales
+  // by variance_scale, so every uncertainty scales by its square root.
+  const auto exact = exact_points(truth);
+  auto scaled = exact;
+  for (FitPoint& p : scaled) p.variance_scale = 0.25;
+  const Ieee952Fit a = fit(exact, FitCurve::avar, 0, 0.0), b = fit(scaled, FitCurve::avar, 0, 0.0);
+  ASSERT_TRUE(a.ok() && b.ok());
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_NEAR(b.p[k].uncertainty / a.p[k].uncertainty, 0.5, 1e-6) << k;
+  // Only the long taus (where K dominates) more precise: K gains, Q does not.
+  auto longer = exact;
+  for (FitPoint& p : longer)
+    if (p.m >= 4096) p.variance_scale = 0.25;
+  const Ieee952Fit c = fit(longer, FitCurve::avar, 0, 0.0);
+  ASSERT_TRUE(c.ok());
+  EXPECT_LT(c.p[3].uncertainty, 0.8 * a.p[3].uncertainty);
+  EXPECT_NEAR(c.p[0].uncertainty / a.p[0].uncertainty, 1.0, 0.01);
+}
+
 TEST(Ieee952, TheModelsExactCurveTendsToTheStandardsClosedForm) {
   // At large m the exact expectation is IEEE 952's AVAR (oracle: the closed form in the standard).
   for (std::uint64_t m : {1u << 12, 1u << 16}) {

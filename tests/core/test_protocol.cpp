@@ -470,12 +470,13 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
   // Envelope, in the order decode() checks it.
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.error = true; }), ProtocolError::error_frame);
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.extended = false; }), ProtocolError::not_extended);
-  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.fd = true; }), ProtocolError::fd_frame);
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x14FF4411; }), ProtocolError::unknown_id);  // PGN
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x18FF4011; }), ProtocolError::unknown_id);  // priority
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id |= 0x20000000; }), ProtocolError::unknown_id); // > 29 bits
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x14FF40FE; }), ProtocolError::bad_address);
   EXPECT_EQ(decode_mutated(counter, [](CanFrame& f) { f.id = 0x0CFF50FF; }), ProtocolError::bad_address);
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.fd = true; }), ProtocolError::fd_frame);
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.fd = true, f.id = 0x14FF40FE; }), ProtocolError::bad_address);
   for (std::uint8_t len : {0, 6, 7, 9, 64}) {
     EXPECT_EQ(decode_mutated(adev, [&](CanFrame& f) { f.len = len; }), ProtocolError::wrong_length) << int(len);
   }
@@ -567,7 +568,7 @@ TEST(ProtocolDecode, VersionOneIeee952FramesStillDecode) {
 
 TEST(ProtocolDecode, RandomFramesNeverCrashAndAcceptedOnesAreCanonical) {
   // Half the frames are random, half are valid frames with 1 to 3 random bits flipped (in the data,
-  // the identifier, the length or the flags). Oracle: any frame decode() accepts must come back bit
+  // the identifier, the length or the flags: extended, FD). Oracle: any frame decode() accepts must come back bit
   // for bit from encode() of its message.
   std::mt19937_64 rng(20240611);
   const std::vector<Message> valid = typical_messages();
@@ -590,7 +591,8 @@ TEST(ProtocolDecode, RandomFramesNeverCrashAndAcceptedOnesAreCanonical) {
         if (where < 90) f.data[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
         else if (where < 96) f.id ^= 1u << (bit % 30);
         else if (where < 98) f.len = static_cast<std::uint8_t>(bit % 10);
-        else f.extended = !f.extended;
+        else if (where < 99) f.extended = !f.extended;
+        else f.fd = !f.fd;
       }
     }
     const Decoded d = decode(f);

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "board.hpp"
-#include "decode_session.hpp"
+#include "session.hpp"
 #include "dynamic.hpp"
 #include "hal/fake/fake_can_bus.hpp"
 #include "hal/fake/fake_clock.hpp"
@@ -85,7 +85,7 @@ TEST(DynamicEndToEnd, TheBoardTheDecoderAndTheAnalyzerSeeTheAngleRandomWalkDoubl
 
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> csv(std::tmpfile(), std::fclose), jsonl(std::tmpfile(), std::fclose);
   decoding::SessionOptions so;
-  so.rate_unit = decoding::RateUnit::native;  // arcsec/s, as the analyzer's counts of 1 arcsec
+  so.rate_unit = std::nullopt;  // native: arcsec/s, as the analyzer's counts of 1 arcsec
   so.csv = csv.get();
   so.jsonl = jsonl.get();
   decoding::Session session(so);

@@ -1,6 +1,6 @@
 // gyrochar-analyze as a user meets it: every kind of bad input gets one line
 // 'gyrochar-analyze: what: why' on stderr, nothing on stdout and exit code 2; good input gives the
-// documented formats and units. Oracles: the CLI contract in --help; unit identities; the
+// documented formats and units. Oracles: the exit codes of hal/exit_codes.hpp; unit identities; the
 // closed-form angle random walk of white rate noise (values themselves: test_analyze_reference).
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -11,13 +11,23 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
 #include <string>
+#include <vector>
+
+#include "hal/exit_codes.hpp"
+
+#include "gyrochar/total.hpp"
 
 namespace {
+
+using namespace gyrochar;
 
 const std::string tool = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-analyze";
 
@@ -50,7 +60,7 @@ std::string file_with(const std::string& name, const std::string& content) {
 
 void expect_bad_input(const std::string& args, const std::string& what) {
   const Outcome r = run(args);
-  EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+  EXPECT_EQ(r.code, exit_code::bad_input) << args << "\n" << r.err;
   static const std::regex one_line("gyrochar-analyze: [^\n]+: [^\n]+\n");
   EXPECT_TRUE(std::regex_match(r.err, one_line)) << "not 'gyrochar-analyze: what: why': " << r.err;
   EXPECT_NE(r.err.find(what), std::string::npos) << "expected '" << what << "' in: " << r.err;
@@ -89,6 +99,9 @@ TEST(AnalyzeCli, BadInputsGetExitCodeTwoAndAReason) {
   expect_bad_input("--type phase --tau0 1 /nonexistent/file.txt", "No such file");
   expect_bad_input("--type phase --tau0 1 --stats adev,foo " + good, "foo");
   expect_bad_input("--type phase --tau0 1 --stride-factor 6 " + good, "--stride-factor");
+  expect_bad_input("--type phase --tau0 1 --stats totdev --total-stride-factor 3 " + good, "--total-stride-factor");
+  expect_bad_input("--type phase --tau0 1 --fit-long-tau totdev " + good, "--fit-long-tau");  // needs --fit
+  expect_bad_input("--type phase --tau0 1 --fit ieee952 --fit-long-tau theo2 " + good, "--fit-long-tau");
   expect_bad_input("--type phase --tau0 1 --alpha 5 " + good, "--alpha");
   expect_bad_input("--type phase --tau0 1 --confidence 1.5 " + good, "--confidence");
   expect_bad_input("--type phase --tau0 1 --taus 4,2 " + good, "--taus");
@@ -115,17 +128,158 @@ TEST(AnalyzeCli, BadInputsGetExitCodeTwoAndAReason) {
   expect_bad_input("--type phase --tau0 1 " + dir, "directory");
 }
 
+// A deviation that is not a finite number is an error naming the statistic, the tau and the cause,
+// wherever it arises after reading: never inf, nan or null in the output.
+TEST(AnalyzeCli, NonFiniteResultsAreErrorsWithTheirCause) {
+  std::string huge;
+  for (int i = 0; i < 8; ++i) huge += i % 2 ? "-1e308\n" : "1e308\n";
+  expect_bad_input("--type phase --tau0 1 " + file_with("huge.txt", huge),
+                   "oadev at tau = 1 s (m = 1): the squared differences of the values overflow a double");
+  expect_bad_input("--type phase --tau0 1e-200 --format json " + good_phase(),
+                   "oadev at tau = 1e-200 s (m = 1): tau0^2 = (1e-200 s)^2 is outside the range of a double: tau0 is too small");
+  // Finite deviations, but the output unit takes them out of range (1e308 arcsec pulses in deg/h).
+  expect_bad_input("--type counts --pulse-weight 1e308arcsec --tau0 1 " + file_with("c.txt", "100\n-100\n100\n-100\n100\n"),
+                   "oadev at tau = 1 s (m = 1): ");
+}
+
+TEST(AnalyzeCli, EachStatisticOnceAndListedTausTooLongForTheDataGetANote) {
+  expect_bad_input("--type phase --tau0 1 --stats oadev,oadev " + good_phase(), "--stats: 'oadev' is asked twice");
+  // 200 phase points: oadev needs 2m + 1 (m = 90 fits), mdev 3m + 1 (m = 90 does not), m = 1000 neither.
+  const Outcome r = run("--type phase --tau0 1 --taus 1,90,1000 --format csv " + good_phase());
+  EXPECT_EQ(r.code, exit_code::ok) << r.err;
+  EXPECT_EQ(r.err,
+            "gyrochar-analyze: note: m = 90 (tau = 90 s) left out of mdev: 200 phase points are too few for a term\n"
+            "gyrochar-analyze: note: m = 1000 (tau = 1000 s) left out of oadev, mdev: 200 phase points are too few for a "
+            "term\n");
+  EXPECT_NE(r.out.find("\noadev,90,"), std::string::npos) << r.out;
+  // Generated lists stop where the data end: no note.
+  EXPECT_EQ(run("--type phase --tau0 1 " + good_phase()).err, "");
+}
+
+// --kalibr writes the recommended fit's N and K in SI: the JSON's N [deg/sqrt(h)] times
+// (pi/180) / 60 and K [deg/h/sqrt(h)] times (pi/180) / 3600 / 60 (closed forms, kalibr.hpp).
+TEST(AnalyzeCli, KalibrYamlHoldsTheFitsNAndKInSI) {
+  const std::string counts = temp("sim_counts.txt"), yaml = temp("imu.yaml");
+  ASSERT_EQ(std::system((GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim --duration 2000 --tau0 0.01 --arw 0.003 "
+                         "--rrw 0.5 --white-angle 2 --seed 3 --out " + counts).c_str()), 0);
+  const Outcome r = run("--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --format json --kalibr " + yaml +
+                        " " + counts);
+  ASSERT_EQ(r.code, exit_code::ok) << r.err;
+  const auto fit = nlohmann::json::parse(r.out)["fit"][0];
+  ASSERT_EQ(fit["curve"], "both");
+  std::ifstream in(yaml);
+  std::map<std::string, double> keys;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#' && line.rfind("rostopic", 0) != 0)
+      keys[line.substr(0, line.find(':'))] = std::stod(line.substr(line.find(':') + 1));
+  const double pi = 3.14159265358979323846;
+  EXPECT_NEAR(keys.at("gyroscope_noise_density") / (fit["N"]["value"].get<double>() * pi / 180 / 60), 1.0, 1e-12);
+  EXPECT_NEAR(keys.at("gyroscope_random_walk") / (fit["K"]["value"].get<double>() * pi / 180 / 3600 / 60), 1.0, 1e-12);
+  EXPECT_EQ(keys.at("update_rate"), 100.0);
+
+  expect_bad_input("--type counts --tau0 0.01 --pulse-weight 1arcsec --kalibr " + yaml + " " + counts,
+                   "--kalibr: needs --fit ieee952");
+  expect_bad_input("--type phase --tau0 1 --fit ieee952 --kalibr " + yaml + " " + good_phase(),
+                   "--kalibr: needs gyro data");
+}
+
+// --format stable32 against the layout of Stable32's own file for PHASE.DAT (../shared/refdata):
+// the same header lines but the file's name, the same column line, every row in the same columns
+// with AF, Tau and # equal, Sigma within Stable32's 5 printed digits. (Min/Max Sigma: gyrochar's
+// intervals use the exact EDF, Stable32's Greenhall's approximation: within 5 % here.)
+TEST(AnalyzeCli, Stable32TablesHaveStable32sLayout) {
+  for (const std::string stat : {"oadev", "mdev"}) {
+    const Outcome r = run("--type phase --tau0 1 --alpha 0 --format stable32 --stats " + stat + " " GYROCHAR_REFDATA
+                          "/phasedat/PHASE.DAT");
+    ASSERT_EQ(r.code, exit_code::ok) << r.err;
+    std::ifstream ref(GYROCHAR_REFDATA "/phasedat/phase_dat_" + stat + "_octave.txt");
+    std::vector<std::string> want, got;
+    for (std::string line; std::getline(ref, line);) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      if (!want.empty() || line.rfind("# STATISTICS", 0) == 0) want.push_back(line);  // from the header on
+    }
+    std::istringstream out(r.out);
+    for (std::string line; std::getline(out, line);) got.push_back(line);
+    ASSERT_GE(got.size(), 10u);
+    EXPECT_EQ(got[0], "# STATISTICS FOR FILE: PHASE.DAT");
+    for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(got[i], want[i]) << stat << " header line " << i;
+    std::size_t compared = 0;
+    for (std::size_t i = 10; i < want.size(); ++i) {
+      const auto row = std::find_if(got.begin() + 10, got.end(), [&](const std::string& g) { return g.substr(0, 5) == want[i].substr(0, 5); });
+      if (row == got.end()) continue;
+      ++compared;
+      ASSERT_EQ(row->size(), want[i].size()) << *row << "\n" << want[i];
+      for (std::size_t c = 0; c < row->size(); ++c)  // fields end in the same columns
+        EXPECT_EQ((*row)[c] == ' ', want[i][c] == ' ') << stat << ": column " << c << "\n" << *row << "\n" << want[i];
+      EXPECT_EQ(row->substr(0, 33), want[i].substr(0, 33)) << "AF, Tau, #, Alpha";
+      std::istringstream g(*row), w(want[i]);
+      double gv[7], wv[7];
+      for (int k = 0; k < 7; ++k) g >> gv[k], w >> wv[k];
+      EXPECT_NEAR(gv[5] / wv[5], 1.0, 1e-4) << *row;
+      EXPECT_NEAR(gv[4] / wv[4], 1.0, 0.05) << *row;
+      EXPECT_NEAR(gv[6] / wv[6], 1.0, 0.05) << *row;
+    }
+    EXPECT_GE(compared, 8u) << stat;
+  }
+}
+
 TEST(AnalyzeCli, HelpHasExamplesAndExitCodes) {
   const Outcome r = run("--help");
   EXPECT_EQ(r.code, 0);
-  for (const char* part : {"Examples:", "Exit codes:", "--type", "--pulse-weight", "--stride-factor", "2^16"})
+  for (const char* part : {"Examples:", exit_code::help, "--type", "--pulse-weight", "--stride-factor", "2^16"})
     EXPECT_NE(r.out.find(part), std::string::npos) << part;
 }
 
-TEST(AnalyzeCli, UnwritableOutputIsExitCodeThree) {
+TEST(AnalyzeCli, TotalFamilyInEveryFormat) {
+  // 20000 counts of white rate noise (white FM): every statistic of the family gives rows in the
+  // table, CSV and JSON. Oracles: white FM's TOTDEV, MTOTDEV and Theo1 follow ADEV's 1/sqrt(tau)
+  // shape (SP 1065: all of them estimate it, Theo1 at tau = 0.75 m tau0) and their unbiased
+  // expectation at m = 1 is 2 pulses / 1 ms = ADEV; ttotdev is in the angle unit.
+  std::string s;
+  for (const int c : white_rate_counts()) s += std::to_string(c) + "\n";
+  const std::string path = file_with("white_total.txt", s);
+  const std::string args = "--type counts --tau0 0.001 --pulse-weight 1arcsec --rate-unit deg/h "
+                           "--stats oadev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh ";
+  const Outcome table = run(args + path);
+  ASSERT_EQ(table.code, 0) << table.err;
+  for (const char* stat : {"\ntotdev ", "\nmtotdev ", "\nttotdev ", "\nhtotdev ", "\ntheo1 ", "\ntheoh "})
+    EXPECT_NE(table.out.find(stat), std::string::npos) << stat;
+  const Outcome csv = run(args + "--format csv " + path);
+  ASSERT_EQ(csv.code, 0) << csv.err;
+  EXPECT_NE(csv.out.find("\nttotdev,1,0.001,"), std::string::npos);
+  EXPECT_NE(csv.out.find(",arcsec,"), std::string::npos) << "ttotdev in the angle unit";
+  const Outcome js = run(args + "--format json " + path);
+  ASSERT_EQ(js.code, 0) << js.err;
+  const auto j = nlohmann::json::parse(js.out);
+  std::map<std::string, std::vector<nlohmann::json>> by_stat;
+  for (const auto& row : j["results"]) by_stat[row["stat"]].push_back(row);
+  for (const char* stat : {"totdev", "mtotdev", "ttotdev", "htotdev", "theo1", "theoh"}) EXPECT_GT(by_stat[stat].size(), 5u) << stat;
+  const double adev1 = by_stat["oadev"][0]["dev"];  // deg/h at m = 1
+  EXPECT_NEAR(by_stat["totdev"][0]["dev"].get<double>() / adev1, 1.0, 0.02);
+  for (const auto& row : by_stat["theo1"]) {  // 1/sqrt(tau) from ADEV at m = 1, within 25 % (EDF >= 30 here)
+    const double want = adev1 / std::sqrt(row["tau"].get<double>() / 0.001);
+    if (row["edf"].get<double>() > 30) {
+      EXPECT_NEAR(row["dev"].get<double>() / want, 1.0, 0.25) << row["m"];
+    }
+    EXPECT_DOUBLE_EQ(row["tau"].get<double>(), 0.75 * row["m"].get<double>() * 0.001);
+  }
+  // Each row says which estimator made it: the plan of core/total.hpp (its own test), exact below
+  // 2^26 operations (mtotdev and htotdev to m = 128 here, theo1 at every m), blocks of m/16 beyond.
+  for (const auto& [stat, rows] : by_stat)
+    for (const auto& row : rows) {
+      const std::uint64_t m = row["m"];
+      const std::uint64_t want = stat == "mtotdev" || stat == "ttotdev" || stat == "htotdev" ? gyrochar::total_block(m, 20001, 16)
+                                 : stat == "theo1" || (stat == "theoh" && row["tau"] != m * 0.001) ? gyrochar::theo1_stride(m, 20001, 16)
+                                                                                                   : 1;
+      EXPECT_EQ(row["stride"].get<std::uint64_t>(), want) << stat << " m=" << m;
+    }
+  EXPECT_EQ(by_stat["mtotdev"].back()["stride"], 256) << "m = 4096: blocks of 256";
+}
+
+TEST(AnalyzeCli, UnwritableOutputIsOutputFailed) {
   const Outcome r = run("--type phase --tau0 1 " + good_phase() + " > /dev/full");
-  EXPECT_EQ(r.code, 3) << r.err;
-  EXPECT_EQ(r.err.rfind("gyrochar-analyze: output: ", 0), 0u) << r.err;
+  EXPECT_EQ(r.code, exit_code::output_failed) << r.err;
+  EXPECT_EQ(r.err, "gyrochar-analyze: standard output: write failed: No space left on device\n");
 }
 
 TEST(AnalyzeCli, JsonHasTheDocumentedShape) {
@@ -218,6 +372,19 @@ TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
   EXPECT_NE(table.out.find("IEEE-952 fit of both curves (recommended)"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("IEEE-952 fit of the Allan curve alone"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("deg/sqrt(h)"), std::string::npos) << table.out;
+  // With TOTDEV or TheoH at long tau (docs/metrology.md): the same closed form, and the fit says
+  // what its Allan curve was made of.
+  for (const char* input : {"totdev", "theoh"}) {
+    const Outcome t = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 --format json "
+                          "--fit-long-tau " + std::string(input) + " " + temp("white.txt"));
+    ASSERT_EQ(t.code, 0) << t.err;
+    const auto k = nlohmann::json::parse(t.out);
+    EXPECT_EQ(k["fit"][0]["long_tau"], input);
+    EXPECT_EQ(k["fit"][2]["long_tau"], "oadev");  // the modified Allan curve alone has no Allan points
+    const auto& n = k["fit"][0]["N"];
+    ASSERT_TRUE(n["resolved"].get<bool>()) << input;
+    EXPECT_NEAR(n["value"].get<double>(), n_true, 3 * n["uncertainty"].get<double>()) << input;
+  }
 }
 
 TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {

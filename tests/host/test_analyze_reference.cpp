@@ -9,6 +9,7 @@
 // where both use the lag-1 rule.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -35,18 +36,31 @@ struct Stable32Row {
   double min = 0, sigma = 0, max = 0;
 };
 
-std::vector<Stable32Row> read_stable32(const std::string& path) {
+// commented: also the rows the files keep behind a '#' (the longest taus of some total-family files).
+std::vector<Stable32Row> read_stable32(const std::string& path, bool commented = false) {
   std::ifstream in(path);
   EXPECT_TRUE(in) << path;
   std::vector<Stable32Row> rows;
   for (std::string line; std::getline(in, line);) {
+    if (commented && line.size() > 1 && line[0] == '#' && std::isdigit(static_cast<unsigned char>(line[line.find_first_not_of("# ")])))
+      line = line.substr(1);
     if (line.empty() || line[0] == '#') continue;
     std::istringstream ss(line);
     Stable32Row r;
-    double tau = 0;
-    if (ss >> r.m >> tau >> r.n >> r.alpha >> r.min >> r.sigma >> r.max) rows.push_back(r);
+    double tau = 0, n = 0;  // Theo1 prints # as 4.9550e+03
+    if (ss >> r.m >> tau >> n >> r.alpha >> r.min >> r.sigma >> r.max) {
+      r.n = static_cast<std::uint64_t>(std::llround(n));
+      rows.push_back(r);
+    }
   }
   return rows;
+}
+
+// n as Stable32 prints it: to 5 significant digits, halves rounded up (102245 -> 1.0225e+05).
+std::uint64_t printed(std::uint64_t n) {
+  std::uint64_t unit = 1;
+  while (n / unit >= 100000) unit *= 10;
+  return (n + unit / 2) / unit * unit;
 }
 
 std::vector<double> read_values(const std::string& path) {
@@ -62,9 +76,11 @@ Analysis run(const std::vector<double>& values, DataType type, DevStat stat, std
   o.edf = edf;
   o.type = type;
   o.tau0_s = 1.0;
+  o.theo_m_list = m_list;  // Theo1 and TheoBR rows at the file's averaging factors
   o.m_list = std::move(m_list);
   o.stats = {stat};
   o.alpha = alpha;
+  o.total_stride_factor = 0;  // the exact estimators
   Analyzer analyzer(o);
   for (const double v : values) analyzer.add(v);
   return analyzer.result();
@@ -79,12 +95,17 @@ const AnalysisRow* find(const Analysis& a, std::uint64_t m) {
 struct Tolerance {
   double dev = 1e-4;
   double ci = 1e-3;
+  bool commented = false;  // compare the '#' rows too
+  // Rows whose bounds must be within `ci`; the others (where Stable32's EDF is not the one gyrochar
+  // uses, documented in docs/total.md) within `departure`.
+  std::function<bool(const Stable32Row&)> ci_where = [](const Stable32Row&) { return true; };
+  double departure = 0;
 };
 
 // Every row of a Stable32 file: n, deviation and (where the file has them) the CI bounds computed
 // with the file's alpha. Returns the engine's automatic analysis of the same taus.
 Analysis compare(const std::vector<double>& values, DataType type, DevStat stat, const std::string& file, Tolerance tol) {
-  const auto rows = read_stable32(file);
+  const auto rows = read_stable32(file, tol.commented);
   EXPECT_FALSE(rows.empty()) << file;
   std::vector<std::uint64_t> m_list;
   for (const auto& r : rows) m_list.push_back(r.m);
@@ -97,12 +118,13 @@ Analysis compare(const std::vector<double>& values, DataType type, DevStat stat,
       ADD_FAILURE() << file << " m=" << r.m << " missing";
       continue;
     }
-    EXPECT_EQ(got->n, r.n) << file << " m=" << r.m;
+    EXPECT_EQ(printed(got->n), printed(r.n)) << file << " m=" << r.m;  // exact below 10^5
     EXPECT_NEAR(got->dev / r.sigma, 1.0, tol.dev) << file << " m=" << r.m;
     if (r.min > 0) {
       EXPECT_TRUE(got->ci.valid) << file << " m=" << r.m;
-      EXPECT_NEAR(got->ci.low / r.min, 1.0, tol.ci) << file << " m=" << r.m << " low";
-      EXPECT_NEAR(got->ci.high / r.max, 1.0, tol.ci) << file << " m=" << r.m << " high";
+      const double t = tol.ci_where(r) ? tol.ci : tol.departure;
+      EXPECT_NEAR(got->ci.low / r.min, 1.0, t) << file << " m=" << r.m << " low";
+      EXPECT_NEAR(got->ci.high / r.max, 1.0, t) << file << " m=" << r.m << " high";
     }
   }
   return run(values, type, stat, m_list);
@@ -212,6 +234,42 @@ TEST(Stable32, KeysightNoiseIdentificationAtEveryAveragingFactor) {
   EXPECT_GE(agree, 222);
 }
 
+// The total and Theo family (docs/total.md): every row of Stable32's files, the '#' rows included,
+// with Stable32's alpha: deviations within 1e-4 (2e-3 OCXO octave), n exact (Theo1's as printed).
+// Intervals from NIST SP 1065's EDF formulas within 1e-2 of Stable32's where Stable32 uses them:
+// TOTDEV (white, flicker, random-walk FM), HTOTDEV for alpha <= 0 (table 9 from m = 16, the OHDEV
+// estimate's EDF below), MTOTDEV and TTOTDEV up to m = 16. Elsewhere Stable32's EDF is not SP
+// 1065's (inverted from its bounds: about 1.33 N/m - 1.9 for MTOTDEV at white FM where table 8 has
+// 1.10 N/m - 1.2; for TOTDEV and HTOTDEV at flicker PM, where SP 1065 has no formula and gyrochar
+// takes the Allan-family estimate's exact EDF): there the bounds depart by up to the amounts below,
+// measured, the largest at the longest taus.
+TEST(Stable32, TotalFamilyOnPhaseDat) {
+  const auto x = read_values(ref + "/phasedat/PHASE.DAT");
+  const std::string dir = ref + "/phasedat/phase_dat_";
+  Tolerance tol{1e-4, 1e-2, true};
+  for (const char* f : {"totdev", "totdev_octave"}) compare(x, DataType::phase, DevStat::totdev, dir + f + ".txt", tol);
+  tol.ci_where = [](const Stable32Row& r) { return r.alpha <= 0; };
+  tol.departure = 0.035;  // measured 3.1 % (alpha 1, m = 256)
+  for (const char* f : {"htotdev_octave", "htotdev_octave_nobias"}) compare(x, DataType::phase, DevStat::htotdev, dir + f + ".txt", tol);
+  tol.ci_where = [](const Stable32Row& r) { return r.m <= 16; };
+  tol.departure = 0.07;  // measured 6.4 % (m = 200, alpha 1)
+  for (const char* f : {"mtotdev_octave", "mtotdev_octave_alpha0", "mtotdev_decade"})
+    compare(x, DataType::phase, DevStat::mtotdev, dir + f + ".txt", tol);
+  for (const char* f : {"ttotdev_octave", "ttotdev_decade"}) compare(x, DataType::phase, DevStat::ttotdev, dir + f + ".txt", tol);
+  for (const char* f : {"theo1_alpha0", "theo1_alpha0_decade"}) compare(x, DataType::phase, DevStat::theo1, dir + f + ".txt", tol);
+}
+
+TEST(Stable32, TotdevOnTheOcxoAndKeysightSets) {
+  const auto y = ocxo_fractional_frequency();
+  compare(y, DataType::freq, DevStat::totdev, ref + "/ocxo/stable32_totdev_alltau.txt", {5e-5, 0});
+  compare(y, DataType::freq, DevStat::totdev, ref + "/ocxo/totdev_octave.txt", {2e-3, 1e-2});
+  Tolerance tol{1e-4, 1e-2};
+  tol.ci_where = [](const Stable32Row& r) { return r.alpha != 1; };
+  tol.departure = 0.02;  // measured 1.5 % (m = 4096)
+  compare(read_values(ref + "/Keysight53230A_ti_noise_floor/tic_phase.txt"), DataType::phase, DevStat::totdev,
+          ref + "/Keysight53230A_ti_noise_floor/tic_totdev.txt", tol);
+}
+
 // NIST SP 1065 values from a *_expected.csv: {stat -> deviations at the file's m}.
 std::map<DevStat, std::vector<double>> read_expected(const std::string& path, std::size_t columns) {
   std::ifstream in(path);
@@ -223,16 +281,16 @@ std::map<DevStat, std::vector<double>> read_expected(const std::string& path, st
     std::string field;
     std::getline(ss, field, ',');
     const auto stat = parse_dev_stat(field);
-    if (!stat) continue;  // header, totdev and the other statistics the engine does not have
+    if (!stat) continue;  // header, and the statistics the engine does not have
     for (std::size_t k = 0; k < columns && std::getline(ss, field, ','); ++k) out[*stat].push_back(std::stod(field));
   }
   return out;
 }
 
 void expect_nist(const std::vector<double>& values, DataType type, const std::string& expected_csv,
-                 const std::vector<std::uint64_t>& m_list) {
+                 const std::vector<std::uint64_t>& m_list, std::size_t statistics) {
   const auto expected = read_expected(expected_csv, m_list.size());
-  EXPECT_EQ(expected.size(), 6u) << expected_csv;  // all six statistics are in the table
+  EXPECT_EQ(expected.size(), statistics) << expected_csv;  // every statistic of the table the engine has
   for (const auto& [stat, devs] : expected) {
     ASSERT_EQ(devs.size(), m_list.size());
     const Analysis a = run(values, type, stat, m_list, 0);
@@ -248,13 +306,15 @@ TEST(NistSp1065, Nbs14TenPointPhaseAndNinePointFrequency) {
   // The 9 frequency values are the differences of the 10 phase values plus a constant, which no
   // statistic sees: both reproduce the same table (NIST SP 1065 NBS14, m = 1 and 2).
   const std::string expected = ref + "/nbs14/nbs14_10point_expected.csv";
-  expect_nist(read_values(ref + "/nbs14/nbs14_10point_phase.txt"), DataType::phase, expected, {1, 2});
-  expect_nist(read_values(ref + "/nbs14/nbs14_10point_freq.txt"), DataType::freq, expected, {1, 2});
+  // The six Allan-family statistics and TOTDEV, MTOTDEV, TTOTDEV, HTOTDEV (HTOTDEV at m = 2 with the
+  // white-FM bias correction the table's value carries).
+  expect_nist(read_values(ref + "/nbs14/nbs14_10point_phase.txt"), DataType::phase, expected, {1, 2}, 10);
+  expect_nist(read_values(ref + "/nbs14/nbs14_10point_freq.txt"), DataType::freq, expected, {1, 2}, 10);
 }
 
 TEST(NistSp1065, Nbs14ThousandPointFrequency) {
   expect_nist(read_values(ref + "/nbs14/nbs14_1000point_freq.txt"), DataType::freq,
-              ref + "/nbs14/nbs14_1000point_expected.csv", {1, 10, 100});
+              ref + "/nbs14/nbs14_1000point_expected.csv", {1, 10, 100}, 8);
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "candump.hpp"
 #include "confidence.hpp"
 #include "gyrochar/protocol.hpp"
+#include "hal/exit_codes.hpp"
 
 namespace gyrochar {
 namespace {
@@ -621,10 +622,10 @@ TEST(DecodeCli, TruncatedLogClosesItsLastReportWithTheMissingFramesShown) {
   }
 }
 
-TEST(DecodeCli, BadInvocationsExitTwoWithWhatAndWhy) {
-  const auto expect_bad = [](const std::string& args, const std::string& first_line) {
+TEST(DecodeCli, BadInvocationsAreBadInputWithWhatAndWhy) {
+  const auto expect_bad = [](const std::string& args, const std::string& first_line, int code = exit_code::bad_input) {
     const Outcome r = run(args);
-    EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.code, code) << args << "\n" << r.err;
     EXPECT_EQ(r.err.rfind(first_line, 0), 0u) << "expected '" << first_line << "' first in: " << r.err;
     EXPECT_TRUE(r.out.empty()) << "no data on stdout after an error";
   };
@@ -640,25 +641,29 @@ TEST(DecodeCli, BadInvocationsExitTwoWithWhatAndWhy) {
   expect_bad("x.log --view sometimes", "gyrochar-decode: --view: 'sometimes' is not live, final or none");
   expect_bad("x.log --plot-every 10", "gyrochar-decode: --plot-every: needs --plot PREFIX");
   expect_bad("x.log --csv /nonexistent/dir/out.csv",
-             "gyrochar-decode: /nonexistent/dir/out.csv: No such file or directory");
+             "gyrochar-decode: /nonexistent/dir/out.csv: No such file or directory", exit_code::output_failed);
   expect_bad("x.log --plot /nonexistent/dir/plot",
-             "gyrochar-decode: /nonexistent/dir/plot.svg.part: No such file or directory");
+             "gyrochar-decode: /nonexistent/dir/plot.svg.part: No such file or directory", exit_code::output_failed);
+  const std::string empty = temp("empty.log");
+  std::ofstream{empty};
+  expect_bad(empty + " --view none", "gyrochar-decode: " + empty + ": empty: no candump log line\n");
   const std::string garbage = temp("garbage.log");
   std::ofstream(garbage) << "hello\nworld\n";
   const Outcome all_bad = run(garbage + " --view none");
-  EXPECT_EQ(all_bad.code, 2);
+  EXPECT_EQ(all_bad.code, exit_code::bad_input);
   EXPECT_TRUE(contains(all_bad.err, "gyrochar-decode: " + garbage + ": none of its 2 lines is a candump log line\n"))
       << all_bad.err;
   const Outcome help = run("--help");
   EXPECT_EQ(help.code, 0);
   EXPECT_TRUE(contains(help.out, "Examples:"));
-  EXPECT_TRUE(contains(help.out, "Exit codes: 0"));
+  EXPECT_TRUE(contains(help.out, exit_code::help));
 }
 
-TEST(DecodeCli, MissingInterfaceExitsThree) {
+TEST(DecodeCli, MissingInterfaceIsNoHardwareNamedByItsName) {
   const Outcome r = run("--interface nosuchcan7 --view none --duration 0.1");
-  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_EQ(r.code, exit_code::no_hardware) << r.err;
   EXPECT_EQ(r.err.rfind("gyrochar-decode: nosuchcan7: ", 0), 0u) << r.err;
+  EXPECT_FALSE(contains(r.err, "nosuchcan7: nosuchcan7")) << r.err;
 }
 
 TEST(DecodeCli, PlotFilesAreWrittenForEveryNode) {

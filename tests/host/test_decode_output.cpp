@@ -1,6 +1,6 @@
-// The pieces behind gyrochar-decode's outputs (decode_output.hpp, decode_session.hpp): units,
-// memoized confidence intervals, which values a closed report really carried, the plot's IEEE-952
-// lines and read-off points, and the line reader. Oracles: closed forms (1 rad = 180/pi deg,
+// The pieces behind gyrochar-decode's outputs (display_units, confidence, decoder's slot table,
+// rows, view, plot_data, session): units, memoized confidence intervals, which values a closed
+// report really carried, the plot's IEEE-952 lines and read-off points, and the line reader. Oracles: closed forms (1 rad = 180/pi deg,
 // 1 h = 3600 s; the IEEE Std 952 AVAR terms of the design brief section 3), confidence.hpp
 // (Boost.Math chi-squared, NIST SP 1065 eq. 45) and values the test encodes with the codec.
 #include <gtest/gtest.h>
@@ -8,11 +8,13 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include "decode_output.hpp"
-#include "decode_session.hpp"
+#include "plot_data.hpp"
+#include "session.hpp"
+#include "view.hpp"
 
 namespace gyrochar::decoding {
 namespace {
@@ -32,10 +34,10 @@ void expect_rel(double got, double want, double rel = 1e-15) { EXPECT_NEAR(got, 
 
 TEST(DecodeOutput, UnitsConvertAnglesButNeverPulses) {
   // 1 arcsec/s = (1/3600) deg/s = 3600/3600 deg/h.
-  Units u = units_for(node_in(AngleUnit::arcsec), RateUnit::deg_per_h);
+  Units u = units_for(node_in(AngleUnit::arcsec), rate_unit("deg/h"));
   EXPECT_EQ(u.rate_name, "deg/h");
   expect_rel(u.rate, 1.0);
-  u = units_for(node_in(AngleUnit::rad), RateUnit::deg_per_h);
+  u = units_for(node_in(AngleUnit::rad), rate_unit("deg/h"));
   expect_rel(u.rate, rad_to_deg * 3600.0);
   // IEEE-952 terms from rad and s: Q arcsec, N deg/sqrt(h) = 60 deg/sqrt(s), B deg/h,
   // K deg/h/sqrt(h) = 3600^1.5 deg/s^1.5, R deg/h/h = 3600^2 deg/s^2.
@@ -46,25 +48,25 @@ TEST(DecodeOutput, UnitsConvertAnglesButNeverPulses) {
     expect_rel(u.ieee[k], gyro[k]);
     EXPECT_EQ(u.ieee_name[k], names[k]);
   }
-  u = units_for(node_in(AngleUnit::rad), RateUnit::deg_per_s);
+  u = units_for(node_in(AngleUnit::rad), rate_unit("deg/s"));
   EXPECT_EQ(u.rate_name, "deg/s");
   expect_rel(u.rate, rad_to_deg);
-  u = units_for(node_in(AngleUnit::urad), RateUnit::rad_per_s);
+  u = units_for(node_in(AngleUnit::urad), rate_unit("rad/s"));
   EXPECT_EQ(u.rate_name, "rad/s");
   expect_rel(u.rate, 1e-6);
-  u = units_for(node_in(AngleUnit::deg), RateUnit::native);
+  u = units_for(node_in(AngleUnit::deg), DisplayRate{});
   EXPECT_EQ(u.rate_name, "deg/s");
   EXPECT_EQ(u.rate, 1.0);
   EXPECT_EQ(u.ieee_name[1], "deg/sqrt(s)");
 
-  u = units_for(node_in(AngleUnit::pulse), RateUnit::deg_per_h);
+  u = units_for(node_in(AngleUnit::pulse), rate_unit("deg/h"));
   EXPECT_TRUE(u.pulses);
   EXPECT_EQ(u.rate_name, "pulse/s");
   EXPECT_EQ(u.rate, 1.0);
   for (std::size_t k = 0; k < 5; ++k) EXPECT_EQ(u.ieee[k], 1.0);
   EXPECT_EQ(u.ieee_name[3], "pulse/s/sqrt(s)");
 
-  u = units_for(NodeView{}, RateUnit::deg_per_h);  // no metadata yet: shown as sent, unit unknown
+  u = units_for(NodeView{}, rate_unit("deg/h"));  // no metadata yet: shown as sent, unit unknown
   EXPECT_FALSE(u.known);
   EXPECT_EQ(u.rate_name, "unknown");
   EXPECT_EQ(u.rate, 1.0);
@@ -96,20 +98,25 @@ CanFrame frame_of(const Message& m, std::uint8_t node) {
   return f;
 }
 
-TEST(DecodeOutput, TrackerAndRowsTellMissingFromInvalidFromOk) {
-  ReportTracker tracker;
-  tracker.note(frame_of(StatusMsg{5, NodeState::running, 3, 500}, 0x12), 10.0);
-  tracker.note(frame_of(TauDevMsg{5, 0, DevKind::adev, 2.0f, 16.0, NoiseType::white_fm, true}, 0x12), 10.1);
-  tracker.note(frame_of(TauDevMsg{5, 0, DevKind::mdev, 1.0f, 8.0, NoiseType::white_fm, true}, 0x12), 10.2);
-  tracker.note(frame_of(TauDevMsg{5, 1, DevKind::adev, 0.0f, 0.0, NoiseType::not_identified, false}, 0x12), 10.3);
-  tracker.note(frame_of(TauDevMsg{9, 2, DevKind::adev, 1.0f, 4.0, NoiseType::white_fm, true}, 0x13),
+TEST(DecodeOutput, TheDecodersSlotTableAndRowsTellMissingFromInvalidFromOk) {
+  std::optional<Decoder::Report> closed;  // the slot table as the report_closed listener sees it
+  Decoder decoder([&](DecoderEvent e, const NodeView& node, std::uint8_t) {
+    if (e == DecoderEvent::report_closed && node.address == 0x12) closed = *decoder.report(0x12);
+  });
+  decoder.feed(frame_of(StatusMsg{5, NodeState::running, 3, 500}, 0x12), 10.0);
+  decoder.feed(frame_of(TauDevMsg{5, 0, DevKind::adev, 2.0f, 16.0, NoiseType::white_fm, true}, 0x12), 10.1);
+  decoder.feed(frame_of(TauDevMsg{5, 0, DevKind::mdev, 1.0f, 8.0, NoiseType::white_fm, true}, 0x12), 10.2);
+  decoder.feed(frame_of(TauDevMsg{5, 1, DevKind::adev, 0.0f, 0.0, NoiseType::not_identified, false}, 0x12), 10.3);
+  decoder.feed(frame_of(TauDevMsg{9, 2, DevKind::adev, 1.0f, 4.0, NoiseType::white_fm, true}, 0x13),
                10.4);  // other node
-  const ReportTracker::Report& r = tracker.report(0x12);
-  EXPECT_TRUE(r.open);
+  decoder.flush();
+  ASSERT_TRUE(closed.has_value());
+  const Decoder::Report& r = *closed;
   EXPECT_EQ(r.seq, 5);
   EXPECT_EQ(r.start_s, 10.0);
-  EXPECT_TRUE(r.adev[0] && r.mdev[0] && r.adev[1]);
-  EXPECT_FALSE(r.mdev[1] || r.adev[2] || r.mdev[2]);
+  EXPECT_TRUE(r.received(Slot::adev, 0) && r.received(Slot::mdev, 0) && r.received(Slot::adev, 1));
+  EXPECT_FALSE(r.received(Slot::mdev, 1) || r.received(Slot::adev, 2) || r.received(Slot::mdev, 2));
+  EXPECT_FALSE(r.received(Slot::adev, 3));  // beyond the report's TauCount: not in its schedule
 
   // The view holds stale values for tau 2 (from an earlier report): the row must not show them.
   NodeView v = node_in(AngleUnit::arcsec);
@@ -121,7 +128,7 @@ TEST(DecodeOutput, TrackerAndRowsTellMissingFromInvalidFromOk) {
   v.taus[2] = {4, 0, 99, {true, 9.0f, 4.0, NoiseType::white_fm, true}, {true, 9.0f, 4.0, NoiseType::white_fm, true}};
   ConfidenceIntervals intervals(0.683);
   std::vector<TauRow> rows;
-  tau_rows(v, r, units_for(v, RateUnit::native), intervals, rows);
+  tau_rows(v, r, units_for(v, DisplayRate{}), intervals, rows);
   ASSERT_EQ(rows.size(), 3u);
   EXPECT_EQ(rows[0].adev.status, DevCell::Status::ok);
   EXPECT_EQ(rows[0].adev.value, 2.0);
@@ -137,10 +144,10 @@ TEST(DecodeOutput, TrackerAndRowsTellMissingFromInvalidFromOk) {
   EXPECT_EQ(rows[2].mdev.status, DevCell::Status::missing);
   EXPECT_FALSE(rows[2].adev.ci.valid);
 
-  tracker.close(0x12);
-  tracker.note(frame_of(StatusFaultsMsg{5, 0, 0, 0, 0}, 0x12), 11.0);  // same seq after a close: a new report
-  EXPECT_EQ(tracker.report(0x12).start_s, 11.0);
-  EXPECT_FALSE(tracker.report(0x12).adev[0]);
+  decoder.feed(frame_of(StatusFaultsMsg{5, 0, 0, 0, 0}, 0x12), 11.0);  // same seq after a close: a new report
+  EXPECT_EQ(decoder.report(0x12)->start_s, 11.0);
+  EXPECT_FALSE(decoder.report(0x12)->received(Slot::adev, 0));
+  EXPECT_EQ(decoder.report(0x99), nullptr);  // never heard
 }
 
 TEST(DecodeOutput, PlotDrawsEachIeeeTermAsItsOwnLineAndReadsItOff) {
@@ -157,7 +164,7 @@ TEST(DecodeOutput, PlotDrawsEachIeeeTermAsItsOwnLineAndReadsItOff) {
   }
   for (std::size_t k = 0; k < 5; ++k) v.ieee952[k] = {true, true, qnbkr[k], 0.1};
   ConfidenceIntervals intervals(0.683);
-  const NodePlot p = plot_data(v, RateUnit::deg_per_h, intervals);
+  const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals);
 
   EXPECT_EQ(p.rate_name, "deg/h");
   ASSERT_EQ(p.adev.size(), 9u);  // tau 4 is not valid
@@ -212,7 +219,7 @@ TEST(DecodeOutput, PlotDrawsEachIeeeTermAsItsOwnLineAndReadsItOff) {
 
   v.ieee952[1].resolved = false;  // N not resolved: no line, no read-off
   v.ieee952[3].received = false;  // K never received
-  const NodePlot fewer = plot_data(v, RateUnit::deg_per_h, intervals);
+  const NodePlot fewer = plot_data(v, rate_unit("deg/h"), intervals);
   EXPECT_EQ(fewer.terms.size(), 4u);  // Q B R and the sum
   EXPECT_EQ(fewer.read_offs.size(), 3u);
 }
@@ -236,7 +243,7 @@ TEST(DecodeOutput, PlotOfARejectedFitDrawsNoModelAndSaysSo) {
   v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::rejected, 12.5f, 20, true, {0, 0}};
   for (auto& t : v.ieee952) t.resolved = false;  // a rejected fit resolves nothing
   ConfidenceIntervals intervals(0.683);
-  const NodePlot p = plot_data(v, RateUnit::deg_per_h, intervals);
+  const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals);
   EXPECT_EQ(p.adev.size(), 10u);  // the measurements are still drawn
   EXPECT_TRUE(p.terms.empty());
   EXPECT_TRUE(p.read_offs.empty());
@@ -245,7 +252,7 @@ TEST(DecodeOutput, PlotOfARejectedFitDrawsNoModelAndSaysSo) {
   EXPECT_EQ(p.notes[1], "the model does not describe the curve");
 
   v.ieee952_summary->status = Ieee952Status::too_few_points;
-  const NodePlot none = plot_data(v, RateUnit::deg_per_h, intervals);
+  const NodePlot none = plot_data(v, rate_unit("deg/h"), intervals);
   EXPECT_TRUE(none.terms.empty());
   ASSERT_EQ(none.notes.size(), 1u);
   EXPECT_EQ(none.notes[0], "no IEEE-952 fit: too few points");
@@ -258,7 +265,7 @@ TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
   v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::ok, 0.875f, 18, false, {3, 2}};
   const TrueTerms truth{2.5 * std::numbers::pi / 648000, 0.12 * std::numbers::pi / 648000, 0.0, 0.0, 0.0};  // arcsec -> rad
   ConfidenceIntervals intervals(0.683);
-  const NodePlot p = plot_data(v, RateUnit::deg_per_h, intervals, &truth);
+  const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals, &truth);
   ASSERT_EQ(p.terms.size(), 2u);  // N's own line and the model
   EXPECT_EQ(p.terms[0].term, Ieee952Term::angle_random_walk);
   EXPECT_EQ(p.terms[1].label, "IEEE-952 model, chi2/dof 0.88");
@@ -284,7 +291,7 @@ TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
   // A node reporting pulses: no angle to put the truth in.
   NodeView pulses = v;
   pulses.scale->angle_unit = AngleUnit::pulse;
-  EXPECT_FALSE(plot_data(pulses, RateUnit::deg_per_h, intervals, &truth).truth.has_value());
+  EXPECT_FALSE(plot_data(pulses, rate_unit("deg/h"), intervals, &truth).truth.has_value());
 }
 
 TEST(DecodeOutput, ViewShowsTheSimulatedValueBesideEachTerm) {
@@ -301,12 +308,12 @@ TEST(DecodeOutput, ViewShowsTheSimulatedValueBesideEachTerm) {
   truth[0x12] = {0.0, 0.003 * std::numbers::pi / 180 / 60, 0.01 * std::numbers::pi / 180 / 3600, 0.0, 0.0};
   InputCounters input;
   ConfidenceIntervals intervals(0.683);
-  const std::string view = format_view(decoder, input, NodeFilter{}.set(), RateUnit::deg_per_h, intervals, &truth);
+  const std::string view = format_view(decoder, input, NodeFilter{}.set(), rate_unit("deg/h"), intervals, &truth);
   EXPECT_NE(view.find("IEEE-952 (node's fit of both curves, chi2/dof 0.93 on 24 points):"), std::string::npos) << view;
   EXPECT_NE(view.find("  N 0.003 deg/sqrt(h) (+-1.8%), simulated 0.003"), std::string::npos) << view;
   EXPECT_NE(view.find("  B 0.01 deg/h (not resolved, +-150.0%), simulated 0.01"), std::string::npos) << view;
   EXPECT_NE(view.find("  K -, simulated 0"), std::string::npos) << view;  // K's frame not received
-  const std::string plain = format_view(decoder, input, NodeFilter{}.set(), RateUnit::deg_per_h, intervals);
+  const std::string plain = format_view(decoder, input, NodeFilter{}.set(), rate_unit("deg/h"), intervals);
   EXPECT_EQ(plain.find(", simulated"), std::string::npos) << plain;
 }
 

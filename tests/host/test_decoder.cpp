@@ -299,6 +299,19 @@ TEST(Decoder, BadFramesAreCountedNeverFatal) {
   EXPECT_EQ(v.health.duplicates, 1u);
 }
 
+// A CAN FD frame with a protocol identifier is refused (the protocol is classic CAN) and counted
+// against the node its identifier names, never against a node 0x00 that does not exist.
+TEST(Decoder, CanFdFrameIsCountedAgainstItsSender) {
+  Feed feed;
+  CanFrame fd = report(0x11, 0, 4, 100)[0];
+  fd.fd = true;
+  fd.len = 16;
+  feed.frames({fd});
+  EXPECT_EQ(feed.decoder.rejected_frames(), 1u);
+  EXPECT_EQ(feed.node(0x11).health.rejected.at(ProtocolError::fd_frame), 1u);
+  EXPECT_EQ(feed.decoder.nodes().count(0x00), 0u);
+}
+
 // --- the window curves (protocol version 3) ----------------------------------------------------
 
 TEST(Decoder, WindowCurvesAreKeptPerWindowAndCountedAsExpectedFrames) {

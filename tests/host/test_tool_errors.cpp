@@ -1,8 +1,10 @@
-// Every host program answers bad input with "program: what: why" on stderr and a distinct exit
-// code (its --help lists them): unknown options, out-of-range, NaN and huge values, a path that
-// cannot be written, an empty or garbage input. gyrochar-analyze and gyrochar-decode have their own
-// suites (test_analyze_cli, test_decode_cli); gyrochard's start-up is in tests/firmware.
-// Oracle: the exit codes each program's --help states.
+// The contract every program keeps (hal/exit_codes.hpp): bad input gets one line
+// "program: what: why" on stderr and exit_code::bad_input; an output that cannot be written,
+// standard output included (`> /dev/full`), exit_code::output_failed; a CAN interface that does
+// not exist exit_code::no_hardware, named by its name; every --help and the README state the same
+// exit codes. gyrochar-analyze and gyrochar-decode have their own suites for their many options
+// (test_analyze_cli, test_decode_cli); gyrochard's start-up is in tests/firmware.
+// Oracle: the exit codes of hal/exit_codes.hpp.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,25 +12,39 @@
 #include <fstream>
 #include <string>
 
+#include "hal/exit_codes.hpp"
+
 namespace {
+
+using namespace gyrochar;
 
 const std::string bin = GYROCHAR_BINARY_DIR "/host_tools/";
 
 struct Outcome {
   int code = -1;
-  std::string err;
+  std::string out, err;
 };
 
+std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_" + name; }
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// `command` with stdout to a file unless it redirects stdout itself.
 Outcome run(const std::string& command) {
-  const std::string err_file = ::testing::TempDir() + std::to_string(getpid()) + "_tool_err.txt";
-  const int status = std::system((command + " >/dev/null 2>" + err_file).c_str());
-  std::ifstream e(err_file);
+  const std::string out_file = temp("tool_out.txt"), err_file = temp("tool_err.txt");
+  const bool own_stdout = command.find(" > ") != std::string::npos;
+  const int status = std::system((command + (own_stdout ? "" : " >" + out_file) + " 2>" + err_file).c_str());
   Outcome r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
+  r.out = own_stdout ? "" : slurp(out_file);
+  r.err = slurp(err_file);
   return r;
 }
 
+// The program exits `code` and its first line on stderr is "program: what...".
 void expect(const std::string& program, const std::string& args, int code, const std::string& what) {
   const Outcome r = run(bin + program + " " + args);
   EXPECT_EQ(r.code, code) << program << " " << args << ": " << r.err;
@@ -36,30 +52,91 @@ void expect(const std::string& program, const std::string& args, int code, const
 }
 
 TEST(ToolErrors, SimulatorNamesWhatIsWrong) {
-  expect("gyrochar-sim", "--bogus", 2, "options:");
-  expect("gyrochar-sim", "--duration", 2, "options:");
-  expect("gyrochar-sim", "--tau0 0", 2, "--tau0:");
-  expect("gyrochar-sim", "--tau0 nan", 2, "--tau0:");
-  expect("gyrochar-sim", "--duration -5", 2, "--duration:");
-  expect("gyrochar-sim", "--duration 1e300", 2, "--duration:");
-  expect("gyrochar-sim", "--rate nan --duration 1", 2, "--rate:");
-  expect("gyrochar-sim", "--arw -1 --duration 1", 2, "noise parameters:");
-  expect("gyrochar-sim", "--arw inf --duration 1", 2, "noise parameters:");
-  expect("gyrochar-sim", "--bias-instability 0.05 --bias-time 0.001 --duration 1", 2, "--bias-time:");
-  expect("gyrochar-sim", "--duration 1 --out /nonexistent-dir/counts.txt", 3, "/nonexistent-dir/counts.txt:");
-  expect("gyrochar-sim", "--duration 1 --can nosuchcan9", 4, "--can:");
-  expect("gyrochar-sim", "--duration 1 --speed 2", 2, "--can-node, --speed:");
-  EXPECT_EQ(run(bin + "gyrochar-sim --help").code, 0);
+  const int bad = exit_code::bad_input;
+  expect("gyrochar-sim", "--bogus", bad, "options:");
+  expect("gyrochar-sim", "--duration", bad, "options:");
+  expect("gyrochar-sim", "--tau0 0", bad, "--tau0:");
+  expect("gyrochar-sim", "--tau0 nan", bad, "--tau0:");
+  expect("gyrochar-sim", "--duration -5", bad, "--duration:");
+  expect("gyrochar-sim", "--duration 1e300", bad, "--duration:");
+  expect("gyrochar-sim", "--rate nan --duration 1", bad, "--rate:");
+  expect("gyrochar-sim", "--arw -1 --duration 1", bad, "noise parameters:");
+  expect("gyrochar-sim", "--arw inf --duration 1", bad, "noise parameters:");
+  expect("gyrochar-sim", "--bias-instability 0.05 --bias-time 0.001 --duration 1", bad, "--bias-time:");
+  expect("gyrochar-sim", "--duration 1 --speed 2", bad, "--can-node, --speed:");
+  expect("gyrochar-sim", "--duration 1 --seed -1", bad, "options: --seed: must be an integer 0..2^64-1");
+  expect("gyrochar-sim", "--duration 1 --seed 18446744073709551616", bad, "options: --seed: must be an integer 0..2^64-1");
+  expect("gyrochar-sim", "--duration 1 --out /nonexistent-dir/counts.txt", exit_code::output_failed,
+         "/nonexistent-dir/counts.txt: No such file or directory");
+  expect("gyrochar-sim", "--duration 10 > /dev/full", exit_code::output_failed,
+         "standard output: write failed: No space left on device");
+  expect("gyrochar-sim", "--duration 1 --can nosuchcan9", exit_code::no_hardware, "nosuchcan9: ");
+  EXPECT_EQ(run(bin + "gyrochar-sim --duration 1 --seed 18446744073709551615").code, exit_code::ok);
 }
 
-TEST(ToolErrors, DemoNamesWhatIsWrong) {
-  expect("gyrochar-demo", "--bogus", 2, "options:");
-  expect("gyrochar-demo", "--nodes 9", 2, "options:");
-  expect("gyrochar-demo", "--hours nan", 2, "options:");
-  expect("gyrochar-demo", "--loss 1", 2, "options:");
-  expect("gyrochar-demo", "--hours 0.001 --csv /nonexistent-dir/x.csv", 1, "/nonexistent-dir/x.csv:");
-  expect("gyrochar-demo", "--hours 0.001 --plot '' --candump /nonexistent-dir/x.log", 1, "/nonexistent-dir/x.log:");
-  EXPECT_EQ(run(bin + "gyrochar-demo --help").code, 0);
+TEST(ToolErrors, DemoGivesEachOptionRuleItsOwnMessage) {
+  const int bad = exit_code::bad_input;
+  expect("gyrochar-demo", "--bogus", bad, "options:");
+  expect("gyrochar-demo", "--nodes 9", bad, "--nodes: must be 1..8, not 9");
+  expect("gyrochar-demo", "--hours nan", bad, "--hours: must be a positive number of hours, not nan");
+  expect("gyrochar-demo", "--tau0 0", bad, "--tau0: must be a positive number of seconds");
+  expect("gyrochar-demo", "--octaves 41", bad, "--octaves: must be 1..40, not 41");
+  expect("gyrochar-demo", "--loss 1", bad, "--loss: must be a probability in [0, 1), not 1");
+  expect("gyrochar-demo", "--view-every -1", bad, "--view-every: must be a number of minutes >= 0");
+  expect("gyrochar-demo", "--hours 0.001 --csv /nonexistent-dir/x.csv", exit_code::output_failed,
+         "/nonexistent-dir/x.csv: No such file or directory");
+  expect("gyrochar-demo", "--hours 0.001 --plot '' --candump /nonexistent-dir/x.log", exit_code::output_failed,
+         "/nonexistent-dir/x.log: No such file or directory");
+  // An empty --csv, like an empty --plot, means none.
+  const Outcome none = run(bin + "gyrochar-demo --hours 0.001 --plot '' --csv ''");
+  EXPECT_EQ(none.code, exit_code::ok) << none.err;
+  EXPECT_EQ(none.err.find(": cannot write"), std::string::npos) << none.err;
+}
+
+TEST(ToolErrors, EveryToolChecksItsStandardOutput) {
+  const std::string log = temp("demo.log");
+  ASSERT_EQ(run(bin + "gyrochar-demo --hours 0.01 --plot '' --csv '' --candump " + log).code, exit_code::ok);
+  const std::string counts = temp("counts.txt");
+  ASSERT_EQ(run(bin + "gyrochar-sim --duration 100 --out " + counts).code, exit_code::ok);
+  const std::string lost = "standard output: write failed: ";
+  expect("gyrochar-analyze", "--type counts --tau0 0.01 --pulse-weight 1arcsec " + counts + " > /dev/full",
+         exit_code::output_failed, lost);
+  for (const char* program : {"gyrochar-analyze", "gyrochar-decode", "gyrochar-sim", "gyrochar-demo"})
+    expect(program, "--help > /dev/full", exit_code::output_failed, lost);
+  // The decoder's and the demo's summaries come first on stderr; the last line says what was lost.
+  for (const std::string& command : {"gyrochar-decode " + log + " --view final", std::string("gyrochar-demo --hours 0.01 --plot '' --csv ''")}) {
+    const Outcome r = run(bin + command + " > /dev/full");
+    EXPECT_EQ(r.code, exit_code::output_failed) << command << ": " << r.err;
+    const std::string program = command.substr(0, command.find(' '));
+    EXPECT_NE(r.err.find(program + ": " + lost), std::string::npos) << r.err;
+  }
+}
+
+// The decoder's Kalibr file describes one node with an accepted fit; anything else is refused.
+TEST(ToolErrors, DecoderKalibrNeedsOneNodeWithAFit) {
+  const std::string log = temp("kalibr_demo.log"), yaml = temp("imu.yaml");
+  ASSERT_EQ(run(bin + "gyrochar-demo --hours 0.01 --plot '' --csv '' --candump " + log).code, exit_code::ok);
+  const Outcome two = run(bin + "gyrochar-decode " + log + " --view none --kalibr " + yaml);
+  EXPECT_EQ(two.code, exit_code::bad_input) << two.err;
+  EXPECT_NE(two.err.find("gyrochar-decode: --kalibr: nodes 0x10, 0x11 seen: choose one with --node\n"), std::string::npos)
+      << two.err;
+  // 36 s of gyro time: too short for a fit of N and K.
+  const Outcome young = run(bin + "gyrochar-decode " + log + " --view none --node 0x10 --kalibr " + yaml);
+  EXPECT_EQ(young.code, exit_code::bad_input) << young.err;
+  EXPECT_NE(young.err.find("gyrochar-decode: --kalibr: "), std::string::npos) << young.err;
+}
+
+TEST(ToolErrors, EveryHelpAndTheReadmeStateTheSameExitCodes) {
+  for (const std::string program : {"gyrochar-analyze", "gyrochar-decode", "gyrochar-sim", "gyrochar-demo"}) {
+    const Outcome r = run(bin + program + " --help");
+    EXPECT_EQ(r.code, exit_code::ok) << program;
+    EXPECT_NE(r.out.find(exit_code::help), std::string::npos) << program << ":\n" << r.out;
+  }
+  const Outcome board = run(GYROCHAR_BINARY_DIR "/firmware/gyrochard --help");
+  EXPECT_EQ(board.code, exit_code::ok);
+  EXPECT_NE(board.out.find(exit_code::help), std::string::npos) << board.out;
+  EXPECT_NE(slurp(GYROCHAR_SOURCE_DIR "/README.md").find(exit_code::help), std::string::npos)
+      << "README.md must quote hal/exit_codes.hpp's help text verbatim";
 }
 
 // Runs `command` as an unprivileged user when this test runs as root (root reads and writes
@@ -77,9 +154,9 @@ TEST(ToolErrors, PermissionDeniedIsNamedWithItsReason) {
     std::string program, args;
     int code;
   } cases[] = {
-      {"gyrochar-analyze", "--type counts --tau0 1 --pulse-weight 1arcsec " + dir + "/secret.txt", 2},
-      {"gyrochar-decode", dir + "/secret.txt", 2},
-      {"gyrochar-sim", "--duration 1 --out " + dir + "/locked/counts.txt", 3},
+      {"gyrochar-analyze", "--type counts --tau0 1 --pulse-weight 1arcsec " + dir + "/secret.txt", exit_code::bad_input},
+      {"gyrochar-decode", dir + "/secret.txt", exit_code::bad_input},
+      {"gyrochar-sim", "--duration 1 --out " + dir + "/locked/counts.txt", exit_code::output_failed},
   };
   for (const auto& c : cases) {
     const Outcome r = run(unprivileged(bin + c.program + " " + c.args));

@@ -50,6 +50,13 @@
 namespace gyrochar {
 
 /// One point of a curve: an overlapping (or strided) AVAR or MVAR estimate and its geometry.
+///
+/// A total-family estimate (TOTVAR or TheoBR for AVAR, bias-corrected: docs/total.md) may stand in
+/// for the Allan estimate of the same tau: stat avar, the Allan geometry (m, stride 1, n = N - 2m),
+/// and variance_scale = its variance over the Allan estimate's (EDF of the Allan estimate over its
+/// own, below 1 where it has more degrees of freedom). Its covariance with every point is the Allan
+/// estimate's scaled by sqrt(variance_scale): the correlations of the Allan estimates it replaces,
+/// its own smaller variance (docs/metrology.md says why that is the honest choice we can make).
 struct FitPoint {
   Stat stat = Stat::avar;    // avar or mvar
   std::uint64_t m = 1;       // averaging factor
@@ -57,6 +64,7 @@ struct FitPoint {
   std::uint64_t n = 0;       // terms formed (gaps remove some)
   double variance = 0;       // the estimate, (r/s)^2
   double edf = 0;            // the per-tau EDF (first weights only); <= 0: n
+  double variance_scale = 1; // 1: the Allan-family estimate itself; < 1: a total-family one for it
 };
 
 struct FitSetup {

@@ -319,7 +319,8 @@ struct Decoded {
 };
 
 /// Decodes any frame. Never fails hard: a frame that is not exactly a valid protocol frame gives the
-/// first reason found (in the order of ProtocolError). A frame decode() accepts is canonical:
+/// first reason found (in the order of ProtocolError, but fd_frame after bad_address: a refused
+/// frame with a protocol identifier names its sender in `node`). A frame decode() accepts is canonical:
 /// encode(decoded.message, decoded.node, f) reproduces it bit for bit.
 Decoded decode(const CanFrame& frame);
 

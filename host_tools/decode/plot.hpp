@@ -3,13 +3,13 @@
 // plplot-driver-cairo): one log-log panel per node with both deviations and their confidence
 // intervals as error bars, each resolved IEEE-952 term as its own line, the model's sum, the
 // read-off points, the simulated model where known (dashed), and in the legend what the node's fit
-// says: rejected (no model drawn), short taus left out (decode_output.hpp, plot_data()); beside
-// it, for a node with window curves, the heat map of its dynamic Allan deviation (heat_map.hpp).
+// says: rejected (no model drawn), short taus left out (plot_data.hpp); beside it, for a node
+// with window curves, the heat map of its dynamic Allan deviation (heat_map.hpp).
 #include <string>
 #include <vector>
 
-#include "decode_output.hpp"
 #include "figure.hpp"
+#include "plot_data.hpp"
 
 namespace gyrochar::decoding {
 

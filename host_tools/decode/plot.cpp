@@ -1,4 +1,4 @@
-#include "decode_plot.hpp"
+#include "plot.hpp"
 
 #include <fmt/format.h>
 #include <plplot/plstream.h>

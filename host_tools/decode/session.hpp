@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "candump.hpp"
-#include "decode_output.hpp"
+#include "recording.hpp"
 #include "decoder.hpp"
 
 namespace gyrochar::decoding {
@@ -38,7 +38,7 @@ class LineReader {
 };
 
 struct SessionOptions {
-  RateUnit rate_unit = RateUnit::deg_per_h;
+  DisplayRate rate_unit = gyrochar::rate_unit("deg/h");  // empty: native
   double confidence = 0.683;
   NodeFilter shown = NodeFilter{}.set();  // nodes recorded (the decoder follows all of them)
   std::FILE* csv = nullptr;               // not owned; null: no CSV
@@ -75,7 +75,6 @@ class Session {
 
   SessionOptions options_;
   ConfidenceIntervals intervals_;
-  ReportTracker tracker_;
   std::unique_ptr<CsvWriter> csv_;
   std::unique_ptr<JsonlWriter> jsonl_;
   InputCounters input_;

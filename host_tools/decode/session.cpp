@@ -1,4 +1,4 @@
-#include "decode_session.hpp"
+#include "session.hpp"
 
 #include <unistd.h>
 
@@ -75,7 +75,6 @@ void Session::feed(const CanFrame& frame, double t_s) {
   }
   ++input_.frames;
   decoder_.feed(frame, input_.now_s);
-  tracker_.note(frame, input_.now_s);
 }
 
 void Session::tick(double t_s) {
@@ -92,8 +91,7 @@ void Session::finish() {
 void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
   const bool record = options_.shown[node.address];
   if (e == DecoderEvent::report_closed && record && (csv_ || jsonl_)) {
-    ReportTracker::Report report = tracker_.report(node.address);
-    if (!report.open || report.seq != seq) report = {true, seq, input_.now_s, {}, {}};  // none of its values arrived
+    const Decoder::Report& report = *decoder_.report(node.address);  // the slot table of the report just closed
     const Units units = units_for(node, options_.rate_unit);
     rows_.clear();
     tau_rows(node, report, units, intervals_, rows_);
@@ -112,7 +110,6 @@ void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
       if (jsonl_) jsonl_->row(row, units);
     }
   }
-  if (e == DecoderEvent::report_closed || e == DecoderEvent::restart) tracker_.close(node.address);
   const bool noteworthy = e == DecoderEvent::restart || e == DecoderEvent::offline || e == DecoderEvent::online ||
                           e == DecoderEvent::duplicate || e == DecoderEvent::unknown_version;
   if (noteworthy && record && jsonl_) jsonl_->event(input_.now_s, e, node);

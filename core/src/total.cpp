@@ -1,0 +1,298 @@
+// The total and Theo family; definitions, costs and the decimated variants in total.hpp.
+#include "gyrochar/total.hpp"
+
+#include <cmath>
+
+namespace gyrochar {
+namespace {
+
+using Index = std::size_t;  // indices into the record (32 bits on the MCU builds)
+double as_double(std::uint64_t v) { return static_cast<double>(v); }
+Index as_index(std::uint64_t v) { return static_cast<Index>(v); }  // after checking v <= a span's size
+
+// The record's values seen through a sequence: v(k), k in [0, size).
+struct Values {  // x itself, or its block sums
+  std::span<const double> v;
+  Index size() const { return v.size(); }
+  double operator()(Index k) const { return v[k]; }
+};
+struct Increments {  // x[(k+1) b] - x[k b]: frequencies summed over blocks of b samples, times tau0
+  std::span<const double> x;
+  Index b;
+  Index size() const { return (x.size() - 1) / b; }
+  double operator()(Index k) const { return x[(k + 1) * b] - x[k * b]; }
+};
+
+// The kernel MTOTVAR and HTOTVAR share: over every run of 3S consecutive values v (the
+// sub-sequences), remove the line through the means of its halves, mirror it at both ends to 9S
+// values e, and average z_k^2 = (E[k+3S] - 3E[k+2S] + 3E[k+S] - E[k])^2 over k in [0, 6S), E the
+// prefix sums of e. Returns the sum of those averages; `runs` gets their number.
+// E (scratch) holds 9S + 1 prefix sums. O(15 S) per sub-sequence.
+template <class Seq>
+double total_kernel(const Seq& v, Index S, std::span<double> E, std::uint64_t& runs) {
+  const Index len = 3 * S, total = v.size();
+  const Index starts = total >= len ? total - len + 1 : 0;
+  runs = starts;
+  const Index half = len / 2;  // points in each half; the middle one of an odd run is in neither
+  const double run = as_double(len - half);  // distance between the centres of the halves
+  double sum = 0.0;
+  for (Index n = 0; n < starts; ++n) {
+    double first = 0.0, second = 0.0;
+    for (Index t = 0; t < half; ++t) {
+      first += v(n + t);
+      second += v(n + len - half + t);
+    }
+    const double slope = (second - first) / as_double(half) / run;
+    // Detrended values, centred (a constant does not change z but would cost precision):
+    // u_t = v(n + t) - slope (t - c) - mean, with c the run's centre.
+    const double centre = 0.5 * as_double(len - 1);
+    const double mean = (first + second) / as_double(2 * half);  // = the mean of the line at the centre
+    // E over the extension [u reversed, u, u reversed].
+    E[0] = 0.0;
+    for (Index t = 0; t < len; ++t) {
+      const Index s = len - 1 - t;
+      E[t + 1] = E[t] + (v(n + s) - slope * (as_double(s) - centre) - mean);
+    }
+    for (Index t = 0; t < len; ++t)
+      E[len + t + 1] = E[len + t] + (v(n + t) - slope * (as_double(t) - centre) - mean);
+    for (Index t = 0; t < len; ++t) E[2 * len + t + 1] = E[2 * len + t] + (E[t + 1] - E[t]);
+    // z over [0, 6S) is symmetric: the extension is even about -1/2 and the modified Allan filter
+    // about its centre, so z_k = z_{3S-k} on [0, 3S] and z_k = z_{9S-k} on (3S, 6S). Each pair once,
+    // twice weighted, a term that is its own partner once: half the work.
+    auto z2 = [&](Index k) {
+      const double z = E[k + len] - 3.0 * E[k + 2 * S] + 3.0 * E[k + S] - E[k];
+      return z * z;
+    };
+    double acc = 0.0;
+    for (Index k = 0; 2 * k < len; ++k) acc += 2.0 * z2(k);
+    if (len % 2 == 0) acc += z2(len / 2);
+    for (Index k = len + 1; 2 * k < 3 * len; ++k) acc += 2.0 * z2(k);
+    if (len % 2 == 0) acc += z2(3 * len / 2);
+    sum += acc / as_double(2 * len);
+  }
+  return sum;
+}
+
+bool block_ok(std::uint64_t block, std::uint64_t m) {
+  return block >= 1 && m >= 1 && m % block == 0 && (block == 1 || (m / block) % 2 == 0);
+}
+
+}  // namespace
+
+TotalVariance totvar(std::span<const double> x, std::uint64_t m, double tau0_s) {
+  const Index N = x.size();
+  if (N < 3 || m < 1 || m > N - 1 || !(tau0_s > 0)) return {};
+  const Index M = as_index(m), last = N - 1;
+  // x* by odd reflection about the end points; i - M and i + M stay within (-(N-1), 2(N-1)).
+  auto left = [&](Index i) { return i >= M ? x[i - M] : 2.0 * x[0] - x[M - i]; };
+  auto right = [&](Index i) { return i + M <= last ? x[i + M] : 2.0 * x[last] - x[2 * last - i - M]; };
+  double sum = 0.0;
+  for (Index i = 1; i < last; ++i) {
+    const double t = left(i) - 2.0 * x[i] + right(i);
+    sum += t * t;
+  }
+  const double tau = as_double(m) * tau0_s;
+  return {sum / (2.0 * tau * tau * as_double(N - 2)), N - 2, 1};
+}
+
+TotalVariance mtotvar(std::span<const double> block_sums, std::uint64_t block, std::uint64_t m, double tau0_s,
+                      std::span<double> scratch) {
+  if (!block_ok(block, m) || !(tau0_s > 0)) return {};
+  const std::uint64_t S = m / block;
+  if (block_sums.size() < 3 * S || scratch.size() < total_scratch_size(m, block)) return {};
+  std::uint64_t runs = 0;
+  const double sum = total_kernel(Values{block_sums}, as_index(S), scratch, runs);
+  const double tau = as_double(m) * tau0_s;
+  return {sum / (as_double(runs) * 2.0 * as_double(m) * as_double(m) * tau * tau), runs, block};
+}
+
+TotalVariance htotvar(std::span<const double> x, std::uint64_t block, std::uint64_t m, double tau0_s,
+                      std::span<double> scratch) {
+  const Index N = x.size();
+  if (!block_ok(block, m) || !(tau0_s > 0) || N < 4 || block >= N) return {};
+  if (m == 1) {  // the overlapping Hadamard variance (SP 1065 eq. 18)
+    double sum = 0.0;
+    for (Index i = 0; i + 3 < N; ++i) {
+      const double h = x[i + 3] - 3.0 * x[i + 2] + 3.0 * x[i + 1] - x[i];
+      sum += h * h;
+    }
+    return {sum / (6.0 * as_double(N - 3) * tau0_s * tau0_s), N - 3, 1};
+  }
+  const std::uint64_t S = m / block;
+  const Increments y{x, as_index(block)};
+  if (y.size() < 3 * S || scratch.size() < total_scratch_size(m, block)) return {};
+  std::uint64_t runs = 0;
+  const double sum = total_kernel(y, as_index(S), scratch, runs);
+  // z sums m frequencies times tau0: H = z / (m tau0).
+  const double scale = as_double(m) * tau0_s;
+  return {sum / (as_double(runs) * 6.0 * scale * scale), runs, block};
+}
+
+TotalVariance theo1(std::span<const double> x, std::uint64_t m, double tau0_s, std::uint64_t stride) {
+  const Index N = x.size();
+  if (N < 3 || m < 2 || m % 2 != 0 || m > N - 1 || stride < 1 || !(tau0_s > 0)) return {};
+  const Index M = as_index(m), h = M / 2, step = stride < N ? as_index(stride) : N;
+  double sum = 0.0;
+  std::uint64_t starts = 0;
+  for (Index i = 0; i < N - M; i += step, ++starts) {
+    const double* p = x.data() + i;
+    double inner = 0.0;
+    for (Index k = 1; k <= h; ++k) {
+      const double t = p[0] - p[k] - p[M - k] + p[M];
+      inner += t * t / static_cast<double>(k);
+    }
+    sum += inner;
+  }
+  const double tau = as_double(m) * tau0_s;  // the definition's scale (tau is 0.75 of it)
+  return {sum / (0.75 * as_double(starts) * tau * tau), starts * h, stride};
+}
+
+TotalVariance oavar(std::span<const double> x, std::uint64_t m, double tau0_s, std::uint64_t stride) {
+  const Index N = x.size();
+  if (m < 1 || N < 2 * m + 1 || stride < 1 || !(tau0_s > 0)) return {};
+  const Index M = as_index(m), step = stride < N ? as_index(stride) : N;
+  double sum = 0.0;
+  std::uint64_t n = 0;
+  for (Index i = 0; i + 2 * M < N; i += step, ++n) {
+    const double t = x[i + 2 * M] - 2.0 * x[i + M] + x[i];
+    sum += t * t;
+  }
+  const double tau = as_double(m) * tau0_s;
+  return {sum / (2.0 * as_double(n) * tau * tau), n, stride};
+}
+
+TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
+                              std::uint64_t ratio_taus) {
+  const std::uint64_t N = x.size();
+  if (N < 24 || ratio_taus < 2 || !(tau0_s > 0)) return {};
+  std::uint64_t last = N / 6 - 3;  // n of the definition, floor(N / 6 - 3)
+  if (2 * (9 + 3 * last) + 1 > N) --last;  // its AVAR would need N + 1 points
+  const std::uint64_t count = last + 1 <= ratio_taus ? last + 1 : ratio_taus;
+  TheoBiasRatio out;
+  out.defined = last + 1;
+  out.exact = count == last + 1 && stride_factor == 0;
+  double sum = 0.0;
+  for (std::uint64_t j = 0; j < count; ++j) {
+    // Evenly spread over 0..last, first and last included.
+    const std::uint64_t i = count == last + 1 ? j : (j * last + (count - 1) / 2) / (count - 1);
+    const std::uint64_t mt = 12 + 4 * i, ma = 9 + 3 * i;
+    const TotalVariance t = theo1(x, mt, tau0_s, stride_factor == 0 || mt <= stride_factor ? 1 : mt / stride_factor);
+    const TotalVariance a = oavar(x, ma, tau0_s, stride_factor == 0 || ma <= stride_factor ? 1 : ma / stride_factor);
+    if (t.n == 0 || a.n == 0 || !(t.var > 0)) return {};
+    sum += a.var / t.var;
+  }
+  out.ratio = sum / as_double(count);
+  out.taus = count;
+  return out;
+}
+
+std::span<double> block_sums(std::span<const double> x, std::uint64_t block, std::span<double> out) {
+  if (block == 0 || out.size() < x.size() / block) return {};
+  const Index b = as_index(block), count = x.size() / b;
+  for (Index k = 0; k < count; ++k) {
+    double sum = 0.0;
+    for (Index t = 0; t < b; ++t) sum += x[k * b + t];
+    out[k] = sum;
+  }
+  return out.first(count);
+}
+
+std::uint64_t theo_bias_taus(std::uint64_t n_phase, std::uint32_t S) {
+  if (n_phase < 24) return 0;
+  const std::uint64_t all = n_phase / 6 - 2;
+  if (S == 0) return all;
+  double cost = 0.0;
+  for (std::uint64_t i = 0; i < all; ++i) cost += total_exact_cost(true, 12 + 4 * i, n_phase);
+  return cost <= total_exact_budget ? all : (all < 64 ? all : 64);
+}
+
+double total_exact_cost(bool theo, std::uint64_t m, std::uint64_t n_phase) {
+  if (theo) return m < n_phase ? as_double(n_phase - m) * as_double(m / 2) : 0.0;
+  return 3 * m <= n_phase ? as_double(n_phase - 3 * m + 1) * 15.0 * as_double(m) : 0.0;
+}
+
+std::uint64_t total_block(std::uint64_t m, std::uint64_t n_phase, std::uint32_t S) {
+  if (S == 0 || m <= S || total_exact_cost(false, m, n_phase) <= total_exact_budget) return 1;
+  std::uint64_t b = 1;
+  while (2 * b <= m / S && m % (4 * b) == 0) b *= 2;  // 2b divides m with m / (2b) even
+  return b;
+}
+
+std::uint64_t theo1_stride(std::uint64_t m, std::uint64_t n_phase, std::uint32_t S) {
+  if (S == 0 || m <= S || total_exact_cost(true, m, n_phase) <= total_exact_budget) return 1;
+  return m / S;
+}
+
+std::uint64_t theoh_switch(std::uint64_t n_phase) {
+  const std::uint64_t limit = n_phase > 1 ? (n_phase - 1) / 10 : 0;
+  std::uint64_t k = 1;
+  while (2 * k <= limit) k *= 2;
+  return k;
+}
+
+double totvar_bias(int alpha, double n_phase, double m) {
+  const double a = alpha == -1 ? 1.0 / (3.0 * std::log(2.0)) : alpha == -2 ? 0.75 : 0.0;
+  return 1.0 - a * m / (n_phase - 1.0);
+}
+
+double htotvar_bias(int alpha, std::uint64_t m) {
+  if (m < 2) return 1.0;
+  switch (alpha) {
+    case 0: return 1.0 - 0.005;
+    case -1: return 1.0 - 0.149;
+    case -2: return 1.0 - 0.229;
+    case -3: return 1.0 - 0.283;
+    case -4: return 1.0 - 0.321;
+    default: return 1.0;
+  }
+}
+
+// b N / m - c from a table of (alpha, b, c) rows; 0 where alpha has none.
+struct EdfRow {
+  int alpha;
+  double b, c;
+};
+template <std::size_t R>
+double linear_edf(const EdfRow (&table)[R], int alpha, double n_phase, double m) {
+  for (const EdfRow& row : table)
+    if (row.alpha == alpha) return row.b * n_phase / m - row.c;
+  return 0.0;
+}
+
+double edf_totvar(int alpha, double n_phase, double m) {
+  static constexpr EdfRow table7[] = {{0, 1.50, 0.0}, {-1, 1.17, 0.22}, {-2, 0.93, 0.36}};
+  return linear_edf(table7, alpha, n_phase, m);
+}
+
+double edf_mtotvar(int alpha, double n_phase, double m) {
+  static constexpr EdfRow table8[] = {{2, 1.90, 2.1}, {1, 1.20, 1.40}, {0, 1.10, 1.2}, {-1, 0.85, 0.50}, {-2, 0.75, 0.31}};
+  return linear_edf(table8, alpha, n_phase, m);
+}
+
+double edf_htotvar(int alpha, double n_phase, double m) {
+  double b0 = 0, b1 = 0;
+  switch (alpha) {
+    case 0: b0 = 0.559; b1 = 1.004; break;
+    case -1: b0 = 0.868; b1 = 1.140; break;
+    case -2: b0 = 0.938; b1 = 1.696; break;
+    default: return 0.0;
+  }
+  return (n_phase / m) / (b0 + b1 * m / n_phase);
+}
+
+double edf_theo1(int alpha, double n_phase, double m) {
+  const double N = n_phase, r = 0.75 * m;
+  switch (alpha) {
+    case 2: return (0.86 * (N + 1) * (N - 4 * r / 3) / (N - r)) * (r / (r + 1.14));
+    case 1: return ((4.798 * N * N - 6.374 * N * r + 12.387 * r) / (std::sqrt(r + 36.6) * (N - r))) * (r / (r + 0.3));
+    case 0: return ((4.1 * N + 0.8) / r - (3.1 * N + 6.5) / N) * (std::pow(r, 1.5) / (std::pow(r, 1.5) + 5.2));
+    case -1: return ((2 * N * N - 1.3 * N * r - 3.5 * r) / (N * r)) * (r * r * r / (r * r * r + 2.3));
+    case -2: {
+      const double a = 4.4 * N;
+      return ((a - 2) / (2.9 * r)) * (((a - 1) * (a - 1) - 8.6 * r * (a - 1) + 11.4 * r * r) / ((a - 3) * (a - 3)));
+    }
+    default: return 0.0;
+  }
+}
+
+}  // namespace gyrochar

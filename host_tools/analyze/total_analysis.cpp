@@ -1,0 +1,118 @@
+#include "total_analysis.hpp"
+
+#include <cmath>
+
+#include "confidence.hpp"
+#include "gyrochar/total.hpp"
+
+namespace gyrochar {
+namespace {
+
+// The Allan-family row of `stat` at the largest m at or below `m`, or null.
+const AnalysisRow* allan_row(const std::vector<AnalysisRow>& allan, DevStat stat, double m) {
+  const AnalysisRow* found = nullptr;
+  for (const AnalysisRow& r : allan)
+    if (r.stat == stat && static_cast<double>(r.m) <= m) found = &r;
+  return found;
+}
+
+// A row of a total statistic: deviation, noise and EDF from the Allan row it leans on, interval.
+AnalysisRow make_row(DevStat stat, std::uint64_t m, double tau_s, const TotalVariance& v, double variance,
+                     const AnalysisRow* allan, double edf, const AnalysisOptions& o) {
+  AnalysisRow row;
+  row.stat = stat;
+  row.m = m;
+  row.tau_s = tau_s;
+  row.n = v.n;
+  row.stride = v.stride;
+  row.dev = std::sqrt(variance);
+  if (allan != nullptr) {
+    row.alpha = allan->alpha;
+    row.noise = allan->noise;
+    row.edf_alpha = allan->edf_alpha;
+  }
+  row.edf = edf > 0 ? edf : 0.0;
+  if (row.edf > 0) row.ci = confidence_interval(row.dev, row.edf, o.confidence);
+  return row;
+}
+
+}  // namespace
+
+std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, double phase_scale,
+                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan) {
+  std::vector<AnalysisRow> rows;
+  const std::uint64_t N = x.size();
+  const double n = static_cast<double>(N), tau0 = o.tau0_s, k2 = phase_scale * phase_scale;
+  const std::uint32_t S = o.total_stride_factor;
+  std::vector<double> blocks, scratch;
+  // Whether the Allan row has an identified (or given) alpha: else no bias correction, no EDF.
+  auto known = [](const AnalysisRow* r) { return r != nullptr && r->alpha.has_value(); };
+
+  if (stat == DevStat::theo1 || stat == DevStat::theoh) {
+    const std::uint64_t k = theoh_switch(N);
+    double ratio = 1.0;
+    if (stat == DevStat::theoh) {
+      for (const AnalysisRow& r : allan)
+        if (r.stat == DevStat::oadev && r.m < k) {
+          AnalysisRow a = r;
+          a.stat = DevStat::theoh;
+          rows.push_back(a);
+        }
+      ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S)).ratio;
+      if (!(ratio > 0)) return rows;
+    }
+    for (const std::uint64_t m : o.theo_m_list) {
+      if (stat == DevStat::theoh && 3 * m < 4 * k) continue;  // 0.75 m < k: ADEV's part
+      const TotalVariance v = theo1(x, m, tau0, theo1_stride(m, N, S));
+      if (v.n == 0) continue;
+      const AnalysisRow* a = allan_row(allan, DevStat::oadev, 0.75 * static_cast<double>(m));
+      const double edf = known(a) ? edf_theo1(*a->alpha, n, static_cast<double>(m)) : 0.0;
+      rows.push_back(make_row(stat, m, 0.75 * static_cast<double>(m) * tau0, v, v.var * ratio * k2, a, edf, o));
+    }
+    return rows;
+  }
+
+  for (const std::uint64_t m : o.m_list) {
+    const double md = static_cast<double>(m);
+    TotalVariance v;
+    if (stat == DevStat::totdev) {
+      if (m > N / 2) break;
+      v = totvar(x, m, tau0);
+      if (v.n == 0) continue;
+      const AnalysisRow* a = allan_row(allan, DevStat::oadev, md);
+      const double bias = known(a) ? totvar_bias(*a->alpha, n, md) : 1.0;
+      double edf = known(a) ? edf_totvar(*a->alpha, n, md) : 0.0;
+      if (!(edf > 0) && a != nullptr && a->m == m) edf = a->edf;  // PM noise: the OADEV estimate's
+      rows.push_back(make_row(stat, m, md * tau0, v, v.var / bias * k2, a, edf, o));
+      continue;
+    }
+    if (stat == DevStat::mtotdev || stat == DevStat::ttotdev) {
+      if (3 * m > N) break;
+      const std::uint64_t b = total_block(m, N, S);
+      scratch.resize(total_scratch_size(m, b));
+      if (b > 1 && blocks.empty()) blocks.resize(N / 2);
+      v = b == 1 ? mtotvar(x, 1, m, tau0, scratch) : mtotvar(block_sums(x, b, blocks), b, m, tau0, scratch);
+      if (v.n == 0) continue;
+      const AnalysisRow* a = allan_row(allan, DevStat::mdev, md);
+      const double edf = known(a) ? edf_mtotvar(*a->alpha, n, md) : 0.0;
+      const double tdev = stat == DevStat::ttotdev ? md * tau0 * md * tau0 / 3.0 : 1.0;
+      rows.push_back(make_row(stat, m, md * tau0, v, v.var * tdev * k2, a, edf, o));
+      continue;
+    }
+    if (stat == DevStat::htotdev) {
+      if (3 * m > N - 1) break;
+      const std::uint64_t b = total_block(m, N, S);
+      scratch.resize(total_scratch_size(m, b));
+      v = htotvar(x, b, m, tau0, scratch);
+      if (v.n == 0) continue;
+      const AnalysisRow* a = allan_row(allan, DevStat::ohdev, md);
+      const double bias = known(a) ? htotvar_bias(*a->alpha, m) : 1.0;
+      double edf = known(a) && m >= 16 ? edf_htotvar(*a->alpha, n, md) : 0.0;
+      if (!(edf > 0) && a != nullptr && a->m == m) edf = a->edf;  // below m = 16, or PM noise: OHDEV's
+      rows.push_back(make_row(stat, m, md * tau0, v, v.var / bias * k2, a, edf, o));
+    }
+  }
+  return rows;
+}
+
+}  // namespace gyrochar

@@ -1,0 +1,29 @@
+#pragma once
+// The total and Theo family in gyrochar-analyze (core/include/gyrochar/total.hpp, docs/total.md):
+// TOTDEV, MTOTDEV, TTOTDEV, HTOTDEV, Theo1 and TheoH rows from the phase record the analyzer holds
+// when one of them is asked for (8 bytes a point: the record as doubles; counts stay exact up to
+// 2^53 pulses), beside one buffer of block sums (4 bytes a point) for the decimated MTOTDEV.
+//
+// Each row borrows from the Allan-family row of the same run at the same tau (for Theo1 and
+// TheoBR, at the largest tau at or below 0.75 m tau0): its noise identification, and its EDF where
+// SP 1065 has no formula for the total statistic at that noise (TOTDEV for white and flicker PM,
+// HTOTDEV below m = 16 or for PM noise). Where alpha is known the deviations carry Stable32's bias
+// corrections (TOTDEV for flicker and random-walk FM, HTOTDEV for alpha <= 0). TheoH's rows below
+// its switch point are the overlapping ADEV rows themselves.
+#include <span>
+#include <vector>
+
+#include "analysis.hpp"
+
+namespace gyrochar {
+
+/// The rows of total statistic `stat` (is_total(stat)) of phase points `phase` (phase unit /
+/// phase_scale: the engine's representation), at o.m_list (TOTDEV, MTOTDEV, TTOTDEV, HTOTDEV,
+/// TheoH's ADEV part) or o.theo_m_list (Theo1, TheoH's TheoBR part), the exact estimator where it
+/// costs at most 2^26 operations per tau and the decimated one with o.total_stride_factor beyond.
+/// `allan`: the run's oadev, mdev and ohdev rows at its taus. Allocates the block-sum buffer and the
+/// rows; O(N) per tau for TOTDEV, O(N S) to O(N S^2 / m) for the others (docs/total.md).
+std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> phase, double phase_scale,
+                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan);
+
+}  // namespace gyrochar

@@ -1,0 +1,161 @@
+#include "plot_data.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "gyrochar/ieee952.hpp"
+
+namespace gyrochar::decoding {
+
+using namespace protocol;
+
+namespace {
+
+constexpr std::size_t line_points = 97;
+
+std::vector<double> log_grid(double lo, double hi) {
+  std::vector<double> tau(line_points);
+  for (std::size_t k = 0; k < line_points; ++k)
+    tau[k] = lo * std::pow(hi / lo, static_cast<double>(k) / static_cast<double>(line_points - 1));
+  return tau;
+}
+
+// ADEV of the AVAR model with the given terms (wire units: A, s), in display units.
+double model_adev(const std::array<double, 5>& qnbkr, double tau_s, double rate) {
+  return std::sqrt(ieee952_avar(qnbkr, tau_s)) * rate;
+}
+
+// The heat map of the node's window curves: a column per window, a row per window tau (while tau0,
+// the window length or a window tau's m is unknown: no columns yet).
+HeatMap window_heat_map(const NodeView& node, const Units& u) {
+  HeatMap h;
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  const double length_s = static_cast<double>(node.window_length) * tau0_s;
+  h.title = length_s > 0 ? fmt::format("node 0x{:02X}, session {}: dynamic ADEV, windows of {:.4g} s", node.address,
+                                       node.session, length_s)
+                         : fmt::format("node 0x{:02X}, session {}: dynamic ADEV", node.address, node.session);
+  h.value_name = "ADEV";
+  h.unit = u.rate_name;
+  for (std::size_t i = 0; i < node.window_taus; ++i) {
+    if (!(node.tau_s(i) > 0)) return h;
+    h.tau_s.push_back(node.tau_s(i));
+  }
+  if (!(length_s > 0)) return h;
+  for (const auto& [k, w] : node.windows) {
+    HeatMap::Column c{static_cast<double>(k) * length_s, static_cast<double>(k + 1) * length_s, {}};
+    for (std::size_t i = 0; i < w.adev.size(); ++i) c.value.push_back(w.received[i] ? w.adev[i] * u.rate : 0.0);
+    h.columns.push_back(std::move(c));
+  }
+  return h;
+}
+
+}  // namespace
+
+NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceIntervals& intervals, const TrueTerms* truth) {
+  const Units u = units_for(node, rate);
+  NodePlot p;
+  p.title = fmt::format("node 0x{:02X}, session {}", node.address, node.session);
+  p.rate_name = u.rate_name;
+  if (node.window_taus != 0) p.dynamic = window_heat_map(node, u);
+  double lo = INFINITY, hi = 0.0;
+  for (std::size_t i = 0; i < node.status.tau_count && i < max_taus; ++i) {
+    const double tau = node.tau_s(i);
+    if (!(tau > 0)) continue;
+    for (auto [dev, series] : {std::pair{&node.taus[i].adev, &p.adev}, std::pair{&node.taus[i].mdev, &p.mdev}}) {
+      if (!dev->received || !dev->valid) continue;
+      const double value = static_cast<double>(dev->dev) * u.rate;
+      series->push_back({tau, value, intervals(value, dev->edf)});
+      lo = std::min(lo, tau);
+      hi = std::max(hi, tau);
+    }
+  }
+  if (hi == 0.0) return p;
+  p.tau_min_s = lo / 2.0;
+  p.tau_max_s = hi * 2.0;
+  const std::vector<double> grid = log_grid(p.tau_min_s, p.tau_max_s);
+  if (truth != nullptr) {
+    if (const std::optional<double> to_wire = wire_per_si(node)) {
+      std::array<double, 5> wire{};
+      for (std::size_t k = 0; k < 5; ++k) wire[k] = (*truth)[k] * *to_wire;
+      PlotLine line{std::nullopt, "simulated gyro (truth)", grid, {}};
+      for (const double tau : grid) line.dev.push_back(model_adev(wire, tau, u.rate));
+      p.truth = std::move(line);
+    }
+  }
+
+  // What the node's fit says, before any model line is drawn.
+  const auto& fit = node.ieee952_summary;
+  if (fit && fit->status == Ieee952Status::rejected) {
+    p.notes.push_back(fmt::format("IEEE-952 fit REJECTED (chi2/dof {:.3g}):", fit->chi2_per_dof));
+    p.notes.push_back("the model does not describe the curve");
+    return p;
+  }
+  if (fit && fit->status != Ieee952Status::ok) {
+    p.notes.push_back(fmt::format("no IEEE-952 fit: {}", fit->status == Ieee952Status::too_few_points
+                                                              ? "too few points"
+                                                              : "singular"));
+    return p;
+  }
+  if (fit && !fit->quantization_white) {
+    const auto below = [&](std::size_t k) {
+      const std::optional<double> tau = fit_excluded_below_tau_s(node, k);
+      return tau ? fmt::format("{:.3g} s", *tau) : std::string("?");
+    };
+    std::string note = "left out:";
+    const auto [avar, mvar] = fit->excluded_below_log2_m;
+    if (avar != 0) note += " ADEV < " + below(0);
+    if (mvar != 0) note += std::string(avar != 0 ? "," : "") + " MDEV < " + below(1);
+    p.notes.push_back("quantization not white, fit");
+    p.notes.push_back(note);
+  }
+
+  const auto inside = [&](double tau) { return tau >= p.tau_min_s && tau <= p.tau_max_s; };
+  // Where each term's ADEV equals its parameter (s); B has its own rule below.
+  static constexpr std::array<double, 5> read_tau_s{std::numbers::sqrt3, 1.0, 0.0, 3.0, std::numbers::sqrt2};
+  static constexpr std::array<const char*, 5> read_label{"Q at sqrt(3) s", "N at 1 s", "0.664 B", "K at 3 s",
+                                                         "R at sqrt(2) s"};
+  constexpr auto b_index = static_cast<std::size_t>(Ieee952Term::bias_instability);
+  std::array<double, 5> model{};  // the fitted model, wire units
+  std::size_t fitted = 0;
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Ieee952View& t = node.ieee952[k];
+    if (!t.in_model()) continue;
+    ++fitted;
+    model[k] = t.value;
+    if (!t.resolved) continue;
+    std::array<double, 5> one{};
+    one[k] = t.value;
+    PlotLine line{static_cast<Ieee952Term>(k),
+                  fmt::format("{} {:.3g} {} (±{:.2g}%)", units::ieee952[k].letter, t.value * u.ieee[k], u.ieee_name[k],
+                              100.0 * t.rel_uncertainty),
+                  grid,
+                  {}};
+    for (const double tau : grid) line.dev.push_back(model_adev(one, tau, u.rate));
+    p.terms.push_back(std::move(line));
+    if (k != b_index && inside(read_tau_s[k]))
+      p.read_offs.push_back({read_tau_s[k], model_adev(one, read_tau_s[k], u.rate), read_label[k]});
+  }
+  if (fitted == 0) return p;
+  if (fit && !fit->quantization_white && !node.ieee952[0].in_model() && node.scale)
+    model[0] = static_cast<double>(node.scale->angle_per_pulse) / std::sqrt(12.0);  // Q held there
+  PlotLine sum{std::nullopt,
+               fit ? fmt::format("IEEE-952 model, chi2/dof {:.2g}", fit->chi2_per_dof) : "IEEE-952 model (sum)",
+               grid,
+               {}};
+  for (const double tau : grid) sum.dev.push_back(model_adev(model, tau, u.rate));
+  if (node.ieee952[b_index].resolved && model[b_index] > 0) {  // B: the floor, at the sum's minimum within the points
+    std::optional<std::size_t> floor;
+    for (std::size_t k = 0; k < grid.size(); ++k) {
+      if (grid[k] >= lo && grid[k] <= hi && (!floor || sum.dev[k] < sum.dev[*floor])) floor = k;
+    }
+    std::array<double, 5> b{};
+    b[b_index] = model[b_index];
+    if (floor) p.read_offs.push_back({grid[*floor], model_adev(b, grid[*floor], u.rate), read_label[b_index]});
+  }
+  p.terms.push_back(std::move(sum));
+  return p;
+}
+
+}  // namespace gyrochar::decoding

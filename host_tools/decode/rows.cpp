@@ -1,0 +1,104 @@
+#include "rows.hpp"
+
+#include <cmath>
+
+namespace gyrochar::decoding {
+
+using namespace protocol;
+
+std::optional<double> fit_excluded_below_tau_s(const NodeView& node, std::size_t k) {
+  if (!node.ieee952_summary || k > 1) return std::nullopt;
+  const std::uint8_t c = node.ieee952_summary->excluded_below_log2_m[k];
+  if (c == 0) return 0.0;
+  if (!node.sampling) return std::nullopt;
+  return static_cast<double>(node.sampling->tau0_s) * std::ldexp(1.0, c);
+}
+
+const char* name(DevCell::Status s) {
+  switch (s) {
+    case DevCell::Status::ok: return "ok";
+    case DevCell::Status::invalid: return "invalid";
+    case DevCell::Status::missing: return "missing";
+  }
+  return "invalid";
+}
+
+namespace {
+
+DevCell dev_cell(const TauView::Dev& d, bool received, double rate, ConfidenceIntervals& intervals) {
+  DevCell c;
+  if (!received) return c;  // missing: nothing from this report
+  c.edf = d.edf;
+  c.noise = d.noise;
+  if (!d.valid) {
+    c.status = DevCell::Status::invalid;
+    return c;
+  }
+  c.status = DevCell::Status::ok;
+  c.value = static_cast<double>(d.dev) * rate;
+  c.ci = intervals(c.value, d.edf);
+  return c;
+}
+
+}  // namespace
+
+void tau_rows(const NodeView& node, const Decoder::Report& report, const Units& units, ConfidenceIntervals& intervals,
+              std::vector<TauRow>& out) {
+  for (std::uint8_t i = 0; i < node.status.tau_count && i < max_taus; ++i) {
+    const TauView& t = node.taus[i];
+    TauRow r;
+    r.time_s = report.start_s;
+    r.node = node.address;
+    r.session = node.session;
+    r.seq = report.seq;
+    r.tau_index = i;
+    r.m = t.m;
+    r.tau_s = node.tau_s(i);
+    r.n = t.n;
+    r.adev = dev_cell(t.adev, report.received(Slot::adev, i), units.rate, intervals);
+    r.mdev = dev_cell(t.mdev, report.received(Slot::mdev, i), units.rate, intervals);
+    r.fit = node.ieee952_summary;
+    r.fit_excluded_below_tau_s = {fit_excluded_below_tau_s(node, 0), fit_excluded_below_tau_s(node, 1)};
+    out.push_back(r);
+  }
+}
+
+namespace {
+
+DevCell window_cell(double dev, bool received, double rate) {
+  DevCell c;
+  if (!received) return c;
+  c.status = dev > 0 ? DevCell::Status::ok : DevCell::Status::invalid;
+  c.value = dev * rate;
+  return c;
+}
+
+}  // namespace
+
+void window_rows(const NodeView& node, const WindowView& w, double time_s, std::uint8_t seq, const Units& units,
+                 std::vector<WindowRow>& out) {
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  for (std::size_t i = 0; i < w.adev.size() && i < max_taus; ++i) {
+    WindowRow r;
+    r.time_s = time_s;
+    r.node = node.address;
+    r.session = node.session;
+    r.seq = seq;
+    r.window = w.window;
+    r.length = node.window_length;
+    if (tau0_s > 0 && node.window_length != 0) {
+      const double length_s = static_cast<double>(node.window_length) * tau0_s;
+      r.start_s = static_cast<double>(w.window) * length_s;
+      r.end_s = r.start_s + length_s;
+    }
+    r.gaps = w.gaps;
+    r.tau_index = static_cast<std::uint8_t>(i);
+    r.m = node.taus[i].m;
+    r.tau_s = node.tau_s(i);
+    r.adev = window_cell(w.adev[i], w.received[i], units.rate);
+    r.mdev = window_cell(w.mdev[i], w.received[i], units.rate);
+    out.push_back(r);
+  }
+}
+
+}  // namespace gyrochar::decoding

@@ -1,0 +1,178 @@
+// Speed and memory of the total and Theo family (core/include/gyrochar/total.hpp) as the offline
+// analysis runs them: the phase record held as doubles, the block sums of the decimated MTOTVAR in
+// one reused buffer, the exact estimator where it costs at most 2^26 operations per tau and the
+// decimated one (stride factor S) beyond. toolchain/total_benchmarks.sh runs it beside allantools
+// and writes the figures into BENCHMARKS.md.
+//
+//   bench_total octave FILE S   MTOTDEV and Theo1 at octave taus of the phase values in FILE (one
+//                               per line), exact (S = 0) or with the plan for S; one line per tau
+//   bench_total long N S        N points of random-walk plus white phase: TOTDEV, MTOTDEV and
+//                               TheoH at octave taus; time per statistic and peak RSS
+//   bench_total decimation FILE S [freq]
+//                               the decimated estimators against the exact ones at octave taus
+//                               (a markdown table; freq: FILE holds frequencies in Hz of 10 MHz)
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gyrochar/total.hpp"
+
+namespace {
+
+using namespace gyrochar;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+long peak_rss_kib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss;
+}
+
+// MTOTVAR at m with the plan for S; `blocks` is the reused block-sum buffer (N / 2 doubles).
+TotalVariance mtot(const std::vector<double>& x, std::uint64_t m, std::uint32_t S, std::vector<double>& blocks,
+                   std::vector<double>& scratch) {
+  const std::uint64_t b = total_block(m, x.size(), S);
+  scratch.resize(total_scratch_size(m, b));
+  if (b == 1) return mtotvar(x, 1, m, 1.0, scratch);
+  return mtotvar(block_sums(x, b, blocks), b, m, 1.0, scratch);
+}
+
+// The values of a file, one per line ('#' lines skipped); frequencies in Hz of a 10 MHz
+// oscillator become phase (x[0] = 0, x[k+1] = x[k] + (f - 1e7) / 1e7).
+std::vector<double> read_phase(const char* file, bool frequency_hz) {
+  std::ifstream in(file);
+  std::vector<double> x;
+  if (frequency_hz) x.push_back(0.0);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#') x.push_back(frequency_hz ? x.back() + (std::stod(line) - 1e7) / 1e7 : std::stod(line));
+  return x;
+}
+
+int octave(const char* file, std::uint32_t S) {
+  const std::vector<double> x = read_phase(file, false);
+  if (x.size() < 10) {
+    std::fprintf(stderr, "bench_total: %s: too few values\n", file);
+    return 1;
+  }
+  std::vector<double> blocks(x.size() / 2), scratch;
+  double total = 0;
+  for (std::uint64_t m = 1; 3 * m <= x.size(); m *= 2) {
+    const auto t0 = Clock::now();
+    const TotalVariance v = mtot(x, m, S, blocks, scratch);
+    const double s = seconds_since(t0);
+    total += s;
+    std::printf("mtotdev,%llu,%.9f,%.6e,%llu\n", static_cast<unsigned long long>(m), s, std::sqrt(v.var),
+                static_cast<unsigned long long>(v.stride));
+  }
+  std::printf("mtotdev,total,%.9f\n", total);
+  total = 0;
+  for (std::uint64_t m = 2; m <= x.size() - 1; m *= 2) {
+    const auto t0 = Clock::now();
+    const TotalVariance v = theo1(x, m, 1.0, theo1_stride(m, x.size(), S));
+    const double s = seconds_since(t0);
+    total += s;
+    std::printf("theo1,%llu,%.9f,%.6e,%llu\n", static_cast<unsigned long long>(m), s, std::sqrt(v.var),
+                static_cast<unsigned long long>(v.stride));
+  }
+  std::printf("theo1,total,%.9f\n", total);
+  return 0;
+}
+
+int long_record(std::uint64_t n, std::uint32_t S) {
+  auto t0 = Clock::now();
+  std::vector<double> x(n);
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> z;
+  double walk = 0;
+  for (double& v : x) v = (walk += 0.1 * z(rng)) + z(rng);
+  std::printf("record: %llu points, %.2f s to simulate\n", static_cast<unsigned long long>(n), seconds_since(t0));
+
+  t0 = Clock::now();
+  int rows = 0;
+  for (std::uint64_t m = 1; 2 * m <= n; m *= 2, ++rows) totvar(x, m, 1.0);
+  std::printf("totdev: %d taus in %.2f s\n", rows, seconds_since(t0));
+
+  t0 = Clock::now();
+  std::vector<double> blocks(n / 2), scratch;
+  rows = 0;
+  for (std::uint64_t m = 1; 3 * m <= n; m *= 2, ++rows) mtot(x, m, S, blocks, scratch);
+  std::printf("mtotdev: %d taus in %.2f s\n", rows, seconds_since(t0));
+
+  t0 = Clock::now();
+  const std::uint64_t k = theoh_switch(n);
+  rows = 0;
+  for (std::uint64_t m = 1; m < k; m *= 2, ++rows) oavar(x, m, 1.0);
+  const TheoBiasRatio ratio = theo_bias_ratio(x, 1.0, S, theo_bias_taus(n, S));
+  for (std::uint64_t m = 2 * k; m <= n - 1; m *= 2, ++rows) theo1(x, m, 1.0, theo1_stride(m, n, S));
+  std::printf("theoh: %d taus (AVAR below %llu, TheoBR from %llu; ratio %.4f over %llu taus) in %.2f s\n", rows,
+              static_cast<unsigned long long>(k), static_cast<unsigned long long>(2 * k), ratio.ratio,
+              static_cast<unsigned long long>(ratio.taus), seconds_since(t0));
+  std::printf("peak RSS: %ld KiB\n", peak_rss_kib());
+  return 0;
+}
+
+// Relative difference of the decimated deviation from the exact one, also in units of the exact
+// estimate's standard uncertainty 1 / sqrt(2 EDF) (white FM EDF of SP 1065).
+int decimation(const char* file, std::uint32_t S, bool frequency_hz) {
+  const std::vector<double> x = read_phase(file, frequency_hz);
+  const std::uint64_t N = x.size();
+  const double n = static_cast<double>(N);
+  std::vector<double> blocks(N / 2), scratch, exact_scratch;
+  std::printf("| m | block | MTOTDEV | HTOTDEV | Theo1 stride | Theo1 |\n|---:|---:|---|---|---:|---|\n");
+  auto cell = [](double exact, double fast, double edf) {
+    const double rel = std::sqrt(fast / exact) - 1.0;
+    char text[64];
+    std::snprintf(text, sizeof text, "%+.2f %% (%+.2f sigma)", 100 * rel, edf > 0 ? rel * std::sqrt(2 * edf) : 0.0);
+    return std::string(text);
+  };
+  for (std::uint64_t m = 32; m <= N - 1; m *= 2) {
+    const std::uint64_t b = total_block(m, N, S) > 1 ? total_block(m, N, S) : (m / S);
+    const std::uint64_t d = m / S;
+    std::string mt = "-", ht = "-", th = "-";
+    if (3 * m + 1 <= N) {
+      exact_scratch.resize(total_scratch_size(m, 1));
+      scratch.resize(total_scratch_size(m, b));
+      const double md = static_cast<double>(m);
+      mt = cell(mtotvar(x, 1, m, 1.0, exact_scratch).var, mtotvar(block_sums(x, b, blocks), b, m, 1.0, scratch).var,
+                edf_mtotvar(0, n, md));
+      ht = cell(htotvar(x, 1, m, 1.0, exact_scratch).var, htotvar(x, b, m, 1.0, scratch).var, edf_htotvar(0, n, md));
+    }
+    th = cell(theo1(x, m, 1.0).var, theo1(x, m, 1.0, d).var, edf_theo1(0, n, static_cast<double>(m)));
+    std::printf("| %llu | %llu | %s | %s | %llu | %s |\n", static_cast<unsigned long long>(m),
+                static_cast<unsigned long long>(b), mt.c_str(), ht.c_str(), static_cast<unsigned long long>(d), th.c_str());
+  }
+  // The exact ratio costs sum (N - m) m / 2 over N / 6 taus: computed only where that is below 2^33.
+  double cost = 0;
+  for (std::uint64_t m = 12; m <= 12 + 4 * (N / 6 - 3); m += 4) cost += total_exact_cost(true, m, N);
+  const TheoBiasRatio fast = theo_bias_ratio(x, 1.0, S, 64);
+  if (cost > 8589934592.0) {
+    std::printf("\nTheoBR's bias ratio: decimated %.5f (%llu taus); the exact one (%.1e operations) not computed\n",
+                fast.ratio, static_cast<unsigned long long>(fast.taus), cost);
+    return 0;
+  }
+  const TheoBiasRatio exact = theo_bias_ratio(x, 1.0, 0, ~0ull);
+  std::printf("\nTheoBR's bias ratio: exact %.5f (%llu taus), decimated %.5f (%llu taus): %+.2f %%\n", exact.ratio,
+              static_cast<unsigned long long>(exact.taus), fast.ratio, static_cast<unsigned long long>(fast.taus),
+              100 * (fast.ratio / exact.ratio - 1));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string mode = argc > 1 ? argv[1] : "";
+  if (argc == 4 && mode == "octave") return octave(argv[2], static_cast<std::uint32_t>(std::stoul(argv[3])));
+  if (argc == 4 && mode == "long") return long_record(std::stoull(argv[2]), static_cast<std::uint32_t>(std::stoul(argv[3])));
+  if ((argc == 4 || argc == 5) && mode == "decimation")
+    return decimation(argv[2], static_cast<std::uint32_t>(std::stoul(argv[3])), argc == 5 && std::string(argv[4]) == "freq");
+  std::fprintf(stderr, "usage: bench_total octave FILE S | bench_total long N S | bench_total decimation FILE S [freq]\n");
+  return 2;
+}
