@@ -23,17 +23,28 @@ DynamicAnalyzer::DynamicAnalyzer(const AnalysisOptions& options, std::uint64_t w
   Analyzer check(options_);  // the options' problems now, not at the first value
 }
 
-void DynamicAnalyzer::add(double value) {
-  if (values_ == next_index_ * step_) open_.push_back({next_index_++, 0, std::make_unique<Analyzer>(options_)});
-  ++values_;
-  for (Open& w : open_) {
-    w.analyzer->add(value);
-    ++w.added;
-  }
-  if (!open_.empty() && open_.front().added == window_) {
-    const Open& w = open_.front();
-    completed_.push_back({w.index, w.index * step_, w.analyzer->result()});
-    open_.pop_front();
+void DynamicAnalyzer::add(std::span<const double> values) {
+  for (std::size_t done = 0; done < values.size();) {
+    if (values_ == next_index_ * step_) open_.push_back({next_index_++, 0, std::make_unique<Analyzer>(options_)});
+    // A piece that ends where the next window starts or the oldest one completes.
+    std::uint64_t piece = std::min<std::uint64_t>(values.size() - done, next_index_ * step_ - values_);
+    piece = std::min(piece, window_ - open_.front().added);
+    const auto part = values.subspan(done, static_cast<std::size_t>(piece));
+    for (Open& w : open_) {
+      try {
+        w.analyzer->add(part);
+      } catch (const BadValue& e) {
+        throw BadValue(done + e.index(), e.what());
+      }
+      w.added += piece;
+    }
+    values_ += piece;
+    done += static_cast<std::size_t>(piece);
+    if (open_.front().added == window_) {
+      const Open& w = open_.front();
+      completed_.push_back({w.index, w.index * step_, w.analyzer->result()});
+      open_.pop_front();
+    }
   }
 }
 

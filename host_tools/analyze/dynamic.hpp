@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -38,9 +39,12 @@ class DynamicAnalyzer {
   /// `options` as for an Analyzer, its m_list the window taus; window >= 1, step >= 1 values.
   /// Throws std::invalid_argument as Analyzer does, or for a window or step of 0.
   DynamicAnalyzer(const AnalysisOptions& options, std::uint64_t window, std::uint64_t step);
-  /// The next value, to every window it belongs to. O(ceil(window / step) taus) amortized; starting
-  /// a window allocates its pyramid, completing one its rows. Throws as Analyzer::add.
-  void add(double value);
+  /// The next values, each to every window it belongs to (in pieces that end where a window starts
+  /// or completes). O(ceil(window / step)) times the analyzer's work per value; starting a window
+  /// allocates its pyramid, completing one its rows. Throws as Analyzer::add (BadValue's index
+  /// counts from the start of `values`).
+  void add(std::span<const double> values);
+  void add(double value) { add(std::span<const double>(&value, 1)); }
   /// The windows completed since the last call, in order (moved out).
   std::vector<WindowAnalysis> take_completed();
   std::uint64_t values() const { return values_; }

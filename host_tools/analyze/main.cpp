@@ -4,6 +4,7 @@
 // host_tools/analyze/analysis.*, the output formats host_tools/analyze/analysis_report.*.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +14,8 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <new>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -54,21 +57,27 @@ Sigma MaxSigma, one block per statistic; values in the output unit). --kalibr FI
 IEEE-952 fit's N and K as the gyroscope part of a Kalibr imu.yaml (N in rad/s/sqrt(Hz) = rad/s^0.5,
 K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill).
 
-Input: one value per line, or --column C of lines split by blanks, commas or semicolons; '#'
-starts a comment; gzip is recognized by content; '-' reads standard input.
+Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' starts a comment),
+plain or gzip (recognized by content), '-' for standard input; read once. Every data line has as
+many fields as the first. Without --column a table of two columns whose first one increases
+(time, value) is read from column 2, and stderr says so; other tables need --column. A comma
+between two digits beside another separator is a decimal comma, refused; with no other separator
+it is ambiguous and needs --column. A number is never half read.
 
 Taus (averaging factors m, tau = m tau0) and memory:
-  octave        1, 2, 4, ... while a term fits (standard input: up to 2^39)
-  decade        1, 2, 4, 10, 20, 40, ... (regular files only: needs the number of values)
-  all           every m up to N/2 that the stride factor can form (regular files only; time grows
-                as N min(N, S): meant for short files)
+  octave        1, 2, 4, ... while a term fits
+  decade        1, 2, 4, 10, 20, 40, ... (Stable32's decade)
+  all           every m up to N/2 that the stride factor can form (keeps the values in memory;
+                the EDF of every tau makes it O(N^2): 10^4 values take seconds, 10^5 too long)
   1,10,100      a list of m (strictly increasing)
-  A regular file is read twice (count, then compute) so that the tau list fits it; standard input
-  and pipes are read once. Memory does not depend on the length of the data: the pyramid keeps
-  about 3S (1 + levels/2) points for stride factor S. --stride-factor full (the default) makes
-  every tau up to 2^16 fully overlapped (Stable32's estimators, same number of terms); taus above
-  2^16 are strided, their terms m/2^16 points apart, and their EDF is that of the strided
-  estimator. adev and hdev are Stable32's non-overlapped estimators at any tau.
+  The taus are sized from the file's length (an upper bound: rows the data does not reach are
+  left out) and cover any length on standard input. --stride-factor full (the default) makes
+  every tau up to N/4 fully overlapped (Stable32's estimators, same number of terms): the history
+  then grows with N, up to S = 2^24 (3S points of 24 bytes); on standard input, whose length is
+  unknown, every tau up to 2^16 is fully overlapped and taus above it are strided, their terms
+  m/2^16 points apart, with the EDF of the strided estimator. A stride factor S keeps the history
+  at about 3S (1 + levels/2) points whatever the length. adev and hdev are Stable32's
+  non-overlapped estimators at any tau.
 
 The total and Theo family (docs/total.md): totdev, mtotdev, ttotdev, htotdev, theo1, theoh need the
 whole record, which the analyzer then holds (8 bytes a value, plus 4 for mtotdev). Theo1 and
@@ -161,70 +170,46 @@ double parse_pulse_weight_rad(const std::string& text, const std::string& pulse_
   return value * *rad;
 }
 
-// Prints how far the reading got, every 2^20 values, when enabled; nothing for short inputs.
+// Prints how far the reading got, about every 2^20 values, when enabled; nothing for short inputs.
 class Progress {
  public:
-  Progress(bool enabled, const char* stage, const DataFile& file) : enabled_(enabled), stage_(stage), file_(file) {}
+  Progress(bool enabled, const DataFile& file) : enabled_(enabled), file_(file) {}
   ~Progress() {
     if (progress_line_open) std::fputc('\n', stderr);
     progress_line_open = false;
   }
-  void value() {
-    if (!enabled_ || (++values_ & 0xFFFFF) != 0) return;
+  void values(std::size_t n) {
+    values_ += n;
+    if (!enabled_ || values_ < next_) return;
+    next_ = values_ + (1u << 20);
     progress_line_open = true;
     const std::uint64_t size = file_.size_bytes();
     if (size > 0)
-      std::fprintf(stderr, "\rgyrochar-analyze: %s: %5.1f %%", stage_,
+      std::fprintf(stderr, "\rgyrochar-analyze: reading: %5.1f %%",
                    100.0 * static_cast<double>(file_.bytes_read()) / static_cast<double>(size));
     else
-      std::fprintf(stderr, "\rgyrochar-analyze: %s: %llu values", stage_, static_cast<unsigned long long>(values_));
+      std::fprintf(stderr, "\rgyrochar-analyze: reading: %llu values", static_cast<unsigned long long>(values_));
   }
 
  private:
   bool enabled_;
-  const char* stage_;
   const DataFile& file_;
-  std::uint64_t values_ = 0;
+  std::uint64_t values_ = 0, next_ = 1u << 20;
 };
 
-[[noreturn]] void bad_data(const std::string& path, const DataFileError& e) {
-  bad(path == "-" ? "standard input" : path, e.line() ? fmt::format("line {}: {}", e.line(), e.what()) : e.what());
+[[noreturn]] void bad_data(const std::string& source, const DataFileError& e) {
+  bad(source, e.line() ? fmt::format("line {}: {}", e.line(), e.what()) : e.what());
 }
 
-std::uint64_t count_values(const std::string& path, unsigned column, bool progress) {
-  try {
-    DataFile file(path, column);
-    Progress p(progress, "counting", file);
-    std::uint64_t n = 0;
-    for (double v = 0; file.next(v); ++n) p.value();
-    return n;
-  } catch (const DataFileError& e) {
-    bad_data(path, e);
-  }
-}
-
-// Reads every value of the file (Hz around --nominal-hz made fractional) into `add`; a value `add`
-// refuses (invalid_argument: a bad count; range_error) is bad data at its line. Returns the
-// file's header lines.
-template <class Add>
-std::vector<std::string> read_values(const std::string& path, unsigned column, double nominal_hz, bool progress,
-                                     const char* stage, Add add) {
-  try {
-    DataFile file(path, column);
-    Progress p(progress, stage, file);
-    for (double v = 0; file.next(v);) {
-      if (nominal_hz > 0) v = (v - nominal_hz) / nominal_hz;
-      try {
-        add(v);
-      } catch (const std::exception& e) {
-        bad(path == "-" ? "standard input" : path, fmt::format("line {}: {}", file.line(), e.what()));
-      }
-      p.value();
-    }
-    return file.header();
-  } catch (const DataFileError& e) {
-    bad_data(path, e);
-  }
+// Memory the history may take: half the machine's memory, or of the process's address space
+// limit when one is set.
+std::uint64_t memory_budget() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  std::uint64_t budget = pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2
+                                               : std::uint64_t{1} << 32;
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) budget = std::min<std::uint64_t>(budget, limit.rlim_cur / 2);
+  return budget;
 }
 
 // --dynamic WINDOW[,STEP]: one pass over the file, the surface on stdout, the heat maps to --plot.
@@ -267,10 +252,27 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
   }
   const std::string source = path == "-" ? "standard input" : path;
   std::vector<WindowAnalysis> windows;
-  read_values(path, column, nominal_hz, show_progress, "analyzing windows", [&](double v) {
-    analyzer->add(v);
-    for (WindowAnalysis& w : analyzer->take_completed()) windows.push_back(std::move(w));
-  });
+  try {
+    DataFile file(path, column);
+    Progress p(show_progress, file);
+    std::vector<double> block(1 << 14);
+    while (const std::size_t n = file.read(block)) {
+      const std::span<double> values(block.data(), n);
+      if (nominal_hz > 0)
+        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
+      try {
+        analyzer->add(values);
+      } catch (const BadValue& e) {
+        bad(source, fmt::format("line {}: {}", file.line_of(e.index()), e.what()));
+      } catch (const std::range_error& e) {
+        bad(source, fmt::format("by line {}: {}", file.line_of(n - 1), e.what()));
+      }
+      for (WindowAnalysis& w : analyzer->take_completed()) windows.push_back(std::move(w));
+      p.values(n);
+    }
+  } catch (const DataFileError& e) {
+    bad_data(source, e);
+  }
   if (windows.empty())
     bad(source, fmt::format("{} values are fewer than one window of {} values", analyzer->values(), window));
   const DynamicReport report{windows, o.type, o.tau0_s, o.confidence, units, window, step, analyzer->values(), o.stats};
@@ -297,7 +299,7 @@ int main(int argc, char** argv) {
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
   std::string format = "table", fit_text, kalibr_path, dynamic_text, plot_prefix;
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
-  unsigned column = 1;
+  unsigned column = 0;  // 0: the reader chooses
   bool progress = false;
   app.add_option("file", path, "data file (plain or gzip), '-' for standard input")->required();
   app.add_option("--type", type_text, "phase, freq or counts")->required();
@@ -307,7 +309,7 @@ int main(int argc, char** argv) {
   app.add_option("--pulse-unit", pulse_unit, "unit of --pulse-weight when it has none")->capture_default_str();
   app.add_option("--rate-unit", rate_text, "output unit of gyro data: deg/h, deg/s, rad/s")->capture_default_str();
   app.add_option("--nominal-hz", nominal_hz, "freq values are in Hz around this nominal frequency");
-  app.add_option("--column", column, "column holding the values (1-based)")->capture_default_str();
+  app.add_option("--column", column, "column holding the values (1-based; default: the only one, or the value of time,value)");
   app.add_option("--taus", taus_text, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
   app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh")
       ->capture_default_str();
@@ -349,7 +351,7 @@ int main(int argc, char** argv) {
     else bad("--type", "must be phase, freq or counts, not '" + type_text + "'");
     if (!(tau0_s > 0) || !std::isfinite(tau0_s)) bad("--tau0", "must be a positive number of seconds");
     o.tau0_s = tau0_s;
-    if (column == 0) bad("--column", "columns are numbered from 1");
+    if (app.count("--column") && column == 0) bad("--column", "columns are numbered from 1");
     if (!(confidence > 0 && confidence < 1)) bad("--confidence", "must be between 0 and 1");
     o.confidence = confidence;
     o.stats = parse_stats(stats_text);
@@ -449,39 +451,100 @@ int main(int argc, char** argv) {
                              show_progress);
     }
 
-    // Pass 1 (regular files only): the number of values, so the taus fit the data.
-    std::uint64_t n_phase = 0;  // unknown
-    if (is_regular_file(path)) {
-      const std::uint64_t n_values = count_values(path, column, show_progress);
-      if (n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
-      n_phase = o.type == DataType::phase ? n_values : n_values + 1;
+    // One pass over the data. The taus are chosen before it from the file's length, an upper
+    // bound on the values (rows the data does not reach are left out); --taus all reads the
+    // values into memory first, to know N.
+    const auto phase_points = [&](std::uint64_t values) { return o.type == DataType::phase ? values : values + 1; };
+    std::unique_ptr<DataFile> file;
+    std::vector<double> kept;           // --taus all: every value, and its line
+    std::vector<std::uint64_t> kept_lines;
+    std::uint64_t n_phase = 0;          // phase points: exact (all), an upper bound, or 0 (unknown)
+    try {
+      file = std::make_unique<DataFile>(path, column);
+      if (taus_text == "all") {
+        std::vector<double> block(1 << 14);
+        while (const std::size_t n = file->read(block)) {
+          kept.insert(kept.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(n));
+          for (std::size_t i = 0; i < n; ++i) kept_lines.push_back(file->line_of(i));
+        }
+        if (kept.empty()) bad(source, "no data (empty, or only comments and blank lines)");
+        n_phase = phase_points(kept.size());
+      } else if (file->values_bound() > 0) {
+        n_phase = phase_points(file->values_bound());
+      }
+    } catch (const DataFileError& e) {
+      bad_data(source, e);
     }
+    // full: every tau up to N/4 fully overlapped; for --taus all every m up to N/2 (all of them).
+    if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus_text == "all" ? 2 * n_phase : n_phase);
+    const std::uint32_t s = o.stride_factor;
+    std::vector<std::uint64_t> not_formed;  // decade taus the stride factor cannot form
+    const bool generated = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
     if (taus_text == "octave") {
       o.m_list = octave_taus(n_phase);
-    } else if (taus_text == "decade" || taus_text == "all") {
-      if (n_phase == 0) bad("--taus", taus_text + " needs the number of values: give a regular file, or use octave or a list");
-      o.m_list = taus_text == "decade" ? decade_taus(n_phase)
-                                       : all_taus(n_phase, resolve_stride_factor(o.stride_factor, n_phase / 2));
+    } else if (taus_text == "decade") {
+      for (const std::uint64_t m : decade_taus(n_phase ? n_phase : std::uint64_t{1} << 40))
+        (tau_representable(m, s) ? o.m_list : not_formed).push_back(m);
+    } else if (taus_text == "all") {
+      o.m_list = all_taus(n_phase, s);
     } else {
       o.m_list = parse_tau_list(taus_text);
     }
     if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
-    const bool lists = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
-    o.theo_m_list = theo_taus(lists ? taus_text : "list", o.m_list, n_phase);
+    // Generated taus stop where their history would not fit in memory (a large S on standard
+    // input); a list that does not fit is refused.
+    const std::uint64_t budget = memory_budget();
+    std::uint64_t cut_above = 0;
+    while (generated && o.m_list.size() > 1 && history_bytes(o.type, s, o.m_list.back()) > budget) {
+      cut_above = o.m_list.back();
+      o.m_list.pop_back();
+    }
+    const auto too_big = [&] {
+      bad("--stride-factor", fmt::format("{} with taus up to {} needs {} MiB of history, more than the {} MiB this "
+                                         "process may use: give a smaller stride factor or fewer taus",
+                                         s, o.m_list.back(), history_bytes(o.type, s, o.m_list.back()) >> 20, budget >> 20));
+    };
+    if (history_bytes(o.type, s, o.m_list.back()) > budget) too_big();
+    o.theo_m_list = theo_taus(generated ? taus_text : "list", o.m_list, n_phase);
 
-    // Pass 2: the analysis.
     std::unique_ptr<Analyzer> analyzer;
     try {
       analyzer = std::make_unique<Analyzer>(o);
     } catch (const std::invalid_argument& e) {
       bad("--taus", e.what());
+    } catch (const std::bad_alloc&) {
+      too_big();
     }
     DataRange range;
-    const std::vector<std::string> header =
-        read_values(path, column, nominal_hz, show_progress, "analyzing", [&](double v) {
-          range.add(v);
-          analyzer->add(v);
-        });
+    const auto add = [&](std::span<double> values, auto line_of) {
+      if (nominal_hz > 0)
+        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
+      for (const double v : values) range.add(v);
+      try {
+        analyzer->add(values);
+      } catch (const BadValue& e) {
+        bad(source, fmt::format("line {}: {}", line_of(e.index()), e.what()));
+      } catch (const std::range_error& e) {
+        bad(source, fmt::format("by line {}: {}", line_of(values.size() - 1), e.what()));
+      }
+    };
+    try {
+      Progress p(show_progress, *file);
+      if (taus_text == "all") {
+        for (std::size_t i = 0; i < kept.size(); i += 1 << 14) {
+          const std::size_t n = std::min<std::size_t>(kept.size() - i, 1 << 14);
+          add({kept.data() + i, n}, [&](std::size_t k) { return kept_lines[i + k]; });
+        }
+      } else {
+        std::vector<double> block(1 << 14);
+        while (const std::size_t n = file->read(block)) {
+          add({block.data(), n}, [&](std::size_t k) { return file->line_of(k); });
+          p.values(n);
+        }
+      }
+    } catch (const DataFileError& e) {
+      bad_data(source, e);
+    }
     const Analysis a = [&] {
       try {
         return analyzer->result();
@@ -490,7 +553,16 @@ int main(int argc, char** argv) {
       }
     }();
     if (a.n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
+    for (const std::uint64_t m : not_formed)
+      if (m <= a.n_phase / 2)
+        bad("--taus", fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must be a "
+                                  "multiple of its stride (m/S rounded up to a power of two)", m, s));
     if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
+    if (!file->layout_note().empty()) print_error(program, source, "values from " + file->layout_note());
+    if (cut_above > 0 && cut_above <= a.n_phase / 2)
+      print_error(program, source, fmt::format("taus stop below m = {}: with stride factor {} more would need more than "
+                                               "{} MiB of history", cut_above, s, budget >> 20));
+    const std::vector<std::string>& header = file->header();
 
     std::vector<CurveFit> fits;
     if (!fit_text.empty())
