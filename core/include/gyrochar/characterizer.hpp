@@ -649,7 +649,10 @@ class Characterizer {
     requires(Arith::exact)
   {
     const std::uint64_t a = run_.next_e, b = a + n - 1;
-    for (unsigned l = ring_levels_; l-- > 0;) {
+    // Only the rings with a multiple of 2^l in [a, b] move (their lags are multiples of 2^l too).
+    const auto width = static_cast<unsigned>(std::bit_width((a - 1) ^ b));
+    const unsigned moved = width < ring_levels_ ? width : ring_levels_;
+    for (unsigned l = moved; l-- > 0;) {
       const std::uint64_t lag = ring_lag(l), size = ring_size(l);
       if (b < lag) continue;
       const std::uint64_t newest = (b - lag) >> l;
@@ -657,18 +660,20 @@ class Characterizer {
       if (newest >= first + size) first = newest + 1 - size;
       Entry* ring = &history_[ring_offset(l)];
       unsigned r = l == 0 ? 0 : l - 1;  // the ring holding q before, for q < a (older q sit higher)
+      auto slot = static_cast<std::uint32_t>(first % size);
       for (std::uint64_t k = first; k <= newest; ++k) {
         const std::uint64_t q = k << l;
         if (q >= a) {
           const auto j = static_cast<std::size_t>(q - a);
-          ring[k % size] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
-          continue;
+          ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
+        } else {
+          while (!held(r, q, a - 1)) --r;  // ring 0 holds every q in [a - 3S, a)
+          ring[slot] = history_[ring_offset(r) + (q >> r) % ring_size(r)];
         }
-        while (!held(r, q, a - 1)) --r;  // ring 0 holds every q in [a - 3S, a)
-        ring[k % size] = history_[ring_offset(r) + (q >> r) % ring_size(r)];
+        if (++slot == size) slot = 0;
       }
     }
-    for (unsigned l = 0; l < ring_levels_; ++l) run_.head[l] = static_cast<std::uint32_t>((b >> l) % ring_size(l));
+    for (unsigned l = 0; l < moved; ++l) run_.head[l] = static_cast<std::uint32_t>((b >> l) % ring_size(l));
     run_.next_e = b + 1;
     run_.p = {p_lo[n - 1], p_hi[n - 1]};
   }
