@@ -668,7 +668,7 @@ class Characterizer {
           ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
         } else {
           while (!held(r, q, a - 1)) --r;  // ring 0 holds every q in [a - 3S, a)
-          ring[slot] = history_[ring_offset(r) + (q >> r) % ring_size(r)];
+          ring[slot] = history_[ring_offset(r) + static_cast<std::size_t>((q >> r) % ring_size(r))];
         }
         if (++slot == size) slot = 0;
       }
