@@ -24,6 +24,8 @@
 #include "analysis.hpp"
 #include "analysis_report.hpp"
 #include "datafile.hpp"
+#include "dynamic.hpp"
+#include "heat_map.hpp"
 #include "hal/exit_codes.hpp"
 
 namespace {
@@ -89,6 +91,13 @@ corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and 
 SP 1065's for the statistic. --fit-long-tau totdev or theoh lets the IEEE-952 fit take TOTDEV or
 TheoBR points in place of OADEV at long tau, where they have more degrees of freedom.
 
+Dynamic Allan deviation (--dynamic WINDOW[,STEP], in seconds; STEP defaults to WINDOW): the
+  statistics of every window of WINDOW/tau0 values, one starting every STEP/tau0 values, each as
+  if its values were a file of their own, at the taus with 4 m <= the window's values (--taus
+  chooses among them). Output: the tau x time surface (table, CSV or JSON); --plot PREFIX also
+  draws it as heat maps, one per statistic, in PREFIX.svg and PREFIX.png. Values after the last
+  complete window are counted, not analysed.
+
 Examples:
   gyrochar-analyze --type phase --tau0 1 --stats adev,oadev,mdev,tdev PHASE.DAT
   gyrochar-analyze --type freq --tau0 1 --nominal-hz 10e6 --taus all --stats mdev ocxo.txt
@@ -100,6 +109,8 @@ Examples:
   gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --stats oadev,totdev,theoh run120h.txt
   gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 --fit-long-tau totdev run120h.txt
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
+  gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1arcsec --dynamic 600,60 --format csv \
+                   --plot warmup run.txt > surface.csv
 
 )";
 
@@ -201,6 +212,81 @@ std::uint64_t memory_budget() {
   return budget;
 }
 
+// --dynamic WINDOW[,STEP]: one pass over the file, the surface on stdout, the heat maps to --plot.
+int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::string& dynamic_text,
+                    const std::string& taus_text, const std::string& path, unsigned column, double nominal_hz,
+                    const std::string& format, const std::string& plot_prefix, bool show_progress) {
+  const std::vector<std::string> parts = split(dynamic_text, ',');
+  double window_s = 0, step_s = 0;
+  const auto seconds = [](const std::string& t, double& v) {
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    return ec == std::errc() && end == t.data() + t.size() && v > 0 && std::isfinite(v);
+  };
+  if (parts.empty() || parts.size() > 2 || !seconds(parts[0], window_s) || (parts.size() == 2 && !seconds(parts[1], step_s)))
+    bad("--dynamic", "'" + dynamic_text + "' is not WINDOW or WINDOW,STEP in positive seconds");
+  if (parts.size() == 1) step_s = window_s;
+  const double window_values = std::round(window_s / o.tau0_s), step_values = std::round(step_s / o.tau0_s);
+  if (window_values < 4 || window_values > 1e15)
+    bad("--dynamic", fmt::format("a window of {} s holds {} values of tau0: at least 4 are needed", window_s, window_values));
+  if (step_values < 1) bad("--dynamic", fmt::format("a step of {} s is shorter than tau0", step_s));
+  const auto window = static_cast<std::uint64_t>(window_values), step = static_cast<std::uint64_t>(step_values);
+  // The windows' taus: --taus over the phase points of one window, those with 4 m <= its values.
+  const std::uint64_t window_phase = o.type == DataType::phase ? window : window + 1;
+  std::vector<std::uint64_t> m_list = taus_text == "octave"   ? octave_taus(window_phase)
+                                      : taus_text == "decade" ? decade_taus(window_phase)
+                                      : taus_text == "all"
+                                          ? all_taus(window_phase, resolve_stride_factor(o.stride_factor, window_phase / 2))
+                                          : parse_tau_list(taus_text);
+  const std::size_t asked = m_list.size();
+  m_list = window_taus(m_list, window);
+  if (m_list.empty()) bad("--taus", fmt::format("no tau with 4 m <= the window's {} values", window));
+  if (m_list.size() != asked && taus_text != "octave" && taus_text != "decade" && taus_text != "all")
+    bad("--taus", fmt::format("averaging factors above {} do not fit a quarter of the window", window / 4));
+  o.m_list = m_list;
+
+  std::unique_ptr<DynamicAnalyzer> analyzer;
+  try {
+    analyzer = std::make_unique<DynamicAnalyzer>(o, window, step);
+  } catch (const std::invalid_argument& e) {
+    bad("--dynamic", e.what());
+  }
+  const std::string source = path == "-" ? "standard input" : path;
+  std::vector<WindowAnalysis> windows;
+  try {
+    DataFile file(path, column);
+    Progress p(show_progress, file);
+    std::vector<double> block(1 << 14);
+    while (const std::size_t n = file.read(block)) {
+      const std::span<double> values(block.data(), n);
+      if (nominal_hz > 0)
+        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
+      try {
+        analyzer->add(values);
+      } catch (const BadValue& e) {
+        bad(source, fmt::format("line {}: {}", file.line_of(e.index()), e.what()));
+      } catch (const std::range_error& e) {
+        bad(source, fmt::format("by line {}: {}", file.line_of(n - 1), e.what()));
+      }
+      for (WindowAnalysis& w : analyzer->take_completed()) windows.push_back(std::move(w));
+      p.values(n);
+    }
+  } catch (const DataFileError& e) {
+    bad_data(source, e);
+  }
+  if (windows.empty())
+    bad(source, fmt::format("{} values are fewer than one window of {} values", analyzer->values(), window));
+  const DynamicReport report{windows, o.type, o.tau0_s, o.confidence, units, window, step, analyzer->values(), o.stats};
+  const std::string text = format == "json" ? dynamic_to_json(report).dump(2) + "\n"
+                           : format == "csv" ? format_dynamic_csv(report)
+                                             : format_dynamic_table(report);
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (!plot_prefix.empty()) {
+    std::string why;
+    if (!write_heat_maps(plot_prefix, dynamic_heat_maps(report), why)) fail(exit_code::output_failed, "--plot", why);
+  }
+  return finish(program, exit_code::ok);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -211,7 +297,7 @@ int main(int argc, char** argv) {
   app.footer(std::string(footer) + exit_code::help);
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
-  std::string format = "table", fit_text, kalibr_path;
+  std::string format = "table", fit_text, kalibr_path, dynamic_text, plot_prefix;
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
   unsigned column = 0;  // 0: the reader chooses
   bool progress = false;
@@ -243,6 +329,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--kalibr", kalibr_path, "with --fit ieee952 on gyro data: also write N and K as a Kalibr imu.yaml")
       ->option_text("FILE");
+  app.add_option("--dynamic", dynamic_text, "dynamic Allan deviation: windows of WINDOW s, one every STEP s")
+      ->option_text("WINDOW[,STEP]");
+  app.add_option("--plot", plot_prefix, "with --dynamic: draw the heat maps to PREFIX.svg and PREFIX.png")
+      ->option_text("PREFIX");
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
     app.parse(argc, argv);
@@ -289,6 +379,9 @@ int main(int argc, char** argv) {
     }
     if (format != "table" && format != "csv" && format != "json" && format != "stable32")
       bad("--format", "must be table, csv, json or stable32");
+    if (!plot_prefix.empty()) {
+      if (const std::string missing = plot_devices_missing(); !missing.empty()) bad("--plot", missing);
+    }
     if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
     if (!kalibr_path.empty() && fit_text.empty()) bad("--kalibr", "needs --fit ieee952 (the file holds fitted terms)");
     LongTau long_tau = LongTau::oadev;
@@ -349,11 +442,18 @@ int main(int argc, char** argv) {
       bad("--rate-unit", "only applies to gyro data (counts, or --unit with an angle or a rate)");
     }
 
+    const bool show_progress = progress || isatty(STDERR_FILENO);
+    const std::string source = path == "-" ? "standard input" : path;
+    if (!plot_prefix.empty() && dynamic_text.empty()) bad("--plot", "draws the heat maps of --dynamic only");
+    if (!dynamic_text.empty()) {
+      if (!fit_text.empty()) bad("--fit", "fits the whole run's curves: not with --dynamic");
+      return analyze_dynamic(o, units, dynamic_text, taus_text, path, column, nominal_hz, format, plot_prefix,
+                             show_progress);
+    }
+
     // One pass over the data. The taus are chosen before it from the file's length, an upper
     // bound on the values (rows the data does not reach are left out); --taus all reads the
     // values into memory first, to know N.
-    const bool show_progress = progress || isatty(STDERR_FILENO);
-    const std::string source = path == "-" ? "standard input" : path;
     const auto phase_points = [&](std::uint64_t values) { return o.type == DataType::phase ? values : values + 1; };
     std::unique_ptr<DataFile> file;
     std::vector<double> kept;           // --taus all: every value, and its line

@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <algorithm>
@@ -517,6 +518,70 @@ TEST(AnalyzeCli, AllTausEqualTheirBruteForceFromFileStdinAndGzip) {
   }
   EXPECT_EQ(run(args + "- < " + path).out, file.out);
   EXPECT_EQ(run(args + path + ".gz").out, file.out);
+}
+
+// --- the dynamic Allan deviation -------------------------------------------------------------
+
+TEST(AnalyzeCli, DynamicWritesTheSurfaceAndTheHeatMaps) {
+  // 20000 counts of 1 ms; windows of 5 s (5000 values) every 2.5 s: 7 windows. Oracle for the
+  // values: the same analysis of one window's counts cut out into a file of its own.
+  const std::vector<int> c = white_rate_counts();
+  std::string all, window3;
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    all += std::to_string(c[k]) + "\n";
+    if (k >= 7500 && k < 12500) window3 += std::to_string(c[k]) + "\n";
+  }
+  const std::string path = file_with("dynamic.txt", all), alone = file_with("window3.txt", window3);
+  const std::string common = "--type counts --tau0 0.001 --pulse-weight 1arcsec --stats oadev,mdev ";
+  const Outcome j = run(common + "--dynamic 5,2.5 --format json " + path);
+  ASSERT_EQ(j.code, 0) << j.err;
+  const nlohmann::json doc = nlohmann::json::parse(j.out);
+  EXPECT_EQ(doc["dynamic"]["window"], 5000);
+  EXPECT_EQ(doc["dynamic"]["step"], 2500);
+  ASSERT_EQ(doc["windows"].size(), 7u);
+  const nlohmann::json& w3 = doc["windows"][3];
+  EXPECT_EQ(w3["index"], 3);
+  EXPECT_DOUBLE_EQ(w3["start"].get<double>(), 7.5);
+  EXPECT_DOUBLE_EQ(w3["end"].get<double>(), 12.5);
+  // Taus up to a quarter of the window: octaves 1 .. 1024 (4 x 1024 <= 5000 < 4 x 2048).
+  const Outcome ref = run(common + "--taus 1,2,4,8,16,32,64,128,256,512,1024 --format json " + alone);
+  ASSERT_EQ(ref.code, 0) << ref.err;
+  const nlohmann::json expected = nlohmann::json::parse(ref.out)["results"];
+  ASSERT_EQ(w3["results"].size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(w3["results"][i]["m"], expected[i]["m"]);
+    EXPECT_EQ(w3["results"][i]["dev"], expected[i]["dev"]) << i;
+    EXPECT_EQ(w3["results"][i]["ci_low"], expected[i]["ci_low"]) << i;
+  }
+  // The CSV: one row per window, statistic and tau, after its header.
+  const Outcome csv = run(common + "--dynamic 5,2.5 --format csv " + path);
+  ASSERT_EQ(csv.code, 0) << csv.err;
+  EXPECT_EQ(csv.out.rfind("window,start,end,stat,m,tau,n,dev,unit,", 0), 0u);
+  EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 1 + 7 * 2 * 11);
+  // The heat maps, and the table for people.
+  const std::string prefix = temp("heat");
+  const Outcome table = run(common + "--dynamic 5 --plot " + prefix + " " + path);
+  ASSERT_EQ(table.code, 0) << table.err;
+  EXPECT_NE(table.out.find("windows of 5000 values (5 s) every 5000 values (5 s), 4 complete"), std::string::npos)
+      << table.out;
+  struct stat st {};
+  for (const char* ext : {".svg", ".png"}) {
+    ASSERT_EQ(stat((prefix + ext).c_str(), &st), 0) << ext;
+    EXPECT_GT(st.st_size, 1000) << ext;
+  }
+}
+
+TEST(AnalyzeCli, DynamicRefusesWhatItCannotDo) {
+  const std::string good = good_phase();
+  expect_bad_input("--type phase --tau0 1 --dynamic x " + good, "--dynamic");
+  expect_bad_input("--type phase --tau0 1 --dynamic 100,-1 " + good, "--dynamic");
+  expect_bad_input("--type phase --tau0 1 --dynamic 100,50,25 " + good, "--dynamic");
+  expect_bad_input("--type phase --tau0 1 --dynamic 3 " + good, "at least 4");
+  expect_bad_input("--type phase --tau0 1 --dynamic 100,0.4 " + good, "shorter than tau0");
+  expect_bad_input("--type phase --tau0 1 --dynamic 500 " + good, "fewer than one window");
+  expect_bad_input("--type phase --tau0 1 --dynamic 100 --taus 1,50 " + good, "quarter of the window");
+  expect_bad_input("--type phase --tau0 1 --plot p " + good, "--plot");
+  expect_bad_input("--type counts --tau0 1 --pulse-weight 1arcsec --fit ieee952 --dynamic 100 " + good, "--fit");
 }
 
 }  // namespace
