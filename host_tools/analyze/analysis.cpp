@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <new>
 #include <span>
 #include <stdexcept>
@@ -14,6 +15,7 @@
 #include <type_traits>
 
 #include "gyrochar/batch.hpp"
+#include "edf_table.hpp"
 #include "gyrochar/characterizer.hpp"
 #include "total_analysis.hpp"
 
@@ -142,6 +144,26 @@ class ZeroedArray {
   std::size_t size_;
 };
 
+constexpr std::uint64_t dense_from = 64;
+
+// A dense tau list (at least every other m from 64 on, fully overlapped: --taus all) takes the
+// exact EDF of an overlapping statistic from an interpolating table (edf_table.hpp) from m = 64 on:
+// the exact one of every m would cost O(N) covariance sums a tau. Null otherwise.
+std::unique_ptr<EdfTable> dense_edf_table(DevStat stat, const std::vector<TauSums>& sums, std::uint64_t n_phase,
+                                          EdfModel model, PairSumCache& cache) {
+  constexpr std::uint64_t m_min = dense_from;
+  const SumKind k = sum_kind(stat);
+  if (model != EdfModel::exact || (k != SumKind::avar && k != SumKind::mvar && k != SumKind::hvar)) return nullptr;
+  std::uint64_t m_max = 0, dense = 0;
+  for (const TauSums& t : sums) {
+    if (t.m < m_min || t.stride != 1 || unbroken_grid(stat_of(stat), t.m, 1, n_phase).n == 0) continue;
+    m_max = t.m;
+    ++dense;
+  }
+  if (m_max == 0 || 2 * dense < m_max - m_min + 1) return nullptr;
+  return std::make_unique<EdfTable>(stat, n_phase, m_min, m_max, cache);
+}
+
 // The read-out every engine shares: the noise identification of every tau (Allan and Hadamard
 // curves), then each statistic's rows with their EDF and interval, and the total family from the
 // record. `a` has its counts filled in; the rows are appended.
@@ -154,6 +176,18 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
   std::vector<PairSumCache::Entry> entries(4 * taus + 16);
   PairSumCache cache(entries);
   const bool frequency_input = type == DataType::freq;
+  // Dense taus: the EDF from tables, and the identification's pair sums put in the cache, both
+  // exact at anchors and interpolated between them (edf_table.hpp).
+  std::map<DevStat, std::unique_ptr<EdfTable>> tables;
+  for (const DevStat stat : o.stats)
+    for (const DevStat s : is_total(stat) ? std::vector<DevStat>{DevStat::oadev, DevStat::mdev, DevStat::ohdev} : std::vector{stat})
+      if (!tables.contains(s)) tables[s] = dense_edf_table(s, sums, a.n_phase, o.edf, cache);
+  if (!o.alpha && std::any_of(tables.begin(), tables.end(), [](const auto& t) { return t.second != nullptr; })) {
+    std::vector<std::uint64_t> m_list;
+    for (const TauSums& t : sums)
+      if (t.stride == 1) m_list.push_back(t.m);
+    put_dense_noise_sums(m_list, a.n_phase, dense_from, cache);
+  }
   if (o.alpha) {
     std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
     std::fill(noise3.begin(), noise3.end(), given_noise(*o.alpha));
@@ -163,9 +197,12 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
   }
   const EstimateOptions options{o.tau0_s, type == DataType::freq ? o.tau0_s : 1.0, o.edf};
   auto rows_of = [&](DevStat stat, std::vector<AnalysisRow>& out) {
+    const EdfTable* table = tables[stat].get();
     for (std::size_t i = 0; i < taus; ++i) {
       const NoiseId& id = stat_of(stat) == Stat::hvar ? noise3[i] : noise2[i];
-      const Estimate e = estimate(sums[i], a.n_phase, stat, id, options, &cache);
+      const bool interpolated = table && table->covers(sums[i].m) && sums[i].stride == 1;
+      const Estimate e = interpolated ? table->estimate(sums[i], a.n_phase, id, options)
+                                      : estimate(sums[i], a.n_phase, stat, id, options, &cache);
       if (e.n == 0) continue;
       if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
       AnalysisRow row;
