@@ -242,26 +242,8 @@ echo "- gyrochar-analyze peak RSS independent of file length: met (10^6 and 10^8
 echo "- gyrochard steady-state RSS and zero allocations after start-up: met on the QEMU bench (above:"
 echo "  no allocation, no new page, RSS and HWM unchanged over 40 s)."
 echo
-echo "## Against the targets (issue 11, the analyzer; figures of 2026-11-24 on the loaded machine)"
-echo
-echo "- Reading >= 300 MB/s: met, 725 MB/s of counts text per CPU second (integer fast path), 438 MB/s"
-echo "  of %.9e phase values, 353 MB/s gzip'd through zlib (libdeflate decompresses 4x faster but only"
-echo "  whole members in memory). A regular file is read once; the reader is 6 % of the S = 8 profile."
-echo "- Whole job >= 20x allantools at 10^7 at the default settings: **missed**, 2.3x (CPU). At the"
-echo "  default (full) S >= N/4, so the characterizer never reaches its steady state (e >= 3S) and"
-echo "  forms every term on its general path (form_terms: 70 % of the profile); with S = 8: 8.5x,"
-echo "  the per-sample core (23 M samples/s) is the bound. The reader alone would allow about 100x"
-echo "  (0.08 s of 8.6 s): the figure follows the core's block kernel once it also serves the taus"
-echo "  whose 3m history lies in the segment before e reaches 3S."
-echo "- 10^8 samples: 2.9x at full, 14x at S = 8 (CPU). allantools did not run out of room here: it"
-echo "  finished in 116 s of CPU with a peak of 4.6 GiB (within the 16 GiB address space it is given)."
-echo "- --stride-factor full >= 10x allantools, every tau up to N/4 fully overlapped: the taus are,"
-echo "  the speed is **missed** (2.3x), same reason."
-echo "- --taus all beside allantools' taus=\"all\": 10^4 samples 7.2 s against 0.94 s of CPU (0.13x);"
-echo "  10^5 and 10^6 did not finish in 10 minutes (allantools: 24.5 s at 10^5; at 10^6 neither)."
-echo "  The time goes to the exact EDF and noise identification of every tau (pair_sums() of"
-echo "  noise_model.hpp, 95 % of the profile: O(terms' reach) per tau, so O(N^2) over all m), not to"
-echo "  the sums; allantools gives no intervals. Identification and EDF now share one covariance cache"
-echo "  (2x)."
+cat <<'TARGETS'
+TARGETS_BODY
+TARGETS
 } > "$out"
 echo "benchmarks.sh: wrote $out" >&2
