@@ -251,9 +251,9 @@ cat <<'TARGETS'
 - Whole job >= 20x allantools at 10^7 at the default settings: **missed**, 12.7x (CPU 0.60 s
   against 7.59 s; 2.3x before the batch path). At the default (full) the analyzer holds the counts
   (4 bytes a point) and sums every tau over them with the batch kernel (core/batch.hpp, bit for bit
-  the characterizer's sums). Profile: the batch kernel 45 % (AVX2, about 1.2 ns a point and tau,
-  23 taus: the MVAR running sum is scalar), the decimated series and noise sums 16 %, reading and
-  holding the values 20 %, EDF and identification 7 %. 20x needs 0.38 s: a vectorized running
+  the characterizer's sums). Profile (perf): the batch kernel 48 % (AVX2, about 1.2 ns a point and tau,
+  23 taus: the MVAR running sum is scalar), the decimated series and noise sums 15 %, reading and
+  holding the values 20 %, EDF and identification 10 %. 20x needs 0.38 s: a vectorized running
   sum and a leaner hold would be next.
 - 10^8 samples: 29.9x at full (CPU 5.76 s against 172.17 s; peak RSS 388 MiB instead of
   1726 MiB before), 42.6x at S = 8 (CPU 4.04 s, 6 MiB). allantools shared its cores with other
@@ -262,8 +262,8 @@ cat <<'TARGETS'
 - --stride-factor full >= 10x allantools, every tau up to N/4 fully overlapped: met, 12.7x at
   10^7 (the default is full).
 - --taus all beside allantools' taus="all": 10^4 samples 1.5x (CPU 0.64 s against 0.93 s), 10^5
-  5.0x (4.89 s against 24.66 s); 10^6 finished on neither side within 10 minutes (ours shared its
-  cores with allantools at 10^8 and the test suite). The EDF, skewness and identification sums
+  5.0x (4.89 s against 24.66 s); 10^6 finished on neither side within 10 minutes (ours twice, on
+  cores shared with other jobs). The EDF, skewness and identification sums
   now come from exact anchors 2^(1/16) apart, interpolated within 2e-3 (measured 1.0e-3;
   host_tools/analyze/edf_table.hpp; they were 95 % of the time: 10^4 took 7.2 s); the time now
   goes to the O(N^2) sums themselves (54 % at 10^5).
