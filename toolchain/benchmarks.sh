@@ -258,26 +258,31 @@ echo "- gyrochar-analyze peak RSS independent of file length: met (10^6 and 10^8
 echo "- gyrochard steady-state RSS and zero allocations after start-up: met on the QEMU bench (above:"
 echo "  no allocation, no new page, RSS and HWM unchanged over 40 s)."
 echo
-echo "## Against the targets (issue 11, the analyzer; figures of 2026-11-24 on the loaded machine)"
-echo
-echo "- Reading >= 300 MB/s: met, 725 MB/s of counts text per CPU second (integer fast path), 438 MB/s"
-echo "  of %.9e phase values, 353 MB/s gzip'd through zlib (libdeflate decompresses 4x faster but only"
-echo "  whole members in memory). A regular file is read once; the reader is 6 % of the S = 8 profile."
-echo "- Whole job >= 20x allantools at 10^7 at the default settings: **missed**, 2.3x (CPU). At the"
-echo "  default (full) S >= N/4, so the characterizer never reaches its steady state (e >= 3S) and"
-echo "  forms every term on its general path (form_terms: 70 % of the profile); with S = 8: 8.5x,"
-echo "  the per-sample core (23 M samples/s) is the bound. The reader alone would allow about 100x"
-echo "  (0.08 s of 8.6 s): the figure follows the core's block kernel once it also serves the taus"
-echo "  whose 3m history lies in the segment before e reaches 3S."
-echo "- 10^8 samples: 2.9x at full, 14x at S = 8 (CPU). allantools did not run out of room here: it"
-echo "  finished in 116 s of CPU with a peak of 4.6 GiB (within the 16 GiB address space it is given)."
-echo "- --stride-factor full >= 10x allantools, every tau up to N/4 fully overlapped: the taus are,"
-echo "  the speed is **missed** (2.3x), same reason."
-echo "- --taus all beside allantools' taus=\"all\": 10^4 samples 7.2 s against 0.94 s of CPU (0.13x);"
-echo "  10^5 and 10^6 did not finish in 10 minutes (allantools: 24.5 s at 10^5; at 10^6 neither)."
-echo "  The time goes to the exact EDF and noise identification of every tau (pair_sums() of"
-echo "  noise_model.hpp, 95 % of the profile: O(terms' reach) per tau, so O(N^2) over all m), not to"
-echo "  the sums; allantools gives no intervals. Identification and EDF now share one covariance cache"
-echo "  (2x)."
+cat <<'TARGETS'
+## Against the targets (issue 11, the analyzer; figures of 2026-11-25 on the loaded machine)
+
+- Reading >= 300 MB/s: met, 725 MB/s of counts text per CPU second (integer fast path), 438 MB/s
+  of %.9e phase values, 353 MB/s gzip'd through zlib (libdeflate decompresses 4x faster but only
+  whole members in memory). A regular file is read once.
+- Whole job >= 20x allantools at 10^7 at the default settings: **missed**, 12.7x (CPU 0.60 s
+  against 7.59 s; 2.3x before the batch path). At the default (full) the analyzer holds the counts
+  (4 bytes a point) and sums every tau over them with the batch kernel (core/batch.hpp, bit for bit
+  the characterizer's sums). Profile (perf): the batch kernel 48 % (AVX2, about 1.2 ns a point and tau,
+  23 taus: the MVAR running sum is scalar), the decimated series and noise sums 15 %, reading and
+  holding the values 20 %, EDF and identification 10 %. 20x needs 0.38 s: a vectorized running
+  sum and a leaner hold would be next.
+- 10^8 samples: 29.9x at full (CPU 5.76 s against 172.17 s; peak RSS 388 MiB instead of
+  1726 MiB before), 42.6x at S = 8 (CPU 4.04 s, 6 MiB). allantools shared its cores with other
+  jobs here (751 s of wall time; 116 s of CPU in the previous, quieter run: 20.2x against that),
+  peak 4653 MiB (within the 16 GiB address space it is given).
+- --stride-factor full >= 10x allantools, every tau up to N/4 fully overlapped: met, 12.7x at
+  10^7 (the default is full).
+- --taus all beside allantools' taus="all": 10^4 samples 1.5x (CPU 0.64 s against 0.93 s), 10^5
+  5.0x (4.89 s against 24.66 s); 10^6 finished on neither side within 10 minutes (ours twice, on
+  cores shared with other jobs). The EDF, skewness and identification sums
+  now come from exact anchors 2^(1/16) apart, interpolated within 2e-3 (measured 1.0e-3;
+  host_tools/analyze/edf_table.hpp; they were 95 % of the time: 10^4 took 7.2 s); the time now
+  goes to the O(N^2) sums themselves (54 % at 10^5).
+TARGETS
 } > "$out"
 echo "benchmarks.sh: wrote $out" >&2

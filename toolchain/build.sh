@@ -82,7 +82,9 @@ case "$job" in
     ctest --preset sanitize -j "$(nproc)"
     echo "build.sh: the QEMU bench: a real kernel's CAN and GPIO drivers under emulation (docs/bench.md)" >&2
     toolchain/bench/build.sh
-    ctest --preset host -L bench -j "$(nproc)"
+    # A scenario whose edges the emulator stalled past an interval's end cannot be judged (docs/bench.md,
+    # "GPIO timing"); a failed scenario runs once more, and fails CI only if it fails twice.
+    ctest --preset host -L bench -j "$(nproc)" --repeat until-pass:2
     echo "build.sh: the host test suite" >&2
     ctest --preset host -j "$(nproc)" -LE bench
     ;;

@@ -452,10 +452,8 @@ void add_scaled(PairSums& out, const PairSums& a, double k, const PairSums& b) {
 
 }  // namespace
 
-PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b, bool white_pm_only) {
-  NoiseSet set = allan_noises();
-  if (white_pm_only) set.count = 1;  // alpha = 2 comes first
-  if (entries_.empty() || a.stat == Stat::hvar || b.stat == Stat::hvar) return pair_sums(set, a, b);
+PairSumCache::Entry* PairSumCache::slot(const TermGrid& a, const TermGrid& b, bool white_pm_only) {
+  if (entries_.empty() || a.stat == Stat::hvar || b.stat == Stat::hvar) return nullptr;
   // Open addressing on the grids' shape.
   std::uint64_t h = (a.m * 0x9E3779B97F4A7C15u) ^ (b.m * 0xC2B2AE3D27D4EB4Fu) ^ (a.stride << 7) ^ (b.stride << 13) ^
                     (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5) ^
@@ -469,7 +467,26 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b, bool white_pm_o
       break;
     }
   }
-  if (entry == nullptr) return pair_sums(set, a, b);  // full
+  return entry;
+}
+
+void PairSumCache::put(const TermGrid& a, const TermGrid& b, const PairSums& sums) {
+  Entry* entry = slot(a, b, false);
+  if (entry == nullptr) return;
+  *entry = Entry{};
+  entry->used = true;
+  entry->stat_a = a.stat, entry->stat_b = b.stat, entry->m_a = a.m, entry->m_b = b.m;
+  entry->stride_a = a.stride, entry->stride_b = b.stride;
+  entry->n_a = a.n;
+  entry->n_b = b.n;
+  entry->sums = sums;
+}
+
+PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b, bool white_pm_only) {
+  NoiseSet set = allan_noises();
+  if (white_pm_only) set.count = 1;  // alpha = 2 comes first
+  Entry* entry = slot(a, b, white_pm_only);
+  if (entry == nullptr) return pair_sums(set, a, b);  // hvar, or full
   const bool a_coarse = a.stride >= b.stride;
   const std::uint64_t n = a_coarse ? a.n : b.n;
   if (entry->used && entry->linear && n >= entry->from) {

@@ -7,12 +7,15 @@
 #include <bit>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <new>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 
+#include "gyrochar/batch.hpp"
+#include "edf_table.hpp"
 #include "gyrochar/characterizer.hpp"
 #include "total_analysis.hpp"
 
@@ -141,6 +144,96 @@ class ZeroedArray {
   std::size_t size_;
 };
 
+constexpr std::uint64_t dense_from = 64;
+
+// A dense tau list (at least every other m from 64 on, fully overlapped: --taus all) takes the
+// exact EDF of an overlapping statistic from an interpolating table (edf_table.hpp) from m = 64 on:
+// the exact one of every m would cost O(N) covariance sums a tau. Null otherwise.
+std::unique_ptr<EdfTable> dense_edf_table(DevStat stat, const std::vector<TauSums>& sums, std::uint64_t n_phase,
+                                          EdfModel model, PairSumCache& cache) {
+  constexpr std::uint64_t m_min = dense_from;
+  const SumKind k = sum_kind(stat);
+  if (model != EdfModel::exact || (k != SumKind::avar && k != SumKind::mvar && k != SumKind::hvar)) return nullptr;
+  std::uint64_t m_max = 0, dense = 0;
+  for (const TauSums& t : sums) {
+    if (t.m < m_min || t.stride != 1 || unbroken_grid(stat_of(stat), t.m, 1, n_phase).n == 0) continue;
+    m_max = t.m;
+    ++dense;
+  }
+  if (m_max == 0 || 2 * dense < m_max - m_min + 1) return nullptr;
+  return std::make_unique<EdfTable>(stat, n_phase, m_min, m_max, cache);
+}
+
+// The read-out every engine shares: the noise identification of every tau (Allan and Hadamard
+// curves), then each statistic's rows with their EDF and interval, and the total family from the
+// record. `a` has its counts filled in; the rows are appended.
+void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, const AnalysisOptions& o,
+              std::span<const double> record) {
+  const std::size_t taus = sums.size();
+  std::vector<NoiseId> noise2(taus), noise3(taus);
+  // The identification and the EDF need the same covariance sums of each tau's Allan and
+  // modified Allan grids: computed once (two grids a tau, the table half full at most).
+  std::vector<PairSumCache::Entry> entries(4 * taus + 16);
+  PairSumCache cache(entries);
+  const bool frequency_input = type == DataType::freq;
+  // Dense taus: the EDF from tables, and the identification's pair sums put in the cache, both
+  // exact at anchors and interpolated between them (edf_table.hpp).
+  std::map<DevStat, std::unique_ptr<EdfTable>> tables;
+  for (const DevStat stat : o.stats)
+    for (const DevStat s : is_total(stat) ? std::vector<DevStat>{DevStat::oadev, DevStat::mdev, DevStat::ohdev} : std::vector{stat})
+      if (!tables.contains(s)) tables[s] = dense_edf_table(s, sums, a.n_phase, o.edf, cache);
+  if (!o.alpha && std::any_of(tables.begin(), tables.end(), [](const auto& t) { return t.second != nullptr; })) {
+    std::vector<std::uint64_t> m_list;
+    for (const TauSums& t : sums)
+      if (t.stride == 1) m_list.push_back(t.m);
+    put_dense_noise_sums(m_list, a.n_phase, dense_from, cache);
+  }
+  if (o.alpha) {
+    std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
+    std::fill(noise3.begin(), noise3.end(), given_noise(*o.alpha));
+  } else {
+    identify_noise(sums, a.n_phase, 2, frequency_input, noise2, &cache);
+    identify_noise(sums, a.n_phase, 3, frequency_input, noise3, &cache);
+  }
+  const EstimateOptions options{o.tau0_s, type == DataType::freq ? o.tau0_s : 1.0, o.edf};
+  auto rows_of = [&](DevStat stat, std::vector<AnalysisRow>& out) {
+    const EdfTable* table = tables[stat].get();
+    for (std::size_t i = 0; i < taus; ++i) {
+      const NoiseId& id = stat_of(stat) == Stat::hvar ? noise3[i] : noise2[i];
+      const bool interpolated = table && table->covers(sums[i].m) && sums[i].stride == 1;
+      const Estimate e = interpolated ? table->estimate(sums[i], a.n_phase, id, options)
+                                      : estimate(sums[i], a.n_phase, stat, id, options, &cache);
+      if (e.n == 0) continue;
+      if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
+      AnalysisRow row;
+      row.stat = stat;
+      row.m = e.m;
+      row.tau_s = e.tau_s;
+      row.n = e.n;
+      row.dev = e.deviation;
+      if (e.noise.identified()) row.alpha = e.noise.alpha;
+      row.noise = e.noise;
+      row.edf_alpha = e.edf_alpha;
+      row.stride = e.stride;
+      row.edf = e.edf;
+      row.skew_dof = o.edf == EdfModel::exact ? e.skew_dof : 0.0;  // Greenhall's: Stable32's plain intervals
+      if (e.edf > 0) row.ci = confidence_interval(row.dev, row.edf, o.confidence, row.skew_dof);
+      out.push_back(row);
+    }
+  };
+  std::vector<AnalysisRow> allan;  // what the total family leans on (total_analysis.hpp)
+  if (std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); }))
+    for (const DevStat s : {DevStat::oadev, DevStat::mdev, DevStat::ohdev}) rows_of(s, allan);
+  for (const DevStat stat : o.stats) {
+    if (!is_total(stat)) {
+      rows_of(stat, a.rows);
+      continue;
+    }
+    const auto total = total_rows(stat, record, options.unit, o, allan);
+    a.rows.insert(a.rows.end(), total.begin(), total.end());
+  }
+}
+
 struct EngineBase {
   virtual ~EngineBase() = default;
   virtual void add(std::span<const double> values) = 0;
@@ -194,56 +287,9 @@ class Engine final : public EngineBase {
     a.n_values = type_ == DataType::phase ? characterizer_.phase_points() : characterizer_.increments();
     a.n_phase = characterizer_.phase_points();
     a.stride_factor = characterizer_.stride_factor();
-    const std::size_t taus = characterizer_.tau_count();
-    std::vector<TauSums> sums(taus);
+    std::vector<TauSums> sums(characterizer_.tau_count());
     take_sums(characterizer_, sums);
-    std::vector<NoiseId> noise2(taus), noise3(taus);
-    // The identification and the EDF need the same covariance sums of each tau's Allan and
-    // modified Allan grids: computed once (two grids a tau, the table half full at most).
-    std::vector<PairSumCache::Entry> entries(4 * taus + 16);
-    PairSumCache cache(entries);
-    const bool frequency_input = type_ == DataType::freq;
-    if (o.alpha) {
-      std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
-      std::fill(noise3.begin(), noise3.end(), given_noise(*o.alpha));
-    } else {
-      identify_noise(sums, a.n_phase, 2, frequency_input, noise2, &cache);
-      identify_noise(sums, a.n_phase, 3, frequency_input, noise3, &cache);
-    }
-    const EstimateOptions options{o.tau0_s, type_ == DataType::freq ? o.tau0_s : 1.0, o.edf};
-    auto rows_of = [&](DevStat stat, std::vector<AnalysisRow>& out) {
-      for (std::size_t i = 0; i < taus; ++i) {
-        const NoiseId& id = stat_of(stat) == Stat::hvar ? noise3[i] : noise2[i];
-        const Estimate e = estimate(sums[i], a.n_phase, stat, id, options, &cache);
-        if (e.n == 0) continue;
-        if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
-        AnalysisRow row;
-        row.stat = stat;
-        row.m = e.m;
-        row.tau_s = e.tau_s;
-        row.n = e.n;
-        row.dev = e.deviation;
-        if (e.noise.identified()) row.alpha = e.noise.alpha;
-        row.noise = e.noise;
-        row.edf_alpha = e.edf_alpha;
-        row.stride = e.stride;
-        row.edf = e.edf;
-        row.skew_dof = o.edf == EdfModel::exact ? e.skew_dof : 0.0;  // Greenhall's: Stable32's plain intervals
-        if (e.edf > 0) row.ci = confidence_interval(row.dev, row.edf, o.confidence, row.skew_dof);
-        out.push_back(row);
-      }
-    };
-    std::vector<AnalysisRow> allan;  // what the total family leans on (total_analysis.hpp)
-    if (std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); }))
-      for (const DevStat s : {DevStat::oadev, DevStat::mdev, DevStat::ohdev}) rows_of(s, allan);
-    for (const DevStat stat : o.stats) {
-      if (!is_total(stat)) {
-        rows_of(stat, a.rows);
-        continue;
-      }
-      const auto total = total_rows(stat, record_, options.unit, o, allan);
-      a.rows.insert(a.rows.end(), total.begin(), total.end());
-    }
+    read_out(a, sums, type_, o, record_);
     return a;
   }
 
@@ -275,6 +321,88 @@ class Engine final : public EngineBase {
   std::vector<std::int32_t> counts_;  // a block of counts on its way to the block API
 };
 
+// Counts with the record held: every tau summed over it by the batch kernel (core/batch.hpp), the
+// same sums to the last bit as the characterizer's, O(N) per tau. The phase is held as residuals
+// from the line of the first count, 4 bytes a point while they fit in int32 (a gyro's phase strays
+// little from its mean rate), 8 bytes from the first that does not.
+class CountBatchEngine final : public EngineBase {
+ public:
+  CountBatchEngine(std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list, bool keep_record,
+                   std::uint64_t values_hint)
+      : stride_factor_(stride_factor), m_list_(m_list), keep_record_(keep_record) {
+    narrow_.reserve(values_hint + 1);
+    narrow_.push_back(0);  // x_0 = 0
+  }
+
+  void add(std::span<const double> values) override {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const double v = values[i];
+      if (!(std::fabs(v) < 2147483648.0) || v != std::trunc(v)) throw BadValue(i, "a count must be an integer of magnitude below 2^31");
+      const auto c = static_cast<std::int32_t>(v);
+      if (counts_ == 0) slope_ = c;
+      if (__builtin_add_overflow(x_, std::int64_t{c}, &x_)) throw std::range_error("the accumulated count passed 2^63 pulses");
+      ++counts_;
+      lowest_ = std::min(lowest_, c);
+      highest_ = std::max(highest_, c);
+      residual_ += static_cast<std::uint64_t>(std::int64_t{c} - slope_);  // modulo 2^64, as the kernel reads it
+      const auto r = static_cast<std::int64_t>(residual_);
+      if (wide_.empty() && r >= INT32_MIN && r <= INT32_MAX) {
+        narrow_.push_back(static_cast<std::int32_t>(r));
+      } else {
+        if (wide_.empty()) {
+          wide_.reserve(narrow_.capacity());
+          wide_.assign(narrow_.begin(), narrow_.end());
+          std::vector<std::int32_t>().swap(narrow_);
+        }
+        wide_.push_back(r);
+      }
+      if (keep_record_) {  // as the characterizer's engine keeps it
+        if (record_.empty()) record_.push_back(0.0);
+        record_.push_back(record_.back() + v);
+      }
+    }
+  }
+
+  Analysis result(const AnalysisOptions& o) const override {
+    Analysis a;
+    a.n_values = counts_;
+    a.n_phase = counts_ == 0 ? 0 : counts_ + 1;
+    a.stride_factor = stride_factor_;
+    std::vector<BatchTau> taus;
+    taus.reserve(m_list_.size());
+    for (const std::uint64_t m : m_list_) taus.emplace_back(m, stride_of(m, stride_factor_));
+    const std::uint64_t spread = counts_ == 0 ? 0 : static_cast<std::uint64_t>(std::int64_t{highest_} - lowest_);
+    for (BatchTau& t : taus) {
+      if (counts_ == 0) break;
+      if (wide_.empty()) {
+        t.add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
+      } else {
+        t.add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
+      }
+    }
+    std::vector<TauSums> sums;
+    sums.reserve(taus.size());
+    for (const BatchTau& t : taus) sums.push_back(tau_sums(t.result(), t.noise()));
+    read_out(a, sums, DataType::counts, o, record_);
+    return a;
+  }
+
+  PhaseRecord record(const AnalysisOptions&) const override { return {record_, 1.0}; }
+
+ private:
+  std::uint32_t stride_factor_;
+  std::vector<std::uint64_t> m_list_;
+  bool keep_record_;
+  std::uint64_t counts_ = 0;
+  std::int64_t x_ = 0;            // the phase reached, in pulses
+  std::int64_t slope_ = 0;        // the first count: the line the residuals are taken from
+  std::uint64_t residual_ = 0;    // x - slope * points, modulo 2^64
+  std::int32_t lowest_ = INT32_MAX, highest_ = INT32_MIN;  // the counts' range: it bounds the terms
+  std::vector<std::int32_t> narrow_;  // the residuals while they fit in int32, x_0 first
+  std::vector<std::int64_t> wide_;    // all of them from the first that does not
+  std::vector<double> record_;        // the phase for the total family (keep_record)
+};
+
 }  // namespace
 
 struct Analyzer::Impl {
@@ -302,7 +430,9 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
     if (o.theo_m_list[i] <= o.theo_m_list[i - 1]) throw std::invalid_argument("Theo1 averaging factors must increase");
   impl_->options = o;
   const bool keep_record = o.keep_record || std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
-  if (o.type == DataType::counts)
+  if (o.type == DataType::counts && o.hold_counts)
+    impl_->engine = std::make_unique<CountBatchEngine>(s, o.m_list, keep_record, o.values_hint);
+  else if (o.type == DataType::counts)
     impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record);
   else
     impl_->engine = std::make_unique<Engine<FloatArith>>(o.type, s, o.m_list, keep_record);

@@ -84,6 +84,13 @@ struct AnalysisOptions {
   std::vector<std::uint64_t> theo_m_list;  // averaging factors of Theo1 and TheoBR (even), increasing
   std::uint32_t total_stride_factor = 16;  // S of their decimated estimators; 0: always exact
   bool keep_record = false;                // hold the record without a total statistic (fits)
+  // Counts only: hold the phase (4 bytes a point while it strays less than 2^31 pulses from the
+  // line of the first count, else 8) and sum every tau over it by the batch kernel
+  // (core/include/gyrochar/batch.hpp): the characterizer's sums to the last bit, O(N) per tau,
+  // where the pyramid's history for a stride factor near N/4 would take 24 bytes a point or more.
+  // values_hint: an upper bound on the values to reserve the record for (0: unknown).
+  bool hold_counts = false;
+  std::uint64_t values_hint = 0;
 };
 
 struct AnalysisRow {

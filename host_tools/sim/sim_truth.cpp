@@ -331,7 +331,7 @@ std::optional<SimSegment> parse_segment_option(std::string_view text, std::strin
     return r.ec == std::errc() && r.ptr == t.data() + t.size() && std::isfinite(v);
   };
   if (colon == std::string_view::npos || !number(text.substr(0, colon), g.start_s)) {
-    why = "'" + std::string(text) + "' is not T:NAME=VALUE[,NAME=VALUE...] (T in seconds)";
+    why = std::string("'").append(text).append("' is not T:NAME=VALUE[,NAME=VALUE...] (T in seconds)");
     return std::nullopt;
   }
   std::string_view rest = text.substr(colon + 1);
@@ -344,7 +344,7 @@ std::optional<SimSegment> parse_segment_option(std::string_view text, std::strin
       if (eq != std::string_view::npos && item.substr(0, eq) == k.option) key = &k;
     double v = 0;
     if (key == nullptr || !number(item.substr(eq + 1), v) || (g.*key->field).has_value()) {
-      why = "'" + std::string(item) + "' is not rate=, white-angle=, arw= or rrw= with a number, each once";
+      why = std::string("'").append(item).append("' is not rate=, white-angle=, arw= or rrw= with a number, each once");
       return std::nullopt;
     }
     g.*key->field = v;

@@ -11,6 +11,7 @@
 
 #include "gyrochar/block_kernel.hpp"
 #include "gyrochar/characterizer.hpp"
+#include "core/heap_characterizer.hpp"
 #include "oracle/brute_force.hpp"
 
 namespace gyrochar {
@@ -19,19 +20,6 @@ namespace {
 using oracle::brute_force;
 using oracle::Exact;
 using oracle::u128;
-
-u128 to_u128(UInt128 v) { return (u128{v.hi} << 64) | v.lo; }
-
-// A characterizer on heap storage for any stride factor.
-struct Heap {
-  std::vector<CountArith::Entry> history;
-  std::vector<Characterizer<CountArith>::TauState> taus;
-  Characterizer<CountArith> c;
-  Heap(std::uint32_t s, const std::vector<std::uint64_t>& m_list)
-      : history(history_entries(s, m_list.back())), taus(m_list.size()), c(history, taus) {
-    EXPECT_EQ(c.configure({s, 0}, m_list), ConfigureStatus::ok);
-  }
-};
 
 std::vector<std::uint64_t> taus_for(std::uint32_t s) {
   // Every m <= S (level 0: the kernel) up to 8, then octaves and one sub-octave tau per level.

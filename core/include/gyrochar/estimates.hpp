@@ -82,20 +82,26 @@ struct TauSums {
   Lag1Summary noise;
 };
 
+/// The sums of one tau from its exact or floating sums and its noise sums (either accumulator of
+/// noise_id.hpp): what the characterizer (take_sums()) and the batch path (batch.hpp) both give
+/// the extractors. O(1), no allocation.
+template <class Sum, class NoiseSums>
+TauSums tau_sums(const TauResult<Sum>& r, const NoiseSums& noise) {
+  TauSums t;
+  t.m = r.m;
+  t.stride = r.stride;
+  t.n = r.n;
+  for (std::size_t k = 0; k < sum_kinds; ++k) t.variance[k] = variance(r, static_cast<SumKind>(k), 1.0);
+  t.clean = r.out_of_range == 0 && !r.sum_overflow;
+  t.has_noise = true;
+  t.noise = summarize(noise);
+  return t;
+}
+
 /// Fills out[0 .. tau_count) from the characterizer. O(taus), no allocation.
 template <class Arith>
 void take_sums(const Characterizer<Arith>& c, std::span<TauSums> out) {
-  for (std::size_t i = 0; i < c.tau_count() && i < out.size(); ++i) {
-    const auto r = c.result(i);
-    TauSums& t = out[i];
-    t.m = r.m;
-    t.stride = r.stride;
-    t.n = r.n;
-    for (std::size_t k = 0; k < sum_kinds; ++k) t.variance[k] = variance(r, static_cast<SumKind>(k), 1.0);
-    t.clean = r.out_of_range == 0 && !r.sum_overflow;
-    t.has_noise = true;
-    t.noise = summarize(c.noise(i));
-  }
+  for (std::size_t i = 0; i < c.tau_count() && i < out.size(); ++i) out[i] = tau_sums(c.result(i), c.noise(i));
 }
 
 enum class NoiseIdMethod : std::uint8_t {

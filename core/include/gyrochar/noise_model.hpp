@@ -132,10 +132,15 @@ class PairSumCache {
   /// white_pm_only, the sums of white PM alone (the other noises left 0): what the fit keeps of
   /// estimates far apart.
   PairSums get(const TermGrid& a, const TermGrid& b, bool white_pm_only = false);
+  /// Remembers `sums` as those of grids a and b (Allan and modified Allan), for get() to return
+  /// while neither grid grows (the analyzer's interpolated sums of dense taus). Ignored when the
+  /// table is full. O(1) expected.
+  void put(const TermGrid& a, const TermGrid& b, const PairSums& sums);
   /// Forgets everything (a new configuration). O(capacity).
   void clear();
 
  private:
+  Entry* slot(const TermGrid& a, const TermGrid& b, bool white_pm_only);  // null: not kept
   std::span<Entry> entries_;
 };
 

@@ -1,0 +1,337 @@
+// The batch path of the exact counts statistics (see batch.hpp).
+#include "gyrochar/batch.hpp"
+
+#include <bit>
+
+namespace gyrochar {
+namespace {
+
+constexpr std::size_t chunk = 256;  // terms per partial sum
+
+// A chunk's squares in one 64-bit word: every term's low 32-bit half squared as a signed value,
+// and a bound on the terms, the OR of v XOR sign(v) (|v| <= 2^bit_width of it). Both are SIMD
+// operations on every target (a signed 32x32->64 multiply), and the sum is exact when
+// exact() says so.
+struct Squares {
+  std::uint64_t bound = 0;
+  std::uint64_t sum = 0;
+  void add(std::int64_t v) {
+    bound |= static_cast<std::uint64_t>(v ^ (v >> 63));
+    const auto low = static_cast<std::int32_t>(v);
+    sum += static_cast<std::uint64_t>(std::int64_t{low} * low);
+  }
+  // Every |v| <= 2^b with 2b + bit_width(n) <= 64: each v fits in int32 (its low half is itself)
+  // and n squares of at most 2^2b stay below 2^64.
+  bool exact(std::size_t n) const { return 2 * std::bit_width(bound) + std::bit_width(n) <= 64; }
+};
+
+template <class R>
+inline std::uint64_t word(R v) {
+  return static_cast<std::uint64_t>(static_cast<std::int64_t>(v));
+}
+
+// The overlapping sums of one tau (index: SumKind avar 0, mvar 1, hvar 2) while a segment runs.
+struct Totals {
+  UInt128 sum[3];
+  std::uint64_t n[3];
+  std::uint64_t sticky;
+  void add(int k, std::int64_t v) {
+    sticky |= add_high_word(sum[k], square(v));
+    ++n[k];
+  }
+};
+
+// The terms of a chunk, newest points x0[0 .. n): AVAR, and HVAR when `hvar`, with their squares.
+struct ChunkSquares {
+  Squares a, h;
+};
+template <class R>
+[[gnu::always_inline]] inline ChunkSquares avar_hvar(const R* __restrict x0, std::size_t m, std::size_t n, bool hvar,
+                                                     std::int64_t* __restrict a, std::int64_t* __restrict h) {
+  ChunkSquares sq;
+  for (std::size_t j = 0; j < n; ++j) {
+    const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
+    const std::uint64_t d2 = u1 - u2;
+    const auto av = static_cast<std::int64_t>((u0 - u1) - d2);
+    a[j] = av;
+    sq.a.add(av);
+    if (hvar) {
+      const auto hv = static_cast<std::int64_t>(static_cast<std::uint64_t>(av) - (d2 - (u2 - word(x0[j - 3 * m]))));
+      h[j] = hv;
+      sq.h.add(hv);
+    }
+  }
+  return sq;
+}
+
+// A chunk's squares v[0 .. n) with their partial sum s: s when it is exact, else term by term
+// in 128 bits.
+inline void add_chunk(Totals& tot, int k, const std::int64_t* v, std::size_t n, const Squares& s) {
+  if (s.exact(n)) {
+    tot.sticky |= add_high_word(tot.sum[k], UInt128{s.sum, 0});
+    tot.n[k] += n;
+  } else {
+    for (std::size_t j = 0; j < n; ++j) tot.add(k, v[j]);
+  }
+}
+[[gnu::always_inline]] inline Squares squares(const std::int64_t* __restrict v, std::size_t n) {
+  Squares s;
+  for (std::size_t j = 0; j < n; ++j) s.add(v[j]);
+  return s;
+}
+
+// Strided taus: the chunk's terms at first, first + step, ... only.
+inline void add_selected(Totals& tot, int k, const std::int64_t* v, std::size_t n, std::size_t first, std::size_t step) {
+  for (std::size_t j = first; j < n; j += step) tot.add(k, v[j]);
+}
+
+// t[j] = t[j-1] + h[j] from t[-1] = previous, in four independent runs (a quarter each, started
+// from the quarters' sums) so that the additions overlap. Returns t[n-1].
+[[gnu::always_inline]] inline std::uint64_t running_sum(const std::int64_t* __restrict h, std::int64_t* __restrict t,
+                                                         std::size_t n, std::uint64_t previous) {
+  const std::size_t q = n / 4;
+  std::uint64_t s0 = 0, s1 = 0, s2 = 0;
+  for (std::size_t j = 0; j < q; ++j) {
+    s0 += static_cast<std::uint64_t>(h[j]);
+    s1 += static_cast<std::uint64_t>(h[q + j]);
+    s2 += static_cast<std::uint64_t>(h[2 * q + j]);
+  }
+  std::uint64_t c0 = previous, c1 = previous + s0, c2 = c1 + s1, c3 = c2 + s2;
+  for (std::size_t j = 0; j < q; ++j) {
+    c0 += static_cast<std::uint64_t>(h[j]);
+    c1 += static_cast<std::uint64_t>(h[q + j]);
+    c2 += static_cast<std::uint64_t>(h[2 * q + j]);
+    c3 += static_cast<std::uint64_t>(h[3 * q + j]);
+    t[j] = static_cast<std::int64_t>(c0);
+    t[q + j] = static_cast<std::int64_t>(c1);
+    t[2 * q + j] = static_cast<std::int64_t>(c2);
+    t[3 * q + j] = static_cast<std::int64_t>(c3);
+  }
+  for (std::size_t j = 4 * q; j < n; ++j) t[j] = static_cast<std::int64_t>(c3 += static_cast<std::uint64_t>(h[j]));
+  return c3;
+}
+
+// The overlapping terms of tau m (stride a power of two, terms where first_e + s is a multiple of
+// it) over the segment r[0 .. size), whose terms are proved to fit in int64: AVAR for s >= 2m,
+// MVAR for s >= 3m - 1, HVAR for s >= 3m (s: index in the segment).
+template <class R>
+[[gnu::always_inline]] inline void overlapping(const R* __restrict r, std::size_t size, std::size_t m,
+                                               std::uint64_t first_e, std::uint64_t stride, Totals& tot) {
+  alignas(64) std::int64_t a[chunk], h[chunk], t[chunk];
+  const auto selected = [&](std::size_t s0) {  // first index of the chunk from s0 with a term
+    return static_cast<std::size_t>((stride - (first_e + s0) % stride) % stride);
+  };
+  const auto step = static_cast<std::size_t>(stride);
+  // AVAR alone: 2m <= s < 3m.
+  const std::size_t a_end = size < 3 * m ? size : 3 * m;
+  for (std::size_t s0 = 2 * m; s0 < a_end; s0 += chunk) {
+    const std::size_t n = a_end - s0 < chunk ? a_end - s0 : chunk;
+    const ChunkSquares sq = avar_hvar(r + s0, m, n, false, a, h);
+    if (step == 1) {
+      add_chunk(tot, 0, a, n, sq.a);
+    } else {
+      add_selected(tot, 0, a, n, selected(s0), step);
+    }
+  }
+  if (size < 3 * m) return;
+  // The first MVAR term, s = 3m - 1: P[3m] - 3 P[2m] + 3 P[m] - P[0] over the residuals (the
+  // line's prefix sums are quadratic: their third difference is 0).
+  std::uint64_t q1 = 0, q2 = 0, q3 = 0;
+  for (std::size_t i = 0; i < m; ++i) q1 += word(r[i]);
+  for (std::size_t i = m; i < 2 * m; ++i) q2 += word(r[i]);
+  for (std::size_t i = 2 * m; i < 3 * m; ++i) q3 += word(r[i]);
+  q2 += q1;
+  q3 += q2;
+  std::uint64_t tp = q3 - 3 * q2 + 3 * q1;
+  if ((first_e + 3 * m - 1) % stride == 0) tot.add(1, static_cast<std::int64_t>(tp));
+  // All three: s >= 3m. t_s = t_{s-1} + h_s.
+  for (std::size_t s0 = 3 * m; s0 < size; s0 += chunk) {
+    const std::size_t n = size - s0 < chunk ? size - s0 : chunk;
+    const ChunkSquares sq = avar_hvar(r + s0, m, n, true, a, h);
+    tp = running_sum(h, t, n, tp);
+    if (step == 1) {
+      add_chunk(tot, 0, a, n, sq.a);
+      add_chunk(tot, 2, h, n, sq.h);
+      add_chunk(tot, 1, t, n, squares(t, n));
+    } else {
+      const std::size_t first = selected(s0);
+      add_selected(tot, 0, a, n, first, step);
+      add_selected(tot, 2, h, n, first, step);
+      add_selected(tot, 1, t, n, first, step);
+    }
+  }
+}
+
+// One definition per residual type, compiled twice on the x86-64 host (AVX2 and the baseline,
+// chosen by the loader), once elsewhere.
+#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
+#define GYROCHAR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define GYROCHAR_CLONES
+#endif
+GYROCHAR_CLONES void overlapping32(const std::int32_t* r, std::size_t size, std::size_t m, std::uint64_t first_e,
+                                   std::uint64_t stride, Totals& tot) {
+  overlapping(r, size, m, first_e, stride, tot);
+}
+GYROCHAR_CLONES void overlapping64(const std::int64_t* r, std::size_t size, std::size_t m, std::uint64_t first_e,
+                                   std::uint64_t stride, Totals& tot) {
+  overlapping(r, size, m, first_e, stride, tot);
+}
+void overlapping_of(const std::int32_t* r, std::size_t size, std::size_t m, std::uint64_t first_e, std::uint64_t stride,
+                    Totals& tot) {
+  overlapping32(r, size, m, first_e, stride, tot);
+}
+void overlapping_of(const std::int64_t* r, std::size_t size, std::size_t m, std::uint64_t first_e, std::uint64_t stride,
+                    Totals& tot) {
+  overlapping64(r, size, m, first_e, stride, tot);
+}
+
+// The characterizer's terms_fit(): with spread D every term of tau m fits in int64 when
+// 2 m^2 D < 2^63.
+bool terms_fit(std::uint64_t m, std::uint64_t spread) {
+  if (m > (std::uint64_t{1} << 31)) return false;
+  return spread <= (~std::uint64_t{0} >> 1) / (2 * m * m);
+}
+
+template <class R>
+std::int64_t point(const PhaseSegment<R>& s, std::size_t j) {
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(s.x0) + static_cast<std::uint64_t>(s.slope) * j + word(s.r[j]));
+}
+
+}  // namespace
+
+BatchTau::BatchTau(std::uint64_t m, std::uint64_t stride) {
+  result_.m = m;
+  result_.stride = stride;
+}
+
+void BatchTau::add_segment(const PhaseSegment<std::int32_t>& segment) { add(segment); }
+void BatchTau::add_segment(const PhaseSegment<std::int64_t>& segment) { add(segment); }
+
+template <class R>
+void BatchTau::add(const PhaseSegment<R>& segment) {
+  if (segments_++ > 0) noise_.reset_segment();
+  const std::uint64_t m = result_.m;
+  const bool fits = terms_fit(m, segment.spread);
+  decimate(segment, fits);
+  if (segment.r.size() <= 2 * m) return;  // no term (and m fits in size_t below)
+  if (!fits) {
+    checked_terms(segment);
+    return;
+  }
+  Totals tot{{result_.sum[0], result_.sum[1], result_.sum[2]}, {result_.n[0], result_.n[1], result_.n[2]}, sticky_};
+  overlapping_of(segment.r.data(), segment.r.size(), static_cast<std::size_t>(m), segment.first_e, result_.stride, tot);
+  for (std::size_t k = 0; k < 3; ++k) {
+    result_.sum[k] = tot.sum[k];
+    result_.n[k] = tot.n[k];
+  }
+  sticky_ = tot.sticky;
+}
+
+// The decimated series x[k m] of the segment: the non-overlapped Allan and Hadamard sums and the
+// noise sums, as Characterizer::decimate() forms them, a chunk of points at a time. When the tau's
+// terms fit (they are among the overlapping ones), in modular arithmetic with partial sums of
+// squares; otherwise each checked as the characterizer does.
+template <class R>
+void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits) {
+  const std::uint64_t m = result_.m;
+  const std::uint64_t size = segment.r.size();
+  std::uint64_t s = (m - segment.first_e % m) % m;
+  std::int64_t v[3 + chunk];  // the three points before the chunk, then the chunk
+  std::int64_t a[chunk], h[chunk];
+  std::uint64_t have = 0;     // points of this segment before the chunk
+  const auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
+  const auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
+  while (s < size) {
+    const std::uint64_t left = (size - s + m - 1) / m;
+    const auto n = static_cast<std::size_t>(left < chunk ? left : chunk);
+    for (std::size_t k = 0; k < n; ++k) v[3 + k] = point(segment, static_cast<std::size_t>(s + k * m));
+    s += n * m;
+    std::uint64_t step = 0;  // the largest |x[k m] - x[(k-1) m]| here (all ones: beyond int64)
+    for (std::size_t k = have > 0 ? 0 : 1; k < n; ++k) {
+      std::int64_t d = 0;
+      const bool wide = __builtin_sub_overflow(v[3 + k], v[2 + k], &d);
+      const auto mag = wide ? ~std::uint64_t{0} : d < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(d) : static_cast<std::uint64_t>(d);
+      if (mag > step) step = mag;
+    }
+    noise_.add(v + 3, n, 1, step);
+    const std::size_t first_a = have >= 2 ? 0 : static_cast<std::size_t>(2 - have);
+    const std::size_t first_h = have >= 3 ? 0 : static_cast<std::size_t>(3 - have);
+    if (fits) {
+      Squares sa, sh;
+      for (std::size_t k = 0; k < n; ++k) {
+        const auto u0 = static_cast<std::uint64_t>(v[3 + k]), u1 = static_cast<std::uint64_t>(v[2 + k]);
+        const auto u2 = static_cast<std::uint64_t>(v[1 + k]), u3 = static_cast<std::uint64_t>(v[k]);
+        const std::uint64_t d2 = u1 - u2;
+        const std::uint64_t av = (u0 - u1) - d2;
+        a[k] = k >= first_a ? static_cast<std::int64_t>(av) : 0;
+        h[k] = k >= first_h ? static_cast<std::int64_t>(av - (d2 - (u2 - u3))) : 0;
+        sa.add(a[k]);
+        sh.add(h[k]);
+      }
+      Totals tot{{result_.sum[avar_d], {}, result_.sum[hvar_d]}, {0, 0, 0}, sticky_};
+      if (first_a < n) add_chunk(tot, 0, a + first_a, n - first_a, sa);
+      if (first_h < n) add_chunk(tot, 2, h + first_h, n - first_h, sh);
+      result_.sum[avar_d] = tot.sum[0];
+      result_.sum[hvar_d] = tot.sum[2];
+      result_.n[avar_d] += tot.n[0];
+      result_.n[hvar_d] += tot.n[2];
+      sticky_ = tot.sticky;
+    } else {
+      for (std::size_t k = 0; k < n; ++k) {
+        std::int64_t av = 0, hv = 0;
+        if (k >= first_a && CountArith::x_term2(v[3 + k], v[2 + k], v[1 + k], av)) {
+          sticky_ |= CountArith::accumulate(result_.sum[avar_d], av);
+          ++result_.n[avar_d];
+        }
+        if (k >= first_h && CountArith::x_terms(v[3 + k], v[2 + k], v[1 + k], v[k], av, hv)) {
+          sticky_ |= CountArith::accumulate(result_.sum[hvar_d], hv);
+          ++result_.n[hvar_d];
+        }
+      }
+    }
+    have += n;
+    for (std::size_t k = 0; k < 3; ++k) v[k] = v[n + k];
+  }
+}
+
+// Point by point, every term checked, as the characterizer's form_terms() (for taus whose terms
+// the spread does not prove to fit). P as exact 128-bit prefix sums from the segment's start.
+template <class R>
+void BatchTau::checked_terms(const PhaseSegment<R>& segment) {
+  const std::uint64_t m = result_.m, stride = result_.stride;
+  const std::uint64_t size = segment.r.size();
+  Int128 p[4];  // P[s + 1 - k m] at point s
+  for (std::uint64_t s = 0; s < size; ++s) {
+    for (std::uint64_t k = 0; k < 4 && k * m <= s; ++k) p[k] = p[k] + widen(point(segment, static_cast<std::size_t>(s - k * m)));
+    if (s < 2 * m || (segment.first_e + s) % stride != 0) continue;
+    const std::int64_t x0 = point(segment, static_cast<std::size_t>(s));
+    const std::int64_t x1 = point(segment, static_cast<std::size_t>(s - m));
+    const std::int64_t x2 = point(segment, static_cast<std::size_t>(s - 2 * m));
+    std::int64_t a = 0, h = 0, t = 0;
+    if (s < 3 * m) {
+      if (!CountArith::x_term2(x0, x1, x2, a)) {
+        ++result_.out_of_range;
+      } else {
+        sticky_ |= CountArith::accumulate(result_.sum[0], a);
+        ++result_.n[0];
+      }
+      if (s + 1 != 3 * m) continue;
+    } else if (!CountArith::x_terms(x0, x1, x2, point(segment, static_cast<std::size_t>(s - 3 * m)), a, h)) {
+      ++result_.out_of_range;
+    } else {
+      sticky_ |= CountArith::accumulate(result_.sum[0], a);
+      ++result_.n[0];
+      sticky_ |= CountArith::accumulate(result_.sum[2], h);
+      ++result_.n[2];
+    }
+    if (!CountArith::p_term(p[0], p[1], p[2], p[3], t)) {
+      ++result_.out_of_range;
+      continue;
+    }
+    sticky_ |= CountArith::accumulate(result_.sum[1], t);
+    ++result_.n[1];
+  }
+}
+
+}  // namespace gyrochar
