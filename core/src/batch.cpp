@@ -247,7 +247,14 @@ void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits) {
     const auto n = static_cast<std::size_t>(left < chunk ? left : chunk);
     for (std::size_t k = 0; k < n; ++k) v[3 + k] = point(segment, static_cast<std::size_t>(s + k * m));
     s += n * m;
-    noise_.add(v + 3, n, 1);
+    std::uint64_t step = 0;  // the largest |x[k m] - x[(k-1) m]| here (all ones: beyond int64)
+    for (std::size_t k = have > 0 ? 0 : 1; k < n; ++k) {
+      std::int64_t d = 0;
+      const bool wide = __builtin_sub_overflow(v[3 + k], v[2 + k], &d);
+      const auto mag = wide ? ~std::uint64_t{0} : d < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(d) : static_cast<std::uint64_t>(d);
+      if (mag > step) step = mag;
+    }
+    noise_.add(v + 3, n, 1, step);
     const std::size_t first_a = have >= 2 ? 0 : static_cast<std::size_t>(2 - have);
     const std::size_t first_h = have >= 3 ? 0 : static_cast<std::size_t>(3 - have);
     if (fits) {

@@ -51,14 +51,14 @@ int clamp_alpha(int alpha, int dmax) {
 // nearest on a log scale; for white PM vs flicker PM, R(n) = MVAR/AVAR.
 NoiseId b1_identify(const TauSums& t) {
   NoiseId out;
-  const Lag1Sums y = t.noise->order(1);
+  const std::uint64_t points = t.noise.n[1];
   const double avar = t.variance[static_cast<std::size_t>(SumKind::avar)];
   const double mvar = t.variance[static_cast<std::size_t>(SumKind::mvar)];
   // With fewer than 3 averages every B1(N, mu) is 1: B1 cannot choose.
-  if (y.n < 3 || !(avar > 0)) return out;
+  if (points < 3 || !(avar > 0)) return out;
   const double scale = static_cast<double>(t.m);
-  const double b1 = y.variance() / (scale * scale) / avar;
-  const double n = static_cast<double>(y.n);
+  const double b1 = t.noise.variance1 / (scale * scale) / avar;
+  const double n = static_cast<double>(points);
   static constexpr int alphas[] = {2, 0, -1, -2};
   static constexpr int mus[] = {-2, -1, 0, 1};
   int pick = 3;
@@ -164,7 +164,7 @@ void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dm
     const NoiseId* previous = i > 0 && out[i - 1].identified() ? &out[i - 1] : nullptr;
     std::array<double, 7> chi2{};  // index 2 - alpha
     bool informed = false;
-    const Lag1Estimate lag1 = t.noise ? lag1_estimate(*t.noise, dmin, dmax) : Lag1Estimate{};
+    const Lag1Estimate lag1 = t.has_noise ? lag1_estimate(t.noise, dmin, dmax) : Lag1Estimate{};
     const bool use_lag1 = lag1.valid && lag1.points >= lag1_min_points;
     const std::array<double, 5> rn = rn_scores(t, n_phase, cache);
     for (int alpha = 2; alpha >= lowest; --alpha) {
@@ -188,7 +188,7 @@ void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dm
       if (previous) {
         id = *previous;
         id.method = NoiseIdMethod::neighbour;
-      } else if (t.noise) {
+      } else if (t.has_noise) {
         id = b1_identify(t);
         id.alpha = clamp_alpha(id.alpha, dmax);
         id.low = id.high = id.alpha;

@@ -53,23 +53,173 @@ void NoiseIdAccumulator::add_run(const std::int64_t* z, std::size_t count, std::
   add_steady(z, count, step);
 }
 
-Lag1Estimate lag1_estimate(const NoiseIdAccumulator& acc, int dmin, int dmax) {
+Lag1Estimate lag1_estimate(const Lag1Summary& series, int dmin, int dmax) {
   Lag1Estimate out;
   for (int d = dmin; d <= dmax; ++d) {
-    const Lag1Sums s = acc.order(d);
-    if (s.n < 3) return out;
-    const double r1 = s.r1();
+    const auto k = static_cast<std::size_t>(d);
+    if (series.n[k] < 3) return out;
+    const double r1 = series.r1[k];
     const double delta = r1 / (1.0 + r1);
     if (delta < 0.25 || d == dmax) {
-      const double n = static_cast<double>(s.n);
+      const double n = static_cast<double>(series.n[k]);
       const double sigma_r1 = (1.0 - r1 * r1) / std::sqrt(n);
       out.valid = true;
       out.p = 2.0 * (d + delta);
       out.sigma = 2.0 * sigma_r1 / ((1.0 + r1) * (1.0 + r1));
-      out.points = s.n;
+      out.points = series.n[k];
       return out;
     }
   }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// IntegerNoiseIdAccumulator. All arithmetic is modular (64-bit values, 128-bit sums), which is
+// exact whenever the true value fits.
+
+namespace {
+Int128 square_of(std::int64_t v) {
+  const UInt128 s = square(v);
+  return {s.lo, s.hi};
+}
+}  // namespace
+
+// Order d's value at the newest point: the d-th difference of the last d + 1 points.
+std::int64_t IntegerNoiseIdAccumulator::last_value(int d) const {
+  const auto l0 = static_cast<std::uint64_t>(last_[0]), l1 = static_cast<std::uint64_t>(last_[1]);
+  const auto l2 = static_cast<std::uint64_t>(last_[2]), l3 = static_cast<std::uint64_t>(last_[3]);
+  switch (d) {
+    case 0: return last_[0];
+    case 1: return static_cast<std::int64_t>(l0 - l1);
+    case 2: return static_cast<std::int64_t>(l0 - 2 * l1 + l2);
+    default: return static_cast<std::int64_t>(l0 - 3 * l1 + 3 * l2 - l3);
+  }
+}
+
+void IntegerNoiseIdAccumulator::add_exact(std::int64_t z) {
+  const auto v = static_cast<std::uint64_t>(z), l0 = static_cast<std::uint64_t>(last_[0]);
+  const auto l1 = static_cast<std::uint64_t>(last_[1]), l2 = static_cast<std::uint64_t>(last_[2]);
+  const auto l3 = static_cast<std::uint64_t>(last_[3]);
+  const std::int64_t d[5] = {z, static_cast<std::int64_t>(v - l0), static_cast<std::int64_t>(v - 2 * l0 + l1),
+                             static_cast<std::int64_t>(v - 3 * l0 + 3 * l1 - l2),
+                             static_cast<std::int64_t>(v - 4 * l0 + 6 * l1 - 4 * l2 + l3)};
+  sum_ = sum_ + widen(z);
+  const unsigned orders = have_ < 4 ? have_ : 4;  // order j needs j earlier points
+  for (unsigned j = 0; j <= orders; ++j) {
+    const Int128 sq = square_of(d[j]);
+    sum_sq_[j] = sum_sq_[j] + sq;
+    ++n_[j];
+    if (j < 4 && j == have_) {  // the segment's first value of order j
+      firsts_[j] = firsts_[j] + widen(d[j]);
+      ends_sq_[j] = ends_sq_[j] + sq;
+    }
+  }
+  last_ = {z, last_[0], last_[1], last_[2]};
+  if (have_ < 5) ++have_;
+}
+
+void IntegerNoiseIdAccumulator::add(const std::int64_t* z, std::size_t count, std::size_t step, std::uint64_t step_bound) {
+  std::size_t k = 0;
+  for (; k < count && have_ < 5; ++k) add_exact(z[k * step]);
+  constexpr std::size_t run = 64;
+  while (k < count) {
+    const std::size_t n = count - k < run ? count - k : run;
+    if (!add_run(z + k * step, n, step, step_bound)) {
+      for (std::size_t i = 0; i < n; ++i) add_exact(z[(k + i) * step]);
+    }
+    k += n;
+  }
+}
+
+// Up to 64 values of a segment with at least 5 points. With |z[k] - z[k-1]| <= B, every difference
+// of order j <= 4 is at most 8B and z[k] - base (base: the point before the run) at most 64B, so
+// when 64B < 2^28 they are computed exactly in 32-bit modular arithmetic from the points' low
+// words, and the squares of n <= 64 of them (each below 2^56) add up exactly in 64 bits. Order 0
+// comes from sum (base + w)^2 = n base^2 + 2 base sum w + sum w^2. Returns false (nothing changed)
+// when the bound does not hold. Compiled for AVX2 beside the baseline on the x86-64 host (integer
+// sums: the same bits either way); GCC vectorizes the loop with NEON on aarch64.
+#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+bool IntegerNoiseIdAccumulator::add_run(const std::int64_t* z, std::size_t n, std::size_t step, std::uint64_t step_bound) {
+  if (step_bound == 0 || step_bound >= (std::uint64_t{1} << 22)) return false;
+  std::uint32_t w[4 + 64];
+  for (std::size_t i = 0; i < 4; ++i) w[i] = static_cast<std::uint32_t>(last_[3 - i]);
+  for (std::size_t i = 0; i < n; ++i) w[4 + i] = static_cast<std::uint32_t>(z[i * step]);
+  const std::uint32_t base = w[3];
+  std::int64_t s0 = 0, q0 = 0, q1 = 0, q2 = 0, q3 = 0, q4 = 0;
+  for (std::size_t i = 4; i < n + 4; ++i) {
+    const auto v0 = static_cast<std::int32_t>(w[i] - base);
+    const auto v1 = static_cast<std::int32_t>(w[i] - w[i - 1]);
+    const auto v2 = static_cast<std::int32_t>(w[i] - 2 * w[i - 1] + w[i - 2]);
+    const auto v3 = static_cast<std::int32_t>(w[i] - 3 * w[i - 1] + 3 * w[i - 2] - w[i - 3]);
+    const auto v4 = static_cast<std::int32_t>(w[i] - 4 * w[i - 1] + 6 * w[i - 2] - 4 * w[i - 3] + w[i - 4]);
+    s0 += v0;
+    q0 += std::int64_t{v0} * v0;
+    q1 += std::int64_t{v1} * v1;
+    q2 += std::int64_t{v2} * v2;
+    q3 += std::int64_t{v3} * v3;
+    q4 += std::int64_t{v4} * v4;
+  }
+  const std::int64_t b = last_[0];
+  const auto count = static_cast<std::uint64_t>(n);
+  sum_ = sum_ + mul_signed(b, static_cast<std::int64_t>(count)) + widen(s0);
+  const Int128 cross = mul_signed(b, s0);
+  sum_sq_[0] = sum_sq_[0] + mul_mod(square_of(b), static_cast<std::int64_t>(count)) + cross + cross + widen(q0);
+  sum_sq_[1] = sum_sq_[1] + widen(q1);
+  sum_sq_[2] = sum_sq_[2] + widen(q2);
+  sum_sq_[3] = sum_sq_[3] + widen(q3);
+  sum_sq_[4] = sum_sq_[4] + widen(q4);
+  for (auto& v : n_) v += count;
+  if (n >= 4) {
+    for (std::size_t i = 0; i < 4; ++i) last_[i] = z[(n - 1 - i) * step];
+  } else {
+    for (std::size_t i = 4; i-- > 0;) last_[i] = i >= n ? last_[i - n] : z[(n - 1 - i) * step];
+  }
+  return true;
+}
+
+void IntegerNoiseIdAccumulator::reset_segment() {
+  for (int d = 0; d < 4 && d < have_; ++d) {
+    const std::int64_t v = last_value(d);
+    lasts_[static_cast<std::size_t>(d)] = lasts_[static_cast<std::size_t>(d)] + widen(v);
+    ends_sq_[static_cast<std::size_t>(d)] = ends_sq_[static_cast<std::size_t>(d)] + square_of(v);
+  }
+  have_ = 0;
+}
+
+// Centred on q (the integer nearest the mean), for the k segments holding values of order d:
+//   sum (v - q)^2 = S2 - 2 q S1 + n q^2, and likewise the first and last values;
+//   sum over pairs of (v_i - q)(v_{i+1} - q) = (2 sum (v - q)^2 - sum of the end values' squares
+//   - S2 of order d + 1) / 2; left (right) values: all but each segment's last (first).
+Lag1Sums IntegerNoiseIdAccumulator::order(int d) const {
+  const auto k = static_cast<std::size_t>(d);
+  Lag1Sums out;
+  out.n = n_[k];
+  out.pairs = n_[k + 1];
+  if (out.n == 0) return out;
+  const bool open = have_ > d;  // this segment has a value of order d
+  const Int128 open_last = open ? widen(last_value(d)) : Int128{};
+  const Int128 firsts = firsts_[k], lasts = lasts_[k] + open_last;
+  const Int128 ends_sq = ends_sq_[k] + (open ? square_of(last_value(d)) : Int128{});
+  Int128 s1 = sum_;
+  if (d > 0) s1 = lasts_[k - 1] + (have_ >= d ? widen(last_value(d - 1)) : Int128{}) - firsts_[k - 1];
+  const std::uint64_t segments = n_[k] - n_[k + 1];
+  const auto q = static_cast<std::int64_t>(std::llround(to_double(s1) / static_cast<double>(out.n)));
+  const Int128 sum = s1 - mul_signed(q, static_cast<std::int64_t>(out.n));
+  // sum (v - q)^2 = S2 - 2 q S1 + n q^2 = S2 - q (S1 + sum), as sum = S1 - n q.
+  const Int128 q_times = mul_mod(s1 + sum, q);
+  const Int128 sum_sq = sum_sq_[k] - q_times;
+  // The end values: F + E - 2 k q of them centred, and their squares Q - q (F + E + centred).
+  const Int128 ends = firsts + lasts - mul_signed(q, 2 * static_cast<std::int64_t>(segments));
+  const Int128 ends_centred_sq = ends_sq - mul_mod(firsts + lasts + ends, q);
+  const Int128 twice_lag = sum_sq + sum_sq - ends_centred_sq - sum_sq_[k + 1];
+  out.shift = static_cast<double>(q);
+  out.sum = to_double(sum);
+  out.sum_sq = to_double(UInt128{sum_sq.lo, sum_sq.hi});
+  out.sum_lag = 0.5 * to_double(twice_lag);
+  out.sum_left = to_double(sum - (lasts - mul_signed(q, static_cast<std::int64_t>(segments))));
+  out.sum_right = to_double(sum - (firsts - mul_signed(q, static_cast<std::int64_t>(segments))));
   return out;
 }
 

@@ -109,6 +109,40 @@ TEST_P(BlockKernelProperty, AnyBlocksEqualOnePointAtATimeAndBruteForce) {
 
 INSTANTIATE_TEST_SUITE_P(StrideFactors, BlockKernelProperty, ::testing::Values(2u, 4u, 8u, 16u, 64u, 256u));
 
+// Taus of levels 4 to 12 at S = 4: the kernel leaves them, and the blocks enter the history in
+// runs between the points at which they run. Sums equal one point at a time and brute force.
+TEST(BlockKernel, HistoryEnteredInRunsEqualsOnePointAtATime) {
+  const std::vector<std::uint64_t> m_list = {1, 2, 3, 4, 8, 64, 96, 128, 256, 1024, 4096, 12288, 16384};
+  std::mt19937_64 rng(5);
+  std::vector<std::vector<std::int32_t>> segments;
+  for (const std::size_t n : {70000u, 1000u, 90000u}) {
+    std::vector<std::int32_t> v(n);
+    for (auto& c : v) c = 3600 + static_cast<std::int32_t>(rng() % 100);
+    segments.push_back(v);
+  }
+  Heap blocks(4, m_list), single(4, m_list);
+  feed(blocks.c, segments, &rng);
+  feed(single.c, segments, nullptr);
+  for (std::size_t i = 0; i < m_list.size(); ++i) {
+    Exact want;
+    std::uint64_t start = 0;
+    for (const auto& v : segments) {
+      std::vector<std::int64_t> x{0};
+      for (const std::int32_t c : v) x.push_back(x.back() + c);
+      want += brute_force(x, m_list[i], blocks.c.result(i).stride, false, start);
+      start += x.size();
+    }
+    const auto got = blocks.c.result(i), one = single.c.result(i);
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_EQ(got.n[k], want.n[k]) << "m=" << m_list[i] << " stat " << k;
+      EXPECT_TRUE(to_u128(got.sum[k]) == want.sum[k]) << "m=" << m_list[i] << " stat " << k;
+    }
+    for (std::size_t k = 0; k < sum_kinds; ++k) {
+      EXPECT_TRUE(got.sum[k] == one.sum[k] && got.n[k] == one.n[k]) << "m=" << m_list[i] << " kind " << k;
+    }
+  }
+}
+
 TEST(BlockKernel, PartialSumsAreExactOnlyWhenTheBoundProvesIt) {
   // n = 64 terms of magnitude v: the 64-bit partial sum of squares equals the exact sum (oracle:
   // 128-bit products) whenever squares_exact() says so; at 2^29 = v the bound (2*30 + 7 > 64)

@@ -61,7 +61,7 @@ TEST(CharacterizerAllocation, StateSizeForFortyOctavesStrideEight) {
   const std::size_t history = CharacterizerStorage<CountArith, 40, 8, 40>::history_capacity() * sizeof(CountArith::Entry);
   const std::size_t taus = 40 * sizeof(Characterizer<CountArith>::TauState);
   std::printf("sizeof(StaticCharacterizer<CountArith, 40, 8>) = %zu bytes: history %zu, 40 taus %zu (of which noise sums %zu)\n",
-              sizeof(C), history, taus, 40 * sizeof(NoiseIdAccumulator));
+              sizeof(C), history, taus, 40 * sizeof(CountArith::NoiseSums));
   EXPECT_LE(sizeof(C), 36u * 1024u);
 }
 

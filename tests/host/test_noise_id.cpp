@@ -52,8 +52,8 @@ TEST(NoiseId, DifferencesDoNotSpanAGap) {
     with_gap.add(x[i] + jump);
     without.add(x[i] + jump);
   }
-  EXPECT_EQ(2 - std::lround(lag1_estimate(with_gap, 0, 2).p), 2);
-  EXPECT_NE(2 - std::lround(lag1_estimate(without, 0, 2).p), 2);
+  EXPECT_EQ(2 - std::lround(lag1_estimate(summarize(with_gap), 0, 2).p), 2);
+  EXPECT_NE(2 - std::lround(lag1_estimate(summarize(without), 0, 2).p), 2);
 }
 
 }  // namespace

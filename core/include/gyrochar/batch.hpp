@@ -5,8 +5,8 @@
 //
 // It produces what Characterizer<CountArith> keeps for a tau, to the last bit: the same
 // TauResult (overlapping and non-overlapped sums, term counts, out-of-range terms, the sticky
-// overflow flag) and the same NoiseIdAccumulator, so the same extractors (estimates.hpp) read
-// it. Terms are formed where the characterizer forms them: newest point e a multiple of the
+// overflow flag) and the same exact noise sums (IntegerNoiseIdAccumulator), so the same
+// extractors (estimates.hpp) read it. Terms are formed where the characterizer forms them: newest point e a multiple of the
 // tau's stride (stride_of()), within one segment (a gap starts a new one), decimated points at
 // the multiples of m.
 //
@@ -93,7 +93,7 @@ class BatchTau {
     return r;
   }
   /// The lag-1 autocorrelation sums of the decimated series, as Characterizer::noise().
-  const NoiseIdAccumulator& noise() const { return noise_; }
+  const IntegerNoiseIdAccumulator& noise() const { return noise_; }
 
  private:
   template <class R>
@@ -106,7 +106,7 @@ class BatchTau {
   TauResult<UInt128> result_;
   std::uint64_t sticky_ = 0;  // OR of the sums' high words: bit 63 = a sum reached 2^127
   std::uint64_t segments_ = 0;
-  NoiseIdAccumulator noise_;
+  IntegerNoiseIdAccumulator noise_;
 };
 
 }  // namespace gyrochar

@@ -64,6 +64,7 @@ struct CountArith {
   using X = std::int64_t;
   using Sum = UInt128;
   using Increment = std::int32_t;  // pulses per tau0: the exactness bounds rely on |c| < 2^31
+  using NoiseSums = IntegerNoiseIdAccumulator;  // the decimated phase is integer: exact sums
   static constexpr bool exact = true;
 
   static constexpr Int128 add_prefix(Int128 p, std::int64_t x) { return p + widen(x); }
@@ -110,6 +111,7 @@ struct FloatArith {
   using X = double;
   using Sum = double;
   using Increment = double;
+  using NoiseSums = NoiseIdAccumulator;
   static constexpr bool exact = false;
 
   static constexpr Prefix add_prefix(Prefix a, double b) {  // Knuth two-sum, then renormalize
@@ -240,7 +242,7 @@ class Characterizer {
     std::uint64_t countdown = 0;            // runs of this level until the next multiple of m
     std::array<X, 3> decimated{};           // the last three decimated points of this segment
     std::uint8_t decimated_count = 0;       // how many of them are valid (0..3)
-    NoiseIdAccumulator noise;               // lag-1 autocorrelation sums
+    typename Arith::NoiseSums noise;        // lag-1 autocorrelation sums
   };
 
   /// Binds the characterizer to storage owned by the caller, which must outlive it. No allocation.
@@ -301,7 +303,7 @@ class Characterizer {
       t.sticky = 0;
       t.countdown = 0;
       t.decimated_count = 0;
-      t.noise = NoiseIdAccumulator{};
+      t.noise = typename Arith::NoiseSums{};
     }
     run_ = RunState{};
     run_.steady_from = 3u * stride_;
@@ -377,7 +379,7 @@ class Characterizer {
   // (atomically: firmware/checkpoint.hpp).
 
   static constexpr std::uint32_t checkpoint_magic = 0x43525947;  // "GYRC"
-  static constexpr std::uint16_t checkpoint_version = 3;
+  static constexpr std::uint16_t checkpoint_version = 4;
 
   /// Bytes save() writes for the current configuration. O(1).
   std::size_t checkpoint_size() const {
@@ -458,7 +460,7 @@ class Characterizer {
     return r;
   }
   /// The lag-1 autocorrelation sums of tau i's decimated series.
-  const NoiseIdAccumulator& noise(std::size_t i) const {
+  const typename Arith::NoiseSums& noise(std::size_t i) const {
     flush();
     return taus_[i].noise;
   }
@@ -604,21 +606,82 @@ class Characterizer {
     const Block b{run_.next_e, n, x, &wp[depth], p_hi.data(), &wx[depth], depth, 0};
     for (std::size_t i = 0; i < fast_count_; ++i) level0_block(taus_[i], b);
     const std::size_t done = depth == ring0 ? higher_levels(b, wx.data(), wp.data()) : fast_count_;
-    // The history and the remaining levels, point by point. Odd points only enter ring 0.
+    // The history and the remaining levels. The taus the kernel left run at the multiples of
+    // 2^level of the lowest of them: those points go one by one, as push() takes them, the runs
+    // between them enter the history at once. Below level 4 they run too often for that to pay.
     const bool later = done < ntaus_;
-    for (std::size_t j = 0; j < n; ++j) {
-      const std::uint64_t e = run_.next_e++;
-      run_.p = {wp[depth + j], p_hi[j]};
-      const Entry current{x[j], run_.p};
-      if (e & 1) {
-        if (++run_.head[0] == ring0) run_.head[0] = 0;
-        history_[run_.head[0]] = current;
-        continue;
-      }
-      const unsigned fired = advance_heads(e);
-      if (later && taus_[done].level < fired) later_levels(done, e, fired, current);
-      insert(e, current);
+    if (later && taus_[done].level < 4) {
+      for (std::size_t j = 0; j < n; ++j) block_point(done, x[j], {wp[depth + j], p_hi[j]});
+      return;
     }
+    const std::uint64_t every = later ? std::uint64_t{1} << taus_[done].level : 0;
+    for (std::size_t j = 0; j < n;) {
+      std::size_t k = n;  // the next point at which a later tau runs
+      if (later) {
+        const std::uint64_t wait = (every - (run_.next_e & (every - 1))) & (every - 1);
+        if (wait < n - j) k = j + static_cast<std::size_t>(wait);
+      }
+      if (k > j) insert_run(x + j, &wp[depth + j], p_hi.data() + j, k - j);
+      if (k == n) break;
+      block_point(done, x[k], {wp[depth + k], p_hi[k]});
+      j = k + 1;
+    }
+  }
+
+  // One point of a block (P: its prefix) through the history and the taus from `first` on.
+  void block_point(std::size_t first, X x, Int128 p)
+    requires(Arith::exact)
+  {
+    const std::uint64_t e = run_.next_e++;
+    run_.p = p;
+    const Entry current{x, p};
+    later_levels(first, e, advance_heads(e), current);
+    insert(e, current);
+  }
+
+  // Points a = run_.next_e (>= 1) .. b = a + n - 1 enter the history as insert() would take them
+  // one by one, and run_ moves on past them. After point e, ring l holds the multiples q of 2^l
+  // with q <= e - ring_lag(l), the newest ring_size(l) of them, q at slot (q >> l) mod the size.
+  // So ring l takes the multiples that cross its lag within [a, b] (the newest ring_size(l)), from
+  // these points or from the lower ring that held them before; the rings are written from the top
+  // down, so each reads the rings below it before they change. O(n + rings), no allocation.
+  void insert_run(const X* x, const std::uint64_t* p_lo, const std::uint64_t* p_hi, std::size_t n)
+    requires(Arith::exact)
+  {
+    const std::uint64_t a = run_.next_e, b = a + n - 1;
+    // Only the rings with a multiple of 2^l in [a, b] move (their lags are multiples of 2^l too).
+    const auto width = static_cast<unsigned>(std::bit_width((a - 1) ^ b));
+    const unsigned moved = width < ring_levels_ ? width : ring_levels_;
+    for (unsigned l = moved; l-- > 0;) {
+      const std::uint64_t lag = ring_lag(l), size = ring_size(l);
+      if (b < lag) continue;
+      const std::uint64_t newest = (b - lag) >> l;
+      std::uint64_t first = a > lag ? ((a - 1 - lag) >> l) + 1 : 0;  // not in ring l before
+      if (newest >= first + size) first = newest + 1 - size;
+      Entry* ring = &history_[ring_offset(l)];
+      unsigned r = l == 0 ? 0 : l - 1;  // the ring holding q before, for q < a (older q sit higher)
+      auto slot = static_cast<std::uint32_t>(first % size);
+      for (std::uint64_t k = first; k <= newest; ++k) {
+        const std::uint64_t q = k << l;
+        if (q >= a) {
+          const auto j = static_cast<std::size_t>(q - a);
+          ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
+        } else {
+          while (!held(r, q, a - 1)) --r;  // ring 0 holds every q in [a - 3S, a)
+          ring[slot] = history_[ring_offset(r) + static_cast<std::size_t>((q >> r) % ring_size(r))];
+        }
+        if (++slot == size) slot = 0;
+      }
+    }
+    for (unsigned l = 0; l < moved; ++l) run_.head[l] = static_cast<std::uint32_t>((b >> l) % ring_size(l));
+    run_.next_e = b + 1;
+    run_.p = {p_lo[n - 1], p_hi[n - 1]};
+  }
+
+  // Whether ring l holds point q (a multiple of 2^l) after point e.
+  bool held(unsigned l, std::uint64_t q, std::uint64_t e) const {
+    const std::uint64_t lag = ring_lag(l);
+    return e >= lag && q <= e - lag && (q >> l) + ring_size(l) > ((e - lag) >> l);
   }
 
   static constexpr std::size_t window_depth = 96;  // points before a block copied next to it
@@ -679,6 +742,14 @@ class Characterizer {
                                    ? static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min)
                                    : 0;
     return span <= (~std::uint64_t{0} >> 1) / (2 * m * m);
+  }
+
+  // A bound on |x[e] - x[e-m]| (m increments) in this segment, 0 when it does not fit in 62 bits.
+  std::uint64_t step_bound(std::uint64_t m) const {
+    const std::int64_t lo = run_.increment_min, hi = run_.increment_max;
+    if (hi < lo || m > (std::uint64_t{1} << 31)) return 0;
+    const auto largest = static_cast<std::uint64_t>(-lo > hi ? -lo : hi);
+    return m * largest;
   }
 
   void level0_block(TauState& t, const Block& b)
@@ -742,7 +813,7 @@ class Characterizer {
     }
     r.n[avar_d] += count;
     r.n[hvar_d] += count;
-    t.noise.add(b.x + first, count, m);
+    t.noise.add(b.x + first, count, m, step_bound(t.result.m));
     t.decimated = {b.x[j], x1[j], x2[j]};
     t.decimated_count = 3;
     t.countdown = m - (b.n - 1 - j);
@@ -791,7 +862,7 @@ class Characterizer {
     }
     t.decimated = {x, t.decimated[0], t.decimated[1]};
     if (t.decimated_count < 3) ++t.decimated_count;
-    t.noise.add(static_cast<double>(x));
+    t.noise.add(x);
   }
 
   // Steady state of a ring-0 tau (m <= S, whole history inside the segment). For counts, the input
@@ -867,6 +938,8 @@ class Characterizer {
   // run_.head[l] is the slot of phase point e >> l within ring l, i.e. (e >> l) mod ring_size(l).
   std::uint32_t ring_size(unsigned ring) const { return ring == 0 ? 3u * stride_ : 3u * stride_ / 2; }
   std::size_t ring_offset(unsigned ring) const { return ring == 0 ? 0 : (ring + 1) * (3u * stride_ / 2); }
+  // Age at which points enter ring l: 0 for ring 0, 3S 2^(l-1) above (they leave ring l-1).
+  std::uint64_t ring_lag(unsigned ring) const { return ring == 0 ? 0 : std::uint64_t{3u * stride_} << (ring - 1); }
 
   // The point of age (k+1) m for tau t.
   const Entry& at(const TauState& t, unsigned k) const {

@@ -71,28 +71,30 @@ constexpr SumKind sum_kind(DevStat s) {
 constexpr Stat stat_of(DevStat s) { return stat_of(sum_kind(s)); }
 
 /// The sums of one tau in floating point. variance[k] is in (x step / tau0)^2 (variance() with
-/// tau0 = 1 and unit 1). `noise` points into the characterizer, which must outlive it.
+/// tau0 = 1 and unit 1); `noise` summarizes the lag-1 sums of the decimated series (when has_noise).
 struct TauSums {
   std::uint64_t m = 0;
   std::uint64_t stride = 1;
   std::array<double, sum_kinds> variance{};
   std::array<std::uint64_t, sum_kinds> n{};
   bool clean = true;  // no term out of range, no sum overflow
-  const NoiseIdAccumulator* noise = nullptr;
+  bool has_noise = false;
+  Lag1Summary noise;
 };
 
-/// The sums of one tau from its exact or floating sums and its noise sums (which must outlive
-/// the result): what the characterizer (take_sums()) and the batch path (batch.hpp) both give
+/// The sums of one tau from its exact or floating sums and its noise sums (either accumulator of
+/// noise_id.hpp): what the characterizer (take_sums()) and the batch path (batch.hpp) both give
 /// the extractors. O(1), no allocation.
-template <class Sum>
-TauSums tau_sums(const TauResult<Sum>& r, const NoiseIdAccumulator& noise) {
+template <class Sum, class NoiseSums>
+TauSums tau_sums(const TauResult<Sum>& r, const NoiseSums& noise) {
   TauSums t;
   t.m = r.m;
   t.stride = r.stride;
   t.n = r.n;
   for (std::size_t k = 0; k < sum_kinds; ++k) t.variance[k] = variance(r, static_cast<SumKind>(k), 1.0);
   t.clean = r.out_of_range == 0 && !r.sum_overflow;
-  t.noise = &noise;
+  t.has_noise = true;
+  t.noise = summarize(noise);
   return t;
 }
 

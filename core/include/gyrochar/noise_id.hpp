@@ -1,10 +1,15 @@
 #pragma once
 // Power-law noise identification primitives (W. J. Riley and C. A. Greenhall, "Power law noise
 // identification using the lag 1 autocorrelation", 2004; NIST SP 1065 section 5.6). Streaming:
-// only running sums of a decimated series are kept (about 300 bytes per tau); no heap, no clock.
-// estimates.hpp combines them over the taus of a curve.
+// only running sums of a decimated series are kept (about 350 bytes per tau); no heap, no clock.
+// Two accumulators read out alike: NoiseIdAccumulator for floating series, and
+// IntegerNoiseIdAccumulator, exact, for the decimated phase of counts. estimates.hpp combines them
+// over the taus of a curve.
+#include <array>
 #include <cstddef>
 #include <cstdint>
+
+#include "gyrochar/wide.hpp"
 
 namespace gyrochar {
 
@@ -97,6 +102,62 @@ class NoiseIdAccumulator {
   int have_ = 0;  // values of this segment seen so far (capped at 3)
 };
 
+/// The same sums for an integer series (the decimated phase of counts), exact: every sum is an
+/// integer kept modulo 2^128, and order() centres them exactly (on the integer nearest the mean)
+/// before the one rounding to double, so its read-out does not depend on how the values arrived.
+/// It keeps no lag products: within a segment, sum v_i v_{i+1} = (2 sum v^2 - v_first^2 - v_last^2
+/// - sum (v_{i+1} - v_i)^2) / 2 and the sum of a difference telescopes to v_last - v_first, so it
+/// keeps the sum of the series, the sums of squares of orders 0..4, and the first and last value
+/// of each order per segment. Exact as long as every difference of order 1..4 fits in int64 and
+/// each centred sum of squares stays below 2^127 (for counts: |x| < 2^63 and m^3 rate^2 n bounded).
+class IntegerNoiseIdAccumulator {
+ public:
+  /// Adds the next value. O(1), no allocation.
+  void add(std::int64_t z) { add_exact(z); }
+  /// Adds z[0], z[step], ..., z[(count-1) step], as add() would one by one. `step_bound` bounds
+  /// |z[k] - z[k-1]| when known (0: unknown); with it, runs whose differences provably fit in 28 bits
+  /// are summed in 64-bit partial sums. O(count), no allocation.
+  void add(const std::int64_t* z, std::size_t count, std::size_t step, std::uint64_t step_bound);
+  /// A gap: the next value starts a new segment; no difference or pair spans it.
+  void reset_segment();
+  std::uint64_t points() const { return n_[0]; }
+  /// The sums of difference order d (0..3), centred on the integer nearest their mean.
+  Lag1Sums order(int d) const;
+
+ private:
+  void add_exact(std::int64_t z);
+  bool add_run(const std::int64_t* z, std::size_t count, std::size_t step, std::uint64_t step_bound);
+  std::int64_t last_value(int d) const;  // order d's value at the newest point (have_ > d)
+  std::array<std::int64_t, 4> last_{};   // the segment's last points, newest first
+  std::array<Int128, 5> sum_sq_{};       // sums of squares of orders 0..4
+  Int128 sum_{};                         // sum of the series (order 0)
+  std::array<Int128, 4> firsts_{};       // per order: sum of each segment's first value
+  std::array<Int128, 4> lasts_{};        // ... of each closed segment's last value
+  std::array<Int128, 4> ends_sq_{};      // ... of those values squared
+  std::array<std::uint64_t, 5> n_{};     // values of orders 0..4
+  std::uint8_t have_ = 0;                // points of this segment (capped at 5)
+};
+
+/// What noise identification reads of a decimated series: per difference order d = 0..3 the
+/// number of values and their lag-1 autocorrelation, and the variance of the first differences.
+struct Lag1Summary {
+  std::array<std::uint64_t, 4> n{};
+  std::array<double, 4> r1{};
+  double variance1 = 0;
+};
+/// Either accumulator's summary. O(1), no allocation.
+template <class Accumulator>
+Lag1Summary summarize(const Accumulator& acc) {
+  Lag1Summary s;
+  for (int d = 0; d < 4; ++d) {
+    const Lag1Sums o = acc.order(d);
+    s.n[static_cast<std::size_t>(d)] = o.n;
+    s.r1[static_cast<std::size_t>(d)] = o.r1();
+    if (d == 1) s.variance1 = o.variance();
+  }
+  return s;
+}
+
 /// The lag-1 rule: difference the series (from order dmin) until delta = r1 / (1 + r1) < 0.25 or
 /// d = dmax; then p = 2 (d + delta) estimates 2 - alpha, so alpha = 2 - round(p). sigma is the
 /// standard error of p, from the large-sample variance of r1, (1 - rho^2)^2 / n.
@@ -106,7 +167,7 @@ struct Lag1Estimate {
   double sigma = 0;
   std::uint64_t points = 0;  // values of the series the estimate rests on
 };
-Lag1Estimate lag1_estimate(const NoiseIdAccumulator& acc, int dmin, int dmax);
+Lag1Estimate lag1_estimate(const Lag1Summary& series, int dmin, int dmax);
 
 /// Barnes' expected B1 ratio (standard variance of n frequency averages over the Allan variance)
 /// for the exponent mu of AVAR ~ tau^mu. O(1).

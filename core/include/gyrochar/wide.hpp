@@ -27,12 +27,24 @@ constexpr Int128 widen(std::int64_t v) {
   return {static_cast<std::uint64_t>(v), v < 0 ? ~std::uint64_t{0} : std::uint64_t{0}};
 }
 
+#if defined(__SIZEOF_INT128__)
+__extension__ using native_u128 = unsigned __int128;
+constexpr native_u128 native(Int128 a) { return static_cast<native_u128>(a.hi) << 64 | a.lo; }
+constexpr Int128 from_native(native_u128 v) { return {static_cast<std::uint64_t>(v), static_cast<std::uint64_t>(v >> 64)}; }
+#endif
+
 constexpr Int128 operator+(Int128 a, Int128 b) {
+#if defined(__SIZEOF_INT128__)
+  return from_native(native(a) + native(b));
+#endif
   const std::uint64_t lo = a.lo + b.lo;
   return {lo, a.hi + b.hi + (lo < a.lo ? 1u : 0u)};
 }
 
 constexpr Int128 operator-(Int128 a, Int128 b) {
+#if defined(__SIZEOF_INT128__)
+  return from_native(native(a) - native(b));
+#endif
   const std::uint64_t lo = a.lo - b.lo;
   return {lo, a.hi - b.hi - (a.lo < b.lo ? 1u : 0u)};
 }
@@ -63,17 +75,24 @@ constexpr UInt128 mul_wide(std::uint64_t a, std::uint64_t b) {
 #endif
 }
 
-/// Exact v*v (at most 2^126, so it always fits).
-constexpr UInt128 square(std::int64_t v) {
+/// Exact a*b of two signed values.
+constexpr Int128 mul_signed(std::int64_t a, std::int64_t b) {
 #if defined(__SIZEOF_INT128__)
   __extension__ using i128 = __int128;
   __extension__ using u128 = unsigned __int128;
-  const auto p = static_cast<u128>(static_cast<i128>(v) * v);
-  return {static_cast<std::uint64_t>(p), static_cast<std::uint64_t>(p >> 64)};
+  const auto product = static_cast<u128>(static_cast<i128>(a) * b);
+  return {static_cast<std::uint64_t>(product), static_cast<std::uint64_t>(product >> 64)};
 #endif
-  const std::uint64_t magnitude =
-      v < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v);
-  return mul_wide(magnitude, magnitude);
+  const auto ua = static_cast<std::uint64_t>(a), ub = static_cast<std::uint64_t>(b);
+  const UInt128 m = mul_wide(a < 0 ? 0 - ua : ua, b < 0 ? 0 - ub : ub);
+  const Int128 p{m.lo, m.hi};
+  return (a < 0) != (b < 0) ? Int128{} - p : p;
+}
+
+/// Exact v*v (at most 2^126, so it always fits).
+constexpr UInt128 square(std::int64_t v) {
+  const Int128 p = mul_signed(v, v);
+  return {p.lo, p.hi};
 }
 
 /// acc += v (modulo 2^128). Returns true when the sum wrapped past 2^128.
@@ -93,9 +112,24 @@ constexpr std::uint64_t add_high_word(UInt128& acc, UInt128 v) {
   return acc.hi;
 }
 
+/// a*k modulo 2^128 (two's complement, like the other operations).
+constexpr Int128 mul_mod(Int128 a, std::int64_t k) {
+  const auto uk = static_cast<std::uint64_t>(k);
+  const UInt128 low = mul_wide(a.lo, uk);
+  // k as 128 bits has the high word 0 or all ones, which contributes -a.lo to the high word.
+  return {low.lo, low.hi + a.hi * uk - (k < 0 ? a.lo : 0)};
+}
+
 /// Nearest double to v within 1 ulp (two roundings at most; relative error <= 2^-52).
 constexpr double to_double(UInt128 v) {
   return static_cast<double>(v.hi) * 18446744073709551616.0 + static_cast<double>(v.lo);
+}
+
+/// Nearest double to the signed value v within 1 ulp.
+constexpr double to_double(Int128 v) {
+  if (static_cast<std::int64_t>(v.hi) >= 0) return to_double(UInt128{v.lo, v.hi});
+  const Int128 magnitude = Int128{} - v;
+  return -to_double(UInt128{magnitude.lo, magnitude.hi});
 }
 
 }  // namespace gyrochar
