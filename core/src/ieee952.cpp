@@ -31,12 +31,16 @@ namespace {
 constexpr std::size_t terms = 5;    // Q N B K R
 constexpr std::size_t noises = 4;   // Q N B K: the random ones
 constexpr std::array<int, noises> alphas{2, 0, -1, -2};  // Q N B K
-// Estimates further apart keep only the white PM part of their covariance. It is exact at any
-// distance and need not decay: fully overlapped Allan estimates share the sum of x^2 and stay
-// correlated by about 0.5 across every tau up to the stride factor. The other noises' correlations
-// fall below 0.02 there (random-walk FM decays slowest, by about 0.7 an octave), and further apart
-// their sums could no longer be evaluated accurately (a difference of nearly equal huge numbers).
-constexpr int band_octaves = 10;
+// Two estimates keep a noise's part of their covariance where double precision evaluates it: its
+// correlation known to this (pair_sums_rounding()). Far apart, the closed forms of the flicker and
+// random-walk FM sums are differences of nearly equal huge numbers (from about six octaves between
+// a modified Allan estimate and a longer one, from about sixteen between two Allan estimates) and
+// their correlations are small (random-walk FM, the slowest to decay: 0.04 between the modified
+// Allan estimate at 512 tau0 and the Allan one at 2^19 tau0 of 4.3e6 points, by an exact
+// computation without the closed forms). White PM is exact at any distance and need not decay:
+// fully overlapped Allan estimates share the sum of x^2 and stay correlated by about 0.24 across
+// every tau up to the stride factor.
+constexpr double covariance_rounding_kept = 1e-3;
 constexpr double quantization_left_out = 0.01;  // share of a point that makes it unusable (non-white)
 
 // Innovation variance of term t per unit squared parameter: tau0^k.
@@ -58,8 +62,6 @@ std::array<double, terms> design(Stat s, std::uint64_t m, double tau0) {
   x[4] = tau * tau / 2;
   return x;
 }
-
-int octave(std::uint64_t m) { return 63 - __builtin_clzll(m); }
 
 // In-place Cholesky of the n x n matrix a (row-major, lower triangle used). False when not positive
 // definite.
@@ -186,7 +188,7 @@ void covariance_of_points(const Problem& pr, const std::array<double, terms>& th
   }
 }
 
-// Factors Sigma; where the band cut leaves it indefinite, raises its diagonal by the least relative
+// Factors Sigma; where the covariance parts left out leave it indefinite, raises its diagonal by the least relative
 // amount that makes it definite (from 1e-6, doubling): the points then weigh a little less, their
 // correlations are kept.
 bool factor(const Problem& pr) {
@@ -395,7 +397,7 @@ void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms
   pr.sigma = pr.pair + pr.n * (pr.n + 1) / 2 * 14;
   pr.rows = pr.sigma + pr.n * pr.n;
 
-  // The pair sums of every two points within the band: they depend on the geometry only. Of the
+  // The pair sums of every two points: they depend on the geometry only. Of the
   // five Allan noises (index 2 - alpha) the model has four.
   constexpr std::array<std::size_t, noises> allan_index{0, 2, 3, 4};
   for (std::size_t i = 0; i < pr.n; ++i) {
@@ -408,14 +410,14 @@ void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms
       const FitPoint& b = *pr.point[j];
       double* g = pr.pair_at(i, j);
       for (std::size_t k = 0; k < 14; ++k) g[k] = 0;
-      const int apart = octave(a.m) - octave(b.m);
-      const bool far = apart > band_octaves || apart < -band_octaves;
       const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, setup.n_phase);
-      NoiseSet white_pm = allan_noises();
-      white_pm.count = 1;
-      const PairSums s = cache ? cache->get(ga, gb, far) : pair_sums(far ? white_pm : allan_noises(), ga, gb);
+      const PairSums s = cache ? cache->get(ga, gb) : pair_sums(allan_noises(), ga, gb);
+      std::array<bool, noises> kept{};
+      for (std::size_t t = 0; t < noises; ++t) kept[t] = pair_sums_rounding(alphas[t], ga, gb) <= covariance_rounding_kept;
       for (std::size_t t = 0; t < noises; ++t) {
-        for (std::size_t u = 0; u <= t; ++u) g[cc_index(t, u)] = s.cc[allan_index[t]][allan_index[u]];
+        if (!kept[t]) continue;
+        for (std::size_t u = 0; u <= t; ++u)
+          if (kept[u]) g[cc_index(t, u)] = s.cc[allan_index[t]][allan_index[u]];
         g[10 + t] = s.c[allan_index[t]];
       }
     }
