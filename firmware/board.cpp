@@ -3,6 +3,7 @@
 #include <sys/epoll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -32,10 +33,14 @@ protocol::InputSource input_source(SourceKind s) {
 }
 
 // What a checkpoint must match: everything that shapes the accumulator's state or its meaning.
+// Without a window the text is what it was before windows existed, so those checkpoints resume.
 std::uint32_t hash_settings(const ReportSettings& s) {
-  char text[160];
-  const int n = std::snprintf(text, sizeof text, "tau0=%.17g pulse=%.17g S=%u octaves=%u source=%u", s.tau0_s,
-                              s.pulse_weight_arcsec, s.stride_factor, s.octaves, static_cast<unsigned>(s.source));
+  char text[200];
+  int n = std::snprintf(text, sizeof text, "tau0=%.17g pulse=%.17g S=%u octaves=%u source=%u", s.tau0_s,
+                        s.pulse_weight_arcsec, s.stride_factor, s.octaves, static_cast<unsigned>(s.source));
+  if (s.window_length != 0)
+    n += std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), " window=%llu",
+                       static_cast<unsigned long long>(s.window_length));
   return crc32(std::as_bytes(std::span(text, static_cast<std::size_t>(n))));
 }
 
@@ -47,7 +52,8 @@ const char* restore_reason(RestoreStatus s) {
     case RestoreStatus::wrong_version: return "written by another checkpoint format version";
     case RestoreStatus::corrupted: return "CRC mismatch (corrupted)";
     case RestoreStatus::config_mismatch:
-      return "written under another configuration (tau0, pulse weight, stride factor, octaves or source changed)";
+      return "written under another configuration (tau0, pulse weight, stride factor, octaves, source or window "
+             "changed)";
   }
   return "invalid";
 }
@@ -64,13 +70,20 @@ Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
   settings_.source = input_source(config.source);
   // validate() keeps the period within the protocol's 100..2000 ms: the field cannot wrap.
   settings_.report_period_ms = static_cast<std::uint16_t>(std::lround(config.report_period_s * 1000.0));
+  if (config.window_s > 0) {
+    settings_.window_length = static_cast<std::uint64_t>(std::llround(config.window_s / config.tau0_s));
+    settings_.window_taus = window_taus(config.octaves, settings_.window_length);
+  }
   settings_.config_hash = hash_settings(settings_);
   if (!configure(characterizer_, settings_)) throw std::invalid_argument("estimator settings out of range");
-  checkpoint_buffer_.resize(characterizer_.checkpoint_size());
+  if (settings_.window_taus != 0 &&
+      !window_.configure(settings_.stride_factor, settings_.config_hash, settings_.window_taus, settings_.window_length))
+    throw std::invalid_argument("window settings out of range");
+  checkpoint_buffer_.resize(characterizer_.checkpoint_size() + (settings_.window_taus ? window_.checkpoint_size() : 0));
   checkpoint_period_ns_ = static_cast<std::uint64_t>(config.checkpoint_period_s * 1e9);
   start_ns_ = io.clock.now_ns();
   next_checkpoint_ns_ = start_ns_ + checkpoint_period_ns_;
-  frames_ = protocol::report_frame_count(0, config.octaves);
+  frames_ = protocol::report_frame_count(0, config.octaves, protocol::version, settings_.window_taus);
 
   // The board listens to its counter electronics only (or to nothing: a GPIO source); error
   // frames always come through.
@@ -97,11 +110,18 @@ std::string Board::resume() {
   const long n = checkpoint_file_.read(checkpoint_buffer_);
   if (n == -ENOENT) return "no checkpoint at " + checkpoint_file_.path() + ": starting fresh";
   std::string why;
+  // The cumulative characterizer's bytes, then (with a window) the window's.
+  const auto bytes = std::span(checkpoint_buffer_).first(n < 0 ? 0 : static_cast<std::size_t>(n));
+  const std::size_t cumulative = characterizer_.checkpoint_size();
   if (n < 0) {
     why = n == -EFBIG ? "larger than any checkpoint of this configuration" : std::strerror(static_cast<int>(-n));
-  } else if (const RestoreStatus s = characterizer_.restore(std::span(checkpoint_buffer_).first(static_cast<std::size_t>(n)));
-             s != RestoreStatus::ok) {
+  } else if (const RestoreStatus s = characterizer_.restore(bytes); s != RestoreStatus::ok) {
     why = restore_reason(s);
+  } else if (const RestoreStatus w = settings_.window_taus == 0 ? RestoreStatus::ok
+                                                                 : window_.restore(bytes.subspan(std::min(cumulative, bytes.size())));
+             w != RestoreStatus::ok) {
+    why = std::string("window part: ") + restore_reason(w);
+    configure(characterizer_, settings_);  // start afresh: the cumulative part was taken already
   } else {
     ++faults_.sample_gaps;  // the restart is a gap
     return "resumed from " + checkpoint_file_.path() + ": " + std::to_string(characterizer_.increments()) + " samples";
@@ -114,7 +134,8 @@ std::string Board::resume() {
 
 int Board::checkpoint() {
   if (config_.checkpoint_path.empty()) return 0;
-  const std::size_t n = characterizer_.save(checkpoint_buffer_);
+  std::size_t n = characterizer_.save(checkpoint_buffer_);
+  if (settings_.window_taus != 0) n += window_.save(std::span(checkpoint_buffer_).subspan(n));
   const int e = checkpoint_file_.write(std::span(checkpoint_buffer_).first(n));
   if (e != 0) BOARD_LOG("3", "checkpoint %s: %s", config_.checkpoint_path.c_str(), std::strerror(e));
   return e;
@@ -125,9 +146,11 @@ void Board::on_sample(const hal::CountSample& s) {
   if (s.gap) {
     ++faults_.sample_gaps;  // a new segment, never bridged
     characterizer_.mark_gap();
+    if (settings_.window_taus != 0) window_.mark_gap();
     return;
   }
   characterizer_.add_increment(static_cast<std::int32_t>(s.count));
+  if (settings_.window_taus != 0) window_.add(static_cast<std::int32_t>(s.count));
 }
 
 void Board::on_frames() {
@@ -154,8 +177,9 @@ void Board::on_tick() {
   if (frame_ == 0) {
     faults_.tx_dropped_frames = static_cast<std::uint32_t>(io_.can.counters().tx_dropped);
     faults_.bus_off_events = static_cast<std::uint32_t>(io_.can.counters().bus_off_events);
-    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, report_work_, content_);
-    frames_ = protocol::report_frame_count(seq_, config_.octaves);
+    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, report_work_, content_,
+                 &window_.latest());
+    frames_ = protocol::report_frame_count(seq_, config_.octaves, protocol::version, settings_.window_taus);
     if (config_.verbose)
       BOARD_LOG("7", "report %u: %llu samples", static_cast<unsigned>(seq_),
                 static_cast<unsigned long long>(characterizer_.increments()));

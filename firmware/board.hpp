@@ -1,6 +1,7 @@
 #pragma once
 // The board: counts from a count source (or CounterInput frames on the bus) into the estimator,
-// reports paced over each report period onto the CAN bus, checkpoints to a file. It runs on any
+// reports paced over each report period onto the CAN bus, checkpoints to a file. With a window
+// configured, a second characterizer restarted every window gives the dynamic Allan deviation. It runs on any
 // HAL backends: the Linux ones in gyrochard (main.cpp), the fakes in the host tests. Everything
 // is allocated in the constructor; run_once() and checkpoint() allocate nothing.
 #include <cstdint>
@@ -46,6 +47,8 @@ class Board final : public hal::CountSink {
 
   void on_sample(const hal::CountSample& sample) override;
   const Characterizer<CountArith>& characterizer() const { return characterizer_; }
+  /// The dynamic Allan deviation's window (window.hpp); taus() == 0 when the configuration has none.
+  const DynamicWindow& window() const { return window_; }
   const FaultCounters& faults() const { return faults_; }
 
  private:
@@ -56,6 +59,7 @@ class Board final : public hal::CountSink {
   BoardIo io_;
   ReportSettings settings_;
   BoardCharacterizer characterizer_;
+  DynamicWindow window_;
   ReportContent content_;
   FaultCounters faults_;
   hal::CanCounterDecoder can_counter_;

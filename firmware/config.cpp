@@ -62,6 +62,9 @@ std::unique_ptr<CLI::App> make_app(Config& c, unsigned& node, std::string& confi
   app->add_option("--octaves", c.octaves, "number of octave taus, 1..40")->capture_default_str();
   app->add_option("--report-period", c.report_period_s, "seconds between reports, 0.1..2 (the protocol's range)")
       ->capture_default_str();
+  app->add_option("--window", c.window_s,
+                  "dynamic Allan deviation: seconds per window, restarted every window (0: none)")
+      ->capture_default_str();
   app->add_option("--checkpoint", c.checkpoint_path, "checkpoint file (empty: none)");
   app->add_option("--checkpoint-period", c.checkpoint_period_s, "seconds between checkpoints")->capture_default_str();
   app->add_flag("--verbose", c.verbose, "log every report");
@@ -199,6 +202,9 @@ std::optional<ConfigError> validate(const Config& c) {
   if (!(c.report_period_s >= 0.1 && c.report_period_s <= 2.0))
     return ConfigError{"report-period", "must be 0.1..2 s (the protocol's range)"};
   if (c.report_period_s < c.tau0_s) return ConfigError{"report-period", "must be at least tau0"};
+  if (!std::isfinite(c.window_s) || c.window_s < 0 ||
+      (c.window_s > 0 && (c.window_s < 4 * c.report_period_s || c.window_s < 4 * c.tau0_s || c.window_s / c.tau0_s >= 0x1p40)))
+    return ConfigError{"window", "must be 0 (none) or at least 4 report periods and 4 tau0, below 2^40 tau0"};
   if (!c.checkpoint_path.empty() && !positive(c.checkpoint_period_s))
     return ConfigError{"checkpoint-period", "must be positive"};
   if (c.can_interface.empty() || c.can_interface.size() > 15)

@@ -29,6 +29,8 @@ struct Config {
   std::uint32_t stride_factor = 8;      // S: power of two, 2..64
   unsigned octaves = 32;                // taus m = 1, 2, 4, ..., 2^(octaves-1)
   double report_period_s = 1.0;         // one report per period, frames paced over it
+  double window_s = 0.0;                // dynamic Allan deviation: window length (0: none), at least
+                                        // 4 report periods and 4 tau0 (window.hpp)
   std::string checkpoint_path;          // empty: no checkpoint
   double checkpoint_period_s = 60.0;
   bool verbose = false;

@@ -49,6 +49,31 @@ protocol::Ieee952SummaryMsg ieee952_summary(const Ieee952Fit& fit, std::uint8_t 
   return m;
 }
 
+/// The window frames of report `seq`: the latest completed window's curve in arcsec/s, taken when a
+/// slow cycle begins so that every window frame of a cycle describes the same window.
+void build_window(const ReportSettings& s, std::uint8_t seq, const WindowCurve* window, ReportContent& out) {
+  out.window_taus = window != nullptr ? s.window_taus : 0;
+  if (out.window_taus == 0) return;
+  const auto taus = static_cast<std::uint8_t>(out.window_taus);
+  const bool take = seq % protocol::slow_cycle_reports == 0;
+  if (take) out.window = {seq, taus, window->complete, window->window, window->gaps};
+  out.window.seq = seq;
+  out.window.tau_count = taus;
+  out.window_length = {seq, s.window_length};
+  const double unit = s.pulse_weight_arcsec / s.tau0_s;  // pulses per tau0 -> arcsec/s
+  auto dev = [&](double variance) { return std::max(std::sqrt(variance) * unit, protocol::window_dev_floor); };
+  for (std::size_t i = 0; i < out.window_taus; ++i) {
+    protocol::WindowDevMsg& d = out.window_dev[i];
+    if (take) {
+      const bool valid = window->complete && window->valid[i];
+      d = {seq, static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(window->window & 15u),
+           valid ? dev(window->avar[i]) : 0.0, valid ? dev(window->mvar[i]) : 0.0};
+    }
+    d.seq = seq;
+    d.tau_index = static_cast<std::uint8_t>(i);
+  }
+}
+
 }  // namespace
 
 ReportWorkspace::ReportWorkspace(unsigned octaves, FitMode fit_mode)
@@ -63,7 +88,8 @@ bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau
 }
 
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
-                  std::uint64_t uptime_ms, const FaultCounters& f, ReportWorkspace& work, ReportContent& out) {
+                  std::uint64_t uptime_ms, const FaultCounters& f, ReportWorkspace& work, ReportContent& out,
+                  const WindowCurve* window) {
   using namespace protocol;
   const std::size_t taus = c.tau_count();
   const std::uint64_t samples = c.increments();
@@ -93,12 +119,13 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   out.clock = {seq, uptime_ms, version};
   out.scale = {seq, static_cast<float>(s.pulse_weight_arcsec), AngleUnit::arcsec, s.source};
   out.config = {seq, s.config_hash, s.report_period_ms};
+  build_window(s, seq, window, out);
   // The recommended fit of both curves, in arcsec and seconds; quantization's white level is the
   // pulse weight over sqrt(12). Only for the reports that carry the Ieee952 frames (one in
   // protocol::slow_cycle_reports); they ask for a new fit when refit_due() and send the latest.
   bool carries_fit = false;
-  for (std::size_t k = 0; k < report_frame_count(seq, taus) && !carries_fit; ++k)
-    carries_fit = report_slot(seq, taus, k).slot == Slot::ieee952;
+  for (std::size_t k = 0; k < report_frame_count(seq, taus, version, out.window_taus) && !carries_fit; ++k)
+    carries_fit = report_slot(seq, taus, k, version, out.window_taus).slot == Slot::ieee952;
   if (!carries_fit) return;
   if (refit_due(samples, work.fitter().requested_samples(), s.tau0_s))
     work.fitter().request(std::span(points.data(), n_points),
@@ -121,7 +148,7 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
 
 protocol::Message report_message(const ReportContent& c, std::size_t k) {
   using namespace protocol;
-  const ReportSlot s = report_slot(c.status.seq, c.status.tau_count, k);
+  const ReportSlot s = report_slot(c.status.seq, c.status.tau_count, k, version, c.window_taus);
   switch (s.slot) {
     case Slot::status: return c.status;
     case Slot::faults: return c.faults;
@@ -134,6 +161,9 @@ protocol::Message report_message(const ReportContent& c, std::size_t k) {
     case Slot::scale: return c.scale;
     case Slot::config: return c.config;
     case Slot::ieee952: return s.index == ieee952_summary_page ? Message{c.ieee952_summary} : Message{c.ieee952[s.index]};
+    case Slot::window: return c.window;
+    case Slot::window_length: return c.window_length;
+    case Slot::window_dev: return c.window_dev[s.index];
   }
   return c.status;
 }

@@ -12,12 +12,12 @@
 #include "gyrochar/characterizer.hpp"
 #include "gyrochar/ieee952.hpp"
 #include "gyrochar/protocol.hpp"
+#include "capacities.hpp"
 #include "fit_worker.hpp"
+#include "window.hpp"
 
 namespace gyrochar::firmware {
 
-inline constexpr unsigned max_octaves = 40;
-inline constexpr std::uint32_t max_stride_factor = 64;
 using BoardCharacterizer = StaticCharacterizer<CountArith, max_octaves, max_stride_factor>;
 
 struct ReportSettings {
@@ -28,6 +28,8 @@ struct ReportSettings {
   protocol::InputSource source = protocol::InputSource::unknown;
   std::uint32_t config_hash = 0;     // also the characterizer's checkpoint tag
   std::uint16_t report_period_ms = 1000;
+  std::uint64_t window_length = 0;   // samples per window of the dynamic Allan deviation (window.hpp)
+  unsigned window_taus = 0;          // its taus, window_taus(octaves, window_length); 0: no window
 };
 
 /// Configures `c` for octave taus 1, 2, ..., 2^(octaves-1) with the settings' stride factor and
@@ -54,6 +56,11 @@ struct ReportContent {
   protocol::MetaConfigMsg config;
   std::array<protocol::Ieee952Msg, 5> ieee952{};
   protocol::Ieee952SummaryMsg ieee952_summary;
+  // The window curve (version 3): the window completed last when the slow cycle began.
+  std::size_t window_taus = 0;  // 0: the node has no window, and the reports no window frames
+  protocol::WindowMsg window;
+  protocol::WindowLengthMsg window_length;
+  std::array<protocol::WindowDevMsg, max_window_taus> window_dev{};
   Ieee952Fit fit;  // the fit the IEEE-952 frames were made from (for logs and tests)
   std::uint64_t fit_samples = 0;  // the samples it was made from (0: none yet)
 };
@@ -82,13 +89,17 @@ inline constexpr double refit_after_s = 900.0;
 bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau0_s);
 
 /// Fills `out` for report `seq` from the characterizer's current state: the deviations, EDFs and
-/// noise types of every report, and the IEEE-952 fit for the reports that carry its frames (the
-/// others keep the last one). No allocation: everything is worked out in `work` (built for the
-/// same number of octaves).
+/// noise types of every report, the IEEE-952 fit for the reports that carry its frames (the
+/// others keep the last one) and, when the settings have window taus, the curve of `window` (the
+/// board's latest completed window), taken at the first report of each slow cycle and repeated
+/// through it. No allocation: everything is worked out in `work` (built for the same number of
+/// octaves).
 void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
-                  std::uint64_t uptime_ms, const FaultCounters& faults, ReportWorkspace& work, ReportContent& out);
+                  std::uint64_t uptime_ms, const FaultCounters& faults, ReportWorkspace& work, ReportContent& out,
+                  const WindowCurve* window = nullptr);
 
-/// The message at position k of report `content.status.seq` (protocol::report_slot order).
+/// The message at position k of report `content.status.seq` (protocol::report_slot order, with
+/// content.window_taus window taus).
 protocol::Message report_message(const ReportContent& content, std::size_t k);
 
 }  // namespace gyrochar::firmware

@@ -51,7 +51,7 @@ int clamp_alpha(int alpha, int dmax) {
 // nearest on a log scale; for white PM vs flicker PM, R(n) = MVAR/AVAR.
 NoiseId b1_identify(const TauSums& t) {
   NoiseId out;
-  const Lag1Sums& y = t.noise->order(1);
+  const Lag1Sums y = t.noise->order(1);
   const double avar = t.variance[static_cast<std::size_t>(SumKind::avar)];
   const double mvar = t.variance[static_cast<std::size_t>(SumKind::mvar)];
   // With fewer than 3 averages every B1(N, mu) is 1: B1 cannot choose.

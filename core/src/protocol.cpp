@@ -21,6 +21,10 @@ constexpr std::uint16_t min_report_period_ms = 100;
 constexpr std::uint16_t max_report_period_ms = 2000;
 constexpr unsigned excluded_code_bits = 5;  // Ieee952 summary: log2 m below which points were left out
 constexpr unsigned ieee952_resolved_bit = 8u, ieee952_fitted_bit = 16u;  // Ieee952 term pages, byte 0
+constexpr std::uint64_t min_window_length = 4;  // the shortest window holds an MDEV term at m = 1
+constexpr unsigned window_dev_code_bits = 22;
+constexpr double window_dev_codes_per_octave = 16384.0;  // log2(dev) = code / 2^14 - 128; code 0: none
+constexpr double window_dev_log2_offset = -128.0;
 
 // --- little-endian fields --------------------------------------------------------------------
 
@@ -62,6 +66,15 @@ std::uint16_t edf_code(double edf) {
 }
 double edf_from_code(unsigned c) {
   return c == 0 ? 0.0 : std::exp2(c / edf_codes_per_octave + edf_log2_offset);
+}
+std::uint32_t window_dev_code(double dev) {
+  if (dev == 0.0) return 0;
+  const double c = std::round(window_dev_codes_per_octave * (std::log2(dev) - window_dev_log2_offset));
+  const double max = double((1u << window_dev_code_bits) - 1);
+  return static_cast<std::uint32_t>(c < 1.0 ? 1.0 : c > max ? max : c);
+}
+double window_dev_from_code(std::uint32_t c) {
+  return c == 0 ? 0.0 : std::exp2(c / window_dev_codes_per_octave + window_dev_log2_offset);
 }
 std::uint16_t rel_uncertainty_code(double rel) {
   const double c = std::round(rel / rel_uncertainty_step);
@@ -109,6 +122,14 @@ ProtocolError check(const Ieee952SummaryMsg& m) {
   constexpr unsigned max_code = (1u << excluded_code_bits) - 1;
   return ok_if(m.status <= Ieee952Status::singular && nonnegative(m.chi2_per_dof) && avar <= max_code &&
                mvar <= max_code && (!m.quantization_white || (avar == 0 && mvar == 0)));
+}
+ProtocolError check(const WindowMsg& m) {
+  return ok_if(m.tau_count >= 1 && m.tau_count < max_taus && (m.complete || (m.window == 0 && m.gaps == 0)));
+}
+ProtocolError check(const WindowLengthMsg& m) { return ok_if(m.length >= min_window_length && m.length < max_m); }
+ProtocolError check(const WindowDevMsg& m) {
+  return ok_if(m.tau_index < max_taus && m.window < 16 && nonnegative(m.adev_angle_per_s) &&
+               nonnegative(m.mdev_angle_per_s));
 }
 ProtocolError check(const CounterInputMsg&) { return ProtocolError::none; }
 
@@ -252,6 +273,38 @@ ProtocolError decode_ieee952(const CanFrame& f, Message& out) {
   m.value = get_float(f, 2);
   m.rel_uncertainty = static_cast<double>(get(f, 6, 2)) * rel_uncertainty_step;
   return accept(m, out);
+}
+
+ProtocolError decode_window(const CanFrame& f, Message& out) {
+  const unsigned page = f.data[0] & 3u;
+  if (page == 0) {
+    if (f.data[7] & 0x7Fu) return ProtocolError::reserved_bits;
+    WindowMsg m;
+    m.seq = f.data[1];
+    m.tau_count = u8(f.data[0] >> 2u);
+    m.window = static_cast<std::uint32_t>(get(f, 2, 4));
+    m.gaps = f.data[6];
+    m.complete = (f.data[7] & 0x80u) != 0;
+    return accept(m, out);
+  }
+  if (page == 1) {
+    if ((f.data[0] & 0xFCu) || f.data[7]) return ProtocolError::reserved_bits;
+    WindowLengthMsg m;
+    m.seq = f.data[1];
+    m.length = get(f, 2, 5);
+    return accept(m, out);
+  }
+  if (page == 2) {
+    const std::uint64_t fields = get(f, 2, 6);  // bits 16-63
+    WindowDevMsg m;
+    m.seq = f.data[1];
+    m.tau_index = u8(f.data[0] >> 2u);
+    m.window = u8(static_cast<unsigned>(fields & 0xFu));
+    m.adev_angle_per_s = window_dev_from_code(static_cast<std::uint32_t>(fields >> 4 & 0x3FFFFFu));
+    m.mdev_angle_per_s = window_dev_from_code(static_cast<std::uint32_t>(fields >> 26));
+    return accept(m, out);
+  }
+  return ProtocolError::unknown_page;
 }
 
 ProtocolError decode_counter_input(const CanFrame& f, Message& out) {
@@ -444,6 +497,30 @@ ProtocolError encode(const Ieee952SummaryMsg& msg, std::uint8_t node, CanFrame& 
   });
 }
 
+ProtocolError encode(const WindowMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, window_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 0, msg.tau_count, msg.seq);
+    put(f, 2, 4, msg.window);
+    f.data[6] = u8(static_cast<unsigned>(saturate(msg.gaps, 8)));
+    f.data[7] = u8(msg.complete ? 0x80u : 0u);
+  });
+}
+
+ProtocolError encode(const WindowLengthMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, window_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 1, 0, msg.seq);
+    put(f, 2, 5, msg.length);
+  });
+}
+
+ProtocolError encode(const WindowDevMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, window_id, report_len, frame, [&](CanFrame& f) {
+    header(f, 2, msg.tau_index, msg.seq);
+    put(f, 2, 6, std::uint64_t{msg.window} | std::uint64_t{window_dev_code(msg.adev_angle_per_s)} << 4 |
+                     std::uint64_t{window_dev_code(msg.mdev_angle_per_s)} << 26);
+  });
+}
+
 ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame) {
   return encode_with(msg, node, counter_input_id, counter_input_len, frame, [&](CanFrame& f) {
     put(f, 0, 4, msg.count);
@@ -469,7 +546,7 @@ Decoded decode(const CanFrame& frame) {
   const std::uint32_t base = frame.id & ~std::uint32_t{0xFF};
   const bool known = frame.id <= id_mask && (base == status_id || base == tau_stats_id ||
                                              base == metadata_id || base == ieee952_id ||
-                                             base == counter_input_id);
+                                             base == window_id || base == counter_input_id);
   if (!known) return fail(ProtocolError::unknown_id);
   out.node = u8(frame.id & 0xFFu);  // set before any later refusal: the frame is counted against its node
   if (out.node > max_node_address) return fail(ProtocolError::bad_address);
@@ -481,6 +558,7 @@ Decoded decode(const CanFrame& frame) {
     case tau_stats_id: out.error = decode_tau_stats(frame, out.message); break;
     case metadata_id: out.error = decode_metadata(frame, out.message); break;
     case ieee952_id: out.error = decode_ieee952(frame, out.message); break;
+    case window_id: out.error = decode_window(frame, out.message); break;
     default: out.error = decode_counter_input(frame, out.message); break;
   }
   return out;
@@ -509,6 +587,19 @@ static_assert(part_lengths_agree(), "the summary must not move any frame of the 
 std::size_t slow_part_begin(std::uint8_t seq, std::size_t tau_count) {
   return seq % slow_cycle_reports * slow_part_length(tau_count);
 }
+std::size_t part_of(std::uint8_t seq, std::size_t list_length, std::size_t part_length) {
+  const std::size_t begin = seq % slow_cycle_reports * part_length;
+  return begin >= list_length ? 0 : std::min(part_length, list_length - begin);
+}
+
+/// The window list (version 3): the window page, the window length, then one WindowDevMsg per
+/// window tau; empty without window taus. Cut into parts like the slow list.
+constexpr std::size_t window_list_length(std::size_t window_taus, std::uint8_t protocol_version) {
+  return protocol_version >= 3 && window_taus > 0 ? 2 + window_taus : 0;
+}
+constexpr std::size_t window_part_length(std::size_t window_taus, std::uint8_t protocol_version) {
+  return (window_list_length(window_taus, protocol_version) + slow_cycle_reports - 1) / slow_cycle_reports;
+}
 
 /// Entry j of the slow list: metadata pages, tau info for every tau, terms for every tau, IEEE-952
 /// terms, then the fit summary (version 2; the caller keeps j below the version's list length).
@@ -523,29 +614,45 @@ ReportSlot slow_slot(std::size_t j, std::size_t tau_count) {
   if (j < tau_count) return {Slot::terms, u8(static_cast<unsigned>(j))};
   return {Slot::ieee952, u8(static_cast<unsigned>(j - tau_count))};
 }
-}  // namespace
 
-std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version) {
-  const std::size_t begin = slow_part_begin(seq, tau_count);
-  const std::size_t total = slow_list_length(tau_count, protocol_version);
-  const std::size_t part = begin >= total ? 0 : std::min(slow_part_length(tau_count), total - begin);
-  return fast_frames(tau_count) + part;
+/// Entry j of the window list.
+ReportSlot window_slot(std::size_t j) {
+  if (j == 0) return {Slot::window, 0};
+  if (j == 1) return {Slot::window_length, 0};
+  return {Slot::window_dev, u8(static_cast<unsigned>(j - 2))};
 }
 
-ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position,
-                       std::uint8_t /*protocol_version: same positions, only the count differs*/) {
+/// Frames of report seq before its window part: the fast frames and its part of the slow list.
+std::size_t frames_before_window(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version) {
+  return fast_frames(tau_count) + part_of(seq, slow_list_length(tau_count, protocol_version), slow_part_length(tau_count));
+}
+}  // namespace
+
+std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version,
+                               std::size_t window_taus) {
+  return frames_before_window(seq, tau_count, protocol_version) +
+         part_of(seq, window_list_length(window_taus, protocol_version), window_part_length(window_taus, protocol_version));
+}
+
+ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position, std::uint8_t protocol_version,
+                       std::size_t window_taus) {
   if (position == 0) return {Slot::status, 0};
   if (position == 1) return {Slot::faults, 0};
   if (position < fast_frames(tau_count)) {
     const std::size_t k = position - 2;
     return {k % 2 == 0 ? Slot::adev : Slot::mdev, u8(static_cast<unsigned>(k / 2))};
   }
-  return slow_slot(slow_part_begin(seq, tau_count) + position - fast_frames(tau_count), tau_count);
+  const std::size_t before_window = frames_before_window(seq, tau_count, protocol_version);
+  if (position < before_window)
+    return slow_slot(slow_part_begin(seq, tau_count) + position - fast_frames(tau_count), tau_count);
+  return window_slot(seq % slow_cycle_reports * window_part_length(window_taus, protocol_version) + position -
+                     before_window);
 }
 
-double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps) {
+double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps, std::size_t window_taus) {
   std::size_t frames = 0;
-  for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) frames = std::max(frames, report_frame_count(seq, tau_count));
+  for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq)
+    frames = std::max(frames, report_frame_count(seq, tau_count, version, window_taus));
   return static_cast<double>(frames) * worst_case_frame_bits(report_len) / report_period_s / bitrate_bps;
 }
 

@@ -57,6 +57,16 @@ std::uint32_t resolve_stride_factor(std::uint32_t requested, std::uint64_t m_max
   return static_cast<std::uint32_t>(std::bit_ceil(std::clamp<std::uint64_t>(m_max, 2, full_stride_cap)));
 }
 
+std::uint32_t full_stride_factor(std::uint64_t n_phase) {
+  if (n_phase == 0) return full_stride_cap;
+  return static_cast<std::uint32_t>(std::bit_ceil(std::clamp<std::uint64_t>(n_phase / 4, 2, std::uint64_t{1} << 24)));
+}
+
+std::uint64_t history_bytes(DataType type, std::uint32_t stride_factor, std::uint64_t m_max) {
+  const std::size_t entry = type == DataType::counts ? sizeof(CountArith::Entry) : sizeof(FloatArith::Entry);
+  return std::uint64_t{history_entries(stride_factor, m_max)} * entry;
+}
+
 bool tau_representable(std::uint64_t m, std::uint32_t stride_factor) {
   if (m == 0) return false;
   std::uint64_t stride = 1;
@@ -133,7 +143,7 @@ class ZeroedArray {
 
 struct EngineBase {
   virtual ~EngineBase() = default;
-  virtual void add(double value) = 0;
+  virtual void add(std::span<const double> values) = 0;
   virtual Analysis result(const AnalysisOptions& o) const = 0;
   virtual PhaseRecord record(const AnalysisOptions& o) const = 0;
 };
@@ -152,20 +162,30 @@ class Engine final : public EngineBase {
       throw std::invalid_argument("the taus do not fit the stride factor");
   }
 
-  void add(double value) override {
+  void add(std::span<const double> values) override {
     if constexpr (Arith::exact) {
-      if (!(std::fabs(value) < 2147483648.0) || value != std::trunc(value))
-        throw std::invalid_argument("a count must be an integer of magnitude below 2^31");
-      characterizer_.add_increment(static_cast<std::int32_t>(value));
+      // Counts go to the block API as 32-bit integers, checked first.
+      if (counts_.size() < values.size()) counts_.resize(values.size());
+      std::size_t n = 0;
+      for (; n < values.size(); ++n) {
+        const double v = values[n];
+        if (!(std::fabs(v) < 2147483648.0) || v != std::trunc(v)) break;
+        counts_[n] = static_cast<std::int32_t>(v);
+      }
+      characterizer_.add_increments(std::span<const std::int32_t>(counts_.data(), n));
       if (characterizer_.phase_overflowed()) throw std::range_error("the accumulated count passed 2^63 pulses");
-      keep(value);
+      if (n < values.size()) throw BadValue(n, "a count must be an integer of magnitude below 2^31");
+      for (const double v : values) keep(v);
     } else {
-      if (!std::isfinite(value)) throw std::invalid_argument("not a finite number");
-      if (type_ == DataType::phase)
-        characterizer_.add_phase_point(value);
-      else
-        characterizer_.add_increment(value);  // frequency: phase in units of y tau0
-      keep(value);
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        const double v = values[i];
+        if (!std::isfinite(v)) throw BadValue(i, "not a finite number");
+        if (type_ == DataType::phase)
+          characterizer_.add_phase_point(v);
+        else
+          characterizer_.add_increment(v);  // frequency: phase in units of y tau0
+        keep(v);
+      }
     }
   }
 
@@ -178,19 +198,23 @@ class Engine final : public EngineBase {
     std::vector<TauSums> sums(taus);
     take_sums(characterizer_, sums);
     std::vector<NoiseId> noise2(taus), noise3(taus);
+    // The identification and the EDF need the same covariance sums of each tau's Allan and
+    // modified Allan grids: computed once (two grids a tau, the table half full at most).
+    std::vector<PairSumCache::Entry> entries(4 * taus + 16);
+    PairSumCache cache(entries);
     const bool frequency_input = type_ == DataType::freq;
     if (o.alpha) {
       std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
       std::fill(noise3.begin(), noise3.end(), given_noise(*o.alpha));
     } else {
-      identify_noise(sums, a.n_phase, 2, frequency_input, noise2);
-      identify_noise(sums, a.n_phase, 3, frequency_input, noise3);
+      identify_noise(sums, a.n_phase, 2, frequency_input, noise2, &cache);
+      identify_noise(sums, a.n_phase, 3, frequency_input, noise3, &cache);
     }
     const EstimateOptions options{o.tau0_s, type_ == DataType::freq ? o.tau0_s : 1.0, o.edf};
     auto rows_of = [&](DevStat stat, std::vector<AnalysisRow>& out) {
       for (std::size_t i = 0; i < taus; ++i) {
         const NoiseId& id = stat_of(stat) == Stat::hvar ? noise3[i] : noise2[i];
-        const Estimate e = estimate(sums[i], a.n_phase, stat, id, options);
+        const Estimate e = estimate(sums[i], a.n_phase, stat, id, options, &cache);
         if (e.n == 0) continue;
         if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
         AnalysisRow row;
@@ -248,6 +272,7 @@ class Engine final : public EngineBase {
   ZeroedArray<Entry> history_;
   std::vector<typename Characterizer<Arith>::TauState> states_;
   Characterizer<Arith> characterizer_;
+  std::vector<std::int32_t> counts_;  // a block of counts on its way to the block API
 };
 
 }  // namespace
@@ -285,7 +310,7 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
 
 Analyzer::~Analyzer() = default;
 
-void Analyzer::add(double value) { impl_->engine->add(value); }
+void Analyzer::add(std::span<const double> values) { impl_->engine->add(values); }
 
 Analysis Analyzer::result() const { return impl_->engine->result(impl_->options); }
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,16 @@ inline constexpr std::uint32_t full_stride_cap = 1u << 16;
 /// the smallest power of two >= m_max (so every tau is fully overlapped), at least 2 and at most
 /// full_stride_cap. O(1).
 std::uint32_t resolve_stride_factor(std::uint32_t requested, std::uint64_t m_max);
+
+/// The stride factor of "full" for an input of at most n_phase phase points: the smallest power
+/// of two >= n_phase / 4, so that every tau up to N/4 is fully overlapped (the history then holds
+/// 3N/4 to 3N/2 points, of which the pages the data reaches are used), within [2, 2^24];
+/// full_stride_cap when the length is unknown (0). O(1).
+std::uint32_t full_stride_factor(std::uint64_t n_phase);
+
+/// Bytes of history the characterizer of `type` needs for stride factor S and taus up to m_max
+/// (calloc'd: pages the data never reaches are not used). O(log m_max).
+std::uint64_t history_bytes(DataType type, std::uint32_t stride_factor, std::uint64_t m_max);
 
 /// True when the pyramid with stride factor S can form averaging factor m >= 1: m <= S, or m a
 /// multiple of its stride 2^L, the smallest power of two with S 2^L >= m. O(1).
@@ -106,6 +117,16 @@ struct Analysis {
   std::vector<AnalysisRow> rows;    // by stat (in the order asked), then by m; no row when n = 0
 };
 
+/// A value Analyzer::add() refused: its index in the block, and why (what()).
+class BadValue : public std::invalid_argument {
+ public:
+  BadValue(std::size_t index, const std::string& why) : std::invalid_argument(why), index_(index) {}
+  std::size_t index() const { return index_; }
+
+ private:
+  std::size_t index_;
+};
+
 class Analyzer {
  public:
   /// Allocates the history and per-tau state (O(S log m_max + taus)). Throws std::invalid_argument
@@ -117,10 +138,14 @@ class Analyzer {
   Analyzer(const Analyzer&) = delete;
   Analyzer& operator=(const Analyzer&) = delete;
 
-  /// The next value: a phase, a frequency, or a pulse count (an integer below 2^31 in magnitude).
-  /// O(taus) amortized, no allocation. Throws std::invalid_argument for a value that is not
-  /// finite or not a valid count, std::range_error when the accumulated count passes 2^63 pulses.
-  void add(double value);
+  /// The next values, in order: phases, frequencies, or pulse counts (integers below 2^31 in
+  /// magnitude, given to the characterizer's block API). O(taus) amortized per value; allocates
+  /// only a conversion buffer the size of the largest block. Throws BadValue for a value that is
+  /// not finite or not a valid count (the values before it were added), std::range_error when
+  /// the accumulated count passes 2^63 pulses (within the block).
+  void add(std::span<const double> values);
+  /// One value: add() of a block of one.
+  void add(double value) { add(std::span<const double>(&value, 1)); }
   /// Results so far; may be called at any time. O(taus x stats) plus the EDF, allocates the rows.
   /// Throws std::range_error naming the statistic, the tau and the cause when a deviation is not
   /// a finite number (values whose squared differences overflow a double, a tau0 whose square

@@ -175,6 +175,7 @@ std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, Dat
     const auto same = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::fabs(b); };
     if (!same(t->options.tau0_s, tau0_s) || !same(t->options.pulse_arcsec * units::arcsec, pulse_weight_rad))
       return std::nullopt;
+    if (!t->options.segments.empty()) return std::nullopt;  // the gyro changed: no one truth for the run
     return t->truth;
   }
   return std::nullopt;
@@ -234,49 +235,55 @@ std::string format_table(const Report& r) {
   return out;
 }
 
+std::string csv_fields(const AnalysisRow& row, const ReportUnits& u) {
+  const double k = u.factor();
+  return fmt::format("{},{},{},{},{},{},{},{},{},{},{}", name(row.stat), row.m, row.tau_s, row.n, row.dev * k,
+                     u.unit(row.stat), row.alpha ? fmt::format("{}", *row.alpha) : "",
+                     row.edf > 0 ? fmt::format("{}", row.edf) : "", row.ci.valid ? fmt::format("{}", row.ci.low * k) : "",
+                     row.ci.valid ? fmt::format("{}", row.ci.high * k) : "", row.stride);
+}
+
 std::string format_csv(const Report& r) {
-  std::string out = "stat,m,tau,n,dev,unit,alpha,edf,ci_low,ci_high,stride\n";
-  auto to = std::back_inserter(out);
-  const double k = r.units.factor();
-  for (const AnalysisRow& row : r.analysis.rows) {
-    fmt::format_to(to, "{},{},{},{},{},{},{},{},{},{},{}\n", name(row.stat), row.m, row.tau_s, row.n, row.dev * k,
-                   r.units.unit(row.stat), row.alpha ? fmt::format("{}", *row.alpha) : "",
-                   row.edf > 0 ? fmt::format("{}", row.edf) : "", row.ci.valid ? fmt::format("{}", row.ci.low * k) : "",
-                   row.ci.valid ? fmt::format("{}", row.ci.high * k) : "", row.stride);
-  }
+  std::string out = std::string(csv_header) + "\n";
+  for (const AnalysisRow& row : r.analysis.rows) out += csv_fields(row, r.units) + "\n";
   return out;
+}
+
+nlohmann::json row_json(const AnalysisRow& row, const ReportUnits& u) {
+  using nlohmann::json;
+  const double k = u.factor();
+  return {{"stat", name(row.stat)},
+          {"m", row.m},
+          {"tau", row.tau_s},
+          {"n", row.n},
+          {"dev", row.dev * k},
+          {"unit", u.unit(row.stat)},
+          {"alpha", row.alpha ? json(*row.alpha) : json(nullptr)},
+          {"noise_id", row.noise.identified() ? json(name(row.noise.method)) : json(nullptr)},
+          {"alpha_range", row.noise.identified() ? json({row.noise.low, row.noise.high}) : json(nullptr)},
+          {"edf_alpha", row.edf > 0 ? json(row.edf_alpha) : json(nullptr)},
+          {"edf", row.edf > 0 ? json(row.edf) : json(nullptr)},
+          {"ci_low", row.ci.valid ? json(row.ci.low * k) : json(nullptr)},
+          {"ci_high", row.ci.valid ? json(row.ci.high * k) : json(nullptr)},
+          {"stride", row.stride}};
+}
+
+nlohmann::json units_json(const ReportUnits& u) {
+  return {{"input", u.input}, {"dev", u.gyro ? u.rate.name : "1"}, {"tdev", u.gyro ? u.rate.angle : "s"}};
 }
 
 nlohmann::json to_json(const Report& r) {
   using nlohmann::json;
   const ReportUnits& u = r.units;
-  const double k = u.factor();
   json j;
   j["tau0"] = r.tau0_s;
   j["n_samples"] = r.analysis.n_values;
   j["type"] = name(r.type);
-  j["units"] = {{"input", u.input},
-                {"dev", u.gyro ? u.rate.name : "1"},
-                {"tdev", u.gyro ? u.rate.angle : "s"}};
+  j["units"] = units_json(u);
   j["stride_factor"] = r.analysis.stride_factor;
   j["confidence"] = r.confidence;
   json rows = json::array();
-  for (const AnalysisRow& row : r.analysis.rows) {
-    rows.push_back({{"stat", name(row.stat)},
-                    {"m", row.m},
-                    {"tau", row.tau_s},
-                    {"n", row.n},
-                    {"dev", row.dev * k},
-                    {"unit", u.unit(row.stat)},
-                    {"alpha", row.alpha ? json(*row.alpha) : json(nullptr)},
-                    {"noise_id", row.noise.identified() ? json(name(row.noise.method)) : json(nullptr)},
-                    {"alpha_range", row.noise.identified() ? json({row.noise.low, row.noise.high}) : json(nullptr)},
-                    {"edf_alpha", row.edf > 0 ? json(row.edf_alpha) : json(nullptr)},
-                    {"edf", row.edf > 0 ? json(row.edf) : json(nullptr)},
-                    {"ci_low", row.ci.valid ? json(row.ci.low * k) : json(nullptr)},
-                    {"ci_high", row.ci.valid ? json(row.ci.high * k) : json(nullptr)},
-                    {"stride", row.stride}});
-  }
+  for (const AnalysisRow& row : r.analysis.rows) rows.push_back(row_json(row, u));
   j["results"] = std::move(rows);
   if (!r.fits.empty()) {
     json fits = json::array();

@@ -65,8 +65,8 @@ std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, do
                                  LongTau long_tau = LongTau::oadev, const PhaseRecord& record = {});
 
 /// The truth a simulated input carries (gyrochar-sim's header, sim_truth.hpp), shown beside the
-/// fitted terms when the data are counts with the simulator's own tau0 and pulse weight.
-/// Nothing otherwise. O(header lines).
+/// fitted terms when the data are counts with the simulator's own tau0 and pulse weight, and the
+/// simulated gyro did not change during the run (no segments). Nothing otherwise. O(header lines).
 std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, DataType type, double tau0_s,
                                      double pulse_weight_rad);
 
@@ -100,13 +100,19 @@ struct Report {
 /// row with its unit, then the fits (parameters in gyro units: Q arcsec, N deg/sqrt(h), B deg/h,
 /// K deg/h/sqrt(h), R deg/h/h; clock data: s-based units). O(rows), allocates the text.
 std::string format_table(const Report& r);
-/// CSV: header "stat,m,tau,n,dev,unit,alpha,edf,ci_low,ci_high,stride", numbers shortest
-/// round-trip, empty fields where not available. Fits are not in the CSV. O(rows).
+/// CSV: header csv_header, numbers shortest round-trip, empty fields where not available. Fits are
+/// not in the CSV. O(rows).
 std::string format_csv(const Report& r);
+inline constexpr const char* csv_header = "stat,m,tau,n,dev,unit,alpha,edf,ci_low,ci_high,stride";
+/// One row's CSV fields (csv_header's columns, no newline). O(1).
+std::string csv_fields(const AnalysisRow& row, const ReportUnits& units);
 /// JSON: {"tau0", "n_samples", "type", "results": [{"stat", "m", "tau", "n", "dev", "alpha", "edf",
 /// "ci_low", "ci_high", "unit", "stride"}], "units", "stride_factor", "confidence", "fit" (only
 /// with fits)}; null where not available. O(rows).
 nlohmann::json to_json(const Report& r);
+/// One element of "results", and the "units" object. O(1).
+nlohmann::json row_json(const AnalysisRow& row, const ReportUnits& units);
+nlohmann::json units_json(const ReportUnits& units);
 /// Stable32's result table, one block per statistic (in the order asked), each as Stable32 writes
 /// it: the header ("# STATISTICS FOR FILE:", data points, maximum, minimum, average of the values,
 /// "# Sigma Type: Overlapping Allan", confidence factor, dead time, the column line) and rows

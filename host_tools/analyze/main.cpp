@@ -4,6 +4,7 @@
 // host_tools/analyze/analysis.*, the output formats host_tools/analyze/analysis_report.*.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +14,8 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <new>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -21,6 +24,8 @@
 #include "analysis.hpp"
 #include "analysis_report.hpp"
 #include "datafile.hpp"
+#include "dynamic.hpp"
+#include "heat_map.hpp"
 #include "hal/exit_codes.hpp"
 
 namespace {
@@ -52,21 +57,27 @@ Sigma MaxSigma, one block per statistic; values in the output unit). --kalibr FI
 IEEE-952 fit's N and K as the gyroscope part of a Kalibr imu.yaml (N in rad/s/sqrt(Hz) = rad/s^0.5,
 K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill).
 
-Input: one value per line, or --column C of lines split by blanks, commas or semicolons; '#'
-starts a comment; gzip is recognized by content; '-' reads standard input.
+Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' starts a comment),
+plain or gzip (recognized by content), '-' for standard input; read once. Every data line has as
+many fields as the first. Without --column a table of two columns whose first one increases
+(time, value) is read from column 2, and stderr says so; other tables need --column. A comma
+between two digits beside another separator is a decimal comma, refused; with no other separator
+it is ambiguous and needs --column. A number is never half read.
 
 Taus (averaging factors m, tau = m tau0) and memory:
-  octave        1, 2, 4, ... while a term fits (standard input: up to 2^39)
-  decade        1, 2, 4, 10, 20, 40, ... (regular files only: needs the number of values)
-  all           every m up to N/2 that the stride factor can form (regular files only; time grows
-                as N min(N, S): meant for short files)
+  octave        1, 2, 4, ... while a term fits
+  decade        1, 2, 4, 10, 20, 40, ... (Stable32's decade)
+  all           every m up to N/2 that the stride factor can form (keeps the values in memory;
+                the EDF of every tau makes it O(N^2): 10^4 values take seconds, 10^5 too long)
   1,10,100      a list of m (strictly increasing)
-  A regular file is read twice (count, then compute) so that the tau list fits it; standard input
-  and pipes are read once. Memory does not depend on the length of the data: the pyramid keeps
-  about 3S (1 + levels/2) points for stride factor S. --stride-factor full (the default) makes
-  every tau up to 2^16 fully overlapped (Stable32's estimators, same number of terms); taus above
-  2^16 are strided, their terms m/2^16 points apart, and their EDF is that of the strided
-  estimator. adev and hdev are Stable32's non-overlapped estimators at any tau.
+  The taus are sized from the file's length (an upper bound: rows the data does not reach are
+  left out) and cover any length on standard input. --stride-factor full (the default) makes
+  every tau up to N/4 fully overlapped (Stable32's estimators, same number of terms): the history
+  then grows with N, up to S = 2^24 (3S points of 24 bytes); on standard input, whose length is
+  unknown, every tau up to 2^16 is fully overlapped and taus above it are strided, their terms
+  m/2^16 points apart, with the EDF of the strided estimator. A stride factor S keeps the history
+  at about 3S (1 + levels/2) points whatever the length. adev and hdev are Stable32's
+  non-overlapped estimators at any tau.
 
 The total and Theo family (docs/total.md): totdev, mtotdev, ttotdev, htotdev, theo1, theoh need the
 whole record, which the analyzer then holds (8 bytes a value, plus 4 for mtotdev). Theo1 and
@@ -80,6 +91,13 @@ corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and 
 SP 1065's for the statistic. --fit-long-tau totdev or theoh lets the IEEE-952 fit take TOTDEV or
 TheoBR points in place of OADEV at long tau, where they have more degrees of freedom.
 
+Dynamic Allan deviation (--dynamic WINDOW[,STEP], in seconds; STEP defaults to WINDOW): the
+  statistics of every window of WINDOW/tau0 values, one starting every STEP/tau0 values, each as
+  if its values were a file of their own, at the taus with 4 m <= the window's values (--taus
+  chooses among them). Output: the tau x time surface (table, CSV or JSON); --plot PREFIX also
+  draws it as heat maps, one per statistic, in PREFIX.svg and PREFIX.png. Values after the last
+  complete window are counted, not analysed.
+
 Examples:
   gyrochar-analyze --type phase --tau0 1 --stats adev,oadev,mdev,tdev PHASE.DAT
   gyrochar-analyze --type freq --tau0 1 --nominal-hz 10e6 --taus all --stats mdev ocxo.txt
@@ -91,6 +109,8 @@ Examples:
   gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --stats oadev,totdev,theoh run120h.txt
   gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 --fit-long-tau totdev run120h.txt
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
+  gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1arcsec --dynamic 600,60 --format csv \
+                   --plot warmup run.txt > surface.csv
 
 )";
 
@@ -150,46 +170,121 @@ double parse_pulse_weight_rad(const std::string& text, const std::string& pulse_
   return value * *rad;
 }
 
-// Prints how far the reading got, every 2^20 values, when enabled; nothing for short inputs.
+// Prints how far the reading got, about every 2^20 values, when enabled; nothing for short inputs.
 class Progress {
  public:
-  Progress(bool enabled, const char* stage, const DataFile& file) : enabled_(enabled), stage_(stage), file_(file) {}
+  Progress(bool enabled, const DataFile& file) : enabled_(enabled), file_(file) {}
   ~Progress() {
     if (progress_line_open) std::fputc('\n', stderr);
     progress_line_open = false;
   }
-  void value() {
-    if (!enabled_ || (++values_ & 0xFFFFF) != 0) return;
+  void values(std::size_t n) {
+    values_ += n;
+    if (!enabled_ || values_ < next_) return;
+    next_ = values_ + (1u << 20);
     progress_line_open = true;
     const std::uint64_t size = file_.size_bytes();
     if (size > 0)
-      std::fprintf(stderr, "\rgyrochar-analyze: %s: %5.1f %%", stage_,
+      std::fprintf(stderr, "\rgyrochar-analyze: reading: %5.1f %%",
                    100.0 * static_cast<double>(file_.bytes_read()) / static_cast<double>(size));
     else
-      std::fprintf(stderr, "\rgyrochar-analyze: %s: %llu values", stage_, static_cast<unsigned long long>(values_));
+      std::fprintf(stderr, "\rgyrochar-analyze: reading: %llu values", static_cast<unsigned long long>(values_));
   }
 
  private:
   bool enabled_;
-  const char* stage_;
   const DataFile& file_;
-  std::uint64_t values_ = 0;
+  std::uint64_t values_ = 0, next_ = 1u << 20;
 };
 
-[[noreturn]] void bad_data(const std::string& path, const DataFileError& e) {
-  bad(path == "-" ? "standard input" : path, e.line() ? fmt::format("line {}: {}", e.line(), e.what()) : e.what());
+[[noreturn]] void bad_data(const std::string& source, const DataFileError& e) {
+  bad(source, e.line() ? fmt::format("line {}: {}", e.line(), e.what()) : e.what());
 }
 
-std::uint64_t count_values(const std::string& path, unsigned column, bool progress) {
+// Memory the history may take: half the machine's memory, or of the process's address space
+// limit when one is set.
+std::uint64_t memory_budget() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  std::uint64_t budget = pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2
+                                               : std::uint64_t{1} << 32;
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) budget = std::min<std::uint64_t>(budget, limit.rlim_cur / 2);
+  return budget;
+}
+
+// --dynamic WINDOW[,STEP]: one pass over the file, the surface on stdout, the heat maps to --plot.
+int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::string& dynamic_text,
+                    const std::string& taus_text, const std::string& path, unsigned column, double nominal_hz,
+                    const std::string& format, const std::string& plot_prefix, bool show_progress) {
+  const std::vector<std::string> parts = split(dynamic_text, ',');
+  double window_s = 0, step_s = 0;
+  const auto seconds = [](const std::string& t, double& v) {
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    return ec == std::errc() && end == t.data() + t.size() && v > 0 && std::isfinite(v);
+  };
+  if (parts.empty() || parts.size() > 2 || !seconds(parts[0], window_s) || (parts.size() == 2 && !seconds(parts[1], step_s)))
+    bad("--dynamic", "'" + dynamic_text + "' is not WINDOW or WINDOW,STEP in positive seconds");
+  if (parts.size() == 1) step_s = window_s;
+  const double window_values = std::round(window_s / o.tau0_s), step_values = std::round(step_s / o.tau0_s);
+  if (window_values < 4 || window_values > 1e15)
+    bad("--dynamic", fmt::format("a window of {} s holds {} values of tau0: at least 4 are needed", window_s, window_values));
+  if (step_values < 1) bad("--dynamic", fmt::format("a step of {} s is shorter than tau0", step_s));
+  const auto window = static_cast<std::uint64_t>(window_values), step = static_cast<std::uint64_t>(step_values);
+  // The windows' taus: --taus over the phase points of one window, those with 4 m <= its values.
+  const std::uint64_t window_phase = o.type == DataType::phase ? window : window + 1;
+  std::vector<std::uint64_t> m_list = taus_text == "octave"   ? octave_taus(window_phase)
+                                      : taus_text == "decade" ? decade_taus(window_phase)
+                                      : taus_text == "all"
+                                          ? all_taus(window_phase, resolve_stride_factor(o.stride_factor, window_phase / 2))
+                                          : parse_tau_list(taus_text);
+  const std::size_t asked = m_list.size();
+  m_list = window_taus(m_list, window);
+  if (m_list.empty()) bad("--taus", fmt::format("no tau with 4 m <= the window's {} values", window));
+  if (m_list.size() != asked && taus_text != "octave" && taus_text != "decade" && taus_text != "all")
+    bad("--taus", fmt::format("averaging factors above {} do not fit a quarter of the window", window / 4));
+  o.m_list = m_list;
+
+  std::unique_ptr<DynamicAnalyzer> analyzer;
+  try {
+    analyzer = std::make_unique<DynamicAnalyzer>(o, window, step);
+  } catch (const std::invalid_argument& e) {
+    bad("--dynamic", e.what());
+  }
+  const std::string source = path == "-" ? "standard input" : path;
+  std::vector<WindowAnalysis> windows;
   try {
     DataFile file(path, column);
-    Progress p(progress, "counting", file);
-    std::uint64_t n = 0;
-    for (double v = 0; file.next(v); ++n) p.value();
-    return n;
+    Progress p(show_progress, file);
+    std::vector<double> block(1 << 14);
+    while (const std::size_t n = file.read(block)) {
+      const std::span<double> values(block.data(), n);
+      if (nominal_hz > 0)
+        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
+      try {
+        analyzer->add(values);
+      } catch (const BadValue& e) {
+        bad(source, fmt::format("line {}: {}", file.line_of(e.index()), e.what()));
+      } catch (const std::range_error& e) {
+        bad(source, fmt::format("by line {}: {}", file.line_of(n - 1), e.what()));
+      }
+      for (WindowAnalysis& w : analyzer->take_completed()) windows.push_back(std::move(w));
+      p.values(n);
+    }
   } catch (const DataFileError& e) {
-    bad_data(path, e);
+    bad_data(source, e);
   }
+  if (windows.empty())
+    bad(source, fmt::format("{} values are fewer than one window of {} values", analyzer->values(), window));
+  const DynamicReport report{windows, o.type, o.tau0_s, o.confidence, units, window, step, analyzer->values(), o.stats};
+  const std::string text = format == "json" ? dynamic_to_json(report).dump(2) + "\n"
+                           : format == "csv" ? format_dynamic_csv(report)
+                                             : format_dynamic_table(report);
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (!plot_prefix.empty()) {
+    std::string why;
+    if (!write_heat_maps(plot_prefix, dynamic_heat_maps(report), why)) fail(exit_code::output_failed, "--plot", why);
+  }
+  return finish(program, exit_code::ok);
 }
 
 }  // namespace
@@ -202,9 +297,9 @@ int main(int argc, char** argv) {
   app.footer(std::string(footer) + exit_code::help);
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
-  std::string format = "table", fit_text, kalibr_path;
+  std::string format = "table", fit_text, kalibr_path, dynamic_text, plot_prefix;
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
-  unsigned column = 1;
+  unsigned column = 0;  // 0: the reader chooses
   bool progress = false;
   app.add_option("file", path, "data file (plain or gzip), '-' for standard input")->required();
   app.add_option("--type", type_text, "phase, freq or counts")->required();
@@ -214,7 +309,7 @@ int main(int argc, char** argv) {
   app.add_option("--pulse-unit", pulse_unit, "unit of --pulse-weight when it has none")->capture_default_str();
   app.add_option("--rate-unit", rate_text, "output unit of gyro data: deg/h, deg/s, rad/s")->capture_default_str();
   app.add_option("--nominal-hz", nominal_hz, "freq values are in Hz around this nominal frequency");
-  app.add_option("--column", column, "column holding the values (1-based)")->capture_default_str();
+  app.add_option("--column", column, "column holding the values (1-based; default: the only one, or the value of time,value)");
   app.add_option("--taus", taus_text, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
   app.add_option("--stats", stats_text, "any of adev,oadev,mdev,tdev,hdev,ohdev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh")
       ->capture_default_str();
@@ -234,6 +329,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--kalibr", kalibr_path, "with --fit ieee952 on gyro data: also write N and K as a Kalibr imu.yaml")
       ->option_text("FILE");
+  app.add_option("--dynamic", dynamic_text, "dynamic Allan deviation: windows of WINDOW s, one every STEP s")
+      ->option_text("WINDOW[,STEP]");
+  app.add_option("--plot", plot_prefix, "with --dynamic: draw the heat maps to PREFIX.svg and PREFIX.png")
+      ->option_text("PREFIX");
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
     app.parse(argc, argv);
@@ -252,7 +351,7 @@ int main(int argc, char** argv) {
     else bad("--type", "must be phase, freq or counts, not '" + type_text + "'");
     if (!(tau0_s > 0) || !std::isfinite(tau0_s)) bad("--tau0", "must be a positive number of seconds");
     o.tau0_s = tau0_s;
-    if (column == 0) bad("--column", "columns are numbered from 1");
+    if (app.count("--column") && column == 0) bad("--column", "columns are numbered from 1");
     if (!(confidence > 0 && confidence < 1)) bad("--confidence", "must be between 0 and 1");
     o.confidence = confidence;
     o.stats = parse_stats(stats_text);
@@ -280,6 +379,9 @@ int main(int argc, char** argv) {
     }
     if (format != "table" && format != "csv" && format != "json" && format != "stable32")
       bad("--format", "must be table, csv, json or stable32");
+    if (!plot_prefix.empty()) {
+      if (const std::string missing = plot_devices_missing(); !missing.empty()) bad("--plot", missing);
+    }
     if (!fit_text.empty() && fit_text != "ieee952") bad("--fit", "the only model is ieee952");
     if (!kalibr_path.empty() && fit_text.empty()) bad("--kalibr", "needs --fit ieee952 (the file holds fitted terms)");
     LongTau long_tau = LongTau::oadev;
@@ -340,53 +442,108 @@ int main(int argc, char** argv) {
       bad("--rate-unit", "only applies to gyro data (counts, or --unit with an angle or a rate)");
     }
 
-    // Pass 1 (regular files only): the number of values, so the taus fit the data.
     const bool show_progress = progress || isatty(STDERR_FILENO);
     const std::string source = path == "-" ? "standard input" : path;
-    std::uint64_t n_phase = 0;  // unknown
-    if (is_regular_file(path)) {
-      const std::uint64_t n_values = count_values(path, column, show_progress);
-      if (n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
-      n_phase = o.type == DataType::phase ? n_values : n_values + 1;
+    if (!plot_prefix.empty() && dynamic_text.empty()) bad("--plot", "draws the heat maps of --dynamic only");
+    if (!dynamic_text.empty()) {
+      if (!fit_text.empty()) bad("--fit", "fits the whole run's curves: not with --dynamic");
+      return analyze_dynamic(o, units, dynamic_text, taus_text, path, column, nominal_hz, format, plot_prefix,
+                             show_progress);
     }
+
+    // One pass over the data. The taus are chosen before it from the file's length, an upper
+    // bound on the values (rows the data does not reach are left out); --taus all reads the
+    // values into memory first, to know N.
+    const auto phase_points = [&](std::uint64_t values) { return o.type == DataType::phase ? values : values + 1; };
+    std::unique_ptr<DataFile> file;
+    std::vector<double> kept;           // --taus all: every value, and its line
+    std::vector<std::uint64_t> kept_lines;
+    std::uint64_t n_phase = 0;          // phase points: exact (all), an upper bound, or 0 (unknown)
+    try {
+      file = std::make_unique<DataFile>(path, column);
+      if (taus_text == "all") {
+        std::vector<double> block(1 << 14);
+        while (const std::size_t n = file->read(block)) {
+          kept.insert(kept.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(n));
+          for (std::size_t i = 0; i < n; ++i) kept_lines.push_back(file->line_of(i));
+        }
+        if (kept.empty()) bad(source, "no data (empty, or only comments and blank lines)");
+        n_phase = phase_points(kept.size());
+      } else if (file->values_bound() > 0) {
+        n_phase = phase_points(file->values_bound());
+      }
+    } catch (const DataFileError& e) {
+      bad_data(source, e);
+    }
+    // full: every tau up to N/4 fully overlapped; for --taus all every m up to N/2 (all of them).
+    if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus_text == "all" ? 2 * n_phase : n_phase);
+    const std::uint32_t s = o.stride_factor;
+    std::vector<std::uint64_t> not_formed;  // decade taus the stride factor cannot form
+    const bool generated = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
     if (taus_text == "octave") {
       o.m_list = octave_taus(n_phase);
-    } else if (taus_text == "decade" || taus_text == "all") {
-      if (n_phase == 0) bad("--taus", taus_text + " needs the number of values: give a regular file, or use octave or a list");
-      o.m_list = taus_text == "decade" ? decade_taus(n_phase)
-                                       : all_taus(n_phase, resolve_stride_factor(o.stride_factor, n_phase / 2));
+    } else if (taus_text == "decade") {
+      for (const std::uint64_t m : decade_taus(n_phase ? n_phase : std::uint64_t{1} << 40))
+        (tau_representable(m, s) ? o.m_list : not_formed).push_back(m);
+    } else if (taus_text == "all") {
+      o.m_list = all_taus(n_phase, s);
     } else {
       o.m_list = parse_tau_list(taus_text);
     }
     if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
-    const bool lists = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
-    o.theo_m_list = theo_taus(lists ? taus_text : "list", o.m_list, n_phase);
+    // Generated taus stop where their history would not fit in memory (a large S on standard
+    // input); a list that does not fit is refused.
+    const std::uint64_t budget = memory_budget();
+    std::uint64_t cut_above = 0;
+    while (generated && o.m_list.size() > 1 && history_bytes(o.type, s, o.m_list.back()) > budget) {
+      cut_above = o.m_list.back();
+      o.m_list.pop_back();
+    }
+    const auto too_big = [&] {
+      bad("--stride-factor", fmt::format("{} with taus up to {} needs {} MiB of history, more than the {} MiB this "
+                                         "process may use: give a smaller stride factor or fewer taus",
+                                         s, o.m_list.back(), history_bytes(o.type, s, o.m_list.back()) >> 20, budget >> 20));
+    };
+    if (history_bytes(o.type, s, o.m_list.back()) > budget) too_big();
+    o.theo_m_list = theo_taus(generated ? taus_text : "list", o.m_list, n_phase);
 
-    // Pass 2: the analysis.
     std::unique_ptr<Analyzer> analyzer;
     try {
       analyzer = std::make_unique<Analyzer>(o);
     } catch (const std::invalid_argument& e) {
       bad("--taus", e.what());
+    } catch (const std::bad_alloc&) {
+      too_big();
     }
-    std::vector<std::string> header;
     DataRange range;
-    try {
-      DataFile file(path, column);
-      Progress p(show_progress, "analyzing", file);
-      for (double v = 0; file.next(v);) {
-        if (nominal_hz > 0) v = (v - nominal_hz) / nominal_hz;
-        range.add(v);
-        try {
-          analyzer->add(v);
-        } catch (const std::exception& e) {  // invalid_argument (a bad count), range_error
-          bad(source, fmt::format("line {}: {}", file.line(), e.what()));
-        }
-        p.value();
+    const auto add = [&](std::span<double> values, auto line_of) {
+      if (nominal_hz > 0)
+        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
+      for (const double v : values) range.add(v);
+      try {
+        analyzer->add(values);
+      } catch (const BadValue& e) {
+        bad(source, fmt::format("line {}: {}", line_of(e.index()), e.what()));
+      } catch (const std::range_error& e) {
+        bad(source, fmt::format("by line {}: {}", line_of(values.size() - 1), e.what()));
       }
-      header = file.header();
+    };
+    try {
+      Progress p(show_progress, *file);
+      if (taus_text == "all") {
+        for (std::size_t i = 0; i < kept.size(); i += 1 << 14) {
+          const std::size_t n = std::min<std::size_t>(kept.size() - i, 1 << 14);
+          add({kept.data() + i, n}, [&](std::size_t k) { return kept_lines[i + k]; });
+        }
+      } else {
+        std::vector<double> block(1 << 14);
+        while (const std::size_t n = file->read(block)) {
+          add({block.data(), n}, [&](std::size_t k) { return file->line_of(k); });
+          p.values(n);
+        }
+      }
     } catch (const DataFileError& e) {
-      bad_data(path, e);
+      bad_data(source, e);
     }
     const Analysis a = [&] {
       try {
@@ -396,7 +553,16 @@ int main(int argc, char** argv) {
       }
     }();
     if (a.n_values == 0) bad(source, "no data (empty, or only comments and blank lines)");
+    for (const std::uint64_t m : not_formed)
+      if (m <= a.n_phase / 2)
+        bad("--taus", fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must be a "
+                                  "multiple of its stride (m/S rounded up to a power of two)", m, s));
     if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
+    if (!file->layout_note().empty()) print_error(program, source, "values from " + file->layout_note());
+    if (cut_above > 0 && cut_above <= a.n_phase / 2)
+      print_error(program, source, fmt::format("taus stop below m = {}: with stride factor {} more would need more than "
+                                               "{} MiB of history", cut_above, s, budget >> 20));
+    const std::vector<std::string>& header = file->header();
 
     std::vector<CurveFit> fits;
     if (!fit_text.empty())

@@ -1,5 +1,6 @@
 #include "decoder.hpp"
 
+#include <algorithm>
 #include <type_traits>
 
 namespace gyrochar {
@@ -15,6 +16,7 @@ const char* name(DecoderEvent e) {
     case DecoderEvent::rejected_frame: return "rejected_frame";
     case DecoderEvent::duplicate: return "duplicate";
     case DecoderEvent::unknown_version: return "unknown_version";
+    case DecoderEvent::window_complete: return "window_complete";
   }
   return "invalid";
 }
@@ -120,7 +122,7 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
             open_report(v, a, msg.seq);
           }
           v.clock = msg;
-          relayout_if_version_changed(v, a);
+          relayout_if_schedule_changed(v, a);
           mark_slot(v, a, Slot::clock, 0);
         } else if constexpr (std::is_same_v<M, MetaScaleMsg>) {
           v.scale = msg;
@@ -138,11 +140,53 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
           mark_slot(v, a, Slot::ieee952, static_cast<std::uint8_t>(msg.term));
         } else if constexpr (std::is_same_v<M, Ieee952SummaryMsg>) {
           v.ieee952_summary = msg;
-          relayout_if_version_changed(v, a);
+          relayout_if_schedule_changed(v, a);
           mark_slot(v, a, Slot::ieee952, ieee952_summary_page);
+        } else if constexpr (std::is_same_v<M, WindowMsg>) {
+          if (v.window_taus != 0 && msg.tau_count != v.window_taus) {  // reconfigured, like TauCount
+            restart(v, a);
+            open_report(v, a, msg.seq);
+          }
+          v.window_taus = msg.tau_count;
+          relayout_if_schedule_changed(v, a);
+          v.window_page = msg;
+          if (msg.complete) {
+            WindowView& w = v.windows[msg.window];
+            w.window = msg.window;
+            w.gaps = msg.gaps;
+            w.adev.resize(msg.tau_count);
+            w.mdev.resize(msg.tau_count);
+            w.received.resize(msg.tau_count);
+          }
+          mark_slot(v, a, Slot::window, 0);
+        } else if constexpr (std::is_same_v<M, WindowLengthMsg>) {
+          v.window_length = msg.length;
+          mark_slot(v, a, Slot::window_length, 0);
+        } else if constexpr (std::is_same_v<M, WindowDevMsg>) {
+          accept_window_dev(v, a, msg);
+          mark_slot(v, a, Slot::window_dev, msg.tau_index);
         }
       },
       message);
+}
+
+void Decoder::accept_window_dev(NodeView& v, Assembly& a, const WindowDevMsg& msg) {
+  // The frame belongs to the window its cycle's window page named; WindowMod16 says whether it is
+  // that one (the page may have been lost, and the node moved on to another window). While the
+  // node has no completed window its frames carry nothing.
+  if (v.window_page && !v.window_page->complete && msg.adev_angle_per_s == 0 && msg.mdev_angle_per_s == 0) return;
+  const std::optional<std::uint32_t> k = v.current_window();
+  const auto current = k ? v.windows.find(*k) : v.windows.end();
+  if (current == v.windows.end() || (current->first & 15u) != msg.window || msg.tau_index >= v.window_taus) {
+    ++v.health.window_frames_unplaced;
+    return;
+  }
+  WindowView& w = current->second;
+  const bool was_complete = w.complete();
+  w.adev[msg.tau_index] = msg.adev_angle_per_s;
+  w.mdev[msg.tau_index] = msg.mdev_angle_per_s;
+  w.received[msg.tau_index] = true;
+  if (!was_complete && w.complete()) emit(DecoderEvent::window_complete, v, a.seq);
 }
 
 void Decoder::open_report(NodeView& v, Assembly& a, std::uint8_t seq) {
@@ -167,22 +211,25 @@ void Decoder::open_report(NodeView& v, Assembly& a, std::uint8_t seq) {
   a.lost_at_open = lost;
   a.tau_count = v.have_status ? v.status.tau_count : 0;
   a.version = v.schedule_version();
+  a.window_taus = v.window_taus;
   a.arrived.fill(false);
   layout(a);
 }
 
-void Decoder::relayout_if_version_changed(const NodeView& v, Assembly& a) {
-  // Versions 1 and 2 put every frame at the same position (protocol.hpp): what was received stays.
-  if (a.version == v.schedule_version()) return;
+void Decoder::relayout_if_schedule_changed(const NodeView& v, Assembly& a) {
+  // Every version, with or without window taus, puts the frames it shares with the others at the
+  // same position (protocol.hpp): what was received stays.
+  if (a.version == v.schedule_version() && a.window_taus == v.window_taus) return;
   a.version = v.schedule_version();
+  a.window_taus = v.window_taus;
   layout(a);
 }
 
 void Decoder::layout(Assembly& a) {
   a.position.fill(-1);
-  const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version);
+  const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version, a.window_taus);
   for (std::size_t k = 0; k < frames && k < a.arrived.size(); ++k) {
-    const ReportSlot s = report_slot(a.seq, a.tau_count, k, a.version);
+    const ReportSlot s = report_slot(a.seq, a.tau_count, k, a.version, a.window_taus);
     a.position[static_cast<std::size_t>(s.slot) * max_taus + s.index] = static_cast<std::int16_t>(k);
   }
 }
@@ -190,7 +237,7 @@ void Decoder::layout(Assembly& a) {
 void Decoder::close_report(NodeView& v, Assembly& a) {
   if (!a.open) return;
   a.open = false;
-  const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version);
+  const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version, a.window_taus);
   std::uint64_t missing = 0;
   for (std::size_t k = 0; k < frames && k < a.arrived.size(); ++k) missing += a.arrived[k] ? 0 : 1;
   v.health.frames_missing += missing;

@@ -3,13 +3,16 @@
 // and applies the loss, restart and offline rules of docs/protocol.md section 5. Frames come from
 // anywhere (a live socket, a candump log, a test); time is passed in, never read from a clock.
 // Nothing is papered over: every lost frame, lost report, restart, silent node, duplicate and
-// rejected frame is counted and, where it happens, reported as an event.
+// rejected frame is counted and, where it happens, reported as an event. Each node's window curves
+// (the dynamic Allan deviation, protocol version 3) are kept, one per window, for the heat map.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "gyrochar/can_frame.hpp"
 #include "gyrochar/protocol.hpp"
@@ -44,6 +47,16 @@ struct Ieee952View {
   bool in_model() const { return received && (fitted || resolved); }
 };
 
+/// One window of the node's dynamic Allan deviation (protocol version 3): the window k covers the
+/// node's samples k L .. (k+1) L - 1 (L = NodeView::window_length).
+struct WindowView {
+  std::uint32_t window = 0;   // k
+  std::uint32_t gaps = 0;     // sample gaps inside it
+  std::vector<double> adev, mdev;  // per window tau, angle unit / s; 0: no estimate or not received
+  std::vector<bool> received;      // per window tau: its frame arrived
+  bool complete() const { return !received.empty() && std::find(received.begin(), received.end(), false) == received.end(); }
+};
+
 /// Link health of one node: what went missing and what went wrong, since the decoder started.
 struct LinkHealth {
   std::uint64_t frames = 0;             // frames accepted from this node
@@ -55,6 +68,7 @@ struct LinkHealth {
   std::uint64_t offline_events = 0;     // silences of 3 s or more
   std::uint64_t duplicates = 0;         // a slot received twice in one report: address conflict
   std::uint64_t not_decoded = 0;        // frames of a protocol version this decoder does not know
+  std::uint64_t window_frames_unplaced = 0;  // window tau frames whose window page was not received
   std::map<protocol::ProtocolError, std::uint64_t> rejected;  // frames decode() refused
 };
 
@@ -77,17 +91,33 @@ struct NodeView {
   /// The fit's summary (protocol version 2, slow cycle); empty until received, and always for a
   /// version-1 node, which has none.
   std::optional<protocol::Ieee952SummaryMsg> ieee952_summary;
+  // The dynamic Allan deviation (protocol version 3, slow cycle): 0 until the window pages arrive.
+  std::uint8_t window_taus = 0;     // WindowTauCount; window tau i is tau i
+  std::uint64_t window_length = 0;  // samples per window
+  /// Every window received in this session, by number: the columns of the heat map. A window is
+  /// added when a window page names it and filled as its window tau frames arrive.
+  std::map<std::uint32_t, WindowView> windows;
+  /// The latest window page: the window the frames of the current slow cycle describe (none while
+  /// the node has no completed window); empty until one arrives in this session.
+  std::optional<protocol::WindowMsg> window_page;
+  /// The window the window tau frames now arriving belong to, if any.
+  std::optional<std::uint32_t> current_window() const {
+    return window_page && window_page->complete ? std::optional<std::uint32_t>(window_page->window) : std::nullopt;
+  }
   LinkHealth health;
   /// Non-zero: the ProtocolVersion the node announced, newer than this decoder's; its frames are no
   /// longer decoded (counted in health.not_decoded) until it announces a known version again.
   std::uint8_t unknown_version = 0;
 
-  /// The protocol version whose schedule the node follows: the clock page's, before it arrives 2
-  /// once a summary page came (only version 2 sends one), else 1. A version-1 report then misses
-  /// nothing, and a version-2 report opened before the clock page only leaves its summary
-  /// uncounted.
+  /// The protocol version whose schedule the node follows: the clock page's; before it arrives 3
+  /// once a window page came (only version 3 sends one), 2 once a summary page came (from version
+  /// 2), else 1. A version-1 report then misses nothing, and a newer report opened before the
+  /// clock page only leaves its newer frames uncounted.
   std::uint8_t schedule_version() const {
-    return clock ? clock->protocol_version : ieee952_summary ? std::uint8_t{2} : std::uint8_t{1};
+    return clock            ? clock->protocol_version
+           : window_taus    ? std::uint8_t{3}
+           : ieee952_summary ? std::uint8_t{2}
+                             : std::uint8_t{1};
   }
 
   /// tau in seconds of tau index i, 0 while tau0 or m is unknown.
@@ -96,7 +126,17 @@ struct NodeView {
   }
 };
 
-enum class DecoderEvent { report_closed, restart, offline, online, rejected_frame, duplicate, unknown_version };
+/// window_complete: the last window tau of `node.current_window()` arrived (once per window).
+enum class DecoderEvent {
+  report_closed,
+  restart,
+  offline,
+  online,
+  rejected_frame,
+  duplicate,
+  unknown_version,
+  window_complete
+};
 /// "report_closed", "restart", ...: the enumerator's name. A static string.
 const char* name(DecoderEvent e);
 
@@ -113,8 +153,9 @@ class Decoder {
     std::uint8_t lost_at_open = 0;  // reports counted lost when the current report opened
     std::uint8_t tau_count = 0;
     std::uint8_t version = 1;  // the schedule's protocol version (NodeView::schedule_version())
+    std::uint8_t window_taus = 0;  // the node's window taus (version 3), 0 while unknown
     std::array<bool, 512> arrived{};  // by slot position in the report
-    std::array<std::int16_t, 11 * protocol::max_taus> position{};  // (slot, index) -> position, -1: not in this report
+    std::array<std::int16_t, protocol::slot_kinds * protocol::max_taus> position{};  // (slot, index) -> position, -1: not in this report
 
     /// True when the frame of (slot, index) arrived in this report; false for a frame the report's
     /// schedule does not have. O(1).
@@ -150,9 +191,10 @@ class Decoder {
  private:
   using Assembly = Report;
   static void layout(Assembly& a);
-  static void relayout_if_version_changed(const NodeView& v, Assembly& a);
+  static void relayout_if_schedule_changed(const NodeView& v, Assembly& a);
 
   void accept(NodeView& v, Assembly& a, const protocol::Message& message);
+  void accept_window_dev(NodeView& v, Assembly& a, const protocol::WindowDevMsg& msg);
   void open_report(NodeView& v, Assembly& a, std::uint8_t seq);
   void close_report(NodeView& v, Assembly& a);
   void restart(NodeView& v, Assembly& a);

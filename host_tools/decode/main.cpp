@@ -283,6 +283,8 @@ int main(int argc, char** argv) {
       "fit_chi2_per_dof, fit_points, fit_quantization_white (true/false), fit_avar_excluded_below_tau_s,\n"
       "fit_mvar_excluded_below_tau_s (s; 0 = none left out); empty without a summary. JSON lines: the\n"
       "report records carry it as \"ieee952_fit\" (null without), each term \"fitted\" and \"resolved\".\n"
+      "A node with a window (protocol version 3, gyrochard --window) adds its dynamic Allan deviation: window\n"
+      "rows (column type = window) in the CSV and JSON lines, and a heat map beside its plot.\n"
       "All columns: host_tools/decode/README.md.\n\n"
       "Examples:\n"
       "  gyrochar-decode --interface can0\n"

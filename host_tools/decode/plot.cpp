@@ -5,15 +5,11 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
+#include <utility>
 
-// LeakSanitizer reads this hook in the sanitizer build (unused otherwise): PLplot's cairo driver
-// leaves fontconfig's font caches and libltdl's loaded driver for the life of the process, by design
-// of those libraries; neither is ours to free.
-extern "C" const char* __lsan_default_suppressions() { return "leak:libfontconfig.so\nleak:libltdl.so\n"; }
+#include "figure.hpp"
+#include "heat_map.hpp"
 
 namespace gyrochar::decoding {
 namespace {
@@ -95,14 +91,7 @@ void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
       if (q.ci.valid) y.add(q.ci.low), y.add(q.ci.high);
     }
   }
-  if (!(y.hi > 0)) {
-    pls.vpor(0.1, 0.9, 0.1, 0.9);
-    pls.wind(0, 1, 0, 1);
-    pls.box("bc", 0, 0, "bc", 0, 0);
-    pls.ptex(0.5, 0.5, 1, 0, 0.5, "no positive deviation with a known tau yet");
-    pls.lab("", "", p.title.c_str());
-    return;
-  }
+  if (!(y.hi > 0)) return draw_empty_panel(pls, p.title, "no positive deviation with a known tau yet");
   const double y_lo = std::floor(std::log10(y.lo) - 0.05), y_hi = std::ceil(std::log10(y.hi) + 0.05);
   const double x_lo = std::log10(p.tau_min_s), x_hi = std::log10(p.tau_max_s);
   pls.vpor(0.08, 0.60, 0.10, 0.92);  // the legend, outside on the right, gets the rest
@@ -186,64 +175,26 @@ void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
              glyphs.data());
 }
 
-bool draw(const char* device, const std::string& file, const std::vector<NodePlot>& panels, double confidence,
-          std::string& why) {
-  // PLplot would end the process on a file it cannot open: check first.
-  if (std::FILE* f = std::fopen(file.c_str(), "w")) {
-    std::fclose(f);
-  } else {
-    why = fmt::format("{}: {}", file, std::strerror(errno));
-    return false;
-  }
-  const auto columns = static_cast<PLINT>(std::ceil(std::sqrt(static_cast<double>(panels.size()))));
-  const auto rows = static_cast<PLINT>((static_cast<PLINT>(panels.size()) + columns - 1) / columns);
-  {
-    plstream pls;
-    pls.sdev(device);
-    pls.sfnam(file.c_str());
-    pls.spage(0, 0, 1500 * columns, 900 * rows, 0, 0);
-    std::array<PLINT, palette.size()> red{}, green{}, blue{};
-    for (std::size_t c = 0; c < palette.size(); ++c) {
-      red[c] = palette[c][0];
-      green[c] = palette[c][1];
-      blue[c] = palette[c][2];
-    }
-    pls.scmap0(red.data(), green.data(), blue.data(), static_cast<PLINT>(palette.size()));
-    pls.ssub(columns, rows);
-    pls.init();
-    pls.schr(0, text_scale);
-    for (const NodePlot& p : panels) draw_panel(pls, p, confidence);
-  }  // plend1: the file is complete
-  return true;
-}
-
 }  // namespace
 
-std::string plot_devices_missing() {
-  std::array<const char*, 128> menu_storage{}, name_storage{};  // plgDevs fills arrays of the caller's
-  const char** menus = menu_storage.data();
-  const char** names = name_storage.data();
-  int count = static_cast<int>(name_storage.size());
-  plgDevs(&menus, &names, &count);
-  std::string missing;
-  for (const char* wanted : {"svgcairo", "pngcairo"}) {
-    if (std::none_of(names, names + count, [&](const char* n) { return std::strcmp(n, wanted) == 0; }))
-      missing += std::string(missing.empty() ? "" : ", ") + wanted;
-  }
-  return missing.empty() ? "" : "PLplot has no " + missing + " device (Debian package plplot-driver-cairo)";
-}
-
 bool write_plot(const std::string& prefix, const std::vector<NodePlot>& panels, double confidence, std::string& why) {
-  for (const auto& [device, extension] : {std::pair{"svgcairo", ".svg"}, std::pair{"pngcairo", ".png"}}) {
-    const std::string file = prefix + extension, part = file + ".part";
-    if (!draw(device, part, panels, confidence, why)) return false;
-    if (std::rename(part.c_str(), file.c_str()) != 0) {
-      why = fmt::format("{}: {}", file, std::strerror(errno));
-      std::remove(part.c_str());
-      return false;
-    }
+  // Each node's panel, then beside it the heat map of its dynamic Allan deviation when it has one.
+  std::vector<std::pair<const NodePlot*, bool>> order;  // (node, heat map?)
+  for (const NodePlot& p : panels) {
+    order.emplace_back(&p, false);
+    if (p.dynamic) order.emplace_back(&p, true);
   }
-  return true;
+  Palette colours;
+  for (const auto& rgb : palette) colours.push_back({rgb[0], rgb[1], rgb[2]});
+  return write_figure(prefix, order.size(), colours, 1500, 900,
+                      [&](plstream& pls, std::size_t k) {
+                        pls.schr(0, text_scale);
+                        if (order[k].second)
+                          draw_heat_map(pls, *order[k].first->dynamic);
+                        else
+                          draw_panel(pls, *order[k].first, confidence);
+                      },
+                      why);
 }
 
 }  // namespace gyrochar::decoding

@@ -27,6 +27,30 @@ double model_adev(const std::array<double, 5>& qnbkr, double tau_s, double rate)
   return std::sqrt(ieee952_avar(qnbkr, tau_s)) * rate;
 }
 
+// The heat map of the node's window curves: a column per window, a row per window tau (while tau0,
+// the window length or a window tau's m is unknown: no columns yet).
+HeatMap window_heat_map(const NodeView& node, const Units& u) {
+  HeatMap h;
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  const double length_s = static_cast<double>(node.window_length) * tau0_s;
+  h.title = length_s > 0 ? fmt::format("node 0x{:02X}, session {}: dynamic ADEV, windows of {:.4g} s", node.address,
+                                       node.session, length_s)
+                         : fmt::format("node 0x{:02X}, session {}: dynamic ADEV", node.address, node.session);
+  h.value_name = "ADEV";
+  h.unit = u.rate_name;
+  for (std::size_t i = 0; i < node.window_taus; ++i) {
+    if (!(node.tau_s(i) > 0)) return h;
+    h.tau_s.push_back(node.tau_s(i));
+  }
+  if (!(length_s > 0)) return h;
+  for (const auto& [k, w] : node.windows) {
+    HeatMap::Column c{static_cast<double>(k) * length_s, static_cast<double>(k + 1) * length_s, {}};
+    for (std::size_t i = 0; i < w.adev.size(); ++i) c.value.push_back(w.received[i] ? w.adev[i] * u.rate : 0.0);
+    h.columns.push_back(std::move(c));
+  }
+  return h;
+}
+
 }  // namespace
 
 NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceIntervals& intervals, const TrueTerms* truth) {
@@ -34,6 +58,7 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
   NodePlot p;
   p.title = fmt::format("node 0x{:02X}, session {}", node.address, node.session);
   p.rate_name = u.rate_name;
+  if (node.window_taus != 0) p.dynamic = window_heat_map(node, u);
   double lo = INFINITY, hi = 0.0;
   for (std::size_t i = 0; i < node.status.tau_count && i < max_taus; ++i) {
     const double tau = node.tau_s(i);

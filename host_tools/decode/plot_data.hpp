@@ -1,10 +1,12 @@
 #pragma once
 // The series of gyrochar-decode's ADEV/MDEV plot, in display units, with the IEEE-952 model lines
-// (plot.hpp draws them with PLplot; this part needs no plotting library).
+// and the heat map of the node's window curves (plot.hpp draws them with PLplot; this part needs no
+// plotting library).
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "heat_map.hpp"
 #include "rows.hpp"
 
 namespace gyrochar::decoding {
@@ -33,6 +35,8 @@ struct NodePlot {
   std::vector<ReadOffPoint> read_offs;
   double tau_min_s = 0.0, tau_max_s = 0.0;  // the tau axis: the points' range widened by 2 on each
                                             // side (0, 0 when there are no points)
+  std::optional<HeatMap> dynamic;           // the window curves' ADEV (protocol version 3): a node
+                                            // with window taus has one, empty until a window comes
 };
 
 /// The plot of one node. Each resolved IEEE-952 term is drawn as the ADEV of its own AVAR term
@@ -43,7 +47,9 @@ struct NodePlot {
 /// pulse weight / sqrt(12) where the node held it there (quantization not white). A fit the node
 /// rejected, or could not make, draws no model line and says so in `notes`. With `truth` (SI), its
 /// model is drawn too (`truth`, the same closed form). Lines span the tau axis; read-off points
-/// outside it are left out. O(taus + line points); allocates.
+/// outside it are left out. A node with window taus also gets the heat map of its windows' ADEV
+/// (`dynamic`: one column per window, placed at its samples times tau0). O(taus + line points +
+/// windows x window taus); allocates.
 NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceIntervals& intervals,
                    const TrueTerms* truth = nullptr);
 

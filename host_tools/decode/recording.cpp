@@ -33,20 +33,43 @@ CsvWriter::CsvWriter(std::FILE* out, double confidence) : out_(out), confidence_
       "mdev,mdev_low,mdev_high,mdev_edf,mdev_noise,mdev_status,"
       "rate_unit,ci_level,session,"
       "fit_status,fit_chi2_per_dof,fit_points,fit_quantization_white,"
-      "fit_avar_excluded_below_tau_s,fit_mvar_excluded_below_tau_s\n",
+      "fit_avar_excluded_below_tau_s,fit_mvar_excluded_below_tau_s,"
+      "type,window,window_start_s,window_end_s,window_gaps\n",
       out_);
 }
 
-void CsvWriter::row(const TauRow& r, const Units& units) {
+template <class T>
+void CsvWriter::field(bool known, T value) {
+  if (known) fmt::format_to(fmt::appender(line_), FMT_COMPILE("{}"), value);
+  line_.push_back(',');
+}
+
+void CsvWriter::begin(double time_s, std::uint8_t node, std::uint8_t seq, std::uint8_t tau_index, std::uint64_t m,
+                      double tau_s) {
   line_.clear();
+  fmt::format_to(fmt::appender(line_), FMT_COMPILE("{:.6f},{},{},{},"), time_s, node, seq, tau_index);
+  field(m != 0, m);
+  field(tau_s > 0, static_cast<float>(tau_s));  // tau0 is a float32 on the wire
+}
+
+void CsvWriter::row(const WindowRow& r, const Units& units) {
+  begin(r.time_s, r.node, r.seq, r.tau_index, r.m, r.tau_s);
   const auto out = fmt::appender(line_);
-  const auto field = [&](bool known, auto value) {
-    if (known) fmt::format_to(out, FMT_COMPILE("{}"), value);
-    line_.push_back(',');
-  };
-  fmt::format_to(out, FMT_COMPILE("{:.6f},{},{},{},"), r.time_s, r.node, r.seq, r.tau_index);
-  field(r.m != 0, r.m);
-  field(r.tau_s > 0, static_cast<float>(r.tau_s));  // tau0 is a float32 on the wire
+  line_.push_back(',');  // n: a window's terms are not sent
+  for (const DevCell* c : {&r.adev, &r.mdev}) {
+    field(c->status == DevCell::Status::ok, c->value);
+    fmt::format_to(out, FMT_COMPILE(",,,,{},"), name(c->status));  // no interval, EDF or noise type
+  }
+  fmt::format_to(out, FMT_COMPILE("{},,{},,,,,,,window,{},"), units.rate_name, r.session, r.window);
+  field(r.end_s > 0, r.start_s);
+  field(r.end_s > 0, r.end_s);
+  fmt::format_to(out, FMT_COMPILE("{}\n"), r.gaps);
+  std::fwrite(line_.data(), 1, line_.size(), out_);
+}
+
+void CsvWriter::row(const TauRow& r, const Units& units) {
+  begin(r.time_s, r.node, r.seq, r.tau_index, r.m, r.tau_s);
+  const auto out = fmt::appender(line_);
   field(r.n != 0, r.n);
   for (const DevCell* c : {&r.adev, &r.mdev}) {
     field(c->status == DevCell::Status::ok, c->value);
@@ -63,8 +86,8 @@ void CsvWriter::row(const TauRow& r, const Units& units) {
   field(fit, fit ? r.fit->points : 0u);
   field(fit, fit && r.fit->quantization_white ? "true" : "false");
   field(r.fit_excluded_below_tau_s[0].has_value(), r.fit_excluded_below_tau_s[0].value_or(0.0));
-  if (r.fit_excluded_below_tau_s[1]) fmt::format_to(out, FMT_COMPILE("{}"), *r.fit_excluded_below_tau_s[1]);
-  line_.push_back('\n');
+  field(r.fit_excluded_below_tau_s[1].has_value(), r.fit_excluded_below_tau_s[1].value_or(0.0));
+  fmt::format_to(out, FMT_COMPILE("tau,,,,\n"));
   std::fwrite(line_.data(), 1, line_.size(), out_);
 }
 
@@ -90,10 +113,19 @@ Json health_json(const LinkHealth& h) {
               {"offline_events", h.offline_events},
               {"duplicates", h.duplicates},
               {"not_decoded", h.not_decoded},
+              {"window_frames_unplaced", h.window_frames_unplaced},
               {"rejected", rejected}};
 }
 
 }  // namespace
+
+template <class T>
+void JsonlWriter::member(const char* key, bool known, T value) {
+  if (known)
+    fmt::format_to(fmt::appender(line_), FMT_COMPILE(",\"{}\":{}"), key, value);
+  else
+    fmt::format_to(fmt::appender(line_), FMT_COMPILE(",\"{}\":null"), key);
+}
 
 // The tau rows are the bulk of a recording: written with fmt, not built as JSON objects (5x faster).
 // Every string in them is an enumeration or unit name (plain ASCII, nothing to escape) and every
@@ -101,12 +133,6 @@ Json health_json(const LinkHealth& h) {
 void JsonlWriter::row(const TauRow& r, const Units& units) {
   line_.clear();
   const auto out = fmt::appender(line_);
-  const auto member = [&](const char* key, bool known, auto value) {
-    if (known)
-      fmt::format_to(out, FMT_COMPILE(",\"{}\":{}"), key, value);
-    else
-      fmt::format_to(out, FMT_COMPILE(",\"{}\":null"), key);
-  };
   fmt::format_to(
       out, FMT_COMPILE("{{\"type\":\"tau\",\"time_s\":{:.6f},\"node\":{},\"session\":{},\"seq\":{},\"tau_index\":{}"),
       r.time_s, r.node, r.session, r.seq, r.tau_index);
@@ -124,6 +150,29 @@ void JsonlWriter::row(const TauRow& r, const Units& units) {
       fmt::format_to(out, FMT_COMPILE(",\"noise\":\"{}\"}}"), name(c->noise));
     else
       fmt::format_to(out, FMT_COMPILE(",\"noise\":null}}"));
+  }
+  fmt::format_to(out, FMT_COMPILE("}}\n"));
+  std::fwrite(line_.data(), 1, line_.size(), out_);
+}
+
+void JsonlWriter::row(const WindowRow& r, const Units& units) {
+  line_.clear();
+  const auto out = fmt::appender(line_);
+  fmt::format_to(out,
+                 FMT_COMPILE("{{\"type\":\"window\",\"time_s\":{:.6f},\"node\":{},\"session\":{},\"seq\":{},"
+                             "\"window\":{},\"window_gaps\":{}"),
+                 r.time_s, r.node, r.session, r.seq, r.window, r.gaps);
+  member("window_length", r.length != 0, r.length);
+  member("window_start_s", r.end_s > 0, r.start_s);
+  member("window_end_s", r.end_s > 0, r.end_s);
+  fmt::format_to(out, FMT_COMPILE(",\"tau_index\":{}"), r.tau_index);
+  member("m", r.m != 0, r.m);
+  member("tau_s", r.tau_s > 0, static_cast<float>(r.tau_s));
+  fmt::format_to(out, FMT_COMPILE(",\"rate_unit\":\"{}\""), units.rate_name);
+  for (const auto& [key, c] : {std::pair{"adev", &r.adev}, std::pair{"mdev", &r.mdev}}) {
+    fmt::format_to(out, FMT_COMPILE(",\"{}\":{{\"status\":\"{}\""), key, name(c->status));
+    member("value", c->status == DevCell::Status::ok, c->value);
+    line_.push_back('}');
   }
   fmt::format_to(out, FMT_COMPILE("}}\n"));
   std::fwrite(line_.data(), 1, line_.size(), out_);

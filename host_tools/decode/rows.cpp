@@ -63,4 +63,42 @@ void tau_rows(const NodeView& node, const Decoder::Report& report, const Units& 
   }
 }
 
+namespace {
+
+DevCell window_cell(double dev, bool received, double rate) {
+  DevCell c;
+  if (!received) return c;
+  c.status = dev > 0 ? DevCell::Status::ok : DevCell::Status::invalid;
+  c.value = dev * rate;
+  return c;
+}
+
+}  // namespace
+
+void window_rows(const NodeView& node, const WindowView& w, double time_s, std::uint8_t seq, const Units& units,
+                 std::vector<WindowRow>& out) {
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  for (std::size_t i = 0; i < w.adev.size() && i < max_taus; ++i) {
+    WindowRow r;
+    r.time_s = time_s;
+    r.node = node.address;
+    r.session = node.session;
+    r.seq = seq;
+    r.window = w.window;
+    r.length = node.window_length;
+    if (tau0_s > 0 && node.window_length != 0) {
+      const double length_s = static_cast<double>(node.window_length) * tau0_s;
+      r.start_s = static_cast<double>(w.window) * length_s;
+      r.end_s = r.start_s + length_s;
+    }
+    r.gaps = w.gaps;
+    r.tau_index = static_cast<std::uint8_t>(i);
+    r.m = node.taus[i].m;
+    r.tau_s = node.tau_s(i);
+    r.adev = window_cell(w.adev[i], w.received[i], units.rate);
+    r.mdev = window_cell(w.mdev[i], w.received[i], units.rate);
+    out.push_back(r);
+  }
+}
+
 }  // namespace gyrochar::decoding

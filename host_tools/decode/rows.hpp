@@ -2,7 +2,8 @@
 // What gyrochar-decode records of a node: one row per tau per closed report, built from the
 // Decoder's view of the node and its slot table of that report (which values arrived in it: a
 // value the report lost is "missing", never the previous report's); and what it counts of its
-// input. The recording formats (recording.hpp) and the view (view.hpp) show these.
+// input; and the rows of each window of a node's dynamic Allan deviation. The recording formats
+// (recording.hpp) and the view (view.hpp) show these.
 #include <array>
 #include <bitset>
 #include <cstdint>
@@ -64,6 +65,30 @@ struct TauRow {
 /// it to avoid allocating). O(TauCount).
 void tau_rows(const NodeView& node, const Decoder::Report& report, const Units& units, ConfidenceIntervals& intervals,
               std::vector<TauRow>& out);
+
+/// One window tau of one window of the node's dynamic Allan deviation (protocol version 3), in
+/// display units, written once, when the window's last frame arrives. No interval travels with a
+/// window curve (docs/protocol.md 2.5).
+struct WindowRow {
+  double time_s = 0.0;  // time of the frame that completed the window
+  std::uint8_t node = 0;
+  std::uint32_t session = 0;
+  std::uint8_t seq = 0;  // the report that carried that frame
+  std::uint32_t window = 0;
+  std::uint64_t length = 0;           // samples per window, 0 while unknown
+  double start_s = 0.0, end_s = 0.0;  // the window in the node's run: k L tau0, (k+1) L tau0; 0, 0
+                                      // while tau0 or L is unknown
+  std::uint32_t gaps = 0;
+  std::uint8_t tau_index = 0;
+  std::uint64_t m = 0;  // 0 while unknown
+  double tau_s = 0.0;   // 0 while unknown
+  DevCell adev, mdev;   // ok or invalid (the node had no estimate), without interval
+};
+
+/// The window's rows of `node` (one per window tau), at time `time_s`. Appends to `out`.
+/// O(window taus).
+void window_rows(const NodeView& node, const WindowView& window, double time_s, std::uint8_t seq, const Units& units,
+                 std::vector<WindowRow>& out);
 
 /// What came in.
 struct InputCounters {

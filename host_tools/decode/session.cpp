@@ -101,6 +101,15 @@ void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
     }
     if (jsonl_) jsonl_->report(report.start_s, node, seq, units);
   }
+  if (e == DecoderEvent::window_complete && record && (csv_ || jsonl_) && node.current_window()) {
+    const Units units = units_for(node, options_.rate_unit);
+    window_rows_.clear();
+    window_rows(node, node.windows.at(*node.current_window()), input_.now_s, seq, units, window_rows_);
+    for (const WindowRow& row : window_rows_) {
+      if (csv_) csv_->row(row, units);
+      if (jsonl_) jsonl_->row(row, units);
+    }
+  }
   const bool noteworthy = e == DecoderEvent::restart || e == DecoderEvent::offline || e == DecoderEvent::online ||
                           e == DecoderEvent::duplicate || e == DecoderEvent::unknown_version;
   if (noteworthy && record && jsonl_) jsonl_->event(input_.now_s, e, node);

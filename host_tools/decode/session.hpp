@@ -1,6 +1,7 @@
 #pragma once
 // The pipeline of gyrochar-decode without its I/O: candump log lines or frames go in with their
-// times, the Decoder follows the nodes, and every closed report becomes CSV / JSON lines rows.
+// times, the Decoder follows the nodes, and every closed report becomes CSV / JSON lines rows, as
+// every window of a node's dynamic Allan deviation does once its last frame has come.
 // The program (host_tools/decode/main.cpp) adds the sources, the terminal view and the plot.
 #include <cstddef>
 #include <cstdio>
@@ -79,6 +80,7 @@ class Session {
   InputCounters input_;
   CandumpLine parsed_;
   std::vector<TauRow> rows_;
+  std::vector<WindowRow> window_rows_;
   Decoder decoder_;  // last: its listener uses the members above
 };
 

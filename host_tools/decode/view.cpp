@@ -24,10 +24,12 @@ std::string rejected_text(const LinkHealth& h) {
 std::string health_text(const LinkHealth& h) {
   return fmt::format(
       "frames {}; reports {} complete, {} incomplete, {} lost; frames missing {}; restarts {}; "
-      "offline {}; duplicates {}; rejected {}{}",
+      "offline {}; duplicates {}; rejected {}{}{}",
       h.frames, h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing, h.restarts,
       h.offline_events, h.duplicates, rejected_text(h),
-      h.not_decoded ? fmt::format("; not decoded {} (unknown protocol version)", h.not_decoded) : "");
+      h.not_decoded ? fmt::format("; not decoded {} (unknown protocol version)", h.not_decoded) : "",
+      h.window_frames_unplaced ? fmt::format("; window frames without their window page {}", h.window_frames_unplaced)
+                               : "");
 }
 
 std::string input_text(const Decoder& decoder, const InputCounters& in) {
@@ -100,6 +102,28 @@ void ieee952_view(std::string& s, const NodeView& v, const Units& u, const TrueT
   }
 }
 
+/// The dynamic Allan deviation's line: the window, and the latest window's ADEV at each window tau.
+void window_view(std::string& s, const NodeView& v, const Units& u) {
+  if (v.window_taus == 0) return;
+  auto out = std::back_inserter(s);
+  const double length_s = v.sampling ? static_cast<double>(v.window_length) * static_cast<double>(v.sampling->tau0_s) : 0.0;
+  fmt::format_to(out, "  dynamic ADEV: {} window taus, ", v.window_taus);
+  if (length_s > 0)
+    fmt::format_to(out, "windows of {:.4g} s", length_s);
+  else
+    s += "window length not received yet";
+  std::size_t complete = 0;
+  for (const auto& [k, w] : v.windows) complete += w.complete() ? 1 : 0;
+  fmt::format_to(out, "; {} windows received, {} complete", v.windows.size(), complete);
+  if (!v.windows.empty()) {
+    const WindowView& w = v.windows.rbegin()->second;
+    fmt::format_to(out, "; window {}{} [{}]:", w.window, w.gaps ? fmt::format(" ({} gaps)", w.gaps) : "", u.rate_name);
+    for (std::size_t i = 0; i < w.adev.size(); ++i)
+      s += w.received[i] && w.adev[i] > 0 ? fmt::format(" {:.3e}", w.adev[i] * u.rate) : " -";
+  }
+  s += '\n';
+}
+
 void node_view(std::string& s, const NodeView& v, const DisplayRate& rate, ConfidenceIntervals& intervals,
                const TrueTerms* truth) {
   const Units u = units_for(v, rate);
@@ -142,6 +166,7 @@ void node_view(std::string& s, const NodeView& v, const DisplayRate& rate, Confi
                    dev_text(t.mdev, u.rate, intervals), edf, noise);
   }
   ieee952_view(s, v, u, truth);
+  window_view(s, v, u);
 }
 
 }  // namespace

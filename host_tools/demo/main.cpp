@@ -5,7 +5,8 @@
 // follows every node, shows its table as the run goes, and leaves a CSV and an ADEV/MDEV plot.
 // Hours of gyro time pass in seconds. The demo knows each gyro's true IEEE-952 parameters
 // (sim_truth.hpp, the simulator's own options): the view shows them beside every node's fitted
-// terms, and the plot draws the true model beside the fitted one.
+// terms, and the plot draws the true model beside the fitted one. Each board also keeps the
+// dynamic Allan deviation over --window minutes, which the plot draws as a heat map per node.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <unistd.h>
@@ -58,9 +59,10 @@ int main(int argc, char** argv) {
   CLI::App app{"gyrochar-demo: simulated gyros -> the board program (on HAL fakes) -> virtual CAN bus -> decoder,\n"
                "on a virtual clock.",
                "gyrochar-demo"};
-  app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n\n" +
+  app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n"
+             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n\n" +
              std::string(exit_code::help));
-  double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30;
+  double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30, window_min = 30;
   unsigned nodes = 2, octaves = 20;
   std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo", candump_path;
   app.add_option("--hours", hours, "gyro hours to simulate")->capture_default_str();
@@ -68,6 +70,8 @@ int main(int argc, char** argv) {
   app.add_option("--tau0", tau0, "sample interval in seconds")->capture_default_str();
   app.add_option("--octaves", octaves, "octave taus per node (1..40)")->capture_default_str();
   app.add_option("--loss", loss, "probability that a frame is lost on the bus")->capture_default_str();
+  app.add_option("--window", window_min, "gyro minutes per window of the dynamic Allan deviation (0: none)")
+      ->capture_default_str();
   app.add_option("--view-every", view_every_min, "show the table every N gyro minutes (0: only at the end)")
       ->capture_default_str();
   app.add_option("--csv", csv_path, "decoded reports as CSV (one row per node, report and tau; empty: none)")->capture_default_str();
@@ -90,6 +94,8 @@ int main(int argc, char** argv) {
   if (!(loss >= 0 && loss < 1)) bad("--loss", fmt::format("must be a probability in [0, 1), not {}", loss));
   if (!(view_every_min >= 0) || !std::isfinite(view_every_min))
     bad("--view-every", fmt::format("must be a number of minutes >= 0, not {}", view_every_min));
+  if (!(window_min == 0 || (window_min >= 4.0 / 60 && std::isfinite(window_min))))
+    bad("--window", fmt::format("must be 0 (none) or at least 4 s of gyro time, not {} min", window_min));
   if (!plot_prefix.empty()) {
     if (const std::string why = decoding::plot_devices_missing(); !why.empty()) bad("--plot", why);
   }
@@ -112,6 +118,7 @@ int main(int argc, char** argv) {
     c.tau0_s = tau0;
     c.octaves = octaves;
     c.report_period_s = 1.0;
+    c.window_s = window_min * 60;
     // 1 arcsec pulses at the earth rate with 2 arcsec of white angle noise (so the quantization is
     // white), ARW 0.002, 0.003, ... deg/sqrt(h), bias instability 0.01 deg/h, RRW 0.03 deg/h/sqrt(h).
     SimOptions o;

@@ -30,6 +30,15 @@ std::vector<double> GyroSimulator::flicker_corners_hz() const {
   return f;
 }
 
+void GyroSimulator::retune(const GyroParameters& p) {
+  p_.rate_rad_s = p.rate_rad_s;
+  p_.q_rad = p.q_rad;
+  p_.n_rad_sqrt_s = p.n_rad_sqrt_s;
+  p_.k_rad_s_sqrt_s = p.k_rad_s_sqrt_s;
+  arw_step_rad_ = p.n_rad_sqrt_s * std::sqrt(p_.tau0_s);
+  rrw_step_rad_s_ = p.k_rad_s_sqrt_s * std::sqrt(p_.tau0_s);
+}
+
 std::int64_t GyroSimulator::next_count() {
   const double dt = p_.tau0_s;
   const double t_mid = (static_cast<double>(k_) + 0.5) * dt;

@@ -64,6 +64,10 @@ class GyroSimulator {
   explicit GyroSimulator(const GyroParameters& p);
   /// Pulses in the next tau0 interval. O(flicker processes), no allocation.
   std::int64_t next_count();
+  /// From the next interval on: the input rate, white angle noise, angle random walk and rate random
+  /// walk of `p` (its other parameters are ignored). The angle, the rate random walk's rate and the
+  /// flicker states carry over: the change is a step of the levels, nothing restarts. O(1).
+  void retune(const GyroParameters& p);
   /// True angle (rad) at the end of the last interval, without the white angle noise and dither.
   double angle_rad() const { return angle_; }
   /// Corner frequencies of the flicker band's processes (Hz), lowest first; empty when B is 0. Allocates.

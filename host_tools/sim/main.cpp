@@ -13,6 +13,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
@@ -107,6 +108,11 @@ per sample, or a dither moves it). Bias instability is flicker rate noise (ADEV 
 over the band from 1/(2 pi --bias-time) up to 0.34 / tau0. docs/metrology.md gives each term's
 model and its Allan deviation.
 
+--segment T:NAME=VALUE[,NAME=VALUE...] changes the gyro from T seconds on (repeatable, in time
+order): NAME is rate (deg/h), white-angle (arcsec), arw (deg/sqrt(h)) or rrw (deg/h/sqrt(h)); the
+other parameters stay, and nothing restarts (the angle and the noise processes carry over). The
+truth line then has format 2 and lists the segments.
+
 Output: two '#' header lines, then one count per line. The first describes the run; the second,
 "# gyrochar-sim truth: key=value ...", repeats every parameter and the IEEE-952 truth (Q arcsec,
 N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h/h, Q_white yes/no) for programs to read.
@@ -121,6 +127,7 @@ Examples:
   gyrochar-sim --duration 7200 --tau0 0.01 --arw 0.002 --rrw 0.01 > counts.txt
   gyrochar-sim --duration 3600 --arw 0.002 | gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1 -
   gyrochar-sim --duration 60 --tau0 0.01 --arw 0.003 --can vcan0 --can-node 128 --speed 4 --out counts.txt
+  gyrochar-sim --duration 7200 --arw 0.002 --segment 3600:arw=0.004 > doubling.txt   # N doubles halfway
 
 )" + std::string(exit_code::help));
   SimOptions o;
@@ -151,6 +158,9 @@ Examples:
                        : "must be an integer 0..2^64-1, not '" + text + "'";
           },
           "SEED"));
+  std::vector<std::string> segments;
+  app.add_option("--segment", segments, "from T seconds on, change parameters: T:NAME=VALUE[,NAME=VALUE...]")
+      ->option_text("T:NAME=VALUE");
   app.add_option("--out", out, "output file, '-' for standard output")->capture_default_str();
   std::string can_interface;
   unsigned can_node = 0x80;
@@ -171,6 +181,12 @@ Examples:
     print_error(program, what, why);
     return exit_code::bad_input;
   };
+  for (const std::string& text : segments) {
+    std::string why;
+    const auto segment = parse_segment_option(text, why);
+    if (!segment) return bad("--segment", why.c_str());
+    o.segments.push_back(*segment);
+  }
   if (const auto problem = check_parameters(o)) return bad(problem->what, problem->why);
   if (can_node > protocol::max_node_address) return bad("--can-node", "must be an address 0..253");
   if (!(speed > 0) || !std::isfinite(speed)) return bad("--speed", "must be positive");
@@ -191,10 +207,9 @@ Examples:
   const std::string output_name = out == "-" ? "standard output" : out;
   if (f != nullptr)  // the description, then the machine-readable truth (sim_truth.hpp)
     std::fprintf(f, "%s\n%s\n", format_sim_description_line(o).c_str(), format_sim_truth_line(o).c_str());
-  GyroSimulator sim(p);
-  const auto n = static_cast<std::uint64_t>(std::llround(o.duration_s / o.tau0_s));
+  SimRun sim(o);
   if (sender) sender->send_next(0);  // the start: Count 0
-  for (std::uint64_t k = 0; k < n; ++k) {
+  for (std::uint64_t k = 0; k < sim.samples(); ++k) {
     const std::int64_t count = sim.next_count();
     if (f != nullptr) {
       std::fprintf(f, "%lld\n", static_cast<long long>(count));

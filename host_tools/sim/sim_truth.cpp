@@ -1,17 +1,20 @@
 #include "sim_truth.hpp"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <system_error>
+#include <utility>
 
 namespace gyrochar {
 
 namespace {
 
 constexpr std::string_view truth_prefix = "# gyrochar-sim truth:";
-constexpr std::uint64_t truth_format = 1;
+constexpr std::uint64_t truth_format = 1, segmented_format = 2;
+constexpr std::size_t max_segments = 1000;
 
 // The parameters on the truth line, in the order written. One table for writer and parser.
 struct NumberKey {
@@ -45,6 +48,19 @@ constexpr std::array<TruthKey, 5> truth_keys{{
     {"B_deg_per_h", &Ieee952Truth::b_rad_s, units::deg_per_h},
     {"K_deg_per_h_sqrt_h", &Ieee952Truth::k_rad_s_sqrt_s, units::deg_per_h_sqrt_h},
     {"R_deg_per_h2", &Ieee952Truth::r_rad_s2, units::deg_per_h_per_h},
+}};
+
+// What a segment may change: its key on the truth line, its --segment name, the option it sets.
+struct SegmentKey {
+  std::string_view key, option;
+  std::optional<double> SimSegment::*field;
+  double SimOptions::*target;
+};
+constexpr std::array<SegmentKey, 4> segment_keys{{
+    {"rate_deg_per_h", "rate", &SimSegment::rate_deg_per_h, &SimOptions::rate_deg_per_h},
+    {"white_angle_arcsec", "white-angle", &SimSegment::white_angle_arcsec, &SimOptions::white_angle_arcsec},
+    {"arw_deg_per_sqrt_h", "arw", &SimSegment::arw_deg_per_sqrt_h, &SimOptions::arw_deg_per_sqrt_h},
+    {"rrw_deg_per_h_sqrt_h", "rrw", &SimSegment::rrw_deg_per_h_sqrt_h, &SimOptions::rrw_deg_per_h_sqrt_h},
 }};
 
 void append_number(std::string& out, double v) {
@@ -85,7 +101,28 @@ std::optional<ParameterProblem> check_parameters(const SimOptions& o) {
     if (!(v >= 0) || !std::isfinite(v)) return ParameterProblem{"noise parameters", "must be finite and >= 0"};
   if (o.bias_deg_per_h > 0 && !(o.bias_time_s > o.tau0_s && o.bias_time_s <= 1e15 * o.tau0_s))
     return ParameterProblem{"--bias-time", "must exceed tau0 (and stay within 10^15 tau0) for bias instability"};
+  if (o.segments.size() > max_segments) return ParameterProblem{"--segment", "at most 1000 segments"};
+  double previous_s = 0;
+  for (std::size_t i = 0; i < o.segments.size(); ++i) {
+    const SimSegment& g = o.segments[i];
+    if (!(g.start_s >= o.tau0_s && g.start_s < o.duration_s && g.start_s > previous_s))
+      return ParameterProblem{"--segment", "segments must start in increasing order, at tau0 or later, before the end"};
+    previous_s = g.start_s;
+    if (std::none_of(segment_keys.begin(), segment_keys.end(), [&](const SegmentKey& k) { return (g.*k.field).has_value(); }))
+      return ParameterProblem{"--segment", "a segment must change something"};
+    if (const auto problem = check_parameters(segment_options(o, i + 1)))
+      return ParameterProblem{"--segment", problem->why};
+  }
   return std::nullopt;
+}
+
+SimOptions segment_options(const SimOptions& o, std::size_t i) {
+  SimOptions s = o;
+  s.segments.clear();
+  for (std::size_t j = 0; j < i && j < o.segments.size(); ++j)
+    for (const SegmentKey& k : segment_keys)
+      if (const auto& v = o.segments[j].*k.field) s.*k.target = *v;
+  return s;
 }
 
 GyroParameters gyro_parameters(const SimOptions& o) {
@@ -106,6 +143,8 @@ GyroParameters gyro_parameters(const SimOptions& o) {
 }
 
 bool quantization_expected_white(const SimOptions& o) {
+  for (std::size_t i = 1; i <= o.segments.size(); ++i)
+    if (!quantization_expected_white(segment_options(o, i))) return false;
   const double arw_arcsec = o.arw_deg_per_sqrt_h * units::deg_per_sqrt_h / units::arcsec;  // arcsec/sqrt(s)
   const double random_step_arcsec =
       std::sqrt(arw_arcsec * arw_arcsec * o.tau0_s + 2.0 * o.white_angle_arcsec * o.white_angle_arcsec);
@@ -135,13 +174,23 @@ std::string format_sim_description_line(const SimOptions& o) {
                 o.tau0_s, o.pulse_arcsec, o.rate_deg_per_h, o.white_angle_arcsec, o.arw_deg_per_sqrt_h,
                 o.bias_deg_per_h, o.bias_time_s, o.rrw_deg_per_h_sqrt_h, o.ramp_deg_per_h2, o.dither_arcsec,
                 o.dither_hz, static_cast<unsigned long long>(o.seed));
-  return buf;
+  std::string out = buf;
+  for (const SimSegment& g : o.segments) {
+    std::snprintf(buf, sizeof buf, "; from %g s:", g.start_s);
+    out += buf;
+    for (const SegmentKey& k : segment_keys) {
+      if (!(g.*k.field)) continue;
+      std::snprintf(buf, sizeof buf, " %.*s %g", static_cast<int>(k.option.size()), k.option.data(), *(g.*k.field));
+      out += buf;
+    }
+  }
+  return out;
 }
 
 std::string format_sim_truth_line(const SimOptions& o) {
   std::string out(truth_prefix);
   out += " format=";
-  append_integer(out, truth_format);
+  append_integer(out, o.segments.empty() ? truth_format : segmented_format);
   for (const NumberKey& k : number_keys) {
     out += ' ';
     out += k.key;
@@ -158,8 +207,39 @@ std::string format_sim_truth_line(const SimOptions& o) {
     append_number(out, t.*k.field / k.unit);
   }
   out += t.quantization_white ? " Q_white=yes" : " Q_white=no";
+  if (o.segments.empty()) return out;
+  out += " segments=";
+  append_integer(out, o.segments.size());
+  for (std::size_t i = 0; i < o.segments.size(); ++i) {
+    const std::string prefix = " segment" + std::to_string(i + 1) + "_";
+    out += prefix + "start_s=";
+    append_number(out, o.segments[i].start_s);
+    for (const SegmentKey& k : segment_keys) {
+      if (!(o.segments[i].*k.field)) continue;
+      out += prefix;
+      out += k.key;
+      out += '=';
+      append_number(out, *(o.segments[i].*k.field));
+    }
+  }
   return out;
 }
+
+namespace {
+
+// A segment key: "segment<i>_<name>" with i >= 1; i and name, or nothing.
+std::optional<std::pair<std::size_t, std::string_view>> segment_key(std::string_view key) {
+  constexpr std::string_view head = "segment";
+  if (!key.starts_with(head)) return std::nullopt;
+  key.remove_prefix(head.size());
+  std::size_t i = 0;
+  const auto r = std::from_chars(key.data(), key.data() + key.size(), i);
+  if (r.ec != std::errc() || r.ptr == key.data() || i == 0 || r.ptr == key.data() + key.size() || *r.ptr != '_')
+    return std::nullopt;
+  return std::pair{i, key.substr(static_cast<std::size_t>(r.ptr - key.data()) + 1)};
+}
+
+}  // namespace
 
 std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
   if (!line.starts_with(truth_prefix)) return std::nullopt;
@@ -175,7 +255,8 @@ std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
     seen |= std::uint32_t{1} << bit;
     return fresh;
   };
-  std::uint64_t format = 0;
+  std::uint64_t format = 0, segments = 0;
+  bool has_segments = false;
   std::size_t at = 0;
   while (true) {
     while (at < line.size() && is_blank(line[at])) ++at;
@@ -201,7 +282,32 @@ std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
       r.truth.*truth_keys[i].field = v * truth_keys[i].unit;
     }
     if (known) continue;
-    if (key == "format") {
+    if (const auto segment = segment_key(key)) {  // format 2
+      const auto [i, name] = *segment;
+      if (i > max_segments) return std::nullopt;
+      if (r.options.segments.size() < i) r.options.segments.resize(i);
+      SimSegment& g = r.options.segments[i - 1];
+      double v = 0;
+      if (!read_number(value, v)) return std::nullopt;
+      if (name == "start_s") {
+        if (g.start_s != 0) return std::nullopt;
+        g.start_s = v;
+        continue;
+      }
+      bool named = false;
+      for (const SegmentKey& k : segment_keys) {
+        if (name != k.key) continue;
+        if ((g.*k.field).has_value()) return std::nullopt;
+        g.*k.field = v;
+        named = true;
+      }
+      if (!named) return std::nullopt;
+      continue;
+    }
+    if (key == "segments") {
+      if (!read_integer(value, segments) || segments == 0 || segments > max_segments || has_segments) return std::nullopt;
+      has_segments = true;
+    } else if (key == "format") {
       if (!first_time(bit_format) || !read_integer(value, format)) return std::nullopt;
     } else if (key == "seed") {
       if (!first_time(bit_seed) || !read_integer(value, r.options.seed)) return std::nullopt;
@@ -211,8 +317,52 @@ std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
     }
     // Any other key belongs to a later format: ignored.
   }
-  if (seen != all || format != truth_format || check_parameters(r.options)) return std::nullopt;
+  if (seen != all || format != (has_segments ? segmented_format : truth_format) ||
+      r.options.segments.size() != segments || check_parameters(r.options))
+    return std::nullopt;
   return r;
+}
+
+std::optional<SimSegment> parse_segment_option(std::string_view text, std::string& why) {
+  SimSegment g;
+  const std::size_t colon = text.find(':');
+  const auto number = [](std::string_view t, double& v) {
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    return r.ec == std::errc() && r.ptr == t.data() + t.size() && std::isfinite(v);
+  };
+  if (colon == std::string_view::npos || !number(text.substr(0, colon), g.start_s)) {
+    why = "'" + std::string(text) + "' is not T:NAME=VALUE[,NAME=VALUE...] (T in seconds)";
+    return std::nullopt;
+  }
+  std::string_view rest = text.substr(colon + 1);
+  while (true) {
+    const std::size_t comma = rest.find(',');
+    const std::string_view item = rest.substr(0, comma);
+    const std::size_t eq = item.find('=');
+    const SegmentKey* key = nullptr;
+    for (const SegmentKey& k : segment_keys)
+      if (eq != std::string_view::npos && item.substr(0, eq) == k.option) key = &k;
+    double v = 0;
+    if (key == nullptr || !number(item.substr(eq + 1), v) || (g.*key->field).has_value()) {
+      why = "'" + std::string(item) + "' is not rate=, white-angle=, arw= or rrw= with a number, each once";
+      return std::nullopt;
+    }
+    g.*key->field = v;
+    if (comma == std::string_view::npos) break;
+    rest = rest.substr(comma + 1);
+  }
+  return g;
+}
+
+SimRun::SimRun(const SimOptions& o)
+    : options_(o), gyro_(gyro_parameters(o)), samples_(static_cast<std::uint64_t>(std::llround(o.duration_s / o.tau0_s))) {}
+
+std::int64_t SimRun::next_count() {
+  while (next_segment_ < options_.segments.size() &&
+         k_ >= static_cast<std::uint64_t>(std::llround(options_.segments[next_segment_].start_s / options_.tau0_s)))
+    gyro_.retune(gyro_parameters(segment_options(options_, ++next_segment_)));
+  ++k_;
+  return gyro_.next_count();
 }
 
 }  // namespace gyrochar

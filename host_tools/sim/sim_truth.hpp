@@ -16,16 +16,34 @@
 // it does not know: adding keys keeps format=1; only a change in the meaning of a key raises it,
 // and a reader refuses a format it does not know.
 //
+// A run with segments (gyrochar-sim --segment: the gyro changes during the run, e.g. its angle
+// random walk doubles halfway) writes format=2: the keys above then describe the run before the
+// first change, and `segments=S` is followed, for i = 1..S, by segment<i>_start_s and the keys of
+// the parameters segment i changes (segment<i>_arw_deg_per_sqrt_h=0.004, ...; rate, white angle,
+// ARW and RRW may change). Q_white says whether the quantization is white in every segment. A
+// format-1 reader refuses such a line rather than take the first segment's truth for the run's.
+//
 // The data readers skip '#' lines, so the header costs them nothing. The writer (gyrochar-sim) and
 // the parser share format_sim_truth_line and the key list below: they cannot drift apart.
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "gyro_sim.hpp"
 
 namespace gyrochar {
+
+/// A change of the simulated gyro from start_s on (gyrochar-sim --segment T:NAME=VALUE,...): the
+/// parameters it names take these values, the others stay. Only levels whose process state carries
+/// over unchanged may change: the input rate, the white angle noise, ARW and RRW.
+struct SimSegment {
+  double start_s = 0;  // seconds since the start of the run; the change applies from the sample
+                       // interval that starts at round(start_s / tau0) tau0
+  std::optional<double> rate_deg_per_h, white_angle_arcsec, arw_deg_per_sqrt_h, rrw_deg_per_h_sqrt_h;
+  bool operator==(const SimSegment&) const = default;
+};
 
 /// gyrochar-sim's simulation options, in the units of its command line (defaults included).
 struct SimOptions {
@@ -42,7 +60,12 @@ struct SimOptions {
   double dither_arcsec = 0;
   double dither_hz = 0;
   std::uint64_t seed = 1;
+  std::vector<SimSegment> segments;  // in increasing start_s; empty: the gyro never changes
 };
+
+/// The options in force in segment i of `o` (0: before the first change, up to o.segments.size()),
+/// without segments. O(i).
+SimOptions segment_options(const SimOptions& o, std::size_t i);
 
 /// The IEEE-952 truth of a simulation, SI units (rad, s).
 struct Ieee952Truth {
@@ -68,7 +91,9 @@ struct ParameterProblem {
 
 /// The first problem with `o`, or nothing: tau0 > 0; duration >= tau0 and at most 10^12 samples;
 /// a finite rate within 10^9 deg/h; pulse weight > 0; noise levels, dither and its frequency
-/// finite and >= 0; with bias instability, tau0 < bias_time <= 10^15 tau0. O(1).
+/// finite and >= 0; with bias instability, tau0 < bias_time <= 10^15 tau0; segments starting in
+/// increasing order inside the run (tau0 <= start < duration), each changing something, each
+/// segment's options as valid. O(segments).
 std::optional<ParameterProblem> check_parameters(const SimOptions& o);
 
 /// The simulator's parameters (SI) for `o`. O(1).
@@ -78,11 +103,13 @@ GyroParameters gyro_parameters(const SimOptions& o);
 /// instants moves at random by at least one pulse between samples, sqrt(N^2 tau0 + 2 q^2) >= pulse
 /// (the correlation of two quantization errors is then below 0.61 exp(-2 pi^2) = 2e-9), or when
 /// the dither moves it by at least a pulse per sample, 2 A |sin(pi f tau0)| >= pulse (a
-/// deterministic whitening: docs/metrology.md gives the residual departures). O(1).
+/// deterministic whitening: docs/metrology.md gives the residual departures); in every segment.
+/// O(segments).
 bool quantization_expected_white(const SimOptions& o);
 
-/// The IEEE-952 truth of `o`: Q = sqrt(q^2 + pulse^2 / 12), N, B, K, R, in SI. The dither is not
-/// an IEEE-952 term (its AVAR, 4 A^2 sin^4(pi f tau) / tau^2, is not in the truth). O(1).
+/// The IEEE-952 truth of `o`: Q = sqrt(q^2 + pulse^2 / 12), N, B, K, R, in SI, before the first
+/// segment (segment_options() gives each segment's). The dither is not an IEEE-952 term (its AVAR,
+/// 4 A^2 sin^4(pi f tau) / tau^2, is not in the truth). O(segments).
 Ieee952Truth ieee952_truth(const SimOptions& o);
 
 /// The human-readable first header line ("# gyrochar-sim counts: tau0 0.01 s, ..."), no newline.
@@ -92,8 +119,31 @@ std::string format_sim_truth_line(const SimOptions& o);
 
 /// Reads a truth line (trailing blanks, '\r' or '\n' allowed). Nothing when the line is not one:
 /// wrong prefix, a token without '=', a repeated key, a value that is not a complete number of its
-/// kind (or not finite), a missing key, format other than 1, or parameters check_parameters
-/// refuses. O(line length); allocates nothing beyond the result.
+/// kind (or not finite), a missing key, format other than 1 (2 with segments), or parameters
+/// check_parameters refuses. O(line length); allocates nothing beyond the result.
 std::optional<SimTruth> parse_sim_truth_line(std::string_view line);
+
+/// Reads one --segment argument, "T:NAME=VALUE[,NAME=VALUE...]" with T in seconds and NAME one of
+/// rate (deg/h), white-angle (arcsec), arw (deg/sqrt(h)), rrw (deg/h/sqrt(h)). Nothing, with `why`,
+/// when it is not one. O(text length).
+std::optional<SimSegment> parse_segment_option(std::string_view text, std::string& why);
+
+/// A simulated run as gyrochar-sim makes it: the simulator with the options' segments applied at
+/// their samples. Reproducible from the options alone.
+class SimRun {
+ public:
+  explicit SimRun(const SimOptions& o);
+  /// Samples in the run: round(duration / tau0).
+  std::uint64_t samples() const { return samples_; }
+  /// Pulses in the next tau0 interval (segments switch before the interval they start). O(1)
+  /// amortized, no allocation.
+  std::int64_t next_count();
+
+ private:
+  SimOptions options_;
+  GyroSimulator gyro_;
+  std::uint64_t samples_ = 0, k_ = 0;
+  std::size_t next_segment_ = 0;
+};
 
 }  // namespace gyrochar

@@ -52,6 +52,10 @@ Message message(std::uint8_t node, std::uint8_t seq, ReportSlot s, std::uint64_t
     case Slot::ieee952:
       if (s.index == ieee952_summary_page) return Ieee952SummaryMsg{seq, Ieee952Status::ok, 0.9f, 15, true, {}};
       return Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.01f, 0.1, true};
+    case Slot::window:  // no window taus
+    case Slot::window_length:
+    case Slot::window_dev:
+      break;
   }
   return {};
 }

@@ -1,9 +1,9 @@
 // The per-sample path alone, for instruction counting with valgrind --tool=callgrind:
 //   per_sample N  -> N counts into a 40-octave, S = 8 characterizer (the board's configuration).
-// Instructions per sample = (callgrind total - the same run with N = 0) / N.
+// Instructions per sample = (callgrind total - the same run with N = 0) / N. toolchain/benchmarks.sh
+// also builds it for aarch64 and Cortex-M4 and counts them under QEMU.
 #include <array>
 #include <cstdint>
-#include <cstdio>
 #include <cstdlib>
 
 #include "gyrochar/characterizer.hpp"
@@ -19,6 +19,5 @@ int main(int argc, char** argv) {
     lfsr = (lfsr >> 1) ^ (-(lfsr & 1u) & 0xb400u);
     characterizer.add_increment(static_cast<std::int32_t>(1000 + (lfsr & 63u)));
   }
-  std::printf("%llu\n", static_cast<unsigned long long>(characterizer.result(3).n[0]));
-  return 0;
+  return characterizer.result(3).n[0] == 0 && n > 100 ? 2 : 0;  // reads the result (no stdio: runs bare on Cortex-M)
 }

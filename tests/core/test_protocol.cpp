@@ -1,6 +1,6 @@
 // The CAN codec (core/include/gyrochar/protocol.hpp, docs/protocol.md): round trips of every frame
 // kind, every field at its range limits, saturation and quantization, rejection of malformed frames
-// with the right reason, a fuzz run, the report schedule and the bus load.
+// with the right reason, a fuzz run, the report schedule (versions 1 to 3) and the bus load.
 //
 // Oracles: the byte layouts of docs/protocol.md (written out by hand below), closed forms for
 // saturation (min(v, 2^bits - 1)) and quantization (half a step), the worst-case CAN frame length of
@@ -111,6 +111,18 @@ TEST(ProtocolLayout, FramesMatchTheSpecificationByteForByte) {
   const CanFrame white = encoded(Ieee952SummaryMsg{9, Ieee952Status::ok, 1.5f, 40, true, {0, 0}}, 0x2A);
   EXPECT_EQ(bytes(white), (std::array<std::uint8_t, 8>{0x05, 0x09, 0x00, 0x00, 0xC0, 0x3F, 0x28, 0x20}));
 
+  // Version 3, the Window message: page 0 with 20 window taus in bits 2-7 (0x50), window
+  // 0x01020304, 7 gaps, Complete in bit 63.
+  const CanFrame window = encoded(WindowMsg{9, 20, true, 0x01020304, 7}, 0x2A);
+  EXPECT_EQ(window.id, 0x18FF442Au);
+  EXPECT_EQ(bytes(window), (std::array<std::uint8_t, 8>{0x50, 0x09, 0x04, 0x03, 0x02, 0x01, 0x07, 0x80}));
+  const CanFrame length = encoded(WindowLengthMsg{9, 0x0102030405}, 0x2A);
+  EXPECT_EQ(bytes(length), (std::array<std::uint8_t, 8>{0x01, 0x09, 0x05, 0x04, 0x03, 0x02, 0x01, 0x00}));
+  // Page 2, tau 3 (0x02 | 3 << 2); window 5 in bits 16-19; ADEV 1.0 -> code 128 * 2^14 = 0x200000
+  // in bits 20-41; MDEV 0.5 -> code 127 * 2^14 = 0x1FC000 in bits 42-63.
+  const CanFrame wdev = encoded(WindowDevMsg{9, 3, 5, 1.0, 0.5}, 0x2A);
+  EXPECT_EQ(bytes(wdev), (std::array<std::uint8_t, 8>{0x0E, 0x09, 0x05, 0x00, 0x00, 0x02, 0x00, 0x7F}));
+
   const CanFrame counter = encoded(CounterInputMsg{0xA1B2C3D4, 0x55, true, false}, 0x10);
   EXPECT_EQ(counter.id, 0x0CFF5010u);
   EXPECT_EQ(counter.len, 6);
@@ -135,6 +147,9 @@ std::vector<Message> typical_messages() {
       Ieee952Msg{17, Ieee952Term::angle_random_walk, true, 3.0e-5f, 0.0125, true},
       CounterInputMsg{4000000000u, 200, false, true},
       Ieee952SummaryMsg{17, Ieee952Status::ok, 0.9375f, 24, false, {5, 4}},
+      WindowMsg{17, 12, true, 41, 1},
+      WindowLengthMsg{17, 600000},
+      WindowDevMsg{17, 5, 41 % 16, std::exp2(-10.0), std::exp2(-10.5)},
   };
 }
 
@@ -175,6 +190,13 @@ TEST(ProtocolRoundTrip, EveryFieldAtItsLimits) {
       Ieee952SummaryMsg{1, Ieee952Status::too_few_points, FLT_TRUE_MIN, 1, false, {1, 0}},
       CounterInputMsg{0, 0, false, false},
       CounterInputMsg{0xFFFFFFFF, 255, true, true},
+      WindowMsg{0, 1, false, 0, 0},
+      WindowMsg{255, max_taus - 1, true, 0xFFFFFFFF, 255},
+      WindowMsg{1, 1, true, 0, 0},
+      WindowLengthMsg{0, 4},
+      WindowLengthMsg{255, max40},
+      WindowDevMsg{0, 0, 0, 0.0, 0.0},
+      WindowDevMsg{255, 63, 15, std::exp2(1.0 / 16384 - 128), std::exp2(128.0 - 1.0 / 16384)},  // codes 1, 2^22 - 1
   };
   for (std::uint8_t node : {std::uint8_t{0}, max_node_address}) {
     for (const Message& m : limits) {
@@ -289,6 +311,32 @@ TEST(ProtocolQuantization, EverySummaryCodeIsCanonicalOrOutOfRange) {
   EXPECT_EQ(accepted, 4 * (32 * 32 * 4 + 4));
 }
 
+TEST(ProtocolQuantization, WindowDeviationsWithinHalfAStepOfLog2) {
+  // Step 2^-14 in log2(dev): the decoded deviation is within a factor 2^(2^-15) (2.1e-5) of the
+  // sent one. Outside [2^-128, 2^128) the code clamps; 0 means "no estimate" and stays 0.
+  const double half_step = std::exp2(1.0 / 32768) * (1 + 1e-12);
+  const auto sent = [](double adev, double mdev) {
+    return std::get<WindowDevMsg>(round_trip(WindowDevMsg{1, 2, 3, adev, mdev}));
+  };
+  for (double log2_dev = -126.9; log2_dev < 127.9; log2_dev += 0.0713) {
+    const double dev = std::exp2(log2_dev);
+    const WindowDevMsg back = sent(dev, 0.5 * dev);
+    EXPECT_LE(back.adev_angle_per_s / dev, half_step) << dev;
+    EXPECT_GE(back.adev_angle_per_s / dev, 1 / half_step) << dev;
+    EXPECT_LE(back.mdev_angle_per_s / (0.5 * dev), half_step) << dev;
+    EXPECT_GE(back.mdev_angle_per_s / (0.5 * dev), 1 / half_step) << dev;
+  }
+  EXPECT_EQ(sent(window_dev_floor, 0.0).adev_angle_per_s, std::exp2(1.0 / 16384 - 128));
+  EXPECT_EQ(sent(1e-300, 0.0).adev_angle_per_s, std::exp2(1.0 / 16384 - 128));
+  EXPECT_EQ(sent(1e-300, 0.0).mdev_angle_per_s, 0.0);
+  EXPECT_EQ(sent(1e300, 1.0).adev_angle_per_s, std::exp2(128.0 - 1.0 / 16384));
+  EXPECT_EQ(sent(1e300, 1.0).mdev_angle_per_s, 1.0);
+}
+
+TEST(ProtocolQuantization, CountsOfTheWindowPageSaturate) {
+  EXPECT_EQ(std::get<WindowMsg>(round_trip(WindowMsg{1, 3, true, 9, 256})).gaps, 255u);
+}
+
 TEST(ProtocolQuantization, RelativeUncertaintyInHundredthsOfAPercent) {
   const auto sent = [](double rel) {
     return std::get<Ieee952Msg>(round_trip(Ieee952Msg{1, Ieee952Term::rate_random_walk, true, 1.0f, rel})).rel_uncertainty;
@@ -375,6 +423,18 @@ TEST(ProtocolEncode, RejectsWhatTheWireCannotCarryAndLeavesTheFrameAlone) {
     bad.excluded_below_log2_m[1 - k] = 0;
     EXPECT_EQ(rejects(bad), range) << k;
   }
+  EXPECT_EQ(rejects(WindowMsg{1, 0, true, 1, 0}), range);          // no window taus
+  EXPECT_EQ(rejects(WindowMsg{1, max_taus, true, 1, 0}), range);   // 6 bits
+  EXPECT_EQ(rejects(WindowMsg{1, 3, false, 1, 0}), range);         // no window completed, yet a number
+  EXPECT_EQ(rejects(WindowMsg{1, 3, false, 0, 1}), range);
+  EXPECT_EQ(rejects(WindowLengthMsg{1, 3}), range);
+  EXPECT_EQ(rejects(WindowLengthMsg{1, max40 + 1}), range);
+  EXPECT_EQ(rejects(WindowDevMsg{1, max_taus, 0, 1.0, 1.0}), range);
+  EXPECT_EQ(rejects(WindowDevMsg{1, 1, 16, 1.0, 1.0}), range);
+  for (double bad : {double(nan_f), double(inf_f), -1.0, -1e-300}) {
+    EXPECT_EQ(rejects(WindowDevMsg{1, 1, 1, bad, 1.0}), range) << bad;
+    EXPECT_EQ(rejects(WindowDevMsg{1, 1, 1, 1.0, bad}), range) << bad;
+  }
 }
 
 /// decode() of a valid frame of `m` after `mutate` changed it.
@@ -403,6 +463,9 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
   const Message ieee = Ieee952Msg{1, Ieee952Term::bias_instability, true, 1.0f, 0.1};
   const Message summary = Ieee952SummaryMsg{1, Ieee952Status::ok, 1.0f, 10, true, {0, 0}};
   const Message counter = CounterInputMsg{1, 1, false, false};
+  const Message window = WindowMsg{1, 4, true, 3, 0};
+  const Message window_length = WindowLengthMsg{1, 1000};
+  const Message window_dev = WindowDevMsg{1, 2, 3, 1.0, 0.5};
 
   // Envelope, in the order decode() checks it.
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.error = true; }), ProtocolError::error_frame);
@@ -423,6 +486,7 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
   // Multiplexor values without a layout.
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[0] = 2; }), ProtocolError::unknown_page);
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[0] = 3; }), ProtocolError::unknown_page);
+  EXPECT_EQ(decode_mutated(window, [](CanFrame& f) { f.data[0] |= 3; }), ProtocolError::unknown_page);
   for (std::uint8_t term : {6, 7}) {  // 0-4: the terms, 5: the fit summary
     EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { f.data[0] = term; }), ProtocolError::unknown_page);
     EXPECT_EQ(decode_mutated(summary, [&](CanFrame& f) { f.data[0] = term; }), ProtocolError::unknown_page);
@@ -439,6 +503,14 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
       EXPECT_EQ(decode_mutated(meta, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
     }
     EXPECT_EQ(decode_mutated(counter, [&](CanFrame& f) { f.data[5] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    EXPECT_EQ(decode_mutated(window_length, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }),
+              ProtocolError::reserved_bits);
+  }
+  for (std::uint8_t bit = 0; bit < 8; ++bit) {
+    EXPECT_EQ(decode_mutated(window_length, [&](CanFrame& f) { f.data[7] |= std::uint8_t(1u << bit); }),
+              ProtocolError::reserved_bits);
+    if (bit == 7) continue;  // Complete
+    EXPECT_EQ(decode_mutated(window, [&](CanFrame& f) { f.data[7] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
   }
 
   // Values out of range.
@@ -466,6 +538,10 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
     EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
     EXPECT_EQ(decode_mutated(summary, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;  // chi2/dof
   }
+  EXPECT_EQ(decode_mutated(window, [](CanFrame& f) { f.data[0] = 0; }), range);                    // no window taus
+  EXPECT_EQ(decode_mutated(window, [](CanFrame& f) { f.data[7] = 0; }), range);                    // incomplete, number 3
+  EXPECT_EQ(decode_mutated(window_length, [](CanFrame& f) { f.data[2] = 3, f.data[3] = 0; }), range);  // length 3
+  EXPECT_EQ(decode_mutated(window_dev, [](CanFrame& f) { f.data[2] = 0xFF; }), ProtocolError::none);  // any code
   // White quantization with points left out.
   EXPECT_EQ(decode_mutated(summary, [](CanFrame& f) { f.data[0] |= 1u << 3; }), range);
   EXPECT_EQ(decode_mutated(summary, [](CanFrame& f) { f.data[7] |= 1u; }), range);
@@ -568,7 +644,7 @@ TEST(ProtocolNames, EveryValueHasItsOwnName) {
 // --- schedule and bus load -----------------------------------------------------------------
 
 TEST(ProtocolSchedule, FastFramesEveryReportSlowListOncePerCycle) {
-  for (std::uint8_t protocol_version : {std::uint8_t{1}, std::uint8_t{2}}) {
+  for (std::uint8_t protocol_version : {std::uint8_t{1}, std::uint8_t{2}, std::uint8_t{3}}) {
     for (std::size_t taus : {0u, 1u, 3u, 32u, 40u, 64u}) {
       // Brute force: count every slot over the four reports of a cycle.
       std::map<std::pair<Slot, int>, int> count;
@@ -651,6 +727,50 @@ TEST(ProtocolSchedule, VersionTwoOnlyAppendsTheSummary) {
   }
 }
 
+TEST(ProtocolSchedule, VersionThreeAppendsTheWindowListToEveryReport) {
+  // Brute force over every tau count and window tau count: the version-2 frames keep their
+  // positions; after them each report carries its part of the window list (window page, length
+  // page, one dev page per window tau), so that over a cycle every window slot comes exactly once,
+  // the window page first, in the report whose seq is a multiple of 4. Without window taus,
+  // version 3 is version 2.
+  for (std::size_t taus = 0; taus <= max_taus; ++taus) {
+    for (std::size_t window_taus = 0; window_taus <= taus; ++window_taus) {
+      std::map<std::pair<Slot, int>, int> count;
+      std::size_t longest_tail = 0;
+      for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) {
+        const std::size_t v2 = report_frame_count(seq, taus, 2), v3 = report_frame_count(seq, taus, 3, window_taus);
+        ASSERT_GE(v3, v2);
+        longest_tail = std::max(longest_tail, v3 - v2);
+        EXPECT_EQ(report_frame_count(seq, taus, 2, window_taus), v2) << "version 2 has no window";
+        for (std::size_t p = 0; p < v3; ++p) {
+          const ReportSlot a = report_slot(seq, taus, p, 3, window_taus);
+          if (p < v2) {
+            const ReportSlot b = report_slot(seq, taus, p, 2);
+            ASSERT_EQ(a.slot, b.slot) << taus << " " << window_taus << " " << int(seq) << " " << p;
+            ASSERT_EQ(a.index, b.index);
+          } else {
+            ASSERT_TRUE(a.slot == Slot::window || a.slot == Slot::window_length || a.slot == Slot::window_dev);
+            if (a.slot == Slot::window) {
+              EXPECT_EQ(seq, 0);
+              EXPECT_EQ(p, v2) << "the window page opens the window list";
+            }
+            ++count[{a.slot, a.index}];
+          }
+        }
+      }
+      if (window_taus == 0) {
+        EXPECT_TRUE(count.empty());
+        continue;
+      }
+      EXPECT_EQ(count.size(), 2 + window_taus);
+      EXPECT_EQ((count[{Slot::window, 0}]), 1);
+      EXPECT_EQ((count[{Slot::window_length, 0}]), 1);
+      for (std::size_t i = 0; i < window_taus; ++i) EXPECT_EQ((count[{Slot::window_dev, static_cast<int>(i)}]), 1) << i;
+      EXPECT_EQ(longest_tail, (2 + window_taus + 3) / 4);
+    }
+  }
+}
+
 TEST(ProtocolBusLoad, WorstCaseFrameLengthsAndLoadPerNode) {
   // Davis et al. 2007: 8 s + 67 + floor((54 + 8 s - 1) / 4) bits for a 29-bit identifier.
   EXPECT_EQ(worst_case_frame_bits(0), 80u);
@@ -663,6 +783,14 @@ TEST(ProtocolBusLoad, WorstCaseFrameLengthsAndLoadPerNode) {
   EXPECT_LE(load32, 0.03);
   // 40 taus (the design brief's example): 2 + 80 + ceil(90 / 4) = 105 frames.
   EXPECT_DOUBLE_EQ(worst_case_bus_load(40, 1.0, 500000.0), 105 * 160 / 500000.0);
+  // Version 3 with the window curve: 32 taus and 30 window taus (the board's most) add
+  // ceil((2 + 30) / 4) = 8 frames to the longest report, 93 frames: still within 3 %; a 31st window
+  // tau would make it 94, 3.008 %.
+  const double window30 = worst_case_bus_load(32, 1.0, 500000.0, 30);
+  EXPECT_DOUBLE_EQ(window30, 93 * 160 / 500000.0);
+  EXPECT_LE(window30, 0.03);
+  EXPECT_GT(worst_case_bus_load(32, 1.0, 500000.0, 31), 0.03);
+  EXPECT_DOUBLE_EQ(worst_case_bus_load(32, 1.0, 500000.0, 0), load32);
 }
 
 }  // namespace

@@ -9,8 +9,8 @@
 //                                    (gyrochar-demo --candump): lines that are not gyrochar frames
 //                                    are an error
 //
-// The frames are four paced reports of a 3-tau node (every slot of the schedule, sequence wrapping
-// 254 -> 1) and a set of messages at their range limits, covering every enumeration value.
+// The frames are four paced reports of a 3-tau node with 2 window taus (every slot of the
+// schedule, sequence wrapping 254 -> 1) and a set of messages at their range limits, covering every enumeration value.
 #include <cerrno>
 #include <cfloat>
 #include <cmath>
@@ -101,6 +101,19 @@ Expected expected(const Ieee952SummaryMsg& m) {
            {"FitStatus", static_cast<int>(m.status)}},
           {{"Term", "fit_summary"}, {"FitStatus", name(m.status)}}};
 }
+// A window deviation's log2 on the wire's grid (2^-14 steps); raw 0 (no estimate) is the offset, -128.
+double window_log2(double dev) {
+  return dev == 0.0 ? -128.0 : std::round(std::log2(dev) * 16384.0) / 16384.0;
+}
+Expected expected(const WindowMsg& m) {
+  return {{{"Page", 0}, {"TauCount", m.tau_count}, {"Seq", m.seq}, {"Window", m.window}, {"WindowGaps", m.gaps},
+           {"Complete", m.complete ? 1 : 0}}};
+}
+Expected expected(const WindowLengthMsg& m) { return {{{"Page", 1}, {"Seq", m.seq}, {"WindowLength", m.length}}}; }
+Expected expected(const WindowDevMsg& m) {
+  return {{{"Page", 2}, {"TauIndex", m.tau_index}, {"Seq", m.seq}, {"WindowMod16", m.window},
+           {"ADEV_Log2", window_log2(m.adev_angle_per_s)}, {"MDEV_Log2", window_log2(m.mdev_angle_per_s)}}};
+}
 Expected expected(const CounterInputMsg& m) {
   return {{{"Count", m.count}, {"Seq", m.seq}, {"CountError", m.count_error ? 1 : 0},
            {"SensorNotReady", m.sensor_not_ready ? 1 : 0}}};
@@ -127,6 +140,10 @@ Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
       if (i == ieee952_summary_page) return Ieee952SummaryMsg{seq, Ieee952Status::ok, 0.875f, 6, true, {0, 0}};
       return Ieee952Msg{seq, static_cast<Ieee952Term>(i), i < 3, i < 4 ? 0.001f * static_cast<float>(i + 1) : 0.0f,
                         i < 4 ? 0.05 * (i + 1) : 0.0, i < 4};  // K fitted, not resolved; R not fitted
+    case Slot::window: return WindowMsg{seq, 2, true, 41, 1};  // 2 window taus, windows of 60 s
+    case Slot::window_length: return WindowLengthMsg{seq, 60000};
+    case Slot::window_dev:
+      return WindowDevMsg{seq, i, 41 % 16, 0.021 / std::sqrt(tau_s), i == 0 ? 0.016 / std::sqrt(tau_s) : 0.0};
   }
   return StatusMsg{};
 }
@@ -134,13 +151,13 @@ Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
 std::vector<Entry> frames() {
   std::vector<Entry> out;
   constexpr std::uint64_t t0_us = 1'700'000'000'000'000;
-  constexpr std::size_t taus = 3;
+  constexpr std::size_t taus = 3, window_taus = 2;
   for (std::uint64_t report = 0; report < slow_cycle_reports; ++report) {
     const auto seq = static_cast<std::uint8_t>(254 + report);
-    const std::size_t count = report_frame_count(seq, taus);
+    const std::size_t count = report_frame_count(seq, taus, version, window_taus);
     for (std::size_t p = 0; p < count; ++p) {
       const std::uint64_t t_us = t0_us + report * 1'000'000 + p * 1'000'000 / count;
-      out.push_back({t_us, 0x2A, for_slot(report_slot(seq, taus, p), seq, report)});
+      out.push_back({t_us, 0x2A, for_slot(report_slot(seq, taus, p, version, window_taus), seq, report)});
     }
   }
 
@@ -174,6 +191,12 @@ std::vector<Entry> frames() {
       CounterInputMsg{0xFFFFFFFFu, 255, true, true},
       CounterInputMsg{0, 0, false, false},
       CounterInputMsg{123456789, 17, false, true},
+      WindowMsg{0, 1, false, 0, 0},
+      WindowMsg{255, 63, true, 0xFFFFFFFFu, 255},
+      WindowLengthMsg{0, 4},
+      WindowLengthMsg{255, (std::uint64_t{1} << 40) - 1},
+      WindowDevMsg{0, 0, 0, 0.0, 0.0},
+      WindowDevMsg{255, 63, 15, window_dev_floor, std::exp2(128.0 - 1.0 / 16384)},  // codes 1, 2^22 - 1
   };
   for (int k = 0; k < 16; ++k)  // every noise type on both pages
     limits.push_back(TauDevMsg{static_cast<std::uint8_t>(k), static_cast<std::uint8_t>(k), static_cast<DevKind>(k / 8),

@@ -1,15 +1,19 @@
 // The board program's loop on the HAL fakes (in-process CAN bus, scripted count source, virtual
 // clock): no heap allocation after start-up, quadrature edges end up as the exact counts, a downed
-// bus costs reports but no samples, and checkpoints resume or are refused with the reason.
+// bus costs reports but no samples, checkpoints resume or are refused with the reason, and the
+// window frames of the dynamic Allan deviation carry the curve of each window.
 // Oracles: a characterizer fed the same counts directly (same exact integer sums), the fake bus's own
 // counters, and the checkpoint format's checks.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <new>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -114,6 +118,7 @@ TEST(Board, NoHeapAllocationAfterStartUp) {
   Config c = test_config();
   c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_alloc.ckpt";
   c.checkpoint_period_s = 0.5;
+  c.window_s = 0.5;  // ten windows of the dynamic Allan deviation complete too
   Rig rig(c);
   const auto counts = test_counts(5000);
   rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
@@ -123,6 +128,7 @@ TEST(Board, NoHeapAllocationAfterStartUp) {
   armed = false;
   EXPECT_EQ(allocations.load(), 0u);
   EXPECT_EQ(rig.board->characterizer().increments(), counts.size());
+  EXPECT_EQ(rig.board->window().latest().window, 9u);
   EXPECT_GT(rig.bus.frames_on_bus(), 50u * 40u);
   std::remove(c.checkpoint_path.c_str());
 }
@@ -173,25 +179,33 @@ TEST(Board, ADownedBusCostsReportsButNoSamples) {
 
 TEST(Board, MeasuredBusLoadOfOneNodeIsUnderThreePercentOf500kbits) {
   // 32 taus, one report per second, for 60 s of virtual time: every frame that crossed the bus is
-  // counted at its worst-case length on the wire (maximum stuffing). Oracle: the 3 % budget of the
-  // protocol specification (docs/protocol.md) and the codec's own worst-case figure.
-  Config c = test_config();
-  c.octaves = 32;
-  c.report_period_s = 1.0;
-  Rig rig(c);
-  auto listener = rig.bus.attach(1 << 16);
-  const auto counts = test_counts(60000);
-  rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
-  double bits = 0;
-  for (int s = 0; s < 60; ++s) {
-    rig.run_for(1000 * ms);
-    while (auto f = listener->receive()) bits += protocol::worst_case_frame_bits(f->len);
+  // counted at its worst-case length on the wire (maximum stuffing); without a window, and with the
+  // longest window the capacity allows (2^31 samples: 30 window taus). Oracle: the 3 % budget of
+  // the protocol specification (docs/protocol.md) and the codec's own worst-case figure.
+  for (const double window_s : {0.0, 2147483.648}) {
+    Config c = test_config();
+    c.octaves = 32;
+    c.report_period_s = 1.0;
+    c.window_s = window_s;
+    Rig rig(c);
+    const std::size_t window_taus = rig.board->window().taus();
+    EXPECT_EQ(window_taus, window_s > 0 ? max_window_taus : 0u);
+    auto listener = rig.bus.attach(1 << 16);
+    const auto counts = test_counts(60000);
+    rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+    double bits = 0;
+    for (int s = 0; s < 60; ++s) {
+      rig.run_for(1000 * ms);
+      while (auto f = listener->receive()) bits += protocol::worst_case_frame_bits(f->len);
+    }
+    const double load = bits / 60.0 / 500000.0;
+    const double worst = protocol::worst_case_bus_load(32, 1.0, 500000.0, window_taus);
+    std::printf("measured bus load, 32 taus and %zu window taus at 1 report/s: %.3f %% of 500 kbit/s\n", window_taus,
+                100 * load);
+    EXPECT_LE(load, 0.03);
+    EXPECT_LE(load, worst * (1 + 1e-9));
+    EXPECT_GT(load, 0.5 * worst) << "reports were sent";
   }
-  const double load = bits / 60.0 / 500000.0;
-  std::printf("measured bus load, 32 taus at 1 report/s: %.3f %% of 500 kbit/s\n", 100 * load);
-  EXPECT_LE(load, 0.03);
-  EXPECT_LE(load, protocol::worst_case_bus_load(32, 1.0, 500000.0) * (1 + 1e-9));
-  EXPECT_GT(load, 0.5 * protocol::worst_case_bus_load(32, 1.0, 500000.0)) << "reports were sent";
 }
 
 TEST(Board, FullTxQueueAndBusOffAreCountedReportedAndSurvived) {
@@ -360,6 +374,120 @@ TEST_F(BoardCheckpoint, AnotherConfigurationIsNotResumed) {
   rewrite(std::string(4096, 'x'));
   Rig rig2(c);
   EXPECT_NE(rig2.board->resume().find("not a gyrochard checkpoint"), std::string::npos);
+}
+
+// --- the dynamic Allan deviation --------------------------------------------------------------
+
+// The window's oracle: a characterizer of the window's taus fed one window's counts directly.
+std::unique_ptr<WindowPyramid> direct_window(const Board& board, const std::vector<std::int64_t>& counts, std::size_t k) {
+  const std::uint64_t length = board.window().length();
+  auto p = std::make_unique<WindowPyramid>();
+  std::vector<std::uint64_t> m;
+  for (unsigned i = 0; i < board.window().taus(); ++i) m.push_back(std::uint64_t{1} << i);
+  EXPECT_EQ(p->configure({8, 0}, m), ConfigureStatus::ok);
+  for (std::size_t j = k * length; j < (k + 1) * length; ++j) p->add_increment(static_cast<std::int32_t>(counts[j]));
+  return p;
+}
+
+TEST(Board, TheWindowFramesCarryTheCurveOfTheWindowCompletedLastWhenTheCycleBegan) {
+  // Windows of 500 samples (0.5 s at 1 ms), reports every 0.1 s: 2000 samples, 4 windows. Oracle:
+  // each window's counts fed to a characterizer directly, within the wire's 2^-15 octave rounding.
+  Config c = test_config();
+  c.window_s = 0.5;
+  Rig rig(c);
+  ASSERT_EQ(rig.board->window().taus(), 7u);  // 4 m <= 500: m up to 64
+  auto listener = rig.bus.attach(1 << 16);
+  const auto counts = test_counts(2000);
+  rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+  rig.run_for(2500 * ms);  // the last window completes at 2.0 s, the cycle at 2.4 s sends it
+  std::optional<protocol::WindowMsg> named;  // the window page of the current slow cycle
+  std::map<std::uint32_t, std::unique_ptr<WindowPyramid>> oracles;
+  std::size_t compared = 0, before_first = 0;
+  while (auto f = listener->receive()) {
+    const protocol::Decoded d = protocol::decode(*f);
+    ASSERT_EQ(d.error, protocol::ProtocolError::none);
+    if (const auto* w = std::get_if<protocol::WindowMsg>(&d.message)) {
+      EXPECT_EQ(w->seq % 4, 0) << "the window page opens the slow cycle";
+      EXPECT_EQ(w->tau_count, 7u);
+      named = *w;
+    } else if (const auto* l = std::get_if<protocol::WindowLengthMsg>(&d.message)) {
+      EXPECT_EQ(l->length, 500u);
+    } else if (const auto* v = std::get_if<protocol::WindowDevMsg>(&d.message)) {
+      ASSERT_TRUE(named.has_value());
+      ASSERT_LT(v->seq - named->seq, 4) << "a window frame of the cycle the window page opened";
+      EXPECT_EQ(v->window, named->window % 16);
+      if (!named->complete) {
+        EXPECT_EQ(v->adev_angle_per_s, 0.0);
+        EXPECT_EQ(v->mdev_angle_per_s, 0.0);
+        ++before_first;
+        continue;
+      }
+      auto& oracle = oracles[named->window];
+      if (!oracle) oracle = direct_window(*rig.board, counts, named->window);
+      const auto r = oracle->result(v->tau_index);
+      const double to_arcsec_per_s = c.pulse_weight_arcsec / c.tau0_s;
+      const double adev = std::sqrt(variance(r, SumKind::avar, 1.0)) * to_arcsec_per_s;
+      const double mdev = std::sqrt(variance(r, SumKind::mvar, 1.0)) * to_arcsec_per_s;
+      EXPECT_NEAR(v->adev_angle_per_s / adev, 1.0, 2.2e-5) << "window " << named->window << " tau " << int(v->tau_index);
+      EXPECT_NEAR(v->mdev_angle_per_s / mdev, 1.0, 2.2e-5) << "window " << named->window << " tau " << int(v->tau_index);
+      ++compared;
+    }
+  }
+  EXPECT_GT(before_first, 0u) << "the first cycles say no window completed";
+  EXPECT_EQ(oracles.size(), 4u) << "every window was sent";
+  EXPECT_GE(compared, 4u * 7u);
+}
+
+TEST(Board, AWindowSurvivesACheckpointAndAWindowlessCheckpointIsAnotherConfiguration) {
+  Config c = test_config();
+  c.window_s = 0.5;
+  c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_window.ckpt";
+  std::remove(c.checkpoint_path.c_str());
+  const auto counts = test_counts(1300);
+  {
+    Rig rig(c);
+    rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+    rig.run_for(1400 * ms);
+    ASSERT_EQ(rig.board->checkpoint(), 0);
+  }
+  {
+    Rig rig(c);
+    const std::string said = rig.board->resume();
+    EXPECT_NE(said.find("resumed"), std::string::npos) << said;
+    EXPECT_EQ(rig.board->window().samples_in_window(), 300u);
+    ASSERT_TRUE(rig.board->window().latest().complete);
+    EXPECT_EQ(rig.board->window().latest().window, 1u);
+    const auto oracle = direct_window(*rig.board, counts, 1);
+    for (std::size_t i = 0; i < rig.board->window().taus(); ++i)
+      EXPECT_EQ(rig.board->window().latest().avar[i], variance(oracle->result(i), SumKind::avar, 1.0)) << i;
+    expect_same_sums(rig.board->characterizer(), *direct(c, counts));
+  }
+  // Without its window part the file is refused (truncated), kept aside, and the run starts afresh.
+  {
+    std::ifstream in(c.checkpoint_path, std::ios::binary);
+    const std::string b{std::istreambuf_iterator<char>(in), {}};
+    std::ofstream(c.checkpoint_path, std::ios::binary) << b.substr(0, b.size() - 100);
+    Rig rig(c);
+    const std::string said = rig.board->resume();
+    EXPECT_NE(said.find("window part: truncated"), std::string::npos) << said;
+    EXPECT_EQ(rig.board->characterizer().increments(), 0u);
+    EXPECT_EQ(rig.board->window().samples_in_window(), 0u);
+    std::remove((c.checkpoint_path + ".bad").c_str());
+  }
+  // A checkpoint written without a window does not resume a board with one.
+  Config windowless = c;
+  windowless.window_s = 0;
+  {
+    Rig rig(windowless);
+    rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+    rig.run_for(1400 * ms);
+    ASSERT_EQ(rig.board->checkpoint(), 0);
+  }
+  Rig rig(c);
+  const std::string said = rig.board->resume();
+  EXPECT_NE(said.find("another configuration"), std::string::npos) << said;
+  std::remove(c.checkpoint_path.c_str());
+  std::remove((c.checkpoint_path + ".bad").c_str());
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <algorithm>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "hal/exit_codes.hpp"
+#include "oracle/brute_force.hpp"
 
 #include "gyrochar/total.hpp"
 
@@ -38,10 +40,11 @@ struct Outcome {
 // Per-process names: CTest runs the tests of this file in parallel processes.
 std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_" + name; }
 
-Outcome run(const std::string& args) {
+// A shell command line; its stderr is collected.
+Outcome run_shell(const std::string& command) {
   const std::string err_file = temp("analyze_err.txt");
   Outcome r;
-  FILE* p = popen((tool + " " + args + " 2>" + err_file).c_str(), "r");
+  FILE* p = popen(("(" + command + ") 2>" + err_file).c_str(), "r");
   char buf[4096];
   while (const std::size_t n = fread(buf, 1, sizeof buf, p)) r.out.append(buf, n);
   const int status = pclose(p);
@@ -51,14 +54,16 @@ Outcome run(const std::string& args) {
   return r;
 }
 
+Outcome run(const std::string& args) { return run_shell(tool + " " + args); }
+
 std::string file_with(const std::string& name, const std::string& content) {
   const std::string path = temp(name);
   std::ofstream(path) << content;
   return path;
 }
 
-void expect_bad_input(const std::string& args, const std::string& what) {
-  const Outcome r = run(args);
+void expect_bad_input(const std::string& args, const std::string& what, const std::string& before = "") {
+  const Outcome r = run_shell(before + tool + " " + args);
   EXPECT_EQ(r.code, exit_code::bad_input) << args << "\n" << r.err;
   static const std::regex one_line("gyrochar-analyze: [^\n]+: [^\n]+\n");
   EXPECT_TRUE(std::regex_match(r.err, one_line)) << "not 'gyrochar-analyze: what: why': " << r.err;
@@ -106,7 +111,6 @@ TEST(AnalyzeCli, BadInputsGetExitCodeTwoAndAReason) {
   expect_bad_input("--type phase --tau0 1 --taus 4,2 " + good, "--taus");
   expect_bad_input("--type phase --tau0 1 --taus 1,11 --stride-factor 8 " + good, "cannot be formed");
   expect_bad_input("--type phase --tau0 1 --taus 500,600 " + good, "too few");
-  expect_bad_input("--type phase --tau0 1 --taus all - < " + good, "--taus");  // stdin: no count
   expect_bad_input("--type phase --tau0 1 --format xml " + good, "--format");
   expect_bad_input("--type phase --tau0 1 --unit furlong " + good, "--unit");
   expect_bad_input("--type phase --tau0 1 --rate-unit deg/h " + good, "--rate-unit");  // clock data
@@ -387,19 +391,197 @@ TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
 }
 
 TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
-  // Progress appears every 2^20 values: a file of 2^20 + 1 values shows it, with --progress, in
-  // both passes (counting, analyzing); stdout still carries only the table.
+  // Progress appears every 2^20 values: a file of 2^20 + 1 values shows it with --progress (one
+  // pass: reading); stdout still carries only the table.
   std::string s;
   s.reserve(2u << 21);
   for (int i = 0; i <= (1 << 20); ++i) s += "1\n";
   const std::string path = file_with("long.txt", s);
   const Outcome r = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 --progress " + path);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("counting"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("analyzing"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("reading: 100.0 %"), std::string::npos) << r.err;
   EXPECT_EQ(r.out.find("gyrochar-analyze"), std::string::npos);
   const Outcome quiet = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 " + path);
   EXPECT_TRUE(quiet.err.empty()) << quiet.err;  // stderr is a file here, not a terminal
+}
+
+// The rows of --format csv: stat, m, n, dev.
+struct CsvRow {
+  std::string stat;
+  std::uint64_t m = 0, n = 0;
+  double dev = 0;
+};
+std::vector<CsvRow> csv_rows(const std::string& csv) {
+  std::vector<CsvRow> rows;
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);  // the column names
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    std::string stat, m, tau, n, dev;
+    std::getline(fields, stat, ',');
+    std::getline(fields, m, ',');
+    std::getline(fields, tau, ',');
+    std::getline(fields, n, ',');
+    std::getline(fields, dev, ',');
+    rows.push_back({stat, std::stoull(m), std::stoull(n), std::stod(dev)});
+  }
+  return rows;
+}
+
+TEST(AnalyzeCli, TheReaderNeverMisreads) {
+  const std::string counts = "--type counts --tau0 1 --pulse-weight 1arcsec ";
+  // A NUL byte does not join "3" and "4" into 34: the line is refused, the byte named.
+  const Outcome nul = run_shell("printf '1\\n2\\n3\\0\\n4\\n5\\n6\\n' | " + tool + " " + counts + "-");
+  EXPECT_EQ(nul.code, 2) << nul.err;
+  EXPECT_NE(nul.err.find("standard input: line 3: "), std::string::npos) << nul.err;
+  EXPECT_NE(nul.err.find("\\x00"), std::string::npos) << nul.err;
+  // Decimal commas are not read as their integer part.
+  expect_bad_input(counts + file_with("comma.txt", "1,288185\n1,288190\n1,288195\n"), "decimal comma");
+  expect_bad_input("--type phase --tau0 1 --column 2 " + file_with("semi.csv", "0,1;1,5\n0,2;1,6\n"), "decimal comma");
+  // A binary file's bytes are not echoed: the one line on stderr is printable ASCII.
+  std::string bytes = "\x89PNG\r\n";
+  for (int i = 0; i < 2000; ++i) bytes += static_cast<char>((i * 131 + 7) % 256);
+  const Outcome binary = run(counts + file_with("image.png", bytes));
+  EXPECT_EQ(binary.code, 2);
+  for (const char c : binary.err) EXPECT_TRUE((c >= 0x20 && c < 0x7f) || c == '\n') << binary.err;
+  // A gzip error on standard input names standard input.
+  std::string many;
+  for (int i = 0; i < 20000; ++i) many += std::to_string(1000 + i * 7919 % 1013) + "\n";
+  const std::string whole = file_with("stdin.txt", many);
+  ASSERT_EQ(std::system(("gzip -kf " + whole + " && head -c 2000 " + whole + ".gz > " + whole + ".cut.gz").c_str()), 0);
+  const Outcome cut = run(counts + "- < " + whole + ".cut.gz");
+  EXPECT_EQ(cut.code, 2);
+  EXPECT_EQ(cut.err.rfind("gyrochar-analyze: standard input: ", 0), 0u) << cut.err;
+  EXPECT_NE(cut.err.find("unexpected end of file"), std::string::npos) << cut.err;
+  EXPECT_EQ(cut.err.find("<fd:"), std::string::npos) << cut.err;
+}
+
+TEST(AnalyzeCli, TimeAndValueTableIsReadFromItsValueColumnAndSaysSo) {
+  std::string table = "# time, count\n";
+  for (int i = 0; i < 3000; ++i) table += std::to_string(i * 0.01) + "," + std::to_string(1000 + (i * 7919) % 13) + "\n";
+  const std::string path = file_with("time_value.csv", table);
+  const std::string args = "--type counts --tau0 0.01 --pulse-weight 1arcsec --format csv ";
+  const Outcome chosen = run(args + path);
+  ASSERT_EQ(chosen.code, 0) << chosen.err;
+  EXPECT_NE(chosen.err.find("column 2"), std::string::npos) << chosen.err;  // said, on stderr
+  const Outcome asked = run(args + "--column 2 " + path);
+  ASSERT_EQ(asked.code, 0) << asked.err;
+  EXPECT_TRUE(asked.err.empty()) << asked.err;
+  EXPECT_EQ(chosen.out, asked.out);
+  // Time stamps that do not increase: no guess, a hint.
+  expect_bad_input(args + file_with("two.txt", "5 1000\n3 1001\n4 1002\n"), "--column");
+}
+
+TEST(AnalyzeCli, HugeStrideFactorOnStandardInputIsNoAllocationFailure) {
+  // S = 2^24 with octave taus for an input of unknown length: the taus stop where the history
+  // fits the memory the process may use (here an address space of 4 GB); below 2 GB not even
+  // the first level fits, which is said, not a std::bad_alloc.
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: it cannot run under ulimit -v";
+#endif
+  const std::string args = "--type counts --tau0 1 --pulse-weight 1arcsec --stride-factor 16777216 --format csv - ";
+  const Outcome fits = run_shell("ulimit -v 4000000; printf '1\\n2\\n3\\n4\\n5\\n6\\n7\\n' | " + tool + " " + args);
+  EXPECT_EQ(fits.code, 0) << fits.err;
+  EXPECT_EQ(csv_rows(fits.out).size(), 4u) << fits.out;  // 8 phase points: oadev and mdev at m = 1, 2
+  expect_bad_input(args + "< " + good_phase(), "--stride-factor", "ulimit -v 1000000; ");
+}
+
+TEST(AnalyzeCli, AllTausEqualTheirBruteForceFromFileStdinAndGzip) {
+  // 300 counts (301 phase points): every m up to 150 for oadev, up to 100 for mdev and ohdev. The
+  // oracle sums the definitions exactly (tests/oracle/brute_force.hpp); with 1 arcsec pulses and
+  // tau0 = 1 s the deviations in deg/h are those in pulses per second.
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> count(900, 1100);
+  std::string text;
+  std::vector<std::int64_t> x{0};
+  for (int i = 0; i < 300; ++i) {
+    const int c = count(rng);
+    text += std::to_string(c) + "\n";
+    x.push_back(x.back() + c);
+  }
+  const std::string path = file_with("all.txt", text);
+  ASSERT_EQ(std::system(("gzip -kf " + path).c_str()), 0);
+  const std::string args = "--type counts --tau0 1 --pulse-weight 1arcsec --taus all --stats oadev,mdev,ohdev --format csv ";
+  const Outcome file = run(args + path);
+  ASSERT_EQ(file.code, 0) << file.err;
+  const auto rows = csv_rows(file.out);
+  ASSERT_EQ(rows.size(), 150u + 100u + 100u);
+  for (const CsvRow& r : rows) {
+    const auto exact = gyrochar::oracle::brute_force(x, r.m, 1);
+    const double m = static_cast<double>(r.m);
+    const int k = r.stat == "oadev" ? 0 : r.stat == "mdev" ? 1 : 2;
+    const double scale = k == 0 ? 2 * m * m : k == 1 ? 2 * m * m * m * m : 6 * m * m;
+    EXPECT_EQ(r.n, exact.n[k]) << r.stat << " m=" << r.m;
+    EXPECT_NEAR(r.dev / std::sqrt(static_cast<double>(exact.sum[k]) / (scale * static_cast<double>(exact.n[k]))), 1.0, 1e-12)
+        << r.stat << " m=" << r.m;
+  }
+  EXPECT_EQ(run(args + "- < " + path).out, file.out);
+  EXPECT_EQ(run(args + path + ".gz").out, file.out);
+}
+
+// --- the dynamic Allan deviation -------------------------------------------------------------
+
+TEST(AnalyzeCli, DynamicWritesTheSurfaceAndTheHeatMaps) {
+  // 20000 counts of 1 ms; windows of 5 s (5000 values) every 2.5 s: 7 windows. Oracle for the
+  // values: the same analysis of one window's counts cut out into a file of its own.
+  const std::vector<int> c = white_rate_counts();
+  std::string all, window3;
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    all += std::to_string(c[k]) + "\n";
+    if (k >= 7500 && k < 12500) window3 += std::to_string(c[k]) + "\n";
+  }
+  const std::string path = file_with("dynamic.txt", all), alone = file_with("window3.txt", window3);
+  const std::string common = "--type counts --tau0 0.001 --pulse-weight 1arcsec --stats oadev,mdev ";
+  const Outcome j = run(common + "--dynamic 5,2.5 --format json " + path);
+  ASSERT_EQ(j.code, 0) << j.err;
+  const nlohmann::json doc = nlohmann::json::parse(j.out);
+  EXPECT_EQ(doc["dynamic"]["window"], 5000);
+  EXPECT_EQ(doc["dynamic"]["step"], 2500);
+  ASSERT_EQ(doc["windows"].size(), 7u);
+  const nlohmann::json& w3 = doc["windows"][3];
+  EXPECT_EQ(w3["index"], 3);
+  EXPECT_DOUBLE_EQ(w3["start"].get<double>(), 7.5);
+  EXPECT_DOUBLE_EQ(w3["end"].get<double>(), 12.5);
+  // Taus up to a quarter of the window: octaves 1 .. 1024 (4 x 1024 <= 5000 < 4 x 2048).
+  const Outcome ref = run(common + "--taus 1,2,4,8,16,32,64,128,256,512,1024 --format json " + alone);
+  ASSERT_EQ(ref.code, 0) << ref.err;
+  const nlohmann::json expected = nlohmann::json::parse(ref.out)["results"];
+  ASSERT_EQ(w3["results"].size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(w3["results"][i]["m"], expected[i]["m"]);
+    EXPECT_EQ(w3["results"][i]["dev"], expected[i]["dev"]) << i;
+    EXPECT_EQ(w3["results"][i]["ci_low"], expected[i]["ci_low"]) << i;
+  }
+  // The CSV: one row per window, statistic and tau, after its header.
+  const Outcome csv = run(common + "--dynamic 5,2.5 --format csv " + path);
+  ASSERT_EQ(csv.code, 0) << csv.err;
+  EXPECT_EQ(csv.out.rfind("window,start,end,stat,m,tau,n,dev,unit,", 0), 0u);
+  EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 1 + 7 * 2 * 11);
+  // The heat maps, and the table for people.
+  const std::string prefix = temp("heat");
+  const Outcome table = run(common + "--dynamic 5 --plot " + prefix + " " + path);
+  ASSERT_EQ(table.code, 0) << table.err;
+  EXPECT_NE(table.out.find("windows of 5000 values (5 s) every 5000 values (5 s), 4 complete"), std::string::npos)
+      << table.out;
+  struct stat st {};
+  for (const char* ext : {".svg", ".png"}) {
+    ASSERT_EQ(stat((prefix + ext).c_str(), &st), 0) << ext;
+    EXPECT_GT(st.st_size, 1000) << ext;
+  }
+}
+
+TEST(AnalyzeCli, DynamicRefusesWhatItCannotDo) {
+  const std::string good = good_phase();
+  expect_bad_input("--type phase --tau0 1 --dynamic x " + good, "--dynamic");
+  expect_bad_input("--type phase --tau0 1 --dynamic 100,-1 " + good, "--dynamic");
+  expect_bad_input("--type phase --tau0 1 --dynamic 100,50,25 " + good, "--dynamic");
+  expect_bad_input("--type phase --tau0 1 --dynamic 3 " + good, "at least 4");
+  expect_bad_input("--type phase --tau0 1 --dynamic 100,0.4 " + good, "shorter than tau0");
+  expect_bad_input("--type phase --tau0 1 --dynamic 500 " + good, "fewer than one window");
+  expect_bad_input("--type phase --tau0 1 --dynamic 100 --taus 1,50 " + good, "quarter of the window");
+  expect_bad_input("--type phase --tau0 1 --plot p " + good, "--plot");
+  expect_bad_input("--type counts --tau0 1 --pulse-weight 1arcsec --fit ieee952 --dynamic 100 " + good, "--fit");
 }
 
 }  // namespace

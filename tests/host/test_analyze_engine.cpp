@@ -22,6 +22,15 @@ TEST(AnalyzeEngine, StrideFactorAndRepresentableTaus) {
   EXPECT_EQ(resolve_stride_factor(0, 1u << 16), 1u << 16);
   EXPECT_EQ(resolve_stride_factor(0, 1u << 30), full_stride_cap);
   EXPECT_EQ(resolve_stride_factor(8, 1u << 30), 8u);
+  // The analyzer's "full" for a file of N phase points: the smallest power of two >= N/4, within
+  // [2, 2^24]; 2^16 for an input of unknown length.
+  EXPECT_EQ(full_stride_factor(0), full_stride_cap);
+  EXPECT_EQ(full_stride_factor(5), 2u);
+  EXPECT_EQ(full_stride_factor(10'000'001), 1u << 22);  // N/4 = 2.5e6 <= 2^22
+  EXPECT_EQ(full_stride_factor(std::uint64_t{1} << 40), 1u << 24);
+  // History: 3S points for ring 0, 3S/2 for each level above (24 bytes a point, counts or floats).
+  EXPECT_EQ(history_bytes(DataType::counts, 8, 8), 24u * 24u);
+  EXPECT_EQ(history_bytes(DataType::phase, 8, 32), (24u + 2u * 12u) * 24u);
   // S = 8: every m <= 8, then multiples of 2 up to 16, of 4 up to 32, ...
   EXPECT_TRUE(tau_representable(7, 8));
   EXPECT_TRUE(tau_representable(10, 8));

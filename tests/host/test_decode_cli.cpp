@@ -131,6 +131,10 @@ Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t
                         held ? 0.0 : 0.125,
                         fitted};
     }
+    case Slot::window:  // these nodes have no window taus
+    case Slot::window_length:
+    case Slot::window_dev:
+      break;
   }
   return {};
 }

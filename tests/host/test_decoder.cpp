@@ -17,14 +17,17 @@ const Ieee952SummaryMsg fit_summary{0, Ieee952Status::ok, 0.93f, 24, true, {0, 0
 
 // The frames of report `seq` of a node with `taus` taus, values derived from (seq, tau), speaking
 // protocol version `protocol_version` (1: no summary page, no Fitted flag; B is fitted but not
-// resolved in version 2, and goes out as zeros in version 1).
+// resolved in version 2, and goes out as zeros in version 1). With `window_taus` (version 3) the
+// window frames describe window `window`, its ADEV at window tau i 1 + i + window, MDEV half that.
 std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t taus, std::uint64_t samples,
                              std::uint64_t uptime_ms = 0, std::uint32_t hash = 7,
-                             std::uint8_t protocol_version = version) {
+                             std::uint8_t protocol_version = version, std::uint8_t window_taus = 0,
+                             std::uint32_t window = 0) {
   std::vector<CanFrame> frames;
   const bool v2 = protocol_version >= 2;
-  for (std::size_t k = 0; k < report_frame_count(seq, taus, protocol_version); ++k) {
-    const ReportSlot s = report_slot(seq, taus, k, protocol_version);
+  const auto window_dev = [&](std::size_t i) { return 1.0 + static_cast<double>(i + window); };
+  for (std::size_t k = 0; k < report_frame_count(seq, taus, protocol_version, window_taus); ++k) {
+    const ReportSlot s = report_slot(seq, taus, k, protocol_version, window_taus);
     Message m;
     switch (s.slot) {
       case Slot::status: m = StatusMsg{seq, NodeState::running, taus, samples}; break;
@@ -48,6 +51,12 @@ std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t t
         } else {
           m = Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.25f, 0.1, v2};
         }
+        break;
+      case Slot::window: m = WindowMsg{seq, window_taus, true, window, 0}; break;
+      case Slot::window_length: m = WindowLengthMsg{seq, 1000}; break;
+      case Slot::window_dev:
+        m = WindowDevMsg{seq, s.index, static_cast<std::uint8_t>(window % 16), window_dev(s.index),
+                         window_dev(s.index) / 2};
         break;
     }
     CanFrame f;
@@ -89,7 +98,7 @@ TEST(Decoder, CompleteReportsCarryEveryValue) {
   Ieee952SummaryMsg want = fit_summary;
   want.seq = v.ieee952_summary->seq;
   EXPECT_EQ(*v.ieee952_summary, want);
-  EXPECT_EQ(v.schedule_version(), 2);
+  EXPECT_EQ(v.schedule_version(), version);
 }
 
 TEST(Decoder, VersionOneNodeHasNoSummaryAndMissesNothing) {
@@ -127,10 +136,10 @@ TEST(Decoder, VersionTwoNodeJoinedLateMissesNothingAndItsLostSummaryCounts) {
 }
 
 TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
-  // docs/protocol.md 2.2. A node announcing version 3 (its clock page, in report 0 of the 4-report
+  // docs/protocol.md 2.2. A node announcing version 4 (its clock page, in report 0 of the 4-report
   // slow cycle, comes after the 2 + 2 x 8 fast frames and the sampling page) is decoded no further: the frames after
   // its clock page and of its next reports are counted as not decoded and change no value. When it
-  // announces version 2 again, a new session starts.
+  // announces version 3 (this decoder's) again, a new session starts.
   Feed feed;
   std::vector<DecoderEvent> events;
   feed.decoder = Decoder([&](DecoderEvent e, const NodeView&, std::uint8_t) { events.push_back(e); });
@@ -139,7 +148,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
   const std::uint64_t frames_before = feed.node(5).health.frames;
   std::size_t sent = 0;
   for (std::uint8_t s = 4; s < 8; ++s) {
-    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, 3);
+    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, 4);
     // Tau 0's ADEV (position 2) differs in every report, so that a decoded frame would show.
     EXPECT_EQ(encode(TauDevMsg{s, 0, DevKind::adev, 10.0f + s, 100.0, NoiseType::white_fm, true}, 5, frames[2]),
               ProtocolError::none);
@@ -148,7 +157,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
     feed.frames(frames);
   }
   const NodeView& v = feed.node(5);
-  EXPECT_EQ(v.unknown_version, 3);
+  EXPECT_EQ(v.unknown_version, 4);
   EXPECT_EQ(std::count(events.begin(), events.end(), DecoderEvent::unknown_version), 1);
   const std::size_t before_clock = 19;  // report 4's frames before its clock page
   EXPECT_EQ(v.health.frames, frames_before + before_clock);
@@ -162,7 +171,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
   const NodeView& w = feed.node(5);
   EXPECT_EQ(w.unknown_version, 0);
   EXPECT_EQ(w.health.restarts, 1u);
-  EXPECT_EQ(w.schedule_version(), 2);
+  EXPECT_EQ(w.schedule_version(), 3);
   EXPECT_EQ(w.taus[0].adev.dev, 1.0f);
 }
 
@@ -301,6 +310,73 @@ TEST(Decoder, CanFdFrameIsCountedAgainstItsSender) {
   EXPECT_EQ(feed.decoder.rejected_frames(), 1u);
   EXPECT_EQ(feed.node(0x11).health.rejected.at(ProtocolError::fd_frame), 1u);
   EXPECT_EQ(feed.decoder.nodes().count(0x00), 0u);
+}
+
+// --- the window curves (protocol version 3) ----------------------------------------------------
+
+TEST(Decoder, WindowCurvesAreKeptPerWindowAndCountedAsExpectedFrames) {
+  // A node with 8 taus and 5 window taus: window 3 for two slow cycles, then window 4. Oracle: the
+  // values the frames carry, and the schedule (report_slot with the window taus).
+  Feed feed;
+  std::vector<std::uint32_t> completed;
+  feed.decoder = Decoder([&](DecoderEvent e, const NodeView& v, std::uint8_t) {
+    if (e == DecoderEvent::window_complete) completed.push_back(*v.current_window());
+  });
+  for (std::uint8_t s = 0; s < 12; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, s < 8 ? 3 : 4));
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.window_taus, 5u);
+  EXPECT_EQ(v.window_length, 1000u);
+  EXPECT_EQ(v.health.frames_missing, 0u);
+  EXPECT_EQ(v.health.reports_complete, 12u);
+  EXPECT_EQ(v.health.window_frames_unplaced, 0u);
+  EXPECT_EQ(completed, (std::vector<std::uint32_t>{3, 4})) << "once per window, though sent in two cycles";
+  ASSERT_EQ(v.windows.size(), 2u);
+  for (const std::uint32_t k : {3u, 4u}) {
+    const WindowView& w = v.windows.at(k);
+    ASSERT_TRUE(w.complete());
+    for (std::size_t i = 0; i < 5; ++i) {
+      EXPECT_NEAR(w.adev[i], 1.0 + static_cast<double>(i + k), 2.2e-5 * w.adev[i]);
+      EXPECT_NEAR(w.mdev[i], w.adev[i] / 2, 2.2e-5 * w.adev[i]);
+    }
+  }
+}
+
+TEST(Decoder, WindowFramesWithoutTheirPageAreNotTakenForAnotherWindow) {
+  // Window 3, then window 4 whose window page is lost: its frames (WindowMod16 = 4) are counted as
+  // unplaced, never stored as window 3's; the next cycle's page brings window 4.
+  Feed feed;
+  for (std::uint8_t s = 0; s < 4; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, 3));
+  for (std::uint8_t s = 4; s < 8; ++s) {
+    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, 4);
+    if (s == 4) {
+      const auto page = std::find_if(frames.begin(), frames.end(), [](const CanFrame& f) {
+        const Decoded d = decode(f);
+        return std::holds_alternative<WindowMsg>(d.message);
+      });
+      ASSERT_NE(page, frames.end());
+      frames.erase(page);
+    }
+    feed.frames(frames);
+  }
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.window_frames_unplaced, 5u);
+  EXPECT_EQ(v.windows.count(4), 0u);
+  EXPECT_NEAR(v.windows.at(3).adev[0], 4.0, 1e-4) << "window 3 keeps its own values";
+  for (std::uint8_t s = 8; s < 12; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, 4));
+  ASSERT_EQ(v.windows.count(4), 1u);
+  EXPECT_TRUE(v.windows.at(4).complete());
+}
+
+TEST(Decoder, AChangedWindowTauCountEndsTheSession) {
+  Feed feed;
+  for (std::uint8_t s = 0; s < 4; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 5, 3));
+  for (std::uint8_t s = 4; s < 8; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, version, 6, 3));
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.restarts, 1u);
+  EXPECT_EQ(v.window_taus, 6u);
+  ASSERT_EQ(v.windows.size(), 1u);
+  EXPECT_EQ(v.windows.at(3).adev.size(), 6u) << "the new session's window";
 }
 
 }  // namespace

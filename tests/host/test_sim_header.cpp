@@ -3,6 +3,7 @@
 // the program itself writes. Oracles: the options given (round trip), the closed-form truth
 // Q = sqrt(q^2 + pulse^2 / 12) in arcsec and the identity of N, B, K, R in the fit's units.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <limits>
 #include <string>
 
+#include "gyro_sim.hpp"
 #include "sim_truth.hpp"
 
 namespace gyrochar {
@@ -31,6 +33,7 @@ void expect_same_options(const SimOptions& a, const SimOptions& b) {
   EXPECT_EQ(a.dither_arcsec, b.dither_arcsec);
   EXPECT_EQ(a.dither_hz, b.dither_hz);
   EXPECT_EQ(a.seed, b.seed);
+  EXPECT_EQ(a.segments, b.segments);
 }
 
 SimOptions awkward() {
@@ -172,6 +175,124 @@ TEST(SimHeader, TheProgramWritesTheTruthLine) {
   expect_same_options(t->options, want);
   EXPECT_EQ(second, format_sim_truth_line(want));
   EXPECT_EQ(values, 20);
+}
+
+// --- segments (the gyro changes during the run) ------------------------------------------------
+
+SimOptions doubling() {
+  SimOptions o;
+  o.duration_s = 20;
+  o.arw_deg_per_sqrt_h = 0.002;
+  o.segments = {{10, std::nullopt, std::nullopt, 0.004, std::nullopt}, {15, -20.0, 0.5, std::nullopt, 0.1}};
+  return o;
+}
+
+TEST(SimSegments, TheTruthLineSaysFormatTwoAndCarriesEverySegmentExactly) {
+  const SimOptions o = doubling();
+  const std::string line = format_sim_truth_line(o);
+  ASSERT_EQ(line.rfind("# gyrochar-sim truth: format=2 ", 0), 0u) << line;
+  EXPECT_NE(line.find(" segments=2 segment1_start_s=10 segment1_arw_deg_per_sqrt_h=0.004 segment2_start_s=15 "),
+            std::string::npos)
+      << line;
+  const auto t = parse_sim_truth_line(line);
+  ASSERT_TRUE(t) << line;
+  expect_same_options(t->options, o);
+  EXPECT_EQ(t->truth.n_rad_sqrt_s, 0.002 * units::deg_per_sqrt_h) << "the truth keys describe the first segment";
+  // Each segment's options: what it names, the rest carried over.
+  EXPECT_EQ(segment_options(o, 1).arw_deg_per_sqrt_h, 0.004);
+  EXPECT_EQ(segment_options(o, 2).arw_deg_per_sqrt_h, 0.004);
+  EXPECT_EQ(segment_options(o, 2).rate_deg_per_h, -20.0);
+  EXPECT_TRUE(segment_options(o, 2).segments.empty());
+  // A format-1 line never has segment keys; a format-2 line needs them all.
+  auto replaced = [&line](const std::string& from, const std::string& to) {
+    std::string s = line;
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return s.replace(at, from.size(), to);
+  };
+  EXPECT_FALSE(parse_sim_truth_line(replaced("format=2", "format=1")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced(" segments=2", " segments=3")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced(" segment1_start_s=10", "")));
+  EXPECT_FALSE(parse_sim_truth_line(line + " segment1_start_s=10"));               // repeated
+  EXPECT_FALSE(parse_sim_truth_line(line + " segment2_rrw_deg_per_h_sqrt_h=1"));   // a key twice in a segment
+  EXPECT_FALSE(parse_sim_truth_line(line + " segment2_bias_deg_per_h=1"));         // not a level that may change
+  EXPECT_FALSE(parse_sim_truth_line(replaced("segment2_start_s=15", "segment2_start_s=5")));  // out of order
+}
+
+TEST(SimSegments, TheOptionReadsTimeAndChanges) {
+  std::string why;
+  const auto g = parse_segment_option("3600:arw=0.004,rate=-15", why);
+  ASSERT_TRUE(g) << why;
+  EXPECT_EQ(g->start_s, 3600);
+  EXPECT_EQ(g->arw_deg_per_sqrt_h, 0.004);
+  EXPECT_EQ(g->rate_deg_per_h, -15);
+  EXPECT_FALSE(g->rrw_deg_per_h_sqrt_h);
+  for (const char* bad : {"3600", "x:arw=1", "3600:", "3600:arw", "3600:arw=", "3600:bias=1", "3600:arw=1,arw=2",
+                          "3600:arw=nan"}) {
+    EXPECT_FALSE(parse_segment_option(bad, why)) << bad;
+    EXPECT_FALSE(why.empty());
+  }
+  SimOptions o = doubling();
+  o.segments[1].start_s = 10;  // not after the one before
+  EXPECT_TRUE(check_parameters(o));
+  o = doubling();
+  o.segments[1].start_s = 20;  // at the end
+  EXPECT_TRUE(check_parameters(o));
+  o = doubling();
+  o.segments[0] = SimSegment{};  // changes nothing
+  o.segments[0].start_s = 10;
+  EXPECT_TRUE(check_parameters(o));
+  o = doubling();
+  o.segments[1].white_angle_arcsec = -1;
+  EXPECT_TRUE(check_parameters(o));
+}
+
+TEST(SimSegments, TheProgramWritesItsSegmentsAndTheirCounts) {
+  // Oracle: SimRun of the same options (the program's own loop) gives the counts it writes.
+  const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_sim_segments.txt";
+  const std::string sim = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim";
+  ASSERT_EQ(std::system((sim + " --duration 20 --arw 0.002 --segment 10:arw=0.004 --segment 15:rate=-20,white-angle=0.5"
+                              ",rrw=0.1 --out " + out).c_str()),
+            0);
+  std::ifstream in(out);
+  std::string first, second;
+  std::getline(in, first);
+  std::getline(in, second);
+  EXPECT_NE(first.find("; from 10 s: arw 0.004; from 15 s: rate -20 white-angle 0.5 rrw 0.1"), std::string::npos)
+      << first;
+  const auto t = parse_sim_truth_line(second);
+  ASSERT_TRUE(t) << second;
+  expect_same_options(t->options, doubling());
+  SimRun run(doubling());
+  long long count = 0;
+  std::uint64_t k = 0;
+  for (; in >> count; ++k) ASSERT_EQ(count, run.next_count()) << k;
+  EXPECT_EQ(k, run.samples());
+  std::remove(out.c_str());
+  const std::string err = ::testing::TempDir() + std::to_string(getpid()) + "_sim_segments.err";
+  EXPECT_EQ(WEXITSTATUS(std::system((sim + " --duration 20 --segment 25:arw=1 > /dev/null 2> " + err).c_str())), 2);
+  std::ifstream e(err);
+  const std::string why{std::istreambuf_iterator<char>(e), {}};
+  EXPECT_EQ(why.rfind("gyrochar-sim: --segment: ", 0), 0u) << why;
+  std::remove(err.c_str());
+}
+
+TEST(SimSegments, ARunChangesAtItsSegmentAndNowhereElse) {
+  // Oracle: the simulator alone, retuned by hand at the same sample: the same counts, every one;
+  // before the change, the counts of the run without segments.
+  const SimOptions o = doubling();
+  SimRun run(o);
+  ASSERT_EQ(run.samples(), 2000u);
+  GyroSimulator by_hand(gyro_parameters(o)), unchanged(gyro_parameters(o));
+  for (std::uint64_t k = 0; k < run.samples(); ++k) {
+    if (k == 1000) by_hand.retune(gyro_parameters(segment_options(o, 1)));
+    if (k == 1500) by_hand.retune(gyro_parameters(segment_options(o, 2)));
+    const std::int64_t c = run.next_count(), h = by_hand.next_count(), u = unchanged.next_count();
+    ASSERT_EQ(c, h) << k;
+    if (k < 1000) {
+      ASSERT_EQ(c, u) << k;
+    }
+  }
 }
 
 }  // namespace

@@ -45,6 +45,7 @@
 #include <cstring>
 #include <span>
 
+#include "gyrochar/block_kernel.hpp"
 #include "gyrochar/crc32.hpp"
 #include "gyrochar/noise_id.hpp"
 #include "gyrochar/stat.hpp"
@@ -283,9 +284,7 @@ class Characterizer {
     }
     ring_levels_ = max_level + 1;
     fast_count_ = 0;
-    while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0 &&
-           (!Arith::exact || taus_[fast_count_].result.m <= fast_m_max))
-      ++fast_count_;
+    while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0) ++fast_count_;
     if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.size()) return ConfigureStatus::history_too_small;
     restart();
     return ConfigureStatus::ok;
@@ -306,6 +305,7 @@ class Characterizer {
     }
     run_ = RunState{};
     run_.steady_from = 3u * stride_;
+    staged_count_ = 0;
   }
 
   /// Adds the next phase point (floating phase data). O(S) amortized; no allocation; never fails.
@@ -321,7 +321,7 @@ class Characterizer {
     const double b = hi - x;
     const double lo = (x - (hi - b)) - (run_.line_x0 + b);
     if (k == 1) run_.line_slope = hi;
-    push(static_cast<X>(std::fma(-static_cast<double>(k), run_.line_slope, hi) + lo));
+    stage(static_cast<X>(std::fma(-static_cast<double>(k), run_.line_slope, hi) + lo));
   }
 
   /// Adds the next increment of phase: a pulse count per tau0 (CountArith) or frequency * tau0
@@ -331,7 +331,7 @@ class Characterizer {
   /// new segment starts from 0 and phase_overflowed() turns true.
   void add_increment(typename Arith::Increment dx) {
     ++run_.increments;
-    if (run_.next_e == run_.segment_start) push(run_.x);
+    if (phase_points() == run_.segment_start) stage(run_.x);
     if constexpr (!Arith::exact) {
       if (run_.increments == 1) run_.first_increment = dx;
       run_.x += dx - run_.first_increment;
@@ -340,11 +340,13 @@ class Characterizer {
         run_.phase_overflow = true;
         mark_gap();
         run_.x = 0;
-        push(run_.x);
+        stage(run_.x);
         run_.x = dx;
       }
+      if (dx < run_.increment_min) run_.increment_min = dx;
+      if (dx > run_.increment_max) run_.increment_max = dx;
     }
-    push(run_.x);
+    stage(run_.x);
   }
 
   /// The block API: add_increment() for each value of `block`, in order. O(S) amortized per value.
@@ -356,6 +358,9 @@ class Characterizer {
   /// Starts a new segment at the next phase point: no term and no difference of a decimated series
   /// will span the break. O(taus).
   void mark_gap() {
+    flush();
+    run_.increment_min = RunState{}.increment_min;
+    run_.increment_max = RunState{}.increment_max;
     run_.segment_start = run_.next_e;
     run_.steady_from = run_.segment_start + 3u * stride_;
     run_.p_segment_start = run_.p;
@@ -372,7 +377,7 @@ class Characterizer {
   // (atomically: firmware/checkpoint.hpp).
 
   static constexpr std::uint32_t checkpoint_magic = 0x43525947;  // "GYRC"
-  static constexpr std::uint16_t checkpoint_version = 2;
+  static constexpr std::uint16_t checkpoint_version = 3;
 
   /// Bytes save() writes for the current configuration. O(1).
   std::size_t checkpoint_size() const {
@@ -384,6 +389,7 @@ class Characterizer {
   /// O(history + taus), no allocation, does not disturb accumulation.
   std::size_t save(std::span<std::byte> out) const {
     if (out.size() < checkpoint_size()) return 0;
+    flush();
     std::byte* p = out.data();
     const Header h = header();
     p = put(p, &h, sizeof h);
@@ -422,6 +428,7 @@ class Characterizer {
       p = get(p, &m, sizeof m);
       if (m != taus_[i].result.m) return RestoreStatus::config_mismatch;
     }
+    staged_count_ = 0;  // the restored state replaces the points not yet processed
     p = get(p, &run_, sizeof run_);
     p = get(p, history_.data(), used_history() * sizeof(Entry));
     get(p, taus_.data(), ntaus_ * sizeof(TauState));
@@ -435,7 +442,7 @@ class Characterizer {
   /// True once the accumulated pulse count passed 2^63 (CountArith); a gap was inserted there.
   bool phase_overflowed() const { return run_.phase_overflow; }
   /// Phase points added so far (over all segments).
-  std::uint64_t phase_points() const { return run_.next_e; }
+  std::uint64_t phase_points() const { return run_.next_e + staged_count_; }
   /// Increments added so far (samples of counts or frequency; 0 for phase input).
   std::uint64_t increments() const { return run_.increments; }
   /// Gaps marked so far (restores and phase overflows included).
@@ -445,12 +452,16 @@ class Characterizer {
   std::uint32_t tag() const { return tag_; }
   /// Sums of tau i (0 <= i < tau_count()), valid at any time.
   Result result(std::size_t i) const {
+    flush();
     Result r = taus_[i].result;
     r.sum_overflow = (taus_[i].sticky >> 63) != 0;
     return r;
   }
   /// The lag-1 autocorrelation sums of tau i's decimated series.
-  const NoiseIdAccumulator& noise(std::size_t i) const { return taus_[i].noise; }
+  const NoiseIdAccumulator& noise(std::size_t i) const {
+    flush();
+    return taus_[i].noise;
+  }
 
  private:
   struct Header {
@@ -481,31 +492,287 @@ class Characterizer {
     return p + n;
   }
 
+  // Staging. Points wait in staged_ until a block is full or the state is read, then go through
+  // the block kernel (counts, steady state) or one by one through push(). Read-outs are const and
+  // process the staged points first: nothing observable changes, but two threads must not read
+  // at once. A characterizer defined const never has staged points, so nothing is written then.
+  void stage(X x) {
+    staged_[staged_count_++] = x;
+    // Blocks end on multiples of block_points, so the next one starts on one (higher_levels()).
+    if (((run_.next_e + staged_count_) & (block_points - 1)) == 0) flush();
+  }
+  void flush() const { const_cast<Characterizer*>(this)->process_staged(); }
+  void process_staged() {
+    const std::size_t n = staged_count_;
+    if (n == 0) return;
+    staged_count_ = 0;
+    std::size_t i = 0;
+    if constexpr (Arith::exact) {
+      while (i < n && run_.next_e < run_.steady_from) push(staged_[i++]);
+      if (i < n) push_block(&staged_[i], n - i);
+    } else {
+      while (i < n) push(staged_[i++]);
+    }
+  }
+
+  // One phase point through every level that runs at it.
   void push(X x) {
     const std::uint64_t e = run_.next_e++;
     run_.p = Arith::add_prefix(run_.p, x);
     const Entry current{x, run_.p};
-    // Levels 0 .. countr_zero(e) run at e; their ring heads move on by one slot.
+    const unsigned fired = advance_heads(e);
+    if (e == 0) {  // point 0 is a multiple of every m
+      for (std::size_t i = 0; i < ntaus_; ++i) decimate(taus_[i], x);
+    }
+    std::size_t i = 0;
+    if constexpr (!Arith::exact) {
+      if (e >= run_.steady_from) {
+        for (; i < fast_count_; ++i) {
+          fast_terms(taus_[i], current);
+          if (--taus_[i].countdown == 0) decimate(taus_[i], x);
+        }
+      }
+    }
+    later_levels(i, e, fired, current);
+    insert(e, current);
+  }
+
+  // Levels 0 .. countr_zero(e) run at e; their ring heads move on by one slot. Returns how many.
+  unsigned advance_heads(std::uint64_t e) {
     const unsigned fired = e == 0 ? 0 : static_cast<unsigned>(std::countr_zero(e)) + 1;
     const unsigned moved = fired < ring_levels_ ? fired : ring_levels_;
     for (unsigned ring = 0; ring < moved; ++ring) {
       if (++run_.head[ring] == ring_size(ring)) run_.head[ring] = 0;
     }
-    if (e == 0) {  // point 0 is a multiple of every m
-      for (std::size_t i = 0; i < ntaus_; ++i) decimate(taus_[i], x);
-    }
-    std::size_t i = 0;
-    if (e >= run_.steady_from) {
-      for (; i < fast_count_; ++i) {
-        fast_terms(taus_[i], current);
-        if (--taus_[i].countdown == 0) decimate(taus_[i], x);
-      }
-    }
-    for (; i < ntaus_ && taus_[i].level < fired; ++i) {
+    return fired;
+  }
+
+  // Terms and decimation of the taus from index `first` on whose level runs at e.
+  void later_levels(std::size_t first, std::uint64_t e, unsigned fired, const Entry& current) {
+    for (std::size_t i = first; i < ntaus_ && taus_[i].level < fired; ++i) {
       form_terms(taus_[i], e, current);
-      if (--taus_[i].countdown == 0) decimate(taus_[i], x);
+      if (--taus_[i].countdown == 0) decimate(taus_[i], current.x);
     }
-    insert(e, current);
+  }
+
+  // ---------------------------------------------------------------------------------------------
+  // The block kernel (counts, steady state: the points' level-0 history lies in this segment).
+  // The level-0 taus (m <= S) take the whole block at once, tau by tau, in block_terms(); the
+  // history and the higher levels then take the points one by one, as push() does. Level 0 reads
+  // only ring 0 as it was before the block, so the order of the two passes does not matter.
+  // Working memory on the stack: about 5 KiB.
+  struct Block {
+    std::uint64_t e0;  // index of the first point
+    std::size_t n;
+    const X* x;
+    const std::uint64_t* p_lo;  // low words of P (window: valid back to index -depth)
+    const std::uint64_t* p_hi;
+    const std::int64_t* wx;     // x in the window (valid back to index -depth)
+    std::size_t depth;
+    unsigned level;             // the points are the multiples of 2^level: tau m has lag m >> level
+    // Point e0 + j - age, from the block or from ring 0 (ages up to 3S before e0).
+    Entry at(const Characterizer& c, std::size_t j, std::uint64_t age) const
+      requires(Arith::exact)
+    {
+      if (j >= age) return {x[j - age], Int128{p_lo[j - age], p_hi[j - age]}};
+      return c.history_[static_cast<std::size_t>((e0 + j - age) % (3u * c.stride_))];
+    }
+  };
+
+  void push_block(const X* x, std::size_t n)
+    requires(Arith::exact)
+  {
+    // The window: the last `depth` points before the block (from ring 0), then the block.
+    const std::uint32_t ring0 = 3u * stride_;
+    const std::size_t depth = ring0 < window_depth ? ring0 : window_depth;
+    std::array<std::int64_t, window_depth + block_points> wx;
+    std::array<std::uint64_t, window_depth + block_points> wp;
+    std::array<std::uint64_t, block_points> p_hi;
+    std::uint32_t slot = static_cast<std::uint32_t>((run_.next_e - depth) % ring0);
+    for (std::size_t j = 0; j < depth; ++j) {
+      wx[j] = history_[slot].x;
+      wp[j] = history_[slot].p.lo;
+      if (++slot == ring0) slot = 0;
+    }
+    Int128 p = run_.p;
+    for (std::size_t j = 0; j < n; ++j) {
+      p = Arith::add_prefix(p, x[j]);
+      wx[depth + j] = x[j];
+      wp[depth + j] = p.lo;
+      p_hi[j] = p.hi;
+    }
+    const Block b{run_.next_e, n, x, &wp[depth], p_hi.data(), &wx[depth], depth, 0};
+    for (std::size_t i = 0; i < fast_count_; ++i) level0_block(taus_[i], b);
+    const std::size_t done = depth == ring0 ? higher_levels(b, wx.data(), wp.data()) : fast_count_;
+    // The history and the remaining levels, point by point. Odd points only enter ring 0.
+    const bool later = done < ntaus_;
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::uint64_t e = run_.next_e++;
+      run_.p = {wp[depth + j], p_hi[j]};
+      const Entry current{x[j], run_.p};
+      if (e & 1) {
+        if (++run_.head[0] == ring0) run_.head[0] = 0;
+        history_[run_.head[0]] = current;
+        continue;
+      }
+      const unsigned fired = advance_heads(e);
+      if (later && taus_[done].level < fired) later_levels(done, e, fired, current);
+      insert(e, current);
+    }
+  }
+
+  static constexpr std::size_t window_depth = 96;  // points before a block copied next to it
+
+  // Levels 1, 2, ... of a block that starts at a multiple of block_points, with 3S <= window_depth:
+  // the points of level L (the multiples of 2^L) form a series in which a tau r 2^L of that level
+  // is a level-0 tau of lag r, so the same kernel takes them, over a window of the series' last 3S
+  // points (the younger half from level L-1's window, the older half from ring L) and the block's
+  // points of level L. Stops at the first level not yet steady in this segment or whose terms are
+  // not proved to fit. Returns how many taus (a prefix of the list) the kernel took.
+  std::size_t higher_levels(const Block& level0, const std::int64_t* x_prev, const std::uint64_t* p_prev)
+    requires(Arith::exact)
+  {
+    std::size_t done = fast_count_;
+    const std::uint64_t e0 = level0.e0;
+    const std::size_t depth = 3u * stride_;
+    if (e0 % block_points != 0) return done;
+    std::array<std::array<std::int64_t, window_depth + block_points>, 2> x_buf;
+    std::array<std::array<std::uint64_t, window_depth + block_points>, 2> p_buf;
+    std::size_t n = level0.n;
+    for (unsigned level = 1; (std::size_t{1} << level) <= block_points && level < ring_levels_; ++level) {
+      if (done == ntaus_ || taus_[done].level != level || e0 < run_.segment_start + (std::uint64_t{depth} << level))
+        return done;
+      std::int64_t* x_next = x_buf[level % 2].data();
+      std::uint64_t* p_next = p_buf[level % 2].data();
+      const std::size_t half = depth / 2;
+      const std::uint32_t ring = 3u * stride_ / 2;
+      std::uint32_t slot = static_cast<std::uint32_t>(((e0 >> level) - depth) % ring);
+      const std::size_t base = ring_offset(level);
+      for (std::size_t i = 0; i < half; ++i) {  // ages (3S 2^(L-1), 3S 2^L]: ring L
+        x_next[i] = history_[base + slot].x;
+        p_next[i] = history_[base + slot].p.lo;
+        if (++slot == ring) slot = 0;
+      }
+      n = (n + 1) / 2;
+      for (std::size_t i = half; i < depth + n; ++i) {  // younger ones and the block: every other one
+        x_next[i] = x_prev[2 * i - depth];
+        p_next[i] = p_prev[2 * i - depth];
+      }
+      const Block b{e0, n, x_next + depth, p_next + depth, nullptr, x_next + depth, depth, level};
+      for (; done < ntaus_ && taus_[done].level == level; ++done) {
+        if (!terms_fit(taus_[done].result.m)) return done;
+        level0_block(taus_[done], b);
+      }
+      x_prev = x_next;
+      p_prev = p_next;
+    }
+    return done;
+  }
+
+
+  // The block's terms of one level-0 tau, and its decimated points.
+  // The terms of tau m fit in int64 when 2 m^2 (largest increment - smallest) < 2^63 (|a| <= m
+  // span, |h| <= 2 m span, |t| <= m^2 span), always for m <= 2^15 since increments are int32.
+  bool terms_fit(std::uint64_t m) const {
+    if (m > (std::uint64_t{1} << 31)) return false;
+    const std::uint64_t span = run_.increment_max >= run_.increment_min
+                                   ? static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min)
+                                   : 0;
+    return span <= (~std::uint64_t{0} >> 1) / (2 * m * m);
+  }
+
+  void level0_block(TauState& t, const Block& b)
+    requires(Arith::exact)
+  {
+    const auto m = static_cast<std::size_t>(t.result.m >> b.level);  // the lag in the block's series (<= S)
+    if (!terms_fit(t.result.m)) {  // level 0 only (higher_levels() checks first)
+      for (std::size_t j = 0; j < b.n; ++j) {  // the checked path, point by point
+        const Entry now = b.at(*this, j, 0);
+        checked_terms(t, now, b.at(*this, j, m), b.at(*this, j, 2 * m), b.at(*this, j, 3 * m));
+        if (--t.countdown == 0) decimate(t, now.x);
+      }
+      return;
+    }
+    // The points at ages m, 2m, 3m: in the window, or gathered from ring 0.
+    std::array<std::int64_t, block_points> gx1, gx2, gx3, a, h, mt;
+    std::array<std::uint64_t, block_points> gp1, gp2, gp3;
+    const std::int64_t *x1 = gx1.data(), *x2 = gx2.data(), *x3 = gx3.data();
+    const std::uint64_t *p1 = gp1.data(), *p2 = gp2.data(), *p3 = gp3.data();
+    if (3 * m <= b.depth) {
+      x1 = b.wx - m, x2 = b.wx - 2 * m, x3 = b.wx - 3 * m;
+      p1 = b.p_lo - m, p2 = b.p_lo - 2 * m, p3 = b.p_lo - 3 * m;
+    } else {
+      gather(b, m, gx1.data(), gp1.data());
+      gather(b, 2 * m, gx2.data(), gp2.data());
+      gather(b, 3 * m, gx3.data(), gp3.data());
+    }
+    const BlockTerms terms = block_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data(), mt.data());
+    Result& r = t.result;
+    t.sticky |= add_block(r.sum[0], terms.avar, a.data(), b.n) | add_block(r.sum[1], terms.mvar, mt.data(), b.n) |
+                add_block(r.sum[2], terms.hvar, h.data(), b.n);
+    r.n[0] += b.n;
+    r.n[1] += b.n;
+    r.n[2] += b.n;
+    // The decimated series: its terms are the overlapping ones at the multiples of m, so the
+    // block's bound covers their squares too.
+    if (t.countdown > b.n) {
+      t.countdown -= b.n;
+      return;
+    }
+    const std::size_t first = static_cast<std::size_t>(t.countdown - 1);
+    std::size_t count = 0, j = first;
+    BlockSquares da{terms.avar.magnitude_bits, 0}, dh{terms.hvar.magnitude_bits, 0};
+    for (;; j += m) {
+      da.sum += static_cast<std::uint64_t>(a[j]) * static_cast<std::uint64_t>(a[j]);
+      dh.sum += static_cast<std::uint64_t>(h[j]) * static_cast<std::uint64_t>(h[j]);
+      ++count;
+      if (j + m >= b.n) break;
+    }
+    const auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
+    const auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
+    if (squares_exact(da, b.n)) {
+      t.sticky |= add_high_word(r.sum[avar_d], UInt128{da.sum, 0});
+    } else {
+      for (std::size_t k = first; k <= j; k += m) t.sticky |= Arith::accumulate(r.sum[avar_d], a[k]);
+    }
+    if (squares_exact(dh, b.n)) {
+      t.sticky |= add_high_word(r.sum[hvar_d], UInt128{dh.sum, 0});
+    } else {
+      for (std::size_t k = first; k <= j; k += m) t.sticky |= Arith::accumulate(r.sum[hvar_d], h[k]);
+    }
+    r.n[avar_d] += count;
+    r.n[hvar_d] += count;
+    t.noise.add(b.x + first, count, m);
+    t.decimated = {b.x[j], x1[j], x2[j]};
+    t.decimated_count = 3;
+    t.countdown = m - (b.n - 1 - j);
+  }
+
+  // x and the low word of P at age `age` of each point of the block.
+  void gather(const Block& b, std::uint64_t age, std::int64_t* x, std::uint64_t* p) const
+    requires(Arith::exact)
+  {
+    const std::size_t from_history = age < b.n ? static_cast<std::size_t>(age) : b.n;
+    const std::uint32_t size = 3u * stride_;
+    std::uint32_t slot = static_cast<std::uint32_t>((b.e0 - age) % size);
+    for (std::size_t j = 0; j < from_history; ++j) {
+      x[j] = history_[slot].x;
+      p[j] = history_[slot].p.lo;
+      if (++slot == size) slot = 0;
+    }
+    for (std::size_t j = from_history; j < b.n; ++j) {
+      x[j] = b.x[j - age];
+      p[j] = b.p_lo[j - age];
+    }
+  }
+
+  // Adds a block's squares to a 128-bit sum: the 64-bit partial sum when it is exact, else the
+  // terms one by one. Returns the sum's high word (for the sticky overflow bit).
+  static std::uint64_t add_block(UInt128& sum, const BlockSquares& s, const std::int64_t* terms, std::size_t n) {
+    if (squares_exact(s, n)) return add_high_word(sum, UInt128{s.sum, 0});
+    std::uint64_t high = 0;
+    for (std::size_t j = 0; j < n; ++j) high |= add_high_word(sum, square(terms[j]));
+    return high;
   }
 
   // A point of the decimated series x[k m]: the non-overlapped second and third differences, and
@@ -555,7 +822,7 @@ class Characterizer {
     const Entry& e1 = at(t, 0);
     const Entry& e2 = at(t, 1);
     Result& r = t.result;
-    X a{}, h{};
+    X a{};
     if (span < 3 * m) {
       // Only the AVAR term fits; MVAR may still use P just before the segment start.
       if (!Arith::x_term2(now.x, e1.x, e2.x, a)) {
@@ -567,7 +834,13 @@ class Characterizer {
       if (span + 1 == 3 * m) mvar_term(t, now.p, e1.p, e2.p, run_.p_segment_start);
       return;
     }
-    const Entry& e3 = at(t, 2);
+    checked_terms(t, now, e1, e2, at(t, 2));
+  }
+
+  // The three terms at a point whose points of ages m, 2m, 3m lie in its segment, each checked.
+  void checked_terms(TauState& t, const Entry& now, const Entry& e1, const Entry& e2, const Entry& e3) {
+    Result& r = t.result;
+    X a{}, h{};
     if (!Arith::x_terms(now.x, e1.x, e2.x, e3.x, a, h)) {
       ++r.out_of_range;
     } else {
@@ -626,14 +899,16 @@ class Characterizer {
   std::uint32_t stride_ = 8;
   std::uint32_t tag_ = 0;
   unsigned ring_levels_ = 1;
-  std::size_t fast_count_ = 0;  // leading taus that take fast_terms() in the steady state
-  static constexpr std::uint64_t fast_m_max = std::uint64_t{1} << 15;
+  std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
+  static constexpr std::size_t block_points = 64;  // staged points per block (a power of two)
+  std::array<X, block_points> staged_{};
+  std::size_t staged_count_ = 0;
 
   // Everything that changes while data flows (with history_ and the tau states: the checkpoint).
   struct RunState {
     std::uint64_t next_e = 0;         // index of the next phase point
     std::uint64_t segment_start = 0;  // index of the current segment's first point
-    std::uint64_t steady_from = 0;    // from here on fast_terms() applies
+    std::uint64_t steady_from = 0;    // from here on level 0 has its whole history in the segment
     std::uint64_t increments = 0;     // add_increment() calls
     std::uint64_t gaps = 0;
     decltype(Entry{}.p) p{};          // P of the next point
@@ -643,6 +918,8 @@ class Characterizer {
     std::uint64_t line_points = 0;    // FloatArith phase input: the reference line
     double line_x0 = 0, line_slope = 0;
     bool phase_overflow = false;
+    // CountArith: the smallest and largest increment of this segment (they bound the terms).
+    std::int32_t increment_min = INT32_MAX, increment_max = INT32_MIN;
     std::array<std::uint32_t, 64> head{};  // head[l]: slot of (e >> l) in ring l
   };
   RunState run_;

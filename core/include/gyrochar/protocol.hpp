@@ -1,8 +1,9 @@
 #pragma once
-// The gyrochar CAN protocol, version 2: one value type per frame kind, encode() and decode()
-// between those values and CanFrame, and the report schedule. The codec decodes version 1 frames
-// too (version 2 only adds: the IEEE-952 fit summary page and the Fitted flag of the term frames,
-// both of which a version-1 node never sends), and the schedule of either version is available. docs/protocol.md is the specification,
+// The gyrochar CAN protocol, version 3: one value type per frame kind, encode() and decode()
+// between those values and CanFrame, and the report schedule. The codec decodes the frames of
+// versions 1 and 2 too (each version only adds: version 2 the IEEE-952 fit summary page and the
+// Fitted flag of the term frames, version 3 the Window message of the dynamic Allan deviation),
+// and the schedule of every version is available. docs/protocol.md is the specification,
 // docs/gyrochar.dbc describes the same frames for CAN tools (tests/dbc checks it against this codec).
 // The board firmware and the host decoder both use this codec; there is no other.
 //
@@ -20,7 +21,7 @@
 
 namespace gyrochar::protocol {
 
-inline constexpr std::uint8_t version = 2;             // what this codec's nodes send
+inline constexpr std::uint8_t version = 3;             // what this codec's nodes send
 inline constexpr std::uint8_t oldest_version = 1;      // the oldest version decoders accept
 inline constexpr std::size_t max_taus = 64;          // tau index is 6 bits
 inline constexpr std::uint8_t max_node_address = 0xFD;  // J1939: 0xFE null, 0xFF global
@@ -30,6 +31,7 @@ inline constexpr std::uint32_t status_id = 0x14FF4000;         // priority 5, ev
 inline constexpr std::uint32_t tau_stats_id = 0x18FF4100;      // priority 6, every report
 inline constexpr std::uint32_t metadata_id = 0x18FF4200;       // priority 6, slow cycle
 inline constexpr std::uint32_t ieee952_id = 0x18FF4300;        // priority 6, slow cycle
+inline constexpr std::uint32_t window_id = 0x18FF4400;         // priority 6, slow cycle (version 3)
 inline constexpr std::uint32_t counter_input_id = 0x0CFF5000;  // priority 3, gyro electronics -> board
 
 constexpr std::uint32_t frame_id(std::uint32_t base, std::uint8_t node) { return base | node; }
@@ -213,6 +215,43 @@ struct Ieee952SummaryMsg {
   bool operator==(const Ieee952SummaryMsg&) const = default;
 };
 
+/// Window page 0 (version 3): which window of the node's dynamic Allan deviation the Window frames
+/// of this slow cycle describe. The node restarts a second characterizer every `length` samples
+/// (WindowLengthMsg); window k covers the samples k length .. (k+1) length - 1 of the SampleCount.
+struct WindowMsg {
+  std::uint8_t seq = 0;
+  std::uint8_t tau_count = 1;    // window taus: window tau i has the node's tau i's m; 1..63
+  bool complete = false;         // false: no window completed yet (then window = 0, gaps = 0, and
+                                 // every WindowDevMsg says "no estimate")
+  std::uint32_t window = 0;      // k, the number of the window described
+  std::uint32_t gaps = 0;        // sample gaps inside that window; 8 bits, saturates
+  bool operator==(const WindowMsg&) const = default;
+};
+
+/// Window page 1 (version 3): samples per window.
+struct WindowLengthMsg {
+  std::uint8_t seq = 0;
+  std::uint64_t length = 4;  // tau0 samples per window, 4 <= length < 2^40
+  bool operator==(const WindowLengthMsg&) const = default;
+};
+
+/// A deviation of exactly 0 (a perfectly constant rate) goes into a WindowDevMsg as this, since 0
+/// there means "no estimate": like every deviation below 2^-128 it is sent as the smallest code,
+/// 2^(2^-14 - 128).
+inline constexpr double window_dev_floor = 0x1p-128;
+
+/// Window page 2 (version 3): ADEV and MDEV of one window tau in the window WindowMsg names.
+struct WindowDevMsg {
+  std::uint8_t seq = 0;
+  std::uint8_t tau_index = 0;     // 0..max_taus-1; tau = the node's tau tau_index
+  std::uint8_t window = 0;        // the window's number modulo 16 (4 bits), as a check
+  double adev_angle_per_s = 0.0;  // overlapping Allan deviation in the window; 0: no estimate
+  double mdev_angle_per_s = 0.0;  // modified Allan deviation in the window; 0: no estimate
+  // Each deviation is >= 0 and finite; on the wire as log2 in 2^-14 steps (relative error at most
+  // 2.2e-5), clamped to [2^(2^-14 - 128), 2^(128 - 2^-14)] (see window_dev_floor).
+  bool operator==(const WindowDevMsg&) const = default;
+};
+
 /// Counter input: sent by the gyro's readout electronics to the board once per sample interval.
 struct CounterInputMsg {
   std::uint32_t count = 0;  // accumulated pulses, wraps modulo 2^32 (differences are signed)
@@ -224,7 +263,7 @@ struct CounterInputMsg {
 
 using Message = std::variant<StatusMsg, StatusFaultsMsg, TauDevMsg, TauTermsMsg, TauInfoMsg,
                              MetaSamplingMsg, MetaClockMsg, MetaScaleMsg, MetaConfigMsg, Ieee952Msg,
-                             CounterInputMsg, Ieee952SummaryMsg>;
+                             CounterInputMsg, Ieee952SummaryMsg, WindowMsg, WindowLengthMsg, WindowDevMsg>;
 
 // ---------------------------------------------------------------------------------------------
 // Codec
@@ -233,7 +272,7 @@ enum class ProtocolError : std::uint8_t {
   none = 0,
   error_frame,    // the controller reported an error frame
   not_extended,   // 11-bit identifier
-  fd_frame,       // CAN FD frame: protocol versions 1 and 2 are classic CAN only
+  fd_frame,       // CAN FD frame: protocol versions 1 to 3 are classic CAN only
   unknown_id,     // not one of the identifiers above (PGN or priority differ)
   bad_address,    // node address 0xFE or 0xFF
   wrong_length,   // data length differs from the frame kind's (8, counter input 6)
@@ -267,6 +306,9 @@ ProtocolError encode(const MetaScaleMsg& msg, std::uint8_t node, CanFrame& frame
 ProtocolError encode(const MetaConfigMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Ieee952Msg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Ieee952SummaryMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const WindowMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const WindowLengthMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const WindowDevMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Message& msg, std::uint8_t node, CanFrame& frame);
 
@@ -286,31 +328,39 @@ Decoded decode(const CanFrame& frame);
 // Report schedule (docs/protocol.md, "Report schedule"). Every report carries the fast frames
 // (status, faults, ADEV and MDEV of every tau); the slow list (metadata, tau info, terms, IEEE-952
 // terms and, from version 2, the fit summary) is cut into slow_cycle_reports equal parts, one part
-// per report, chosen by seq. Both the node (what to send) and the decoder (what to expect) derive a
-// report's frames from seq, tau count and the node's protocol version.
+// per report, chosen by seq; from version 3, a node with window taus appends a part of its window
+// list (window page, window length, one WindowDevMsg per window tau), cut the same way. Both the
+// node (what to send) and the decoder (what to expect) derive a report's frames from seq, tau
+// count, window tau count and the node's protocol version.
 //
 // The version-2 slow list is version 1's with the summary appended; its length 10 + 2T is even
 // where version 1's 9 + 2T is odd, so both cut into parts of the same length ceil(L/4): every frame
-// keeps its position, and one report of the cycle has one frame more.
+// keeps its position, and one report of the cycle has one frame more. Version 3 keeps every
+// version-2 position too: the window part follows them.
 
 inline constexpr std::size_t slow_cycle_reports = 4;
 
 enum class Slot : std::uint8_t {
-  status, faults, adev, mdev, terms, tau_info, sampling, clock, scale, config, ieee952
+  status, faults, adev, mdev, terms, tau_info, sampling, clock, scale, config, ieee952,
+  window, window_length, window_dev  // version 3
 };
+inline constexpr std::size_t slot_kinds = 14;
 struct ReportSlot {
   Slot slot = Slot::status;
-  std::uint8_t index = 0;  // tau index (adev, mdev, terms, tau_info); for ieee952 the page:
-                           // an Ieee952Term (0-4) or ieee952_summary_page (5)
+  std::uint8_t index = 0;  // tau index (adev, mdev, terms, tau_info, window_dev); for ieee952 the
+                           // page: an Ieee952Term (0-4) or ieee952_summary_page (5)
 };
 
-/// Number of frames in report `seq` for `tau_count` taus (<= max_taus) of a node speaking
-/// `protocol_version` (1, or 2 and above: the current schedule).
-std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version = version);
+/// Number of frames in report `seq` for `tau_count` taus (<= max_taus) and `window_taus` window
+/// taus (<= tau_count; 0: no window, and for versions 1 and 2) of a node speaking
+/// `protocol_version` (1, 2, or 3 and above: the current schedule).
+std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version = version,
+                               std::size_t window_taus = 0);
 /// Frame `position` (< report_frame_count()) of report `seq`, in sending order: status, faults,
-/// ADEV and MDEV of tau 0, 1, ..., then this report's part of the slow list.
+/// ADEV and MDEV of tau 0, 1, ..., then this report's part of the slow list, then (version 3) its
+/// part of the window list.
 ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position,
-                       std::uint8_t protocol_version = version);
+                       std::uint8_t protocol_version = version, std::size_t window_taus = 0);
 
 /// Worst-case bits on the wire of a classic data frame with a 29-bit identifier and `data_bytes`
 /// (<= 8) data bytes, with the maximum number of stuff bits and the 3-bit interframe space:
@@ -320,9 +370,10 @@ constexpr std::uint32_t worst_case_frame_bits(std::uint32_t data_bytes) {
   return stuffed + 13 + (stuffed - 1) / 4;            // + CRC delimiter, ACK, EOF, interframe space
 }
 
-/// Worst-case share of a bus of `bitrate_bps` taken by one node reporting `tau_count` taus every
-/// `report_period_s` seconds (the longest report of the slow cycle, current version).
-/// O(slow_cycle_reports).
-double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps);
+/// Worst-case share of a bus of `bitrate_bps` taken by one node reporting `tau_count` taus and
+/// `window_taus` window taus every `report_period_s` seconds (the longest report of the slow cycle,
+/// current version). O(slow_cycle_reports).
+double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps,
+                           std::size_t window_taus = 0);
 
 }  // namespace gyrochar::protocol

@@ -1,0 +1,47 @@
+#pragma once
+// The block kernel of the exact counts path: the overlapping Allan, modified Allan and Hadamard
+// terms of one tau over a block of consecutive phase points, and their sums of squares in 64-bit
+// partial sums whose exactness is proved per block from the block's largest term.
+//
+// Inputs are the phase points at ages 0, m, 2m and 3m of each of the n newest points (x as
+// int64, P as its low 64-bit word): the caller gathers them from its history. Terms are formed in
+// modular 64-bit arithmetic, which is exact whenever the true term fits in int64 (the caller
+// proves that from the input bounds, characterizer.hpp). Each square is the product of the low
+// 32-bit halves of the term's magnitude, a widening multiply SIMD units have: GCC vectorizes the
+// loop with SSE2 and AVX2 on x86-64 (chosen at run time on the host). On aarch64 GCC 12 leaves
+// it scalar (it does not find NEON's widening multiply here), as on Cortex-M.
+// squares_exact() tells whether a partial sum equals the exact sum of squares.
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+
+namespace gyrochar {
+
+/// One statistic's block: the OR of the terms' magnitudes (a bound: every |term| < 2^bit_width)
+/// and the sum of the squares of their low 32-bit halves, modulo 2^64.
+struct BlockSquares {
+  std::uint64_t magnitude_bits = 0;
+  std::uint64_t sum = 0;
+};
+
+/// Terms of the n newest points of a block (index j = 0..n-1).
+struct BlockTerms {
+  BlockSquares avar, mvar, hvar;
+};
+
+/// The n newest points' terms: x_k[j], p_k[j] are the phase point and its P (P_{e+1}, low word)
+/// at age k m of point j. Writes the terms to avar_out[j], hvar_out[j] and mvar_out[j] (the
+/// decimated series reuses them; a partial sum that is not exact is summed again from them).
+/// O(n), no allocation, cannot fail.
+BlockTerms block_terms(std::size_t n, const std::int64_t* x0, const std::int64_t* x1, const std::int64_t* x2,
+                       const std::int64_t* x3, const std::uint64_t* p0, const std::uint64_t* p1,
+                       const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
+                       std::int64_t* hvar_out, std::int64_t* mvar_out);
+
+/// True when s.sum is the exact sum of the n squared terms: every |term| < 2^b with 2b + bit_width(n)
+/// <= 64, so each term fits in 31 bits (its low half is itself) and n squares stay below 2^64.
+constexpr bool squares_exact(const BlockSquares& s, std::size_t n) {
+  return 2 * std::bit_width(s.magnitude_bits) + std::bit_width(n) <= 64;
+}
+
+}  // namespace gyrochar

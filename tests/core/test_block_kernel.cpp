@@ -1,0 +1,181 @@
+// The block kernel: whatever the blocks the points arrive in, the sums are bit-identical to the
+// definitions evaluated by brute force (oracle: exact 128-bit integers, tests/oracle/brute_force.hpp)
+// and to feeding the points one at a time with a read-out after each (which processes every point
+// alone); the noise identification sums, in floating point, are bit-identical between the two.
+// The 64-bit partial sums are checked against exact 128-bit sums around the bound that proves them.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "gyrochar/block_kernel.hpp"
+#include "gyrochar/characterizer.hpp"
+#include "oracle/brute_force.hpp"
+
+namespace gyrochar {
+namespace {
+
+using oracle::brute_force;
+using oracle::Exact;
+using oracle::u128;
+
+u128 to_u128(UInt128 v) { return (u128{v.hi} << 64) | v.lo; }
+
+// A characterizer on heap storage for any stride factor.
+struct Heap {
+  std::vector<CountArith::Entry> history;
+  std::vector<Characterizer<CountArith>::TauState> taus;
+  Characterizer<CountArith> c;
+  Heap(std::uint32_t s, const std::vector<std::uint64_t>& m_list)
+      : history(history_entries(s, m_list.back())), taus(m_list.size()), c(history, taus) {
+    EXPECT_EQ(c.configure({s, 0}, m_list), ConfigureStatus::ok);
+  }
+};
+
+std::vector<std::uint64_t> taus_for(std::uint32_t s) {
+  // Every m <= S (level 0: the kernel) up to 8, then octaves and one sub-octave tau per level.
+  std::vector<std::uint64_t> m;
+  for (std::uint64_t v = 1; v <= 8 && v <= s; ++v) m.push_back(v);
+  for (std::uint64_t v = 16; v <= 4 * std::uint64_t{s} && v <= 1024; v *= 2) {
+    if (v > s && 3 * v / 4 > m.back() && (3 * v / 4) % (v / s) == 0) m.push_back(3 * v / 4);
+    if (v > m.back()) m.push_back(v);
+  }
+  return m;
+}
+
+// Feeds `counts` as segments separated by gaps, in blocks of random length (0: one point at a
+// time with a read-out after each).
+void feed(Characterizer<CountArith>& c, const std::vector<std::vector<std::int32_t>>& segments, std::mt19937_64* blocks) {
+  for (std::size_t seg = 0; seg < segments.size(); ++seg) {
+    if (seg > 0) c.mark_gap();
+    const auto& v = segments[seg];
+    for (std::size_t k = 0; k < v.size();) {
+      if (blocks == nullptr) {
+        c.add_increment(v[k++]);
+        (void)c.result(0);
+        continue;
+      }
+      const std::size_t len = std::min<std::size_t>(v.size() - k, (*blocks)() % 300);
+      c.add_increments(std::span<const std::int32_t>(v.data() + k, len));
+      k += len;
+    }
+  }
+}
+
+class BlockKernelProperty : public ::testing::TestWithParam<std::uint32_t> {};
+
+TEST_P(BlockKernelProperty, AnyBlocksEqualOnePointAtATimeAndBruteForce) {
+  const std::uint32_t s = GetParam();
+  const auto m_list = taus_for(s);
+  std::mt19937_64 rng(77 + s);
+  for (int trial = 0; trial < 3; ++trial) {
+    // Small noise on a large rate (64-bit partial sums), then swings near the int32 limits (terms
+    // beyond 2^31: the 128-bit path), in three segments.
+    std::vector<std::vector<std::int32_t>> segments;
+    for (int seg = 0; seg < 3; ++seg) {
+      std::vector<std::int32_t> v(500 + rng() % 2500);
+      for (auto& c : v) {
+        const bool wide = trial == 2 || (trial == 1 && seg == 1);
+        c = wide ? static_cast<std::int32_t>(rng() % 4294967295u - 2147483647u) : 1000000 + static_cast<std::int32_t>(rng() % 64);
+      }
+      segments.push_back(v);
+    }
+    Heap blocks(s, m_list), single(s, m_list);
+    feed(blocks.c, segments, &rng);
+    feed(single.c, segments, nullptr);
+    for (std::size_t i = 0; i < m_list.size(); ++i) {
+      const std::uint64_t m = m_list[i];
+      Exact want, decimated;
+      std::uint64_t start = 0;
+      for (const auto& v : segments) {
+        std::vector<std::int64_t> x{0};
+        for (const std::int32_t c : v) x.push_back(x.back() + c);
+        want += brute_force(x, m, blocks.c.result(i).stride, false, start);
+        decimated += brute_force(x, m, 1, true, start);
+        start += x.size();
+      }
+      const auto got = blocks.c.result(i), one = single.c.result(i);
+      for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_EQ(got.n[k], want.n[k]) << "S=" << s << " m=" << m << " stat " << k;
+        EXPECT_TRUE(to_u128(got.sum[k]) == want.sum[k]) << "S=" << s << " m=" << m << " stat " << k;
+      }
+      const auto avar = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
+      const auto hvar = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
+      EXPECT_TRUE(to_u128(got.sum[avar]) == decimated.sum[0] && got.n[avar] == decimated.n[0]) << "m=" << m;
+      EXPECT_TRUE(to_u128(got.sum[hvar]) == decimated.sum[2] && got.n[hvar] == decimated.n[2]) << "m=" << m;
+      for (std::size_t k = 0; k < sum_kinds; ++k) {
+        EXPECT_TRUE(got.sum[k] == one.sum[k] && got.n[k] == one.n[k]) << "m=" << m << " kind " << k;
+      }
+      EXPECT_EQ(got.out_of_range, 0u);
+      EXPECT_FALSE(got.sum_overflow);
+      for (int d = 0; d < 4; ++d) {
+        const Lag1Sums a = blocks.c.noise(i).order(d), b = single.c.noise(i).order(d);
+        EXPECT_TRUE(a.n == b.n && a.pairs == b.pairs && a.sum == b.sum && a.sum_sq == b.sum_sq && a.sum_lag == b.sum_lag &&
+                    a.sum_left == b.sum_left && a.sum_right == b.sum_right)
+            << "m=" << m << " order " << d;
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(StrideFactors, BlockKernelProperty, ::testing::Values(2u, 4u, 8u, 16u, 64u, 256u));
+
+TEST(BlockKernel, PartialSumsAreExactOnlyWhenTheBoundProvesIt) {
+  // n = 64 terms of magnitude v: the 64-bit partial sum of squares equals the exact sum (oracle:
+  // 128-bit products) whenever squares_exact() says so; at 2^29 = v the bound (2*30 + 7 > 64)
+  // refuses, and at 2^29 + 1 the partial sum has indeed wrapped.
+  for (const std::int64_t v : {std::int64_t{1}, std::int64_t{12345}, (std::int64_t{1} << 28) - 1, std::int64_t{1} << 29,
+                               (std::int64_t{1} << 29) + 1, std::int64_t{1} << 40}) {
+    constexpr std::size_t n = 64;
+    std::vector<std::int64_t> x0(n), x1(n, 0), x2(n, 0), x3(n, 0), a(n), h(n), t(n);
+    std::vector<std::uint64_t> p(n, 0);
+    for (std::size_t j = 0; j < n; ++j) x0[j] = j % 2 ? v : -v;  // AVAR term x0 - 2 x1 + x2 = +-v
+    const BlockTerms terms = block_terms(n, x0.data(), x1.data(), x2.data(), x3.data(), p.data(), p.data(), p.data(),
+                                         p.data(), a.data(), h.data(), t.data());
+    u128 exact = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      EXPECT_EQ(a[j], x0[j]);
+      exact += static_cast<u128>(static_cast<__int128>(a[j]) * a[j]);
+    }
+    const bool proved = squares_exact(terms.avar, n);
+    EXPECT_EQ(proved, v < (std::int64_t{1} << 29)) << v;
+    if (proved) {
+      EXPECT_TRUE(u128{terms.avar.sum} == exact) << v;
+    }
+    if (v == (std::int64_t{1} << 29) + 1) {
+      EXPECT_FALSE(u128{terms.avar.sum} == exact);
+    }
+  }
+}
+
+TEST(BlockKernel, LevelZeroTausBeyondTwoToTheFifteenAreCheckedByTheIncrementRange) {
+  // Fully overlapped (S = m = 2^17, level 0). Counts within a narrow range keep every term
+  // provably in int64: the kernel forms them all, equal to brute force. Swings of +-(2^31-1) over
+  // m counts make MVAR terms of about 2 m^2 2^31 = 2^66: the checked path counts them out of range
+  // instead (oracle: that magnitude bound), while AVAR terms (2^50) stay exact.
+  const std::uint64_t m = std::uint64_t{1} << 17;
+  const std::vector<std::uint64_t> m_list{1, m};
+  {
+    Heap h(1u << 17, m_list);
+    std::vector<std::int64_t> x{0};
+    std::mt19937_64 rng(3);
+    for (std::uint64_t k = 0; k < 4 * m; ++k) {
+      const auto c = static_cast<std::int32_t>(rng() % 1000);
+      h.c.add_increment(c);
+      x.push_back(x.back() + c);
+    }
+    const Exact want = brute_force(x, m, 1);
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_TRUE(to_u128(h.c.result(1).sum[k]) == want.sum[k] && h.c.result(1).n[k] == want.n[k]);
+  }
+  Heap h(1u << 17, m_list);
+  const std::int32_t v = 2147483647;
+  for (int block = 0; block < 4; ++block)
+    for (std::uint64_t k = 0; k < m; ++k) h.c.add_increment(block % 2 == 0 ? v : -v);
+  EXPECT_GT(h.c.result(1).out_of_range, 0u);
+  EXPECT_EQ(h.c.result(1).n[1] + h.c.result(1).out_of_range, 4 * m + 1 - 3 * m + 1);
+  EXPECT_EQ(h.c.result(1).n[0], 4 * m + 1 - 2 * m);
+}
+
+}  // namespace
+}  // namespace gyrochar
