@@ -471,6 +471,11 @@ void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms
     p.uncertainty = p.value > 0 ? sd / (2 * p.value) : std::sqrt(sd);
     if (!p.fitted || !(theta > 2 * sd)) continue;
     for (std::size_t i = 0; i < pr.n && !p.resolved; ++i) {  // the largest contribution somewhere
+      // The ramp's response is modeled exactly for Allan and modified Allan estimates only: a
+      // total-family point answers a ramp otherwise (TOTVAR's reflection, TheoBR's ratio), so R is
+      // never resolved on one (the recovery study found it resolved there but off by more than
+      // two sigma).
+      if (t == 4 && pr.point[i]->variance_scale != 1) continue;
       const double mine = theta * pr.row(i)[t];
       bool largest = true;
       for (std::size_t u = 0; u < terms; ++u)

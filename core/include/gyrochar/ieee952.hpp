@@ -29,7 +29,9 @@
 // chi2/dof > 1 every uncertainty is scaled by sqrt(chi2/dof) (the Birge ratio), and where the model
 // is rejected outright (chi2/dof > 2 with a p-value below 1e-4) the fit says so (status).
 // A term is "resolved" when it is fitted, its square lies more than two standard uncertainties
-// above zero, and it is the largest of the five contributions at one of the taus used at least.
+// above zero, and it is the largest of the five contributions at one of the taus used at least (for R,
+// at the tau of an Allan or modified Allan point: a total-family point's expectation takes AVAR's
+// ramp response, which is not its own).
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
 // A steady rate without dither (and with too little random angle per sample to spread it) makes a
