@@ -31,16 +31,20 @@ namespace {
 constexpr std::size_t terms = 5;    // Q N B K R
 constexpr std::size_t noises = 4;   // Q N B K: the random ones
 constexpr std::array<int, noises> alphas{2, 0, -1, -2};  // Q N B K
-// Two estimates keep a noise's part of their covariance where double precision evaluates it: its
-// correlation known to this (pair_sums_rounding()). Far apart, the closed forms of the flicker and
-// random-walk FM sums are differences of nearly equal huge numbers (from about six octaves between
-// a modified Allan estimate and a longer one, from about sixteen between two Allan estimates) and
-// their correlations are small (random-walk FM, the slowest to decay: 0.04 between the modified
-// Allan estimate at 512 tau0 and the Allan one at 2^19 tau0 of 4.3e6 points, by an exact
-// computation without the closed forms). White PM is exact at any distance and need not decay:
-// fully overlapped Allan estimates share the sum of x^2 and stay correlated by about 0.24 across
-// every tau up to the stride factor.
-constexpr double covariance_rounding_kept = 1e-3;
+// Two estimates keep a noise's part of their covariance when they lie at most band_octaves apart
+// and double precision evaluates it: pair_sums_rounding() bounds the rounding of its correlation
+// at covariance_rounding_kept. Far apart, the closed forms of the flicker and random-walk FM sums
+// are differences of nearly equal huge numbers (on a 120 h record at tau0 0.1 s the random-walk FM
+// sum of the modified Allan estimate at 512 tau0 and the Allan one at 2^19 tau0, ten octaves
+// apart, came out wrong by more than its value, and the matrix indefinite: the fit was singular);
+// their correlations there are small (0.04 for that pair, by an exact computation without the
+// closed forms). The bound is loose (typically far above the actual error): at 1e-3 it dropped
+// accurate parts of neighbouring estimates and the fit of short records was rejected where it had
+// been fine, so only parts it cannot vouch for to 0.1 go. White PM is exact at any distance and
+// need not decay: fully overlapped Allan estimates share the sum of x^2 and stay correlated by
+// about 0.24 across every tau up to the stride factor; it is always kept.
+constexpr double covariance_rounding_kept = 0.1;
+constexpr int band_octaves = 10;
 constexpr double quantization_left_out = 0.01;  // share of a point that makes it unusable (non-white)
 
 // Innovation variance of term t per unit squared parameter: tau0^k.
@@ -62,6 +66,8 @@ std::array<double, terms> design(Stat s, std::uint64_t m, double tau0) {
   x[4] = tau * tau / 2;
   return x;
 }
+
+int octave(std::uint64_t m) { return 63 - __builtin_clzll(m); }
 
 // In-place Cholesky of the n x n matrix a (row-major, lower triangle used). False when not positive
 // definite.
@@ -413,7 +419,10 @@ void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms
       const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, setup.n_phase);
       const PairSums s = cache ? cache->get(ga, gb) : pair_sums(allan_noises(), ga, gb);
       std::array<bool, noises> kept{};
-      for (std::size_t t = 0; t < noises; ++t) kept[t] = pair_sums_rounding(alphas[t], ga, gb) <= covariance_rounding_kept;
+      const int apart = octave(a.m) - octave(b.m);
+      const bool near = apart <= band_octaves && apart >= -band_octaves;
+      for (std::size_t t = 0; t < noises; ++t)
+        kept[t] = t == 0 || (near && pair_sums_rounding(alphas[t], ga, gb) <= covariance_rounding_kept);
       for (std::size_t t = 0; t < noises; ++t) {
         if (!kept[t]) continue;
         for (std::size_t u = 0; u <= t; ++u)

@@ -20,10 +20,11 @@
 // one under the current parameters plus, on the diagonal, (model_spread x point)^2, 0.1 % by
 // default: the model is an idealization, and where a point's own sampling error is far below that
 // (short taus, EDF 10^6) it would otherwise weigh in with a precision no model has; it also keeps
-// the covariance of AVAR and MVAR at one tau, correlated up to 0.99, well conditioned. Two
-// estimates keep a noise's part of their covariance only where double precision evaluates it
-// (pair_sums_rounding(); far apart, the flicker and random-walk FM parts are small and their closed
-// forms cancel to nothing: ieee952.cpp says more). As the covariance depends on the parameters, the fit iterates: covariance from the current parameters, then the
+// the covariance of AVAR and MVAR at one tau, correlated up to 0.99, well conditioned. Estimates
+// more than 10 octaves apart keep only the white PM part of their covariance, nearer ones the
+// parts double precision evaluates (pair_sums_rounding(); far apart, the flicker and random-walk
+// FM parts are small and their closed forms cancel to nothing: ieee952.cpp says more). As the
+// covariance depends on the parameters, the fit iterates: covariance from the current parameters, then the
 // non-negative generalized least-squares solution (every subset of terms is tried, the best
 // feasible one kept; a term left out is "not fitted"). chi2 is the generalized residual; where
 // chi2/dof > 1 every uncertainty is scaled by sqrt(chi2/dof) (the Birge ratio), and where the model
