@@ -204,8 +204,8 @@ double exact_correlation(int alpha, Stat sa, std::uint64_t ma, Stat sb, std::uin
 }
 
 TEST(NoiseModel, TheRoundingEstimateSaysWhereTheClosedFormsLoseTheirDigits) {
-  // Oracle: exact_correlation() above. Where pair_sums_rounding() is at most 1e-3 (what the
-  // IEEE-952 fit keeps), pair_sums() gives the correlation within 1e-3; a modified Allan term far
+  // Oracle: exact_correlation() above. Where pair_sums_rounding() is at most 1e-3, pair_sums()
+  // gives the correlation within 1e-3 (the bound holds); a modified Allan term far
   // shorter than an Allan one (the fit of a 120 h record at tau0 0.1 s) is where it is not, and
   // there the closed form has no correct digit left.
   NoiseSet set;
