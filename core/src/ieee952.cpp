@@ -31,11 +31,19 @@ namespace {
 constexpr std::size_t terms = 5;    // Q N B K R
 constexpr std::size_t noises = 4;   // Q N B K: the random ones
 constexpr std::array<int, noises> alphas{2, 0, -1, -2};  // Q N B K
-// Estimates further apart keep only the white PM part of their covariance. It is exact at any
-// distance and need not decay: fully overlapped Allan estimates share the sum of x^2 and stay
-// correlated by about 0.5 across every tau up to the stride factor. The other noises' correlations
-// fall below 0.02 there (random-walk FM decays slowest, by about 0.7 an octave), and further apart
-// their sums could no longer be evaluated accurately (a difference of nearly equal huge numbers).
+// Two estimates keep a noise's part of their covariance when they lie at most band_octaves apart
+// and double precision evaluates it: pair_sums_rounding() bounds the rounding of its correlation
+// at covariance_rounding_kept. Far apart, the closed forms of the flicker and random-walk FM sums
+// are differences of nearly equal huge numbers (on a 120 h record at tau0 0.1 s the random-walk FM
+// sum of the modified Allan estimate at 512 tau0 and the Allan one at 2^19 tau0, ten octaves
+// apart, came out wrong by more than its value, and the matrix indefinite: the fit was singular);
+// their correlations there are small (0.04 for that pair, by an exact computation without the
+// closed forms). The bound is loose (typically far above the actual error): at 1e-3 it dropped
+// accurate parts of neighbouring estimates and the fit of short records was rejected where it had
+// been fine, so only parts it cannot vouch for to 0.1 go. White PM is exact at any distance and
+// need not decay: fully overlapped Allan estimates share the sum of x^2 and stay correlated by
+// about 0.24 across every tau up to the stride factor; it is always kept.
+constexpr double covariance_rounding_kept = 0.1;
 constexpr int band_octaves = 10;
 constexpr double quantization_left_out = 0.01;  // share of a point that makes it unusable (non-white)
 
@@ -186,7 +194,7 @@ void covariance_of_points(const Problem& pr, const std::array<double, terms>& th
   }
 }
 
-// Factors Sigma; where the band cut leaves it indefinite, raises its diagonal by the least relative
+// Factors Sigma; where the covariance parts left out leave it indefinite, raises its diagonal by the least relative
 // amount that makes it definite (from 1e-6, doubling): the points then weigh a little less, their
 // correlations are kept.
 bool factor(const Problem& pr) {
@@ -395,7 +403,7 @@ void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms
   pr.sigma = pr.pair + pr.n * (pr.n + 1) / 2 * 14;
   pr.rows = pr.sigma + pr.n * pr.n;
 
-  // The pair sums of every two points within the band: they depend on the geometry only. Of the
+  // The pair sums of every two points: they depend on the geometry only. Of the
   // five Allan noises (index 2 - alpha) the model has four.
   constexpr std::array<std::size_t, noises> allan_index{0, 2, 3, 4};
   for (std::size_t i = 0; i < pr.n; ++i) {
@@ -408,14 +416,17 @@ void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms
       const FitPoint& b = *pr.point[j];
       double* g = pr.pair_at(i, j);
       for (std::size_t k = 0; k < 14; ++k) g[k] = 0;
-      const int apart = octave(a.m) - octave(b.m);
-      const bool far = apart > band_octaves || apart < -band_octaves;
       const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, setup.n_phase);
-      NoiseSet white_pm = allan_noises();
-      white_pm.count = 1;
-      const PairSums s = cache ? cache->get(ga, gb, far) : pair_sums(far ? white_pm : allan_noises(), ga, gb);
+      const PairSums s = cache ? cache->get(ga, gb) : pair_sums(allan_noises(), ga, gb);
+      std::array<bool, noises> kept{};
+      const int apart = octave(a.m) - octave(b.m);
+      const bool near = apart <= band_octaves && apart >= -band_octaves;
+      for (std::size_t t = 0; t < noises; ++t)
+        kept[t] = t == 0 || (near && pair_sums_rounding(alphas[t], ga, gb) <= covariance_rounding_kept);
       for (std::size_t t = 0; t < noises; ++t) {
-        for (std::size_t u = 0; u <= t; ++u) g[cc_index(t, u)] = s.cc[allan_index[t]][allan_index[u]];
+        if (!kept[t]) continue;
+        for (std::size_t u = 0; u <= t; ++u)
+          if (kept[u]) g[cc_index(t, u)] = s.cc[allan_index[t]][allan_index[u]];
         g[10 + t] = s.c[allan_index[t]];
       }
     }
@@ -469,6 +480,11 @@ void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms
     p.uncertainty = p.value > 0 ? sd / (2 * p.value) : std::sqrt(sd);
     if (!p.fitted || !(theta > 2 * sd)) continue;
     for (std::size_t i = 0; i < pr.n && !p.resolved; ++i) {  // the largest contribution somewhere
+      // The ramp's response is modeled exactly for Allan and modified Allan estimates only: a
+      // total-family point answers a ramp otherwise (TOTVAR's reflection, TheoBR's ratio), so R is
+      // never resolved on one (the recovery study found it resolved there but off by more than
+      // two sigma).
+      if (t == 4 && pr.point[i]->variance_scale != 1) continue;
       const double mine = theta * pr.row(i)[t];
       bool largest = true;
       for (std::size_t u = 0; u < terms; ++u)

@@ -373,6 +373,33 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
   return out;
 }
 
+double pair_sums_rounding(int alpha, const TermGrid& a, const TermGrid& b) {
+  if (!noise_supported(a.stat, alpha) || !noise_supported(b.stat, alpha)) return 0.0;
+  const Kernel k = kernel(a.stat, a.m, b.stat, b.m);
+  const int twice_d = 2 - alpha + 2 * k.level;
+  // The widest argument of R that pair_sums() evaluates: the kernel's span, and for flicker noises
+  // the tails summed directly out to three kernel widths beyond it.
+  const std::int64_t width = k.u_max() - k.u_min() + 1;
+  const std::int64_t widest = twice_d % 2 != 0 ? 4 * width : width;
+  double weights = 0;
+  for (int i = 0; i < k.count; ++i) weights += std::fabs(k.w[static_cast<std::size_t>(i)]);
+  const double r_max = std::fmax(std::fabs(generalized_autocovariance(twice_d, widest)),
+                                 std::fabs(generalized_autocovariance(twice_d, 0)));
+  // Error of one c(lag) (a sum of k.count products, R itself good to a few ulps), relative to
+  // the terms' own standard deviations.
+  constexpr double ulp = 2.220446049250313e-16;
+  const double sd = std::sqrt(term_covariance(alpha, a.stat, a.m, a.stat, a.m, 0) *
+                              term_covariance(alpha, b.stat, b.m, b.stat, b.m, 0));
+  if (!(sd > 0)) return 0.0;
+  const double delta = 16 * ulp * weights * r_max / sd;
+  // sum c^2 over the pairs at about `width` lags, against sqrt(sum c_a^2 sum c_b^2) over the
+  // estimates' own reaches: |c| <= sd, so the correlation moves by at most (2 delta + delta^2)
+  // times width / sqrt(width_a width_b).
+  const Kernel ka = kernel(a.stat, a.m, a.stat, a.m), kb = kernel(b.stat, b.m, b.stat, b.m);
+  const double wa = static_cast<double>(ka.u_max() - ka.u_min() + 1), wb = static_cast<double>(kb.u_max() - kb.u_min() + 1);
+  return (2 * delta + delta * delta) * static_cast<double>(widest) / std::sqrt(wa * wb);
+}
+
 double exact_skew_dof(int alpha, const TermGrid& g) {
   if (g.n == 0 || !noise_supported(g.stat, alpha)) return 0.0;
   const Kernel k = kernel(g.stat, g.m, g.stat, g.m);
@@ -452,17 +479,16 @@ void add_scaled(PairSums& out, const PairSums& a, double k, const PairSums& b) {
 
 }  // namespace
 
-PairSumCache::Entry* PairSumCache::slot(const TermGrid& a, const TermGrid& b, bool white_pm_only) {
+PairSumCache::Entry* PairSumCache::slot(const TermGrid& a, const TermGrid& b) {
   if (entries_.empty() || a.stat == Stat::hvar || b.stat == Stat::hvar) return nullptr;
   // Open addressing on the grids' shape.
   std::uint64_t h = (a.m * 0x9E3779B97F4A7C15u) ^ (b.m * 0xC2B2AE3D27D4EB4Fu) ^ (a.stride << 7) ^ (b.stride << 13) ^
-                    (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5) ^
-                    (white_pm_only ? 0x5555u : 0u);
+                    (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5);
   Entry* entry = nullptr;
   for (std::size_t probe = 0; probe < entries_.size(); ++probe) {
     Entry& e = entries_[static_cast<std::size_t>((h + probe) % entries_.size())];
     if (!e.used || (e.stat_a == a.stat && e.stat_b == b.stat && e.m_a == a.m && e.m_b == b.m &&
-                    e.stride_a == a.stride && e.stride_b == b.stride && e.white_pm_only == white_pm_only)) {
+                    e.stride_a == a.stride && e.stride_b == b.stride)) {
       entry = &e;
       break;
     }
@@ -471,7 +497,7 @@ PairSumCache::Entry* PairSumCache::slot(const TermGrid& a, const TermGrid& b, bo
 }
 
 void PairSumCache::put(const TermGrid& a, const TermGrid& b, const PairSums& sums) {
-  Entry* entry = slot(a, b, false);
+  Entry* entry = slot(a, b);
   if (entry == nullptr) return;
   *entry = Entry{};
   entry->used = true;
@@ -482,10 +508,9 @@ void PairSumCache::put(const TermGrid& a, const TermGrid& b, const PairSums& sum
   entry->sums = sums;
 }
 
-PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b, bool white_pm_only) {
-  NoiseSet set = allan_noises();
-  if (white_pm_only) set.count = 1;  // alpha = 2 comes first
-  Entry* entry = slot(a, b, white_pm_only);
+PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b) {
+  const NoiseSet set = allan_noises();
+  Entry* entry = slot(a, b);
   if (entry == nullptr) return pair_sums(set, a, b);  // hvar, or full
   const bool a_coarse = a.stride >= b.stride;
   const std::uint64_t n = a_coarse ? a.n : b.n;
@@ -509,7 +534,6 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b, bool white_pm_o
   entry->used = true;
   entry->stat_a = a.stat, entry->stat_b = b.stat, entry->m_a = a.m, entry->m_b = b.m;
   entry->stride_a = a.stride, entry->stride_b = b.stride;
-  entry->white_pm_only = white_pm_only;
   // Linear once the coarse grid spans the terms' reach 8 times over: the flicker tails (summed
   // out to the lags that have pairs) then change by less than 1e-4 of the sums.
   const std::uint64_t coarse = a_coarse ? a.stride : b.stride;

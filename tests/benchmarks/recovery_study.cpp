@@ -51,15 +51,20 @@ standard uncertainties; and runs where a term whose truth is zero is resolved ("
 Examples:
   recovery_study                 the full study (100 runs per scenario)
   recovery_study --runs 20       a quick look
-  recovery_study --only long-run the long-run scenarios alone)");
+  recovery_study --only long-run the long-run scenarios alone
+  recovery_study --except long-run every other scenario)");
   RecoverySettings s;
   app.add_option("--runs", s.runs, "runs per scenario")->capture_default_str()->check(CLI::Range(1, 100000));
   app.add_option("--workers", s.workers, "threads")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--seed", s.seed, "base seed (runs are reproducible)")->capture_default_str();
   std::string only;
   app.add_option("--only", only, "run only the scenarios whose name contains this text");
+  std::string except;
+  app.add_option("--except", except, "leave out the scenarios whose name contains this text");
   CLI11_PARSE(app, argc, argv);
-  std::erase_if(s.scenarios, [&](const Scenario& sc) { return sc.name.find(only) == std::string::npos; });
+  std::erase_if(s.scenarios, [&](const Scenario& sc) {
+    return sc.name.find(only) == std::string::npos || (!except.empty() && sc.name.find(except) != std::string::npos);
+  });
 
   const auto start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();

@@ -54,6 +54,30 @@ TEST(Ieee952, ExactCurvesGiveTheirParametersBack) {
   }
 }
 
+TEST(Ieee952, ExactCurvesOfA120HourRunGiveTheirParametersBack) {
+  // Oracle: the model itself, on the geometry of a 120 h record at tau0 0.1 s (fully overlapped
+  // octave taus, 42 points over 21 octaves): the long-run gyro of the recovery study (Q 1.041
+  // arcsec, N 0.002 deg/sqrt(h), B 0.02 deg/h, K 0.05 deg/h/sqrt(h), R 0.01 deg/h/h, in rad and s).
+  // The fit of both curves was singular here: the closed-form random-walk and flicker FM
+  // covariances of a short modified Allan estimate and a long Allan one had no correct digit left.
+  constexpr double tau0_long = 0.1;
+  constexpr std::uint64_t n_long = 4320001;
+  const std::array<double, 5> p{5.047e-6, 5.818e-7, 9.696e-8, 4.040e-9, 1.347e-11};
+  std::vector<FitPoint> pts;
+  for (std::uint64_t m = 1; 2 * m < n_long; m *= 2)
+    for (Stat s : {Stat::avar, Stat::mvar})
+      if (s == Stat::avar || 3 * m < n_long)
+        pts.push_back({s, m, 1, unbroken_grid(s, m, 1, n_long).n, ieee952_variance(p, s, m, tau0_long), 0});
+  ASSERT_EQ(pts.size(), 43u);  // 42 once the modified Allan point at m = 1 is dropped
+  for (FitCurve c : {FitCurve::both, FitCurve::avar, FitCurve::mvar}) {
+    std::vector<double> workspace(ieee952_workspace_doubles(pts.size()));
+    const Ieee952Fit f = fit_ieee952(pts, {tau0_long, n_long, 0}, c, workspace);
+    ASSERT_TRUE(f.ok()) << name(c) << ": " << name(f.status);
+    EXPECT_LT(f.chi2, 1e-12) << name(c);
+    for (std::size_t k = 0; k < 5; ++k) EXPECT_NEAR(f.p[k].value / p[k], 1.0, 1e-6) << name(c) << " term " << k;
+  }
+}
+
 TEST(Ieee952, ATotalFamilyPointWeighsWithItsOwnVariance) {
   // Oracle: with no model spread and exact points (chi2 = 0), the covariance of the points scales
   // by variance_scale, so every uncertainty scales by its square root.

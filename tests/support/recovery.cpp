@@ -102,11 +102,9 @@ Recovery recover(const SimOptions& sim, bool long_tau) {
   units.phase_unit_si = sim.pulse_arcsec * units::arcsec;
   const Analysis analysis = analyzer.result();
   const double qw = units.phase_unit_si / std::sqrt(12.0);
-  // The recommended fit of both curves, once per input (fit_curves() would make all three). The
-  // long-run scenarios compare the Allan curve alone, where the total family stands in: the fit of
-  // both curves is singular on 120 h records (42 points; the Allan and modified Allan fits alone
-  // are not), a limit of the fit found here and not yet fixed.
-  const FitCurve curve = long_tau ? FitCurve::avar : FitCurve::both;
+  // The recommended fit of both curves, once per input (fit_curves() would make all three); in the
+  // long-run scenarios the total family stands in for the Allan curve's long taus.
+  const FitCurve curve = FitCurve::both;
   auto fit = [&](LongTau input) {
     const std::vector<FitPoint> points = fit_points(analysis, units, sim.tau0_s, input, analyzer.record());
     std::vector<double> workspace(ieee952_workspace_doubles(points.size()));

@@ -11,7 +11,7 @@
 // OADEV on the Allan curve (docs/total.md, docs/metrology.md): TOTDEV, bias-corrected, wherever
 // SP 1065's EDF for it exceeds the OADEV estimate's; and TheoH: OADEV below its switch point k,
 // TheoBR points (Theo1 times the data's bias ratio) from tau = 1.5 k on, as far as an Allan
-// geometry exists (tau <= T/2). These scenarios fit the Allan curve alone (recovery.cpp says why).
+// geometry exists (tau <= T/2). Every fit is the recommended one of both curves.
 #include <array>
 #include <cstdint>
 #include <functional>

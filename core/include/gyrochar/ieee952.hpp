@@ -21,14 +21,18 @@
 // default: the model is an idealization, and where a point's own sampling error is far below that
 // (short taus, EDF 10^6) it would otherwise weigh in with a precision no model has; it also keeps
 // the covariance of AVAR and MVAR at one tau, correlated up to 0.99, well conditioned. Estimates
-// more than 10 octaves apart keep only the white PM part of their covariance (ieee952.cpp says
-// why). As the covariance depends on the parameters, the fit iterates: covariance from the current parameters, then the
+// more than 10 octaves apart keep only the white PM part of their covariance, nearer ones the
+// parts double precision evaluates (pair_sums_rounding(); far apart, the flicker and random-walk
+// FM parts are small and their closed forms cancel to nothing: ieee952.cpp says more). As the
+// covariance depends on the parameters, the fit iterates: covariance from the current parameters, then the
 // non-negative generalized least-squares solution (every subset of terms is tried, the best
 // feasible one kept; a term left out is "not fitted"). chi2 is the generalized residual; where
 // chi2/dof > 1 every uncertainty is scaled by sqrt(chi2/dof) (the Birge ratio), and where the model
 // is rejected outright (chi2/dof > 2 with a p-value below 1e-4) the fit says so (status).
 // A term is "resolved" when it is fitted, its square lies more than two standard uncertainties
-// above zero, and it is the largest of the five contributions at one of the taus used at least.
+// above zero, and it is the largest of the five contributions at one of the taus used at least (for R,
+// at the tau of an Allan or modified Allan point: a total-family point's expectation takes AVAR's
+// ramp response, which is not its own).
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
 // A steady rate without dither (and with too little random angle per sample to spread it) makes a

@@ -86,6 +86,15 @@ struct PairSums {
 };
 PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b);
 
+/// How far the correlation of the estimates over grids a and b under noise alpha, as pair_sums()
+/// computes it in double precision, can be off through rounding (a bound, typically far above the
+/// actual error). The closed forms of c are sums of R at arguments as wide as the kernel, nearly
+/// cancelling where one term is much shorter than the other: R grows as |k|^(2d - 1) (to |k|^5
+/// for random-walk FM paired with a modified Allan term), so a modified Allan estimate ten octaves
+/// below an Allan one has no correct digit left under random-walk and flicker FM. 0 when the
+/// statistic does not converge for alpha. O(1).
+double pair_sums_rounding(int alpha, const TermGrid& a, const TermGrid& b);
+
 /// EDF of the estimate over `grid` for pure noise alpha: (n c(0))^2 / sum_{i,j} c(e_i - e_j)^2.
 /// 0 when the statistic does not converge for alpha or the grid has no term. See pair_sums().
 double exact_edf(int alpha, const TermGrid& grid);
@@ -120,7 +129,6 @@ class PairSumCache {
   struct Entry {
     bool used = false;
     bool linear = false;
-    bool white_pm_only = false;
     Stat stat_a = Stat::avar, stat_b = Stat::avar;
     std::uint64_t m_a = 0, m_b = 0, stride_a = 0, stride_b = 0;
     std::uint64_t from = 0;         // linear: valid from this many coarse terms
@@ -128,10 +136,8 @@ class PairSumCache {
     PairSums slope, sums;           // linear: sums = slope * n + sums (the intercept)
   };
   explicit PairSumCache(std::span<Entry> storage) : entries_(storage) {}
-  /// pair_sums(allan_noises(), a, b), from the cache where it can. O(1) once cached. With
-  /// white_pm_only, the sums of white PM alone (the other noises left 0): what the fit keeps of
-  /// estimates far apart.
-  PairSums get(const TermGrid& a, const TermGrid& b, bool white_pm_only = false);
+  /// pair_sums(allan_noises(), a, b), from the cache where it can. O(1) once cached.
+  PairSums get(const TermGrid& a, const TermGrid& b);
   /// Remembers `sums` as those of grids a and b (Allan and modified Allan), for get() to return
   /// while neither grid grows (the analyzer's interpolated sums of dense taus). Ignored when the
   /// table is full. O(1) expected.
@@ -140,7 +146,7 @@ class PairSumCache {
   void clear();
 
  private:
-  Entry* slot(const TermGrid& a, const TermGrid& b, bool white_pm_only);  // null: not kept
+  Entry* slot(const TermGrid& a, const TermGrid& b);  // null: not kept
   std::span<Entry> entries_;
 };
 
