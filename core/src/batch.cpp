@@ -3,6 +3,11 @@
 
 #include <bit>
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#include <immintrin.h>
+#define GYROCHAR_BATCH_AVX2 1
+#endif
+
 namespace gyrochar {
 namespace {
 
@@ -111,6 +116,89 @@ inline void add_selected(Totals& tot, int k, const std::int64_t* v, std::size_t 
   return c3;
 }
 
+// All three terms of a chunk of int32 residuals (s >= 3m), as avar_hvar() and running_sum() form
+// them, in AVX2 by hand: the compiler's vectorization of the squares packs and unpacks the low
+// halves, where one signed 32x32->64 multiply (vpmuldq) per four terms suffices. The x86-64
+// host's offline analyzer spends most of its time here. Chosen at run time (has_avx2()).
+#ifdef GYROCHAR_BATCH_AVX2
+struct ChunkSquares3 {
+  Squares a, h, t;
+};
+[[gnu::target("avx2")]] inline void accumulate(__m256i v, __m256i& bound, __m256i& sum) {
+  const __m256i sign = _mm256_cmpgt_epi64(_mm256_setzero_si256(), v);
+  bound = _mm256_or_si256(bound, _mm256_xor_si256(v, sign));
+  sum = _mm256_add_epi64(sum, _mm256_mul_epi32(v, v));
+}
+[[gnu::target("avx2")]] inline Squares reduce(__m256i bound, __m256i sum) {
+  alignas(32) std::uint64_t b[4], q[4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(b), bound);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(q), sum);
+  return {b[0] | b[1] | b[2] | b[3], q[0] + q[1] + q[2] + q[3]};
+}
+[[gnu::target("avx2")]] inline __m256i load4(const std::int32_t* p) {
+  return _mm256_cvtepi32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+}
+[[gnu::target("avx2")]] ChunkSquares3 all_terms_avx2(const std::int32_t* x0, std::size_t m, std::size_t n,
+                                                     std::int64_t* a, std::int64_t* h, std::int64_t* t,
+                                                     std::uint64_t& previous) {
+  const std::size_t n4 = n / 4 * 4;
+  __m256i ba = _mm256_setzero_si256(), sa = ba, bh = ba, sh = ba, bt = ba, st = ba;
+  for (std::size_t j = 0; j < n4; j += 4) {
+    const __m256i u0 = load4(x0 + j), u1 = load4(x0 + j - m), u2 = load4(x0 + j - 2 * m), u3 = load4(x0 + j - 3 * m);
+    const __m256i d2 = _mm256_sub_epi64(u1, u2);
+    const __m256i av = _mm256_sub_epi64(_mm256_sub_epi64(u0, u1), d2);
+    const __m256i hv = _mm256_sub_epi64(av, _mm256_sub_epi64(d2, _mm256_sub_epi64(u2, u3)));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(a + j), av);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(h + j), hv);
+    accumulate(av, ba, sa);
+    accumulate(hv, bh, sh);
+  }
+  ChunkSquares3 sq{reduce(ba, sa), reduce(bh, sh), {}};
+  for (std::size_t j = n4; j < n; ++j) {  // the tail, as avar_hvar()
+    const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
+    const std::uint64_t d2 = u1 - u2;
+    a[j] = static_cast<std::int64_t>((u0 - u1) - d2);
+    h[j] = static_cast<std::int64_t>(static_cast<std::uint64_t>(a[j]) - (d2 - (u2 - word(x0[j - 3 * m]))));
+    sq.a.add(a[j]);
+    sq.h.add(h[j]);
+  }
+  // MVAR: t[j] = t[j-4] + (h[j] + h[j-1] + h[j-2] + h[j-3]), four terms a step.
+  std::uint64_t c = previous;
+  const std::size_t head = n < 4 ? n : 4;
+  for (std::size_t j = 0; j < head; ++j) {
+    c += static_cast<std::uint64_t>(h[j]);
+    t[j] = static_cast<std::int64_t>(c);
+    sq.t.add(t[j]);
+  }
+  if (n >= 8) {
+    __m256i tv = _mm256_load_si256(reinterpret_cast<const __m256i*>(t));
+    for (std::size_t j = 4; j < n4; j += 4) {
+      const auto* hj = reinterpret_cast<const __m256i*>(h + j);
+      const __m256i w = _mm256_add_epi64(
+          _mm256_add_epi64(_mm256_load_si256(hj), _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h + j - 1))),
+          _mm256_add_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(h + j - 2)),
+                           _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h + j - 3))));
+      tv = _mm256_add_epi64(tv, w);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(t + j), tv);
+      accumulate(tv, bt, st);
+    }
+  }
+  const Squares vt = reduce(bt, st);
+  sq.t.bound |= vt.bound;
+  sq.t.sum += vt.sum;
+  for (std::size_t j = n >= 8 ? n4 : head; j < n; ++j) {
+    t[j] = static_cast<std::int64_t>(static_cast<std::uint64_t>(t[j - 1]) + static_cast<std::uint64_t>(h[j]));
+    sq.t.add(t[j]);
+  }
+  if (n > 0) previous = static_cast<std::uint64_t>(t[n - 1]);
+  return sq;
+}
+bool has_avx2() {
+  static const bool yes = __builtin_cpu_supports("avx2");
+  return yes;
+}
+#endif
+
 // The overlapping terms of tau m (stride a power of two, terms where first_e + s is a multiple of
 // it) over the segment r[0 .. size), whose terms are proved to fit in int64: AVAR for s >= 2m,
 // MVAR for s >= 3m - 1, HVAR for s >= 3m (s: index in the segment).
@@ -147,6 +235,17 @@ template <class R>
   // All three: s >= 3m. t_s = t_{s-1} + h_s.
   for (std::size_t s0 = 3 * m; s0 < size; s0 += chunk) {
     const std::size_t n = size - s0 < chunk ? size - s0 : chunk;
+#ifdef GYROCHAR_BATCH_AVX2
+    if constexpr (sizeof(R) == 4) {
+      if (step == 1 && has_avx2()) {
+        const ChunkSquares3 sq = all_terms_avx2(r + s0, m, n, a, h, t, tp);
+        add_chunk(tot, 0, a, n, sq.a);
+        add_chunk(tot, 2, h, n, sq.h);
+        add_chunk(tot, 1, t, n, sq.t);
+        continue;
+      }
+    }
+#endif
     const ChunkSquares sq = avar_hvar(r + s0, m, n, true, a, h);
     tp = running_sum(h, t, n, tp);
     if (step == 1) {

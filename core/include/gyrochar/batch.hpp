@@ -25,7 +25,10 @@
 //     checked path, point by point, exactly as the characterizer does (out-of-range terms counted);
 //   - squares summed over chunks of 256 terms in 64-bit partial sums of the low 32-bit halves,
 //     exact when the OR of the chunk's magnitudes is below 2^b with 2b + bit_width(n) <= 64
-//     (block_kernel.hpp's squares_exact()), else summed again term by term in 128 bits.
+//     (block_kernel.hpp's squares_exact()), else summed again term by term in 128 bits;
+//   - on x86-64 with AVX2 (checked at run time), int32 residuals and every term taken: the three
+//     terms of a chunk in AVX2 by hand (one vpmuldq squares four terms), the MVAR running sum
+//     four terms a step (t_e = t_{e-4} + h_e + h_{e-1} + h_{e-2} + h_{e-3}).
 // The non-overlapped sums and the noise sums take the decimated points, O(N/m).
 //
 // No allocation, no exceptions; the caller owns the record.
