@@ -285,6 +285,38 @@ void overlapping_of(const std::int64_t* r, std::size_t size, std::size_t m, std:
   overlapping64(r, size, m, first_e, stride, tot);
 }
 
+// One chunk of the decimated series v[3 .. 3 + n) (v[0 .. 3): the three points before it): the
+// largest |v[k] - v[k-1]| from k = `from` on, computed without overflow checks (the caller has
+// proved every difference fits in int64), and, when `terms`, the AVAR terms from first_a and the
+// HVAR terms from first_h (0 before them) with their squares.
+struct DecimatedChunk {
+  std::uint64_t step = 0;
+  Squares a, h;
+};
+GYROCHAR_CLONES DecimatedChunk decimated_chunk(const std::int64_t* v, std::size_t n, std::size_t from, bool terms,
+                                               std::size_t first_a, std::size_t first_h, std::int64_t* a,
+                                               std::int64_t* h) {
+  DecimatedChunk c;
+  for (std::size_t k = from; k < n; ++k) {
+    const std::uint64_t d = static_cast<std::uint64_t>(v[3 + k]) - static_cast<std::uint64_t>(v[2 + k]);
+    const std::uint64_t sign = d >> 63;
+    const std::uint64_t magnitude = (d ^ (0 - sign)) + sign;
+    c.step = magnitude > c.step ? magnitude : c.step;
+  }
+  if (!terms) return c;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto u0 = static_cast<std::uint64_t>(v[3 + k]), u1 = static_cast<std::uint64_t>(v[2 + k]);
+    const auto u2 = static_cast<std::uint64_t>(v[1 + k]), u3 = static_cast<std::uint64_t>(v[k]);
+    const std::uint64_t d2 = u1 - u2;
+    const std::uint64_t av = (u0 - u1) - d2;
+    a[k] = k >= first_a ? static_cast<std::int64_t>(av) : 0;
+    h[k] = k >= first_h ? static_cast<std::int64_t>(av - (d2 - (u2 - u3))) : 0;
+    c.a.add(a[k]);
+    c.h.add(h[k]);
+  }
+  return c;
+}
+
 // The characterizer's terms_fit(): with spread D every term of tau m fits in int64 when
 // 2 m^2 D < 2^63.
 bool terms_fit(std::uint64_t m, std::uint64_t spread) {
@@ -341,33 +373,40 @@ void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits) {
   std::uint64_t have = 0;     // points of this segment before the chunk
   const auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
   const auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
+  // Int32 residuals: x[k m] - x[(k-1) m] = slope m + (a difference of two residuals, below 2^32
+  // in magnitude), which fits in int64 when |slope| m <= 2^62: no overflow check needed.
+  const std::uint64_t slope = segment.slope < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(segment.slope)
+                                                 : static_cast<std::uint64_t>(segment.slope);
+  const bool small_steps = sizeof(R) == 4 && m <= (std::uint64_t{1} << 31) && slope <= (std::uint64_t{1} << 31);
   while (s < size) {
     const std::uint64_t left = (size - s + m - 1) / m;
     const auto n = static_cast<std::size_t>(left < chunk ? left : chunk);
     for (std::size_t k = 0; k < n; ++k) v[3 + k] = point(segment, static_cast<std::size_t>(s + k * m));
     s += n * m;
-    std::uint64_t step = 0;  // the largest |x[k m] - x[(k-1) m]| here (all ones: beyond int64)
-    for (std::size_t k = have > 0 ? 0 : 1; k < n; ++k) {
-      std::int64_t d = 0;
-      const bool wide = __builtin_sub_overflow(v[3 + k], v[2 + k], &d);
-      const auto mag = wide ? ~std::uint64_t{0} : d < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(d) : static_cast<std::uint64_t>(d);
-      if (mag > step) step = mag;
-    }
-    noise_.add(v + 3, n, 1, step);
     const std::size_t first_a = have >= 2 ? 0 : static_cast<std::size_t>(2 - have);
     const std::size_t first_h = have >= 3 ? 0 : static_cast<std::size_t>(3 - have);
-    if (fits) {
-      Squares sa, sh;
-      for (std::size_t k = 0; k < n; ++k) {
-        const auto u0 = static_cast<std::uint64_t>(v[3 + k]), u1 = static_cast<std::uint64_t>(v[2 + k]);
-        const auto u2 = static_cast<std::uint64_t>(v[1 + k]), u3 = static_cast<std::uint64_t>(v[k]);
-        const std::uint64_t d2 = u1 - u2;
-        const std::uint64_t av = (u0 - u1) - d2;
-        a[k] = k >= first_a ? static_cast<std::int64_t>(av) : 0;
-        h[k] = k >= first_h ? static_cast<std::int64_t>(av - (d2 - (u2 - u3))) : 0;
-        sa.add(a[k]);
-        sh.add(h[k]);
+    const std::size_t from = have > 0 ? 0 : 1;
+    DecimatedChunk c;
+    if (small_steps) {
+      c = decimated_chunk(v, n, from, fits, first_a, first_h, a, h);
+    } else {
+      c.step = 0;  // the largest |x[k m] - x[(k-1) m]| here (all ones: beyond int64)
+      for (std::size_t k = from; k < n; ++k) {
+        std::int64_t d = 0;
+        const bool wide = __builtin_sub_overflow(v[3 + k], v[2 + k], &d);
+        const auto mag = wide ? ~std::uint64_t{0} : d < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(d) : static_cast<std::uint64_t>(d);
+        if (mag > c.step) c.step = mag;
       }
+      if (fits) {
+        const DecimatedChunk t = decimated_chunk(v, n, n, true, first_a, first_h, a, h);
+        c.a = t.a;
+        c.h = t.h;
+      }
+    }
+    noise_.add(v + 3, n, 1, c.step);
+    if (fits) {
+      const Squares& sa = c.a;
+      const Squares& sh = c.h;
       Totals tot{{result_.sum[avar_d], {}, result_.sum[hvar_d]}, {0, 0, 0}, sticky_};
       if (first_a < n) add_chunk(tot, 0, a + first_a, n - first_a, sa);
       if (first_h < n) add_chunk(tot, 2, h + first_h, n - first_h, sh);
