@@ -335,32 +335,15 @@ class CountBatchEngine final : public EngineBase {
   }
 
   void add(std::span<const double> values) override {
-    for (std::size_t i = 0; i < values.size(); ++i) {
-      const double v = values[i];
-      if (!(std::fabs(v) < 2147483648.0) || v != std::trunc(v)) throw BadValue(i, "a count must be an integer of magnitude below 2^31");
-      const auto c = static_cast<std::int32_t>(v);
-      if (counts_ == 0) slope_ = c;
-      if (__builtin_add_overflow(x_, std::int64_t{c}, &x_)) throw std::range_error("the accumulated count passed 2^63 pulses");
-      ++counts_;
-      lowest_ = std::min(lowest_, c);
-      highest_ = std::max(highest_, c);
-      residual_ += static_cast<std::uint64_t>(std::int64_t{c} - slope_);  // modulo 2^64, as the kernel reads it
-      const auto r = static_cast<std::int64_t>(residual_);
-      if (wide_.empty() && r >= INT32_MIN && r <= INT32_MAX) {
-        narrow_.push_back(static_cast<std::int32_t>(r));
-      } else {
-        if (wide_.empty()) {
-          wide_.reserve(narrow_.capacity());
-          wide_.assign(narrow_.begin(), narrow_.end());
-          std::vector<std::int32_t>().swap(narrow_);
-        }
-        wide_.push_back(r);
-      }
-      if (keep_record_) {  // as the characterizer's engine keeps it
+    std::size_t i = counts_ == 0 && !values.empty() ? 1 : 0;  // the first count sets the line
+    if (i == 1) add_one(values[0], 0);
+    if (wide_.empty()) i = add_narrow(values, i);
+    for (; i < values.size(); ++i) add_one(values[i], i);
+    if (keep_record_)  // as the characterizer's engine keeps it
+      for (const double v : values) {
         if (record_.empty()) record_.push_back(0.0);
         record_.push_back(record_.back() + v);
       }
-    }
   }
 
   Analysis result(const AnalysisOptions& o) const override {
@@ -390,6 +373,66 @@ class CountBatchEngine final : public EngineBase {
   PhaseRecord record(const AnalysisOptions&) const override { return {record_, 1.0}; }
 
  private:
+  // The common case in one tight loop: counts whose residuals stay within int32, from values[i]
+  // on; stops at the first value that is not such a count (add_one() takes it: an error or the
+  // switch to int64 residuals). Returns where it stopped. The phase cannot pass 2^63 within a
+  // block of fewer than 2^31 counts from below 2^62: checked once.
+  std::size_t add_narrow(std::span<const double> values, std::size_t i) {
+    if (values.size() - i >= (std::size_t{1} << 31) || x_ >= (std::int64_t{1} << 62) || x_ <= -(std::int64_t{1} << 62))
+      return i;
+    const std::size_t base = narrow_.size();
+    narrow_.resize(base + values.size() - i);
+    std::int32_t* out = narrow_.data() + base - i;
+    std::int32_t lowest = lowest_, highest = highest_;
+    std::uint64_t residual = residual_;
+    std::int64_t sum = 0;
+    const std::size_t start = i;
+    for (; i < values.size(); ++i) {
+      const double v = values[i];
+      if (!(std::fabs(v) < 2147483648.0) || v != std::trunc(v)) break;
+      const auto c = static_cast<std::int32_t>(v);
+      const std::uint64_t next = residual + static_cast<std::uint64_t>(std::int64_t{c} - slope_);
+      const auto r = static_cast<std::int64_t>(next);
+      if (r < INT32_MIN || r > INT32_MAX) break;
+      residual = next;
+      out[i] = static_cast<std::int32_t>(r);
+      sum += c;
+      lowest = std::min(lowest, c);
+      highest = std::max(highest, c);
+    }
+    narrow_.resize(base + (i - start));
+    x_ += sum;
+    counts_ += i - start;
+    lowest_ = lowest;
+    highest_ = highest;
+    residual_ = residual;
+    return i;
+  }
+
+  // One value, every case: checked, the line set by the first, int64 residuals from the first
+  // that leaves int32. values[i] names it in an error.
+  void add_one(double v, std::size_t i) {
+    if (!(std::fabs(v) < 2147483648.0) || v != std::trunc(v)) throw BadValue(i, "a count must be an integer of magnitude below 2^31");
+    const auto c = static_cast<std::int32_t>(v);
+    if (counts_ == 0) slope_ = c;
+    if (__builtin_add_overflow(x_, std::int64_t{c}, &x_)) throw std::range_error("the accumulated count passed 2^63 pulses");
+    ++counts_;
+    lowest_ = std::min(lowest_, c);
+    highest_ = std::max(highest_, c);
+    residual_ += static_cast<std::uint64_t>(std::int64_t{c} - slope_);  // modulo 2^64, as the kernel reads it
+    const auto r = static_cast<std::int64_t>(residual_);
+    if (wide_.empty() && r >= INT32_MIN && r <= INT32_MAX) {
+      narrow_.push_back(static_cast<std::int32_t>(r));
+    } else {
+      if (wide_.empty()) {
+        wide_.reserve(narrow_.capacity());
+        wide_.assign(narrow_.begin(), narrow_.end());
+        std::vector<std::int32_t>().swap(narrow_);
+      }
+      wide_.push_back(r);
+    }
+  }
+
   std::uint32_t stride_factor_;
   std::vector<std::uint64_t> m_list_;
   bool keep_record_;

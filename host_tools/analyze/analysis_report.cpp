@@ -70,6 +70,21 @@ std::string fit_summary(const CurveFit& f) {
 
 }  // namespace
 
+// Out of line: inlined into main's read loop, GCC kept the three running values in memory.
+void DataRange::add(std::span<const double> values) {
+  if (values.empty()) return;
+  double lo = count == 0 ? values[0] : min, hi = count == 0 ? values[0] : max, s = sum;
+  for (const double v : values) {
+    lo = v < lo ? v : lo;
+    hi = v > hi ? v : hi;
+    s += v;
+  }
+  min = lo;
+  max = hi;
+  sum = s;
+  count += values.size();
+}
+
 std::string ReportUnits::unit(DevStat s) const {
   const bool time = s == DevStat::tdev || s == DevStat::ttotdev;  // in phase units
   if (gyro) return time ? rate.angle : rate.name;

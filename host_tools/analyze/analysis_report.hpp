@@ -10,6 +10,7 @@
 // that rate times 1 s: deg/h -> arcsec, deg/s -> deg, rad/s -> rad); clock deviations as
 // fractional frequency (TDEV in s).
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -74,12 +75,8 @@ std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, Dat
 struct DataRange {
   double min = 0.0, max = 0.0, sum = 0.0;
   std::uint64_t count = 0;
-  void add(double v) {
-    min = count == 0 || v < min ? v : min;
-    max = count == 0 || v > max ? v : max;
-    sum += v;
-    ++count;
-  }
+  /// Adds finite values in order (the sum in their order). O(n).
+  void add(std::span<const double> values);
   double mean() const { return count ? sum / static_cast<double>(count) : 0.0; }
 };
 

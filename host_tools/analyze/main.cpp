@@ -526,7 +526,7 @@ int main(int argc, char** argv) {
     const auto add = [&](std::span<double> values, auto line_of) {
       if (nominal_hz > 0)
         for (double& v : values) v = (v - nominal_hz) / nominal_hz;
-      for (const double v : values) range.add(v);
+      range.add(values);
       try {
         analyzer->add(values);
       } catch (const BadValue& e) {

@@ -101,6 +101,17 @@ TEST(AnalyzeEngine, RefusesInconsistentOptionsAndValues) {
   EXPECT_THROW(counts.add(2.5), std::invalid_argument);
   EXPECT_THROW(counts.add(2147483648.0), std::invalid_argument);
   EXPECT_NO_THROW(counts.add(-2147483647.0));
+  o.hold_counts = true;  // the batch engine: the bad value's index in its block
+  Analyzer held(o);
+  for (const double bad : {2.5, 2147483648.0, -double{INFINITY}}) {
+    const std::vector<double> block{3600.0, 3601.0, bad, 3599.0};
+    try {
+      held.add(block);
+      ADD_FAILURE() << bad << " taken";
+    } catch (const BadValue& e) {
+      EXPECT_EQ(e.index(), 2u) << bad;
+    }
+  }
 }
 
 TEST(AnalyzeEngine, TausAboveTheFullCapAreStridedAndTheirEdfSaysSo) {
@@ -218,7 +229,10 @@ TEST(AnalyzeEngine, HeldCountsGiveTheCharacterizersRowsBitForBit) {
     o.values_hint = n;
     Analyzer batch(o);
     pyramid.add(std::span<const double>(counts.data(), n));
-    batch.add(std::span<const double>(counts.data(), n));
+    // The batch engine in uneven blocks: the first count alone, then 7, then the rest.
+    batch.add(std::span<const double>(counts.data(), 1));
+    batch.add(std::span<const double>(counts.data() + 1, 7));
+    batch.add(std::span<const double>(counts.data() + 8, n - 8));
     const Analysis a = pyramid.result(), b = batch.result();
     ASSERT_EQ(a.rows.size(), b.rows.size());
     ASSERT_GT(a.rows.size(), 40u);
