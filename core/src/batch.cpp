@@ -71,10 +71,13 @@ template <class R>
 
 // A chunk's squares v[0 .. n) with their partial sum s: s when it is exact, else term by term
 // in 128 bits.
+inline void add_exact(Totals& tot, int k, std::size_t n, const Squares& s) {
+  tot.sticky |= add_high_word(tot.sum[k], UInt128{s.sum, 0});
+  tot.n[k] += n;
+}
 inline void add_chunk(Totals& tot, int k, const std::int64_t* v, std::size_t n, const Squares& s) {
   if (s.exact(n)) {
-    tot.sticky |= add_high_word(tot.sum[k], UInt128{s.sum, 0});
-    tot.n[k] += n;
+    add_exact(tot, k, n, s);
   } else {
     for (std::size_t j = 0; j < n; ++j) tot.add(k, v[j]);
   }
@@ -117,9 +120,13 @@ inline void add_selected(Totals& tot, int k, const std::int64_t* v, std::size_t 
 }
 
 // All three terms of a chunk of int32 residuals (s >= 3m), as avar_hvar() and running_sum() form
-// them, in AVX2 by hand: the compiler's vectorization of the squares packs and unpacks the low
-// halves, where one signed 32x32->64 multiply (vpmuldq) per four terms suffices. The x86-64
-// host's offline analyzer spends most of its time here. Chosen at run time (has_avx2()).
+// them, in AVX2 by hand and in registers: the squares by one signed 32x32->64 multiply (vpmuldq)
+// per four terms, where the compiler's vectorization packs and unpacks the low halves; the MVAR
+// running sum four terms a step, t_e = t_{e-4} + (h_e + h_{e-1} + h_{e-2} + h_{e-3}), the window
+// from lane shifts of this step's and the last step's HVAR terms. Only the squares come out: the
+// caller forms the chunk again when one of them is not exact. `previous`: t before the chunk,
+// then its last. Chosen at run time (has_avx2()); the x86-64 host's analyzer spends most of its
+// time here.
 #ifdef GYROCHAR_BATCH_AVX2
 struct ChunkSquares3 {
   Squares a, h, t;
@@ -139,58 +146,40 @@ struct ChunkSquares3 {
   return _mm256_cvtepi32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
 }
 [[gnu::target("avx2")]] ChunkSquares3 all_terms_avx2(const std::int32_t* x0, std::size_t m, std::size_t n,
-                                                     std::int64_t* a, std::int64_t* h, std::int64_t* t,
                                                      std::uint64_t& previous) {
   const std::size_t n4 = n / 4 * 4;
   __m256i ba = _mm256_setzero_si256(), sa = ba, bh = ba, sh = ba, bt = ba, st = ba;
+  // Before the chunk: no HVAR term (the window counts only this chunk's), t = previous.
+  __m256i h_last = _mm256_setzero_si256(), pair_last = h_last;
+  __m256i tv = _mm256_set1_epi64x(static_cast<std::int64_t>(previous));
   for (std::size_t j = 0; j < n4; j += 4) {
     const __m256i u0 = load4(x0 + j), u1 = load4(x0 + j - m), u2 = load4(x0 + j - 2 * m), u3 = load4(x0 + j - 3 * m);
     const __m256i d2 = _mm256_sub_epi64(u1, u2);
     const __m256i av = _mm256_sub_epi64(_mm256_sub_epi64(u0, u1), d2);
     const __m256i hv = _mm256_sub_epi64(av, _mm256_sub_epi64(d2, _mm256_sub_epi64(u2, u3)));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(a + j), av);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(h + j), hv);
+    // (h_{j-1}, h_j, h_{j+1}, h_{j+2}) from (h_{j-2}, h_{j-1}, h_j, h_{j+1}) and hv.
+    const __m256i h_back1 = _mm256_alignr_epi8(hv, _mm256_permute2x128_si256(h_last, hv, 0x21), 8);
+    const __m256i pair = _mm256_add_epi64(hv, h_back1);  // h_e + h_{e-1}
+    tv = _mm256_add_epi64(tv, _mm256_add_epi64(pair, _mm256_permute2x128_si256(pair_last, pair, 0x21)));
+    h_last = hv;
+    pair_last = pair;
     accumulate(av, ba, sa);
     accumulate(hv, bh, sh);
+    accumulate(tv, bt, st);
   }
-  ChunkSquares3 sq{reduce(ba, sa), reduce(bh, sh), {}};
-  for (std::size_t j = n4; j < n; ++j) {  // the tail, as avar_hvar()
+  ChunkSquares3 sq{reduce(ba, sa), reduce(bh, sh), reduce(bt, st)};
+  std::uint64_t t = n4 > 0 ? static_cast<std::uint64_t>(_mm256_extract_epi64(tv, 3)) : previous;
+  for (std::size_t j = n4; j < n; ++j) {  // the tail, as avar_hvar() and running_sum()
     const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
     const std::uint64_t d2 = u1 - u2;
-    a[j] = static_cast<std::int64_t>((u0 - u1) - d2);
-    h[j] = static_cast<std::int64_t>(static_cast<std::uint64_t>(a[j]) - (d2 - (u2 - word(x0[j - 3 * m]))));
-    sq.a.add(a[j]);
-    sq.h.add(h[j]);
+    const std::uint64_t a = (u0 - u1) - d2;
+    const std::uint64_t h = a - (d2 - (u2 - word(x0[j - 3 * m])));
+    t += h;
+    sq.a.add(static_cast<std::int64_t>(a));
+    sq.h.add(static_cast<std::int64_t>(h));
+    sq.t.add(static_cast<std::int64_t>(t));
   }
-  // MVAR: t[j] = t[j-4] + (h[j] + h[j-1] + h[j-2] + h[j-3]), four terms a step.
-  std::uint64_t c = previous;
-  const std::size_t head = n < 4 ? n : 4;
-  for (std::size_t j = 0; j < head; ++j) {
-    c += static_cast<std::uint64_t>(h[j]);
-    t[j] = static_cast<std::int64_t>(c);
-    sq.t.add(t[j]);
-  }
-  if (n >= 8) {
-    __m256i tv = _mm256_load_si256(reinterpret_cast<const __m256i*>(t));
-    for (std::size_t j = 4; j < n4; j += 4) {
-      const auto* hj = reinterpret_cast<const __m256i*>(h + j);
-      const __m256i w = _mm256_add_epi64(
-          _mm256_add_epi64(_mm256_load_si256(hj), _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h + j - 1))),
-          _mm256_add_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(h + j - 2)),
-                           _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h + j - 3))));
-      tv = _mm256_add_epi64(tv, w);
-      _mm256_store_si256(reinterpret_cast<__m256i*>(t + j), tv);
-      accumulate(tv, bt, st);
-    }
-  }
-  const Squares vt = reduce(bt, st);
-  sq.t.bound |= vt.bound;
-  sq.t.sum += vt.sum;
-  for (std::size_t j = n >= 8 ? n4 : head; j < n; ++j) {
-    t[j] = static_cast<std::int64_t>(static_cast<std::uint64_t>(t[j - 1]) + static_cast<std::uint64_t>(h[j]));
-    sq.t.add(t[j]);
-  }
-  if (n > 0) previous = static_cast<std::uint64_t>(t[n - 1]);
+  previous = t;
   return sq;
 }
 bool has_avx2() {
@@ -238,11 +227,15 @@ template <class R>
 #ifdef GYROCHAR_BATCH_AVX2
     if constexpr (sizeof(R) == 4) {
       if (step == 1 && has_avx2()) {
-        const ChunkSquares3 sq = all_terms_avx2(r + s0, m, n, a, h, t, tp);
-        add_chunk(tot, 0, a, n, sq.a);
-        add_chunk(tot, 2, h, n, sq.h);
-        add_chunk(tot, 1, t, n, sq.t);
-        continue;
+        const std::uint64_t before = tp;
+        const ChunkSquares3 sq = all_terms_avx2(r + s0, m, n, tp);
+        if (sq.a.exact(n) && sq.h.exact(n) && sq.t.exact(n)) {
+          add_exact(tot, 0, n, sq.a);
+          add_exact(tot, 2, n, sq.h);
+          add_exact(tot, 1, n, sq.t);
+          continue;
+        }
+        tp = before;  // formed again below, summed term by term where needed
       }
     }
 #endif
