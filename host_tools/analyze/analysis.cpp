@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -12,6 +13,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <type_traits>
 
 #include <sys/mman.h>
@@ -401,14 +403,22 @@ class CountBatchEngine final : public EngineBase {
     taus.reserve(m_list_.size());
     for (const std::uint64_t m : m_list_) taus.emplace_back(m, stride_of(m, stride_factor_));
     const std::uint64_t spread = counts_ == 0 ? 0 : static_cast<std::uint64_t>(std::int64_t{highest_} - lowest_);
-    for (BatchTau& t : taus) {
-      if (counts_ == 0) break;
-      if (wide_.empty()) {
-        t.add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
-      } else {
-        t.add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
+    // The taus are independent: each thread takes the next one left until none is.
+    std::atomic<std::size_t> next{0};
+    const auto sum_taus = [&] {
+      for (std::size_t i = next++; i < taus.size() && counts_ > 0; i = next++) {
+        if (wide_.empty()) {
+          taus[i].add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
+        } else {
+          taus[i].add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
+        }
       }
-    }
+    };
+    const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), taus.size());
+    std::vector<std::thread> helpers;
+    for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus);
+    sum_taus();
+    for (std::thread& t : helpers) t.join();
     std::vector<TauSums> sums;
     sums.reserve(taus.size());
     for (const BatchTau& t : taus) sums.push_back(tau_sums(t.result(), t.noise()));

@@ -91,6 +91,9 @@ struct AnalysisOptions {
   // values_hint: an upper bound on the values to reserve the record for (0: unknown).
   bool hold_counts = false;
   std::uint64_t values_hint = 0;
+  // Threads summing the held counts' taus (each tau on one; they are independent); 0: one per
+  // core the system offers.
+  unsigned threads = 0;
 };
 
 struct AnalysisRow {

@@ -334,6 +334,9 @@ int main(int argc, char** argv) {
       ->option_text("WINDOW[,STEP]");
   app.add_option("--plot", plot_prefix, "with --dynamic: draw the heat maps to PREFIX.svg and PREFIX.png")
       ->option_text("PREFIX");
+  unsigned threads = 0;
+  app.add_option("--threads", threads, "threads summing the taus of counts at --stride-factor full (default: one per core)")
+      ->check(CLI::Range(1u, 1024u));
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
     app.parse(argc, argv);
@@ -481,6 +484,7 @@ int main(int argc, char** argv) {
     // sums as the characterizer's, at 4 bytes a point instead of its history near N/4) while the
     // record fits in memory at its worst (12 bytes a point while it widens to int64).
     o.values_hint = taus_text == "all" ? kept.size() : file->values_bound();
+    o.threads = threads;
     o.hold_counts = o.type == DataType::counts && o.stride_factor == 0 && n_phase > 0 &&
                     o.values_hint < memory_budget() / 12;
     if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus_text == "all" ? 2 * n_phase : n_phase);

@@ -227,6 +227,7 @@ TEST(AnalyzeEngine, HeldCountsGiveTheCharacterizersRowsBitForBit) {
     Analyzer pyramid(o);
     o.hold_counts = true;
     o.values_hint = n;
+    o.threads = 3;  // the taus shared among three threads on any machine
     Analyzer batch(o);
     pyramid.add(std::span<const double>(counts.data(), n));
     // The batch engine in uneven blocks: the first count alone, then 7, then the rest.
