@@ -182,6 +182,21 @@ struct ChunkSquares3 {
   previous = t;
   return sq;
 }
+// The AVAR terms alone (2m <= s < 3m), likewise: their squares only.
+[[gnu::target("avx2")]] Squares avar_terms_avx2(const std::int32_t* x0, std::size_t m, std::size_t n) {
+  const std::size_t n4 = n / 4 * 4;
+  __m256i ba = _mm256_setzero_si256(), sa = ba;
+  for (std::size_t j = 0; j < n4; j += 4) {
+    const __m256i u0 = load4(x0 + j), u1 = load4(x0 + j - m), u2 = load4(x0 + j - 2 * m);
+    accumulate(_mm256_sub_epi64(_mm256_sub_epi64(u0, u1), _mm256_sub_epi64(u1, u2)), ba, sa);
+  }
+  Squares sq = reduce(ba, sa);
+  for (std::size_t j = n4; j < n; ++j) {
+    const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
+    sq.add(static_cast<std::int64_t>((u0 - u1) - (u1 - u2)));
+  }
+  return sq;
+}
 bool has_avx2() {
   static const bool yes = __builtin_cpu_supports("avx2");
   return yes;
@@ -203,6 +218,17 @@ template <class R>
   const std::size_t a_end = size < 3 * m ? size : 3 * m;
   for (std::size_t s0 = 2 * m; s0 < a_end; s0 += chunk) {
     const std::size_t n = a_end - s0 < chunk ? a_end - s0 : chunk;
+#ifdef GYROCHAR_BATCH_AVX2
+    if constexpr (sizeof(R) == 4) {
+      if (step == 1 && has_avx2()) {
+        const Squares sq = avar_terms_avx2(r + s0, m, n);
+        if (sq.exact(n)) {
+          add_exact(tot, 0, n, sq);
+          continue;
+        }
+      }
+    }
+#endif
     const ChunkSquares sq = avar_hvar(r + s0, m, n, false, a, h);
     if (step == 1) {
       add_chunk(tot, 0, a, n, sq.a);
