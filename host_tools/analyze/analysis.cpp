@@ -404,21 +404,24 @@ class CountBatchEngine final : public EngineBase {
     for (const std::uint64_t m : m_list_) taus.emplace_back(m, stride_of(m, stride_factor_));
     const std::uint64_t spread = counts_ == 0 ? 0 : static_cast<std::uint64_t>(std::int64_t{highest_} - lowest_);
     // The taus are independent: each thread takes the next one left until none is.
-    std::atomic<std::size_t> next{0};
-    const auto sum_taus = [&] {
+    std::atomic<std::size_t> next{0}, done{0};
+    const auto sum_taus = [&](bool tell) {
       for (std::size_t i = next++; i < taus.size() && counts_ > 0; i = next++) {
         if (wide_.empty()) {
           taus[i].add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
         } else {
           taus[i].add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
         }
+        const std::size_t summed = ++done;
+        if (tell && o.on_summed && summed < taus.size()) o.on_summed(summed, taus.size());
       }
     };
     const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), taus.size());
     std::vector<std::thread> helpers;
-    for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus);
-    sum_taus();
+    for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
+    sum_taus(true);
     for (std::thread& t : helpers) t.join();
+    if (o.on_summed) o.on_summed(taus.size(), taus.size());
     std::vector<TauSums> sums;
     sums.reserve(taus.size());
     for (const BatchTau& t : taus) sums.push_back(tau_sums(t.result(), t.noise()));

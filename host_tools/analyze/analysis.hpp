@@ -13,6 +13,7 @@
 // value's unit times s, so deviations are in the value's unit). TDEV is in the phase unit.
 #include <cstdint>
 #include <memory>
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -94,6 +95,9 @@ struct AnalysisOptions {
   // Threads summing the held counts' taus (each tau on one; they are independent); 0: one per
   // core the system offers.
   unsigned threads = 0;
+  // Told, from the thread that calls result(), how many of the held counts' taus are summed, of
+  // how many (the sums of every tau, --taus all, take minutes at 10^6 values). May be empty.
+  std::function<void(std::size_t done, std::size_t total)> on_summed;
 };
 
 struct AnalysisRow {

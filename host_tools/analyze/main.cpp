@@ -485,6 +485,13 @@ int main(int argc, char** argv) {
     // record fits in memory at its worst (12 bytes a point while it widens to int64).
     o.values_hint = taus_text == "all" ? kept.size() : file->values_bound();
     o.threads = threads;
+    if (show_progress)
+      o.on_summed = [shown = std::size_t{0}](std::size_t done, std::size_t total) mutable {
+        if (done < total && 1000 * done / total == 1000 * shown / total) return;  // every 0.1 %
+        shown = done;
+        progress_line_open = done < total;
+        std::fprintf(stderr, "\rgyrochar-analyze: summing: %zu of %zu taus%s", done, total, done < total ? "" : "\n");
+      };
     o.hold_counts = o.type == DataType::counts && o.stride_factor == 0 && n_phase > 0 &&
                     o.values_hint < memory_budget() / 12;
     if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus_text == "all" ? 2 * n_phase : n_phase);

@@ -392,7 +392,8 @@ TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
 
 TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
   // Progress appears every 2^20 values: a file of 2^20 + 1 values shows it with --progress (one
-  // pass: reading); stdout still carries only the table.
+  // pass: reading), then the counts' taus summed (held counts, the default stride factor);
+  // stdout still carries only the table.
   std::string s;
   s.reserve(2u << 21);
   for (int i = 0; i <= (1 << 20); ++i) s += "1\n";
@@ -400,6 +401,7 @@ TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
   const Outcome r = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 --progress " + path);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("reading: 100.0 %"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("summing: 1 of 1 taus\n"), std::string::npos) << r.err;
   EXPECT_EQ(r.out.find("gyrochar-analyze"), std::string::npos);
   const Outcome quiet = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 " + path);
   EXPECT_TRUE(quiet.err.empty()) << quiet.err;  // stderr is a file here, not a terminal
