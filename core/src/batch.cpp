@@ -131,16 +131,23 @@ inline void add_selected(Totals& tot, int k, const std::int64_t* v, std::size_t 
 struct ChunkSquares3 {
   Squares a, h, t;
 };
+// The vectors' bound is the OR of v + 2^27 (modulo 2^64): below 2^28 exactly when every v is in
+// [-2^27, 2^27), where the low halves are the terms and 256 squares stay below 2^62. One
+// operation fewer a term than Squares' OR of magnitudes; reduce() turns it into Squares' bound
+// (2^27 - 1 when in range, else all ones: such a chunk is formed again).
+constexpr std::uint64_t square_range = std::uint64_t{1} << 27;
+static_assert(chunk <= 1024, "2 * 27 + bit_width(chunk) <= 64");
 [[gnu::target("avx2")]] inline void accumulate(__m256i v, __m256i& bound, __m256i& sum) {
-  const __m256i sign = _mm256_cmpgt_epi64(_mm256_setzero_si256(), v);
-  bound = _mm256_or_si256(bound, _mm256_xor_si256(v, sign));
+  const __m256i offset = _mm256_set1_epi64x(static_cast<std::int64_t>(square_range));
+  bound = _mm256_or_si256(bound, _mm256_add_epi64(v, offset));
   sum = _mm256_add_epi64(sum, _mm256_mul_epi32(v, v));
 }
 [[gnu::target("avx2")]] inline Squares reduce(__m256i bound, __m256i sum) {
   alignas(32) std::uint64_t b[4], q[4];
   _mm256_store_si256(reinterpret_cast<__m256i*>(b), bound);
   _mm256_store_si256(reinterpret_cast<__m256i*>(q), sum);
-  return {b[0] | b[1] | b[2] | b[3], q[0] + q[1] + q[2] + q[3]};
+  const bool in_range = (b[0] | b[1] | b[2] | b[3]) < 2 * square_range;
+  return {in_range ? square_range - 1 : ~std::uint64_t{0}, q[0] + q[1] + q[2] + q[3]};
 }
 [[gnu::target("avx2")]] inline __m256i load4(const std::int32_t* p) {
   return _mm256_cvtepi32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
