@@ -100,13 +100,16 @@ echo "$(sed -n 's/.*"version": "\(.*\)".*/\1/p' $peers/allantools/allantools_inf
 echo "(\`toolchain/allantools_job.py\`: np.loadtxt, phase as the cumulative sum once, then oadev, mdev"
 echo "and ohdev on it). Process wall time, CPU time (user + sys) and peak RSS; the ratio is allantools'"
 echo "time over gyrochar-analyze's. The default stride factor is full: every tau up to N/4 fully"
-echo "overlapped, as allantools. The machine is shared: CPU times are the steadier figures."
+echo "overlapped, as allantools; its taus are summed on every core ($(nproc) here; \`--threads 1\`: one)."
+echo "The machine is shared: CPU times are the steadier figures."
 echo
 echo "| samples | file | options | gyrochar-analyze | allantools | ratio |"
 echo "|---|---|---|---|---|---|"
 side_by_side 10000000 1800 "" octave
+side_by_side 10000000 1800 "--threads 1" octave
 side_by_side 10000000 1800 "--stride-factor 8" octave
 side_by_side 100000000 3600 "" octave
+side_by_side 100000000 3600 "--threads 1" octave
 side_by_side 100000000 3600 "--stride-factor 8" octave
 echo
 echo "Every m (\`--taus all\`, Stable32's \"all tau\"; allantools' taus=\"all\"), at most 10 minutes each:"
