@@ -204,10 +204,9 @@ static_assert(chunk <= 1024, "2 * 27 + bit_width(chunk) <= 64");
   }
   return sq;
 }
-bool has_avx2() {
-  static const bool yes = __builtin_cpu_supports("avx2");
-  return yes;
-}
+// A load and a bit test once libgcc's start-up has read the processor's features (before main);
+// no static of its own, which the threads summing taus would race to initialize.
+inline bool has_avx2() { return __builtin_cpu_supports("avx2"); }
 #endif
 
 // The overlapping terms of tau m (stride a power of two, terms where first_e + s is a multiple of
