@@ -659,17 +659,29 @@ class Characterizer {
       std::uint64_t first = a > lag ? ((a - 1 - lag) >> l) + 1 : 0;  // not in ring l before
       if (newest >= first + size) first = newest + 1 - size;
       Entry* ring = &history_[ring_offset(l)];
-      unsigned r = l == 0 ? 0 : l - 1;  // the ring holding q before, for q < a (older q sit higher)
       auto slot = static_cast<std::uint32_t>(first % size);
-      for (std::uint64_t k = first; k <= newest; ++k) {
-        const std::uint64_t q = k << l;
-        if (q >= a) {
-          const auto j = static_cast<std::size_t>(q - a);
-          ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
-        } else {
-          while (!held(r, q, a - 1)) --r;  // ring 0 holds every q in [a - 3S, a)
-          ring[slot] = history_[ring_offset(r) + static_cast<std::size_t>((q >> r) % ring_size(r))];
+      std::uint64_t k = first;
+      // The multiples q < a, from the rings below that held them (older q sit higher): each ring
+      // holds a run of consecutive multiples, read at a fixed step of slots. Ring 0 holds every q
+      // in [a - 3S, a).
+      for (unsigned r = l; k <= newest && (k << l) < a;) {
+        while (!held(--r, k << l, a - 1)) {}
+        const std::uint64_t last = r == 0 ? a - 1 : (a - 1 - ring_lag(r)) >> r << r;  // ring r's newest
+        const std::uint32_t from_size = ring_size(r);
+        const auto step = static_cast<std::uint32_t>((std::uint64_t{1} << (l - r)) % from_size);
+        const Entry* from = &history_[ring_offset(r)];
+        auto from_slot = static_cast<std::uint32_t>(((k << l) >> r) % from_size);
+        for (; k <= newest && (k << l) <= last; ++k) {
+          ring[slot] = from[from_slot];
+          if (++slot == size) slot = 0;
+          from_slot += step;
+          if (from_slot >= from_size) from_slot -= from_size;
         }
+        ++r;  // the next multiple may still sit in ring r - 1 (held() steps down from r - 1)
+      }
+      // The multiples q >= a, from the run itself.
+      for (auto j = static_cast<std::size_t>((k << l) - a); k <= newest; ++k, j += std::size_t{1} << l) {
+        ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
         if (++slot == size) slot = 0;
       }
     }
@@ -702,7 +714,8 @@ class Characterizer {
     std::array<std::array<std::int64_t, window_depth + block_points>, 2> x_buf;
     std::array<std::array<std::uint64_t, window_depth + block_points>, 2> p_buf;
     std::size_t n = level0.n;
-    for (unsigned level = 1; (std::size_t{1} << level) <= block_points && level < ring_levels_; ++level) {
+    // Levels with at least two points in the block: a single point costs less through block_point().
+    for (unsigned level = 1; (std::size_t{2} << level) <= block_points && level < ring_levels_; ++level) {
       if (done == ntaus_ || taus_[done].level != level || e0 < run_.segment_start + (std::uint64_t{depth} << level))
         return done;
       std::int64_t* x_next = x_buf[level % 2].data();
@@ -790,14 +803,19 @@ class Characterizer {
       t.countdown -= b.n;
       return;
     }
-    const std::size_t first = static_cast<std::size_t>(t.countdown - 1);
-    std::size_t count = 0, j = first;
-    BlockSquares da{terms.avar.magnitude_bits, 0}, dh{terms.hvar.magnitude_bits, 0};
-    for (;; j += m) {
-      da.sum += static_cast<std::uint64_t>(a[j]) * static_cast<std::uint64_t>(a[j]);
-      dh.sum += static_cast<std::uint64_t>(h[j]) * static_cast<std::uint64_t>(h[j]);
-      ++count;
-      if (j + m >= b.n) break;
+    // The countdown stays in 1..m, so for m = 1 every point is decimated and the block's partial
+    // sums are already the non-overlapped ones.
+    const auto first = static_cast<std::size_t>(t.countdown - 1);
+    const std::size_t count = (b.n - 1 - first) / m + 1;
+    const std::size_t j = first + (count - 1) * m;  // the newest decimated point
+    BlockSquares da = terms.avar, dh = terms.hvar;
+    if (m > 1) {
+      da.sum = 0;
+      dh.sum = 0;
+      for (std::size_t k = first; k <= j; k += m) {
+        da.sum += static_cast<std::uint64_t>(a[k]) * static_cast<std::uint64_t>(a[k]);
+        dh.sum += static_cast<std::uint64_t>(h[k]) * static_cast<std::uint64_t>(h[k]);
+      }
     }
     const auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
     const auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
@@ -973,7 +991,7 @@ class Characterizer {
   std::uint32_t tag_ = 0;
   unsigned ring_levels_ = 1;
   std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
-  static constexpr std::size_t block_points = 64;  // staged points per block (a power of two)
+  static constexpr std::size_t block_points = 128;  // staged points per block (a power of two)
   std::array<X, block_points> staged_{};
   std::size_t staged_count_ = 0;
 
