@@ -590,12 +590,7 @@ class Characterizer {
     std::array<std::int64_t, window_depth + block_points> wx;
     std::array<std::uint64_t, window_depth + block_points> wp;
     std::array<std::uint64_t, block_points> p_hi;
-    std::uint32_t slot = static_cast<std::uint32_t>((run_.next_e - depth) % ring0);
-    for (std::size_t j = 0; j < depth; ++j) {
-      wx[j] = history_[slot].x;
-      wp[j] = history_[slot].p.lo;
-      if (++slot == ring0) slot = 0;
-    }
+    from_ring(&history_[0], ring0, static_cast<std::uint32_t>((run_.next_e - depth) % ring0), depth, wx.data(), wp.data());
     Int128 p = run_.p;
     for (std::size_t j = 0; j < n; ++j) {
       p = Arith::add_prefix(p, x[j]);
@@ -722,18 +717,12 @@ class Characterizer {
       std::uint64_t* p_next = p_buf[level % 2].data();
       const std::size_t half = depth / 2;
       const std::uint32_t ring = 3u * stride_ / 2;
-      std::uint32_t slot = static_cast<std::uint32_t>(((e0 >> level) - depth) % ring);
-      const std::size_t base = ring_offset(level);
-      for (std::size_t i = 0; i < half; ++i) {  // ages (3S 2^(L-1), 3S 2^L]: ring L
-        x_next[i] = history_[base + slot].x;
-        p_next[i] = history_[base + slot].p.lo;
-        if (++slot == ring) slot = 0;
-      }
+      // Ages (3S 2^(L-1), 3S 2^L]: ring L; the younger ones and the block: every other one.
+      from_ring(&history_[ring_offset(level)], ring, static_cast<std::uint32_t>(((e0 >> level) - depth) % ring), half,
+                x_next, p_next);
       n = (n + 1) / 2;
-      for (std::size_t i = half; i < depth + n; ++i) {  // younger ones and the block: every other one
-        x_next[i] = x_prev[2 * i - depth];
-        p_next[i] = p_prev[2 * i - depth];
-      }
+      every_other(x_prev, x_next + half, depth - half + n);  // depth = 3S is even: x_prev[0] is of level L
+      every_other(p_prev, p_next + half, depth - half + n);
       const Block b{e0, n, x_next + depth, p_next + depth, nullptr, x_next + depth, depth, level};
       for (; done < ntaus_ && taus_[done].level == level; ++done) {
         if (!terms_fit(taus_[done].result.m)) return done;
@@ -745,6 +734,24 @@ class Characterizer {
     return done;
   }
 
+
+  // x and the low word of P of `count` entries of a ring of `size` slots, from `slot` on.
+  static void from_ring(const Entry* ring, std::uint32_t size, std::uint32_t slot, std::size_t count,
+                        std::int64_t* __restrict x, std::uint64_t* __restrict p) {
+    for (std::size_t i = 0; i < count;) {
+      const std::size_t run = count - i < size - slot ? count - i : size - slot;
+      for (std::size_t k = 0; k < run; ++k, ++i) {
+        x[i] = ring[slot + k].x;
+        p[i] = ring[slot + k].p.lo;
+      }
+      slot = 0;
+    }
+  }
+  // to[i] = from[2 i], i < n.
+  template <class T>
+  static void every_other(const T* __restrict from, T* __restrict to, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) to[i] = from[2 * i];
+  }
 
   // The block's terms of one level-0 tau, and its decimated points.
   // The terms of tau m fit in int64 when 2 m^2 (largest increment - smallest) < 2^63 (|a| <= m
