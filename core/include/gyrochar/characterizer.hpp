@@ -562,7 +562,8 @@ class Characterizer {
   // The level-0 taus (m <= S) take the whole block at once, tau by tau, in block_terms(); the
   // history and the higher levels then take the points one by one, as push() does. Level 0 reads
   // only ring 0 as it was before the block, so the order of the two passes does not matter.
-  // Working memory on the stack: about 5 KiB.
+  // Working memory on the stack: about 22 KiB (x86-64, 256 points per block), 34 KiB when S > 32
+  // (the gathered points).
   struct Block {
     std::uint64_t e0;  // index of the first point
     std::size_t n;
@@ -591,13 +592,17 @@ class Characterizer {
     std::array<std::uint64_t, window_depth + block_points> wp;
     std::array<std::uint64_t, block_points> p_hi;
     from_ring(&history_[0], ring0, static_cast<std::uint32_t>((run_.next_e - depth) % ring0), depth, wx.data(), wp.data());
-    Int128 p = run_.p;
+    // P in two words: x sign-extended adds the carry out of the low word, less one when x < 0.
+    std::uint64_t p_lo = run_.p.lo, p_high = run_.p.hi;
     for (std::size_t j = 0; j < n; ++j) {
-      p = Arith::add_prefix(p, x[j]);
-      wx[depth + j] = x[j];
-      wp[depth + j] = p.lo;
-      p_hi[j] = p.hi;
+      const auto v = static_cast<std::uint64_t>(x[j]);
+      const std::uint64_t sum = p_lo + v;
+      p_high += static_cast<std::uint64_t>(sum < p_lo) - (v >> 63);
+      p_lo = sum;
+      wp[depth + j] = p_lo;
+      p_hi[j] = p_high;
     }
+    std::memcpy(&wx[depth], x, n * sizeof(X));
     const Block b{run_.next_e, n, x, &wp[depth], p_hi.data(), &wx[depth], depth, 0};
     for (std::size_t i = 0; i < fast_count_; ++i) level0_block(taus_[i], b);
     const std::size_t done = depth == ring0 ? higher_levels(b, wx.data(), wp.data()) : fast_count_;
@@ -706,8 +711,8 @@ class Characterizer {
     const std::uint64_t e0 = level0.e0;
     const std::size_t depth = 3u * stride_;
     if (e0 % block_points != 0) return done;
-    std::array<std::array<std::int64_t, window_depth + block_points>, 2> x_buf;
-    std::array<std::array<std::uint64_t, window_depth + block_points>, 2> p_buf;
+    std::array<std::array<std::int64_t, window_depth + block_points / 2>, 2> x_buf;  // level 1 on: half the points
+    std::array<std::array<std::uint64_t, window_depth + block_points / 2>, 2> p_buf;
     std::size_t n = level0.n;
     // Levels with at least two points in the block: a single point costs less through block_point().
     for (unsigned level = 1; (std::size_t{2} << level) <= block_points && level < ring_levels_; ++level) {
@@ -784,19 +789,33 @@ class Characterizer {
       }
       return;
     }
-    // The points at ages m, 2m, 3m: in the window, or gathered from ring 0.
-    std::array<std::int64_t, block_points> gx1, gx2, gx3, a, h, mt;
-    std::array<std::uint64_t, block_points> gp1, gp2, gp3;
-    const std::int64_t *x1 = gx1.data(), *x2 = gx2.data(), *x3 = gx3.data();
-    const std::uint64_t *p1 = gp1.data(), *p2 = gp2.data(), *p3 = gp3.data();
+    // The points at ages m, 2m, 3m: in the window, or gathered from ring 0 (S > 32).
     if (3 * m <= b.depth) {
-      x1 = b.wx - m, x2 = b.wx - 2 * m, x3 = b.wx - 3 * m;
-      p1 = b.p_lo - m, p2 = b.p_lo - 2 * m, p3 = b.p_lo - 3 * m;
+      block_sums(t, b, m, b.wx - m, b.wx - 2 * m, b.wx - 3 * m, b.p_lo - m, b.p_lo - 2 * m, b.p_lo - 3 * m);
     } else {
-      gather(b, m, gx1.data(), gp1.data());
-      gather(b, 2 * m, gx2.data(), gp2.data());
-      gather(b, 3 * m, gx3.data(), gp3.data());
+      gathered_sums(t, b, m);
     }
+  }
+
+  // The gathered points live in this function's frame only, not in the usual path's.
+  [[gnu::noinline]] void gathered_sums(TauState& t, const Block& b, std::size_t m)
+    requires(Arith::exact)
+  {
+    std::array<std::int64_t, block_points> x1, x2, x3;
+    std::array<std::uint64_t, block_points> p1, p2, p3;
+    gather(b, m, x1.data(), p1.data());
+    gather(b, 2 * m, x2.data(), p2.data());
+    gather(b, 3 * m, x3.data(), p3.data());
+    block_sums(t, b, m, x1.data(), x2.data(), x3.data(), p1.data(), p2.data(), p3.data());
+  }
+
+  // The block's terms of a tau of lag m from the points at ages m, 2m, 3m, their sums, the
+  // decimated points and the noise sums.
+  void block_sums(TauState& t, const Block& b, std::size_t m, const std::int64_t* x1, const std::int64_t* x2,
+                  const std::int64_t* x3, const std::uint64_t* p1, const std::uint64_t* p2, const std::uint64_t* p3)
+    requires(Arith::exact)
+  {
+    std::array<std::int64_t, block_points> a, h, mt;
     const BlockTerms terms = block_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data(), mt.data());
     Result& r = t.result;
     t.sticky |= add_block(r.sum[0], terms.avar, a.data(), b.n) | add_block(r.sum[1], terms.mvar, mt.data(), b.n) |
@@ -998,7 +1017,7 @@ class Characterizer {
   std::uint32_t tag_ = 0;
   unsigned ring_levels_ = 1;
   std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
-  static constexpr std::size_t block_points = 128;  // staged points per block (a power of two)
+  static constexpr std::size_t block_points = 256;  // staged points per block (a power of two)
   std::array<X, block_points> staged_{};
   std::size_t staged_count_ = 0;
 
