@@ -47,4 +47,11 @@ BlockTerms block_terms(std::size_t n, const std::int64_t* __restrict x0, const s
   return {{bits_a, sum_a}, {bits_m, sum_m}, {bits_h, sum_h}};
 }
 
+#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void every_other(const std::uint64_t* __restrict from, std::uint64_t* __restrict to, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) to[i] = from[2 * i];
+}
+
 }  // namespace gyrochar

@@ -39,6 +39,9 @@ BlockTerms block_terms(std::size_t n, const std::int64_t* x0, const std::int64_t
                        const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
                        std::int64_t* hvar_out, std::int64_t* mvar_out);
 
+/// to[i] = from[2 i] for i < n (the points of the next level up); the arrays do not overlap. O(n).
+void every_other(const std::uint64_t* from, std::uint64_t* to, std::size_t n);
+
 /// True when s.sum is the exact sum of the n squared terms: every |term| <= 2^b with 2b + bit_width(n)
 /// <= 64, so each term fits in int32 (its low half is itself) and n squares of at most 2^2b stay
 /// below 2^64.

@@ -726,7 +726,8 @@ class Characterizer {
       from_ring(&history_[ring_offset(level)], ring, static_cast<std::uint32_t>(((e0 >> level) - depth) % ring), half,
                 x_next, p_next);
       n = (n + 1) / 2;
-      every_other(x_prev, x_next + half, depth - half + n);  // depth = 3S is even: x_prev[0] is of level L
+      // depth = 3S is even: x_prev[0] is of level L.
+      every_other(reinterpret_cast<const std::uint64_t*>(x_prev), reinterpret_cast<std::uint64_t*>(x_next + half), depth - half + n);
       every_other(p_prev, p_next + half, depth - half + n);
       const Block b{e0, n, x_next + depth, p_next + depth, nullptr, x_next + depth, depth, level};
       for (; done < ntaus_ && taus_[done].level == level; ++done) {
@@ -751,11 +752,6 @@ class Characterizer {
       }
       slot = 0;
     }
-  }
-  // to[i] = from[2 i], i < n.
-  template <class T>
-  static void every_other(const T* __restrict from, T* __restrict to, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i) to[i] = from[2 * i];
   }
 
   // The block's terms of one level-0 tau, and its decimated points.
