@@ -54,4 +54,18 @@ void every_other(const std::uint64_t* __restrict from, std::uint64_t* __restrict
   for (std::size_t i = 0; i < n; ++i) to[i] = from[2 * i];
 }
 
+#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void difference_range(const std::int64_t* __restrict x, std::size_t n, std::int32_t& lo, std::int32_t& hi) {
+  std::int32_t smallest = lo, largest = hi;
+  for (std::size_t k = 1; k < n; ++k) {
+    const auto d = static_cast<std::int32_t>(static_cast<std::uint32_t>(x[k]) - static_cast<std::uint32_t>(x[k - 1]));
+    smallest = d < smallest ? d : smallest;
+    largest = d > largest ? d : largest;
+  }
+  lo = smallest;
+  hi = largest;
+}
+
 }  // namespace gyrochar

@@ -39,6 +39,10 @@ BlockTerms block_terms(std::size_t n, const std::int64_t* x0, const std::int64_t
                        const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
                        std::int64_t* hvar_out, std::int64_t* mvar_out);
 
+/// Folds the differences x[k] - x[k-1], k = 1..n-1, into lo (the smallest) and hi (the largest),
+/// each taken from the low 32-bit words: exact when every difference fits in int32. O(n).
+void difference_range(const std::int64_t* x, std::size_t n, std::int32_t& lo, std::int32_t& hi);
+
 /// to[i] = from[2 i] for i < n (the points of the next level up); the arrays do not overlap. O(n).
 void every_other(const std::uint64_t* from, std::uint64_t* to, std::size_t n);
 

@@ -345,8 +345,6 @@ class Characterizer {
         stage(run_.x);
         run_.x = dx;
       }
-      if (dx < run_.increment_min) run_.increment_min = dx;
-      if (dx > run_.increment_max) run_.increment_max = dx;
     }
     stage(run_.x);
   }
@@ -510,6 +508,14 @@ class Characterizer {
     staged_count_ = 0;
     std::size_t i = 0;
     if constexpr (Arith::exact) {
+      // The segment's smallest and largest increment (terms_fit(), step_bound()): the staged points
+      // are all of this segment (gaps flush first) and differ by increments, the first one from
+      // the last point processed unless it opens the segment.
+      if (run_.next_e != run_.segment_start) {
+        const std::array<std::int64_t, 2> first{history_[(run_.next_e - 1) % (3u * stride_)].x, staged_[0]};
+        difference_range(first.data(), 2, run_.increment_min, run_.increment_max);
+      }
+      difference_range(staged_.data(), n, run_.increment_min, run_.increment_max);
       while (i < n && run_.next_e < run_.steady_from) push(staged_[i++]);
       if (i < n) push_block(&staged_[i], n - i);
     } else {
