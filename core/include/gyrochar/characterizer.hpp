@@ -512,7 +512,8 @@ class Characterizer {
       // are all of this segment (gaps flush first) and differ by increments, the first one from
       // the last point processed unless it opens the segment.
       if (run_.next_e != run_.segment_start) {
-        const std::array<std::int64_t, 2> first{history_[(run_.next_e - 1) % (3u * stride_)].x, staged_[0]};
+        const auto last = static_cast<std::size_t>((run_.next_e - 1) % (3u * stride_));  // its slot in ring 0
+        const std::array<std::int64_t, 2> first{history_[last].x, staged_[0]};
         difference_range(first.data(), 2, run_.increment_min, run_.increment_max);
       }
       difference_range(staged_.data(), n, run_.increment_min, run_.increment_max);
