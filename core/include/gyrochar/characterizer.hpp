@@ -497,9 +497,13 @@ class Characterizer {
   // process the staged points first: nothing observable changes, but two threads must not read
   // at once. A characterizer defined const never has staged points, so nothing is written then.
   void stage(X x) {
-    staged_[staged_count_++] = x;
     // Blocks end on multiples of block_points, so the next one starts on one (higher_levels()).
-    if (((run_.next_e + staged_count_) & (block_points - 1)) == 0) flush();
+    // Decided before the store, which the compiler must assume may change run_.
+    const std::size_t k = staged_count_;
+    const bool full = ((run_.next_e + k + 1) & (block_points - 1)) == 0;
+    staged_[k] = x;
+    staged_count_ = k + 1;
+    if (full) flush();
   }
   void flush() const { const_cast<Characterizer*>(this)->process_staged(); }
   void process_staged() {
