@@ -602,7 +602,8 @@ class Characterizer {
     std::array<std::int64_t, window_depth + block_points> wx;
     std::array<std::uint64_t, window_depth + block_points> wp;
     std::array<std::uint64_t, block_points> p_hi;
-    from_ring(&history_[0], ring0, static_cast<std::uint32_t>((run_.next_e - depth) % ring0), depth, wx.data(), wp.data());
+    const auto oldest = static_cast<std::uint32_t>((run_.next_e - depth) % ring0);
+    from_ring(&history_[0], ring0, oldest, depth, wx.data(), wp.data());
     // P in two words: x sign-extended adds the carry out of the low word, less one when x < 0.
     std::uint64_t p_lo = run_.p.lo, p_high = run_.p.hi;
     for (std::size_t j = 0; j < n; ++j) {
@@ -738,7 +739,8 @@ class Characterizer {
                 x_next, p_next);
       n = (n + 1) / 2;
       // depth = 3S is even: x_prev[0] is of level L.
-      every_other(reinterpret_cast<const std::uint64_t*>(x_prev), reinterpret_cast<std::uint64_t*>(x_next + half), depth - half + n);
+      every_other(reinterpret_cast<const std::uint64_t*>(x_prev), reinterpret_cast<std::uint64_t*>(x_next + half),
+                  depth - half + n);
       every_other(p_prev, p_next + half, depth - half + n);
       const Block b{e0, n, x_next + depth, p_next + depth, nullptr, x_next + depth, depth, level};
       for (; done < ntaus_ && taus_[done].level == level; ++done) {
