@@ -146,14 +146,18 @@ isa=build/isa
 mkdir -p "$isa"
 callgrind() { valgrind --tool=callgrind --callgrind-out-file=/dev/null "$@" 2>&1 | awk '/refs/{gsub(",","",$4); print $4}'; }
 qemu_trace() { "$1" -singlestep -d exec,nochain "${@:2}" 2>&1 >/dev/null | grep -c '^Trace'; }
-# The presets' flags; the kernel loop vectorized as core/CMakeLists.txt asks.
-per_sample="tests/benchmarks/per_sample.cpp $(ls core/src/*.cpp | grep -v block_kernel)"
+# The presets' flags; the kernels' loops vectorized as core/CMakeLists.txt asks.
+kernels="block_kernel noise_id"
+per_sample="tests/benchmarks/per_sample.cpp $(ls core/src/*.cpp | grep -v -e block_kernel -e noise_id)"
 vectorize="-ftree-loop-vectorize -fvect-cost-model=dynamic"
-aarch64-linux-gnu-g++ -std=c++20 -O2 -DNDEBUG -Icore/include $vectorize -c core/src/block_kernel.cpp -o $isa/kernel_aarch64.o
-aarch64-linux-gnu-g++ -std=c++20 -O2 -DNDEBUG -static -Icore/include $per_sample $isa/kernel_aarch64.o -o $isa/per_sample_aarch64
 m4="-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -fno-exceptions -fno-rtti -Os -DNDEBUG -std=c++20 -Wno-psabi -Icore/include"
-arm-none-eabi-g++ $m4 $vectorize -c core/src/block_kernel.cpp -o $isa/kernel_m4.o
-arm-none-eabi-g++ $m4 tests/benchmarks/thumb_linux_start.s $per_sample $isa/kernel_m4.o -nostartfiles \
+for k in $kernels; do
+  aarch64-linux-gnu-g++ -std=c++20 -O2 -DNDEBUG -Icore/include $vectorize -c core/src/$k.cpp -o $isa/${k}_aarch64.o
+  arm-none-eabi-g++ $m4 $vectorize -c core/src/$k.cpp -o $isa/${k}_m4.o
+done
+aarch64-linux-gnu-g++ -std=c++20 -O2 -DNDEBUG -static -Icore/include $per_sample $(printf "$isa/%s_aarch64.o " $kernels) \
+    -o $isa/per_sample_aarch64
+arm-none-eabi-g++ $m4 tests/benchmarks/thumb_linux_start.s $per_sample $(printf "$isa/%s_m4.o " $kernels) -nostartfiles \
     --specs=nosys.specs --specs=nano.specs -Wl,--gc-sections -o $isa/per_sample_m4 2>/dev/null
 n=2000000
 x86=$(( ($(callgrind build/perf/tests/bench_per_sample $n) - $(callgrind build/perf/tests/bench_per_sample 0)) / n ))

@@ -3,14 +3,15 @@
 namespace gyrochar {
 namespace {
 
-// |v| of a two's complement word, with operations every SIMD unit has (no 64-bit compare).
-inline std::uint64_t magnitude(std::uint64_t v) {
-  const std::uint64_t sign = v >> 63;
-  return (v ^ (0 - sign)) + sign;
+// v XOR sign(v): |v| for v >= 0, |v| - 1 below, so every |v| <= 2^bit_width of an OR of them.
+// One shifted operand on Arm, a compare and an XOR with SIMD.
+inline std::uint64_t fold(std::uint64_t v) {
+  return v ^ static_cast<std::uint64_t>(static_cast<std::int64_t>(v) >> 63);
 }
+// The square of v's low 32-bit half taken as signed (one multiply-add on Arm): v^2 when v fits in int32.
 inline std::uint64_t low_square(std::uint64_t v) {
-  const auto low = static_cast<std::uint32_t>(v);
-  return std::uint64_t{low} * low;
+  const auto low = static_cast<std::int32_t>(static_cast<std::uint32_t>(v));
+  return static_cast<std::uint64_t>(std::int64_t{low} * low);
 }
 
 }  // namespace
@@ -36,15 +37,35 @@ BlockTerms block_terms(std::size_t n, const std::int64_t* __restrict x0, const s
     avar_out[j] = static_cast<std::int64_t>(a);
     hvar_out[j] = static_cast<std::int64_t>(h);
     mvar_out[j] = static_cast<std::int64_t>(t);
-    const std::uint64_t ma = magnitude(a), mm = magnitude(t), mh = magnitude(h);
-    bits_a |= ma;
-    bits_m |= mm;
-    bits_h |= mh;
-    sum_a += low_square(ma);
-    sum_m += low_square(mm);
-    sum_h += low_square(mh);
+    bits_a |= fold(a);
+    bits_m |= fold(t);
+    bits_h |= fold(h);
+    sum_a += low_square(a);
+    sum_m += low_square(t);
+    sum_h += low_square(h);
   }
   return {{bits_a, sum_a}, {bits_m, sum_m}, {bits_h, sum_h}};
+}
+
+#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void every_other(const std::uint64_t* __restrict from, std::uint64_t* __restrict to, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) to[i] = from[2 * i];
+}
+
+#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void difference_range(const std::int64_t* __restrict x, std::size_t n, std::int32_t& lo, std::int32_t& hi) {
+  std::int32_t smallest = lo, largest = hi;
+  for (std::size_t k = 1; k < n; ++k) {
+    const auto d = static_cast<std::int32_t>(static_cast<std::uint32_t>(x[k]) - static_cast<std::uint32_t>(x[k - 1]));
+    smallest = d < smallest ? d : smallest;
+    largest = d > largest ? d : largest;
+  }
+  lo = smallest;
+  hi = largest;
 }
 
 }  // namespace gyrochar

@@ -5,6 +5,8 @@
 // The 64-bit partial sums are checked against exact 128-bit sums around the bound that proves them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <climits>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -168,6 +170,27 @@ TEST(BlockKernel, PartialSumsAreExactOnlyWhenTheBoundProvesIt) {
     if (v == (std::int64_t{1} << 29) + 1) {
       EXPECT_FALSE(u128{terms.avar.sum} == exact);
     }
+  }
+}
+
+TEST(BlockKernel, DifferenceRangeIsTheIncrementRangeFromTheLowWords) {
+  // Phase points far from zero (near 2^62) whose increments span the whole int32 range: the range
+  // taken from the low 32-bit words equals the smallest and largest increment (oracle: the
+  // increments themselves), and folds into the range already held.
+  std::mt19937_64 rng(11);
+  for (const std::size_t n : {std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{256}}) {
+    std::vector<std::int64_t> x{std::int64_t{1} << 62};
+    std::int32_t want_lo = 5, want_hi = 5;  // the range held before
+    for (std::size_t k = 1; k < n; ++k) {
+      const auto c = k == 1 ? INT32_MIN : k == 2 ? INT32_MAX : static_cast<std::int32_t>(rng());
+      x.push_back(x.back() + c);
+      want_lo = std::min(want_lo, c);
+      want_hi = std::max(want_hi, c);
+    }
+    std::int32_t lo = 5, hi = 5;
+    difference_range(x.data(), n, lo, hi);
+    EXPECT_EQ(lo, want_lo) << n;
+    EXPECT_EQ(hi, want_hi) << n;
   }
 }
 

@@ -6,10 +6,10 @@
 // Inputs are the phase points at ages 0, m, 2m and 3m of each of the n newest points (x as
 // int64, P as its low 64-bit word): the caller gathers them from its history. Terms are formed in
 // modular 64-bit arithmetic, which is exact whenever the true term fits in int64 (the caller
-// proves that from the input bounds, characterizer.hpp). Each square is the product of the low
-// 32-bit halves of the term's magnitude, a widening multiply SIMD units have: GCC vectorizes the
-// loop with SSE2 and AVX2 on x86-64 (chosen at run time on the host). On aarch64 GCC 12 leaves
-// it scalar (it does not find NEON's widening multiply here), as on Cortex-M.
+// proves that from the input bounds, characterizer.hpp). Each square is the signed square of the
+// term's low 32-bit half, a widening multiply SIMD units have: GCC vectorizes the loop with SSE2
+// and AVX2 on x86-64 (chosen at run time on the host) and with NEON on aarch64 (smull, smlal);
+// Cortex-M runs it scalar (one smlal per square).
 // squares_exact() tells whether a partial sum equals the exact sum of squares.
 #include <bit>
 #include <cstddef>
@@ -17,8 +17,9 @@
 
 namespace gyrochar {
 
-/// One statistic's block: the OR of the terms' magnitudes (a bound: every |term| < 2^bit_width)
-/// and the sum of the squares of their low 32-bit halves, modulo 2^64.
+/// One statistic's block: the OR of the terms XOR their sign (|term| for term >= 0, |term| - 1
+/// below: every |term| <= 2^bit_width of the OR) and the sum of the squares of their low 32-bit
+/// halves taken as signed, modulo 2^64.
 struct BlockSquares {
   std::uint64_t magnitude_bits = 0;
   std::uint64_t sum = 0;
@@ -38,8 +39,16 @@ BlockTerms block_terms(std::size_t n, const std::int64_t* x0, const std::int64_t
                        const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
                        std::int64_t* hvar_out, std::int64_t* mvar_out);
 
-/// True when s.sum is the exact sum of the n squared terms: every |term| < 2^b with 2b + bit_width(n)
-/// <= 64, so each term fits in 31 bits (its low half is itself) and n squares stay below 2^64.
+/// Folds the differences x[k] - x[k-1], k = 1..n-1, into lo (the smallest) and hi (the largest),
+/// each taken from the low 32-bit words: exact when every difference fits in int32. O(n).
+void difference_range(const std::int64_t* x, std::size_t n, std::int32_t& lo, std::int32_t& hi);
+
+/// to[i] = from[2 i] for i < n (the points of the next level up); the arrays do not overlap. O(n).
+void every_other(const std::uint64_t* from, std::uint64_t* to, std::size_t n);
+
+/// True when s.sum is the exact sum of the n squared terms: every |term| <= 2^b with 2b + bit_width(n)
+/// <= 64, so each term fits in int32 (its low half is itself) and n squares of at most 2^2b stay
+/// below 2^64.
 constexpr bool squares_exact(const BlockSquares& s, std::size_t n) {
   return 2 * std::bit_width(s.magnitude_bits) + std::bit_width(n) <= 64;
 }

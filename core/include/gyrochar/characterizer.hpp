@@ -345,8 +345,6 @@ class Characterizer {
         stage(run_.x);
         run_.x = dx;
       }
-      if (dx < run_.increment_min) run_.increment_min = dx;
-      if (dx > run_.increment_max) run_.increment_max = dx;
     }
     stage(run_.x);
   }
@@ -499,9 +497,13 @@ class Characterizer {
   // process the staged points first: nothing observable changes, but two threads must not read
   // at once. A characterizer defined const never has staged points, so nothing is written then.
   void stage(X x) {
-    staged_[staged_count_++] = x;
     // Blocks end on multiples of block_points, so the next one starts on one (higher_levels()).
-    if (((run_.next_e + staged_count_) & (block_points - 1)) == 0) flush();
+    // Decided before the store, which the compiler must assume may change run_.
+    const std::size_t k = staged_count_;
+    const bool full = ((run_.next_e + k + 1) & (block_points - 1)) == 0;
+    staged_[k] = x;
+    staged_count_ = k + 1;
+    if (full) flush();
   }
   void flush() const { const_cast<Characterizer*>(this)->process_staged(); }
   void process_staged() {
@@ -510,6 +512,15 @@ class Characterizer {
     staged_count_ = 0;
     std::size_t i = 0;
     if constexpr (Arith::exact) {
+      // The segment's smallest and largest increment (terms_fit(), step_bound()): the staged points
+      // are all of this segment (gaps flush first) and differ by increments, the first one from
+      // the last point processed unless it opens the segment.
+      if (run_.next_e != run_.segment_start) {
+        const auto last = static_cast<std::size_t>((run_.next_e - 1) % (3u * stride_));  // its slot in ring 0
+        const std::array<std::int64_t, 2> first{history_[last].x, staged_[0]};
+        difference_range(first.data(), 2, run_.increment_min, run_.increment_max);
+      }
+      difference_range(staged_.data(), n, run_.increment_min, run_.increment_max);
       while (i < n && run_.next_e < run_.steady_from) push(staged_[i++]);
       if (i < n) push_block(&staged_[i], n - i);
     } else {
@@ -562,7 +573,8 @@ class Characterizer {
   // The level-0 taus (m <= S) take the whole block at once, tau by tau, in block_terms(); the
   // history and the higher levels then take the points one by one, as push() does. Level 0 reads
   // only ring 0 as it was before the block, so the order of the two passes does not matter.
-  // Working memory on the stack: about 5 KiB.
+  // Working memory on the stack: about 22 KiB (x86-64, 256 points per block), 34 KiB when S > 32
+  // (the gathered points).
   struct Block {
     std::uint64_t e0;  // index of the first point
     std::size_t n;
@@ -590,19 +602,19 @@ class Characterizer {
     std::array<std::int64_t, window_depth + block_points> wx;
     std::array<std::uint64_t, window_depth + block_points> wp;
     std::array<std::uint64_t, block_points> p_hi;
-    std::uint32_t slot = static_cast<std::uint32_t>((run_.next_e - depth) % ring0);
-    for (std::size_t j = 0; j < depth; ++j) {
-      wx[j] = history_[slot].x;
-      wp[j] = history_[slot].p.lo;
-      if (++slot == ring0) slot = 0;
-    }
-    Int128 p = run_.p;
+    const auto oldest = static_cast<std::uint32_t>((run_.next_e - depth) % ring0);
+    from_ring(&history_[0], ring0, oldest, depth, wx.data(), wp.data());
+    // P in two words: x sign-extended adds the carry out of the low word, less one when x < 0.
+    std::uint64_t p_lo = run_.p.lo, p_high = run_.p.hi;
     for (std::size_t j = 0; j < n; ++j) {
-      p = Arith::add_prefix(p, x[j]);
-      wx[depth + j] = x[j];
-      wp[depth + j] = p.lo;
-      p_hi[j] = p.hi;
+      const auto v = static_cast<std::uint64_t>(x[j]);
+      const std::uint64_t sum = p_lo + v;
+      p_high += static_cast<std::uint64_t>(sum < p_lo) - (v >> 63);
+      p_lo = sum;
+      wp[depth + j] = p_lo;
+      p_hi[j] = p_high;
     }
+    std::memcpy(&wx[depth], x, n * sizeof(X));
     const Block b{run_.next_e, n, x, &wp[depth], p_hi.data(), &wx[depth], depth, 0};
     for (std::size_t i = 0; i < fast_count_; ++i) level0_block(taus_[i], b);
     const std::size_t done = depth == ring0 ? higher_levels(b, wx.data(), wp.data()) : fast_count_;
@@ -659,17 +671,29 @@ class Characterizer {
       std::uint64_t first = a > lag ? ((a - 1 - lag) >> l) + 1 : 0;  // not in ring l before
       if (newest >= first + size) first = newest + 1 - size;
       Entry* ring = &history_[ring_offset(l)];
-      unsigned r = l == 0 ? 0 : l - 1;  // the ring holding q before, for q < a (older q sit higher)
       auto slot = static_cast<std::uint32_t>(first % size);
-      for (std::uint64_t k = first; k <= newest; ++k) {
-        const std::uint64_t q = k << l;
-        if (q >= a) {
-          const auto j = static_cast<std::size_t>(q - a);
-          ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
-        } else {
-          while (!held(r, q, a - 1)) --r;  // ring 0 holds every q in [a - 3S, a)
-          ring[slot] = history_[ring_offset(r) + static_cast<std::size_t>((q >> r) % ring_size(r))];
+      std::uint64_t k = first;
+      // The multiples q < a, from the rings below that held them (older q sit higher): each ring
+      // holds a run of consecutive multiples, read at a fixed step of slots. Ring 0 holds every q
+      // in [a - 3S, a).
+      for (unsigned r = l; k <= newest && (k << l) < a;) {
+        while (!held(--r, k << l, a - 1)) {}
+        const std::uint64_t last = r == 0 ? a - 1 : (a - 1 - ring_lag(r)) >> r << r;  // ring r's newest
+        const std::uint32_t from_size = ring_size(r);
+        const auto step = static_cast<std::uint32_t>((std::uint64_t{1} << (l - r)) % from_size);
+        const Entry* from = &history_[ring_offset(r)];
+        auto from_slot = static_cast<std::uint32_t>(((k << l) >> r) % from_size);
+        for (; k <= newest && (k << l) <= last; ++k) {
+          ring[slot] = from[from_slot];
+          if (++slot == size) slot = 0;
+          from_slot += step;
+          if (from_slot >= from_size) from_slot -= from_size;
         }
+        ++r;  // the next multiple may still sit in ring r - 1 (held() steps down from r - 1)
+      }
+      // The multiples q >= a, from the run itself.
+      for (auto j = static_cast<std::size_t>((k << l) - a); k <= newest; ++k, j += std::size_t{1} << l) {
+        ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
         if (++slot == size) slot = 0;
       }
     }
@@ -699,28 +723,25 @@ class Characterizer {
     const std::uint64_t e0 = level0.e0;
     const std::size_t depth = 3u * stride_;
     if (e0 % block_points != 0) return done;
-    std::array<std::array<std::int64_t, window_depth + block_points>, 2> x_buf;
-    std::array<std::array<std::uint64_t, window_depth + block_points>, 2> p_buf;
+    std::array<std::array<std::int64_t, window_depth + block_points / 2>, 2> x_buf;  // level 1 on: half the points
+    std::array<std::array<std::uint64_t, window_depth + block_points / 2>, 2> p_buf;
     std::size_t n = level0.n;
-    for (unsigned level = 1; (std::size_t{1} << level) <= block_points && level < ring_levels_; ++level) {
+    // Levels with at least two points in the block: a single point costs less through block_point().
+    for (unsigned level = 1; (std::size_t{2} << level) <= block_points && level < ring_levels_; ++level) {
       if (done == ntaus_ || taus_[done].level != level || e0 < run_.segment_start + (std::uint64_t{depth} << level))
         return done;
       std::int64_t* x_next = x_buf[level % 2].data();
       std::uint64_t* p_next = p_buf[level % 2].data();
       const std::size_t half = depth / 2;
       const std::uint32_t ring = 3u * stride_ / 2;
-      std::uint32_t slot = static_cast<std::uint32_t>(((e0 >> level) - depth) % ring);
-      const std::size_t base = ring_offset(level);
-      for (std::size_t i = 0; i < half; ++i) {  // ages (3S 2^(L-1), 3S 2^L]: ring L
-        x_next[i] = history_[base + slot].x;
-        p_next[i] = history_[base + slot].p.lo;
-        if (++slot == ring) slot = 0;
-      }
+      // Ages (3S 2^(L-1), 3S 2^L]: ring L; the younger ones and the block: every other one.
+      from_ring(&history_[ring_offset(level)], ring, static_cast<std::uint32_t>(((e0 >> level) - depth) % ring), half,
+                x_next, p_next);
       n = (n + 1) / 2;
-      for (std::size_t i = half; i < depth + n; ++i) {  // younger ones and the block: every other one
-        x_next[i] = x_prev[2 * i - depth];
-        p_next[i] = p_prev[2 * i - depth];
-      }
+      // depth = 3S is even: x_prev[0] is of level L.
+      every_other(reinterpret_cast<const std::uint64_t*>(x_prev), reinterpret_cast<std::uint64_t*>(x_next + half),
+                  depth - half + n);
+      every_other(p_prev, p_next + half, depth - half + n);
       const Block b{e0, n, x_next + depth, p_next + depth, nullptr, x_next + depth, depth, level};
       for (; done < ntaus_ && taus_[done].level == level; ++done) {
         if (!terms_fit(taus_[done].result.m)) return done;
@@ -732,6 +753,19 @@ class Characterizer {
     return done;
   }
 
+
+  // x and the low word of P of `count` entries of a ring of `size` slots, from `slot` on.
+  static void from_ring(const Entry* ring, std::uint32_t size, std::uint32_t slot, std::size_t count,
+                        std::int64_t* __restrict x, std::uint64_t* __restrict p) {
+    for (std::size_t i = 0; i < count;) {
+      const std::size_t run = count - i < size - slot ? count - i : size - slot;
+      for (std::size_t k = 0; k < run; ++k, ++i) {
+        x[i] = ring[slot + k].x;
+        p[i] = ring[slot + k].p.lo;
+      }
+      slot = 0;
+    }
+  }
 
   // The block's terms of one level-0 tau, and its decimated points.
   // The terms of tau m fit in int64 when 2 m^2 (largest increment - smallest) < 2^63 (|a| <= m
@@ -764,19 +798,33 @@ class Characterizer {
       }
       return;
     }
-    // The points at ages m, 2m, 3m: in the window, or gathered from ring 0.
-    std::array<std::int64_t, block_points> gx1, gx2, gx3, a, h, mt;
-    std::array<std::uint64_t, block_points> gp1, gp2, gp3;
-    const std::int64_t *x1 = gx1.data(), *x2 = gx2.data(), *x3 = gx3.data();
-    const std::uint64_t *p1 = gp1.data(), *p2 = gp2.data(), *p3 = gp3.data();
+    // The points at ages m, 2m, 3m: in the window, or gathered from ring 0 (S > 32).
     if (3 * m <= b.depth) {
-      x1 = b.wx - m, x2 = b.wx - 2 * m, x3 = b.wx - 3 * m;
-      p1 = b.p_lo - m, p2 = b.p_lo - 2 * m, p3 = b.p_lo - 3 * m;
+      block_sums(t, b, m, b.wx - m, b.wx - 2 * m, b.wx - 3 * m, b.p_lo - m, b.p_lo - 2 * m, b.p_lo - 3 * m);
     } else {
-      gather(b, m, gx1.data(), gp1.data());
-      gather(b, 2 * m, gx2.data(), gp2.data());
-      gather(b, 3 * m, gx3.data(), gp3.data());
+      gathered_sums(t, b, m);
     }
+  }
+
+  // The gathered points live in this function's frame only, not in the usual path's.
+  [[gnu::noinline]] void gathered_sums(TauState& t, const Block& b, std::size_t m)
+    requires(Arith::exact)
+  {
+    std::array<std::int64_t, block_points> x1, x2, x3;
+    std::array<std::uint64_t, block_points> p1, p2, p3;
+    gather(b, m, x1.data(), p1.data());
+    gather(b, 2 * m, x2.data(), p2.data());
+    gather(b, 3 * m, x3.data(), p3.data());
+    block_sums(t, b, m, x1.data(), x2.data(), x3.data(), p1.data(), p2.data(), p3.data());
+  }
+
+  // The block's terms of a tau of lag m from the points at ages m, 2m, 3m, their sums, the
+  // decimated points and the noise sums.
+  void block_sums(TauState& t, const Block& b, std::size_t m, const std::int64_t* x1, const std::int64_t* x2,
+                  const std::int64_t* x3, const std::uint64_t* p1, const std::uint64_t* p2, const std::uint64_t* p3)
+    requires(Arith::exact)
+  {
+    std::array<std::int64_t, block_points> a, h, mt;
     const BlockTerms terms = block_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data(), mt.data());
     Result& r = t.result;
     t.sticky |= add_block(r.sum[0], terms.avar, a.data(), b.n) | add_block(r.sum[1], terms.mvar, mt.data(), b.n) |
@@ -790,14 +838,19 @@ class Characterizer {
       t.countdown -= b.n;
       return;
     }
-    const std::size_t first = static_cast<std::size_t>(t.countdown - 1);
-    std::size_t count = 0, j = first;
-    BlockSquares da{terms.avar.magnitude_bits, 0}, dh{terms.hvar.magnitude_bits, 0};
-    for (;; j += m) {
-      da.sum += static_cast<std::uint64_t>(a[j]) * static_cast<std::uint64_t>(a[j]);
-      dh.sum += static_cast<std::uint64_t>(h[j]) * static_cast<std::uint64_t>(h[j]);
-      ++count;
-      if (j + m >= b.n) break;
+    // The countdown stays in 1..m, so for m = 1 every point is decimated and the block's partial
+    // sums are already the non-overlapped ones.
+    const auto first = static_cast<std::size_t>(t.countdown - 1);
+    const std::size_t count = (b.n - 1 - first) / m + 1;
+    const std::size_t j = first + (count - 1) * m;  // the newest decimated point
+    BlockSquares da = terms.avar, dh = terms.hvar;
+    if (m > 1) {
+      da.sum = 0;
+      dh.sum = 0;
+      for (std::size_t k = first; k <= j; k += m) {
+        da.sum += static_cast<std::uint64_t>(a[k]) * static_cast<std::uint64_t>(a[k]);
+        dh.sum += static_cast<std::uint64_t>(h[k]) * static_cast<std::uint64_t>(h[k]);
+      }
     }
     const auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
     const auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
@@ -973,7 +1026,7 @@ class Characterizer {
   std::uint32_t tag_ = 0;
   unsigned ring_levels_ = 1;
   std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
-  static constexpr std::size_t block_points = 64;  // staged points per block (a power of two)
+  static constexpr std::size_t block_points = 256;  // staged points per block (a power of two)
   std::array<X, block_points> staged_{};
   std::size_t staged_count_ = 0;
 
