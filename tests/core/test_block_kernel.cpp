@@ -173,6 +173,54 @@ TEST(BlockKernel, PartialSumsAreExactOnlyWhenTheBoundProvesIt) {
   }
 }
 
+TEST(BlockKernel, ProvedKernelsEqualTheTermsThemselves) {
+  // Phase points of a steady rate with increments spread over D = 2^12: every lag-m term is within
+  // the proved bounds (|t| <= m^2 D < 2^27 for m <= 8). The kernels without bounds (SIMD where the
+  // target has it, every block length 0..300 so the scalar tail runs too) give the terms and the
+  // sums of their squares computed here one by one from the definitions (x and P; oracle: 128-bit
+  // sums of squares), the running-sum one from the first MVAR term alone.
+  std::mt19937_64 rng(5);
+  for (std::size_t m : {std::size_t{1}, std::size_t{3}, std::size_t{8}}) {
+    for (std::size_t n = 0; n <= 300; ++n) {
+      const std::size_t back = 3 * m;
+      std::vector<std::int64_t> x{std::int64_t{1} << 50};
+      std::vector<std::uint64_t> p{static_cast<std::uint64_t>(x[0])};
+      for (std::size_t k = 1; k < back + n; ++k) {
+        x.push_back(x.back() + 1000000 + static_cast<std::int64_t>(rng() % 4096));
+        p.push_back(p.back() + static_cast<std::uint64_t>(x.back()));
+      }
+      std::vector<std::int64_t> a(n + 1), h(n + 1), a2(n + 1), h2(n + 1);
+      u128 want_a = 0, want_h = 0, want_t = 0;
+      std::uint64_t t_first = 0;
+      for (std::size_t j = 0; j < n; ++j) {
+        const std::size_t e = back + j;
+        const __int128 av = static_cast<__int128>(x[e]) - 2 * static_cast<__int128>(x[e - m]) + x[e - 2 * m];
+        const __int128 hv = av - (static_cast<__int128>(x[e - m]) - 2 * static_cast<__int128>(x[e - 2 * m]) + x[e - 3 * m]);
+        const auto tv = static_cast<std::int64_t>(p[e] - 3 * p[e - m] + 3 * p[e - 2 * m] - p[e - 3 * m]);
+        if (j == 0) t_first = static_cast<std::uint64_t>(tv);
+        want_a += static_cast<u128>(av * av);
+        want_h += static_cast<u128>(hv * hv);
+        want_t += static_cast<u128>(static_cast<__int128>(tv) * tv);
+      }
+      const auto at = [&](std::size_t age) { return x.data() + back - age; };
+      const auto pt = [&](std::size_t age) { return p.data() + back - age; };
+      const ProvedSums direct = proved_terms(n, at(0), at(m), at(2 * m), at(3 * m), pt(0), pt(m), pt(2 * m), pt(3 * m),
+                                             a.data(), h.data());
+      const ProvedSums running =
+          proved_running_terms(n, at(0), at(m), at(2 * m), at(3 * m), t_first, a2.data(), h2.data());
+      for (const ProvedSums& s : {direct, running}) {
+        EXPECT_TRUE(u128{s.avar} == want_a && u128{s.hvar} == want_h && u128{s.mvar} == want_t) << "m=" << m << " n=" << n;
+      }
+      for (std::size_t j = 0; j < n; ++j) {
+        EXPECT_EQ(a[j], x[back + j] - 2 * x[back + j - m] + x[back + j - 2 * m]);
+        EXPECT_EQ(h[j], a[j] - (x[back + j - m] - 2 * x[back + j - 2 * m] + x[back + j - 3 * m]));
+        EXPECT_EQ(a2[j], a[j]);
+        EXPECT_EQ(h2[j], h[j]);
+      }
+    }
+  }
+}
+
 TEST(BlockKernel, DifferenceRangeIsTheIncrementRangeFromTheLowWords) {
   // Phase points far from zero (near 2^62) whose increments span the whole int32 range: the range
   // taken from the low 32-bit words equals the smallest and largest increment (oracle: the

@@ -39,6 +39,27 @@ BlockTerms block_terms(std::size_t n, const std::int64_t* x0, const std::int64_t
                        const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
                        std::int64_t* hvar_out, std::int64_t* mvar_out);
 
+/// The sums of the squares of a block's terms when the caller has proved beforehand that every
+/// |term| <= bound with squares_exact({bound}, n) (characterizer.hpp's proved_small(): |a| <= m D,
+/// |h| <= 2 m D, |t| <= m^2 D for the segment's increment spread D). Each term then fits in int32,
+/// so the sums of the squares of the terms' low halves are the exact sums and no bound is formed.
+struct ProvedSums {
+  std::uint64_t avar = 0, mvar = 0, hvar = 0;
+};
+/// As block_terms() under that proof: the sums of squares, the AVAR and HVAR terms to avar_out[j]
+/// and hvar_out[j] (the decimated series reads them). AVX2 on the x86-64 host (chosen at run
+/// time), NEON on aarch64, scalar elsewhere; the same bits on every path. O(n), cannot fail.
+ProvedSums proved_terms(std::size_t n, const std::int64_t* x0, const std::int64_t* x1, const std::int64_t* x2,
+                        const std::int64_t* x3, const std::uint64_t* p0, const std::uint64_t* p1,
+                        const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
+                        std::int64_t* hvar_out);
+/// The same for consecutive phase points (a level-0 tau) without their P: the MVAR term as the
+/// running sum t_j = t_{j-1} + h_j (t sums m consecutive AVAR terms) from t_first, the term of
+/// point 0, which the caller forms from P.
+ProvedSums proved_running_terms(std::size_t n, const std::int64_t* x0, const std::int64_t* x1, const std::int64_t* x2,
+                                const std::int64_t* x3, std::uint64_t t_first, std::int64_t* avar_out,
+                                std::int64_t* hvar_out);
+
 /// Folds the differences x[k] - x[k-1], k = 1..n-1, into lo (the smallest) and hi (the largest),
 /// each taken from the low 32-bit words: exact when every difference fits in int32. O(n).
 void difference_range(const std::int64_t* x, std::size_t n, std::int32_t& lo, std::int32_t& hi);

@@ -778,6 +778,18 @@ class Characterizer {
     return span <= (~std::uint64_t{0} >> 1) / (2 * m * m);
   }
 
+  // Whether every term of tau m is small enough that the 64-bit sums of n of their squares are
+  // exact (squares_exact()), from the segment's increment spread D: |a| <= m D, |h| <= 2 m D,
+  // |t| <= m^2 D (t sums m consecutive AVAR terms). The bounds go to `terms` (their sums are the
+  // caller's to fill). terms_fit(m) holds: m^2 D < 2^62.
+  bool proved_small(std::uint64_t m, std::size_t n, BlockTerms& terms) const {
+    const auto span = static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min);
+    terms.avar.magnitude_bits = m * span;
+    terms.hvar.magnitude_bits = 2 * m * span;
+    terms.mvar.magnitude_bits = m * m * span;
+    return squares_exact(terms.hvar, n) && squares_exact(terms.mvar, n);
+  }
+
   // A bound on |x[e] - x[e-m]| (m increments) in this segment, 0 when it does not fit in 62 bits.
   std::uint64_t step_bound(std::uint64_t m) const {
     const std::int64_t lo = run_.increment_min, hi = run_.increment_max;
@@ -825,7 +837,21 @@ class Characterizer {
     requires(Arith::exact)
   {
     std::array<std::int64_t, block_points> a, h, mt;
-    const BlockTerms terms = block_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data(), mt.data());
+    BlockTerms terms;
+    if (proved_small(t.result.m, b.n, terms)) {
+      ProvedSums s;
+      if (b.level == 0) {  // the MVAR terms as the running sum of the HVAR terms, from the first one's P
+        const std::uint64_t d = p2[0] - p1[0];
+        s = proved_running_terms(b.n, b.x, x1, x2, x3, (b.p_lo[0] - p3[0]) + (d + d + d), a.data(), h.data());
+      } else {
+        s = proved_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data());
+      }
+      terms.avar.sum = s.avar;
+      terms.mvar.sum = s.mvar;
+      terms.hvar.sum = s.hvar;
+    } else {
+      terms = block_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data(), mt.data());
+    }
     Result& r = t.result;
     t.sticky |= add_block(r.sum[0], terms.avar, a.data(), b.n) | add_block(r.sum[1], terms.mvar, mt.data(), b.n) |
                 add_block(r.sum[2], terms.hvar, h.data(), b.n);
