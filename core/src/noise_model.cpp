@@ -484,8 +484,9 @@ PairSumCache::Entry* PairSumCache::slot(const TermGrid& a, const TermGrid& b) {
   // Open addressing on the grids' shape.
   std::uint64_t h = (a.m * 0x9E3779B97F4A7C15u) ^ (b.m * 0xC2B2AE3D27D4EB4Fu) ^ (a.stride << 7) ^ (b.stride << 13) ^
                     (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5);
+  // At most 64 probes: a full table (say a dense tau list's) answers "not kept" in O(1).
   Entry* entry = nullptr;
-  for (std::size_t probe = 0; probe < entries_.size(); ++probe) {
+  for (std::size_t probe = 0; probe < entries_.size() && probe < 64; ++probe) {
     Entry& e = entries_[static_cast<std::size_t>((h + probe) % entries_.size())];
     if (!e.used || (e.stat_a == a.stat && e.stat_b == b.stat && e.m_a == a.m && e.m_b == b.m &&
                     e.stride_a == a.stride && e.stride_b == b.stride)) {
@@ -496,19 +497,8 @@ PairSumCache::Entry* PairSumCache::slot(const TermGrid& a, const TermGrid& b) {
   return entry;
 }
 
-void PairSumCache::put(const TermGrid& a, const TermGrid& b, const PairSums& sums) {
-  Entry* entry = slot(a, b);
-  if (entry == nullptr) return;
-  *entry = Entry{};
-  entry->used = true;
-  entry->stat_a = a.stat, entry->stat_b = b.stat, entry->m_a = a.m, entry->m_b = b.m;
-  entry->stride_a = a.stride, entry->stride_b = b.stride;
-  entry->n_a = a.n;
-  entry->n_b = b.n;
-  entry->sums = sums;
-}
-
 PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b) {
+  if (PairSums found; source_ != nullptr && source_->find(a, b, found)) return found;
   const NoiseSet set = allan_noises();
   Entry* entry = slot(a, b);
   if (entry == nullptr) return pair_sums(set, a, b);  // hvar, or full

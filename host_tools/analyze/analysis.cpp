@@ -177,12 +177,15 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
   std::vector<NoiseId> noise2(taus), noise3(taus);
   // The identification and the EDF need the same covariance sums of each tau's Allan and
   // modified Allan grids: computed once (two grids a tau, the table half full at most).
-  std::vector<PairSumCache::Entry> entries(4 * taus + 16);
+  // (A dense list's taus take theirs from DenseNoiseSums below, not from the table: its size
+  // stays that of a few thousand taus.)
+  std::vector<PairSumCache::Entry> entries(4 * std::min<std::size_t>(taus, 4096) + 16);
   PairSumCache cache(entries);
   const bool frequency_input = type == DataType::freq;
   // Dense taus: the EDF from tables, and the identification's pair sums put in the cache, both
   // exact at anchors and interpolated between them (edf_table.hpp).
   std::map<DevStat, std::unique_ptr<EdfTable>> tables;
+  std::unique_ptr<DenseNoiseSums> dense_sums;
   for (const DevStat stat : o.stats)
     for (const DevStat s : is_total(stat) ? std::vector<DevStat>{DevStat::oadev, DevStat::mdev, DevStat::ohdev} : std::vector{stat})
       if (!tables.contains(s)) tables[s] = dense_edf_table(s, sums, a.n_phase, o.edf, cache);
@@ -190,7 +193,8 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
     std::vector<std::uint64_t> m_list;
     for (const TauSums& t : sums)
       if (t.stride == 1) m_list.push_back(t.m);
-    put_dense_noise_sums(m_list, a.n_phase, dense_from, cache);
+    dense_sums = std::make_unique<DenseNoiseSums>(m_list, a.n_phase, dense_from, cache);
+    cache.attach(dense_sums.get());
   }
   if (o.alpha) {
     std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
@@ -399,32 +403,27 @@ class CountBatchEngine final : public EngineBase {
     a.n_values = counts_;
     a.n_phase = counts_ == 0 ? 0 : counts_ + 1;
     a.stride_factor = stride_factor_;
-    std::vector<BatchTau> taus;
-    taus.reserve(m_list_.size());
-    for (const std::uint64_t m : m_list_) taus.emplace_back(m, stride_of(m, stride_factor_));
+    const std::size_t taus = m_list_.size();
+    std::vector<TauSums> sums(taus);  // each tau's sums kept as the read-out takes them (not its BatchTau)
     const std::uint64_t spread = counts_ == 0 ? 0 : static_cast<std::uint64_t>(std::int64_t{highest_} - lowest_);
     // The taus are independent: each thread takes the next one left until none is.
     std::atomic<std::size_t> next{0}, done{0};
     const auto sum_taus = [&](bool tell) {
-      for (std::size_t i = next++; i < taus.size() && counts_ > 0; i = next++) {
-        if (wide_.empty()) {
-          taus[i].add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
-        } else {
-          taus[i].add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
-        }
+      for (std::size_t i = next++; i < taus; i = next++) {
+        BatchTau tau(m_list_[i], stride_of(m_list_[i], stride_factor_));
+        if (counts_ > 0 && wide_.empty()) tau.add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
+        if (counts_ > 0 && !wide_.empty()) tau.add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
+        sums[i] = tau_sums(tau.result(), tau.noise());
         const std::size_t summed = ++done;
-        if (tell && o.on_summed && summed < taus.size()) o.on_summed(summed, taus.size());
+        if (tell && o.on_summed && summed < taus) o.on_summed(summed, taus);
       }
     };
-    const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), taus.size());
+    const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), taus);
     std::vector<std::thread> helpers;
     for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
     sum_taus(true);
     for (std::thread& t : helpers) t.join();
-    if (o.on_summed) o.on_summed(taus.size(), taus.size());
-    std::vector<TauSums> sums;
-    sums.reserve(taus.size());
-    for (const BatchTau& t : taus) sums.push_back(tau_sums(t.result(), t.noise()));
+    if (o.on_summed) o.on_summed(taus, taus);
     read_out(a, sums, DataType::counts, o, record_);
     return a;
   }

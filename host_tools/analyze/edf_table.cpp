@@ -143,41 +143,41 @@ PairSums interpolate(const PairSums& p0, const PairSums& p1, double w) {
 
 }  // namespace
 
-std::size_t put_dense_noise_sums(std::span<const std::uint64_t> m_list, std::uint64_t n_phase, std::uint64_t m_min,
-                                 PairSumCache& cache) {
+DenseNoiseSums::DenseNoiseSums(std::span<const std::uint64_t> m_list, std::uint64_t n_phase, std::uint64_t m_min,
+                               PairSumCache& cache)
+    : n_phase_(n_phase) {
   std::uint64_t m_max = 0;
   for (const std::uint64_t m : m_list)
     if (m >= m_min && unbroken_grid(Stat::mvar, m, 1, n_phase).n > 0) m_max = m;
   static constexpr Stat stats[] = {Stat::avar, Stat::mvar};
-  const std::vector<std::uint64_t> anchors = dense_anchors(stats, n_phase, m_min, m_max);
-  if (anchors.empty()) return 0;
-  struct Sums {
-    PairSums aa, mm, am;
-  };
-  const auto grids = [&](std::uint64_t m) {
-    return std::pair{unbroken_grid(Stat::avar, m, 1, n_phase), unbroken_grid(Stat::mvar, m, 1, n_phase)};
-  };
-  const auto exact = [&](std::uint64_t m) {
-    const auto [a, b] = grids(m);
-    return Sums{cache.get(a, a), cache.get(b, b), cache.get(a, b)};
-  };
-  std::size_t k = 0;
-  Sums lo = exact(anchors[0]), hi = lo;
-  for (const std::uint64_t m : m_list) {
-    if (m < m_min || m > m_max) continue;
-    while (anchors[k] < m) {
-      lo = hi;
-      hi = exact(anchors[++k]);
-    }
-    if (anchors[k] == m) continue;  // exact, in the cache already
-    const double w = std::log(static_cast<double>(m) / static_cast<double>(anchors[k - 1])) /
-                     std::log(static_cast<double>(anchors[k]) / static_cast<double>(anchors[k - 1]));
-    const auto [a, b] = grids(m);
-    cache.put(a, a, interpolate(lo.aa, hi.aa, w));
-    cache.put(b, b, interpolate(lo.mm, hi.mm, w));
-    cache.put(a, b, interpolate(lo.am, hi.am, w));
+  for (const std::uint64_t m : dense_anchors(stats, n_phase, m_min, m_max)) {
+    const TermGrid a = unbroken_grid(Stat::avar, m, 1, n_phase), b = unbroken_grid(Stat::mvar, m, 1, n_phase);
+    anchors_.push_back({m, cache.get(a, a), cache.get(b, b), cache.get(a, b)});
   }
-  return anchors.size();
+}
+
+bool DenseNoiseSums::find(const TermGrid& a, const TermGrid& b, PairSums& out) const {
+  if (anchors_.empty() || a.m != b.m || a.m < anchors_.front().m || a.m > anchors_.back().m) return false;
+  const auto unbroken = [&](const TermGrid& g) {
+    const TermGrid u = unbroken_grid(g.stat, g.m, 1, n_phase_);
+    return (g.stat == Stat::avar || g.stat == Stat::mvar) && g.stride == 1 && g.first == u.first && g.n == u.n;
+  };
+  if (!unbroken(a) || !unbroken(b)) return false;
+  const auto pick = [&](const Anchor& anchor) -> const PairSums& {
+    return a.stat != b.stat ? anchor.am : a.stat == Stat::avar ? anchor.aa : anchor.mm;
+  };
+  // Anchors are in the order of m: the first at or above m, and the one before it.
+  const auto hi = std::lower_bound(anchors_.begin(), anchors_.end(), a.m,
+                                   [](const Anchor& anchor, std::uint64_t m) { return anchor.m < m; });
+  if (hi->m == a.m) {
+    out = pick(*hi);
+  } else {
+    const Anchor& lo = *(hi - 1);
+    const double w = std::log(static_cast<double>(a.m) / static_cast<double>(lo.m)) /
+                     std::log(static_cast<double>(hi->m) / static_cast<double>(lo.m));
+    out = interpolate(pick(lo), pick(*hi), w);
+  }
+  return true;  // pair_sums(b, a) is pair_sums(a, b): every pair's lag turns, not its covariance
 }
 
 }  // namespace gyrochar

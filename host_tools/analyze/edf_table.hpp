@@ -75,11 +75,29 @@ TauSums unbroken_sums(DevStat stat, std::uint64_t m, std::uint64_t n_phase);
 std::vector<std::uint64_t> dense_anchors(std::span<const Stat> stats, std::uint64_t n_phase, std::uint64_t m_min,
                                          std::uint64_t m_max);
 
-/// Puts into `cache` the pair sums identify_noise() reads at each tau of m_list from m_min on
-/// (stride 1; Allan with itself, modified Allan with itself, the two): exact at the anchors,
-/// interpolated between them (each diagonal sum log-linearly in m, within 2e-3 of the exact one,
-/// tests/host/test_edf_table.cpp). Returns the anchors computed. O(anchors) pair sums.
-std::size_t put_dense_noise_sums(std::span<const std::uint64_t> m_list, std::uint64_t n_phase, std::uint64_t m_min,
-                                 PairSumCache& cache);
+/// The pair sums identify_noise() reads at each fully overlapped tau of a dense list from m_min on
+/// (Allan with itself, modified Allan with itself, the two), for a PairSumCache to ask first:
+/// exact at the anchors, interpolated between them (each diagonal sum log-linearly in m, within
+/// 2e-3 of the exact one, tests/host/test_edf_table.cpp). Holds the anchors' sums only, so a list
+/// of N/2 taus costs O(log N) memory, not a cache entry a tau. Allocates; may throw std::bad_alloc.
+class DenseNoiseSums final : public PairSumSource {
+ public:
+  /// The anchors for the taus m_min <= m of m_list over an unbroken run of n_phase points, their
+  /// exact sums computed through `cache`. O(anchors) pair sums.
+  DenseNoiseSums(std::span<const std::uint64_t> m_list, std::uint64_t n_phase, std::uint64_t m_min, PairSumCache& cache);
+  /// Anchors computed (what the sums cost).
+  std::size_t anchors() const { return anchors_.size(); }
+  /// The sums of grids a and b when both are the unbroken fully overlapped grids of one covered m
+  /// (Allan or modified Allan). O(log anchors).
+  bool find(const TermGrid& a, const TermGrid& b, PairSums& out) const override;
+
+ private:
+  struct Anchor {
+    std::uint64_t m = 0;
+    PairSums aa, mm, am;
+  };
+  std::uint64_t n_phase_;
+  std::vector<Anchor> anchors_;
+};
 
 }  // namespace gyrochar

@@ -563,7 +563,7 @@ int main(int argc, char** argv) {
     } catch (const DataFileError& e) {
       bad_data(source, e);
     }
-    const Analysis a = [&] {
+    Analysis a = [&] {
       try {
         return analyzer->result();
       } catch (const std::range_error& e) {  // a deviation that is not a finite number, and why
@@ -586,7 +586,7 @@ int main(int argc, char** argv) {
     if (!fit_text.empty())
       fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
                         long_tau, analyzer->record());
-    Analysis displayed = a;
+    Analysis displayed = std::move(a);  // (a --taus all run has millions of rows: not copied)
     std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
     // A tau asked for by number but too long for the data has no row: say so. (The octave,
     // decade and all lists stop where the data end by design.)
@@ -600,7 +600,7 @@ int main(int argc, char** argv) {
       if (!missing.empty())
         print_error(program, "note",
                     fmt::format("m = {} (tau = {:g} s) left out of {}: {} phase points are too few for a term", m,
-                                static_cast<double>(m) * o.tau0_s, missing, a.n_phase));
+                                static_cast<double>(m) * o.tau0_s, missing, displayed.n_phase));
     }
     for (const AnalysisRow& r : displayed.rows)  // the output unit must not take a value out of range
       if (!std::isfinite(r.dev * units.factor()) || (r.ci.valid && !std::isfinite(r.ci.high * units.factor())))

@@ -91,20 +91,22 @@ TEST(EdfTable, EstimateWithGapsAndPlausibleRangesAsEstimate) {
   EXPECT_NEAR(b.high / a.high, 1.0, stated_interval_error);
 }
 
-TEST(EdfTable, NoiseSumsPutInTheCacheWithinTheStatedErrorOfTheExactOnes) {
+TEST(EdfTable, DenseNoiseSumsWithinTheStatedErrorOfTheExactOnes) {
   // The diagonal pair sums identify_noise() reads (R(n)'s variances) at every m of a dense list,
-  // from the cache after put_dense_noise_sums(), against pair_sums() computed here (oracle).
+  // through a cache that asks DenseNoiseSums first, against pair_sums() computed here (oracle).
   const std::uint64_t n_phase = 6001;
   std::vector<std::uint64_t> m_list;
   for (std::uint64_t m = 1; m <= 2000; ++m) m_list.push_back(m);
-  std::vector<PairSumCache::Entry> entries(4 * m_list.size() + 16);
+  std::vector<PairSumCache::Entry> entries(4096);
   PairSumCache cache(entries);
-  const std::size_t anchors = put_dense_noise_sums(m_list, n_phase, 64, cache);
+  const DenseNoiseSums dense(m_list, n_phase, 64, cache);
+  cache.attach(&dense);
+  const std::size_t anchors = dense.anchors();
   EXPECT_LT(anchors, m_list.size() / 4);
   double worst = 0;
   for (std::uint64_t m = 64; m <= 2000; m += 1 + m / 61) {
     const TermGrid a = unbroken_grid(Stat::avar, m, 1, n_phase), b = unbroken_grid(Stat::mvar, m, 1, n_phase);
-    for (const auto& [g, h] : {std::pair{a, a}, std::pair{b, b}, std::pair{a, b}}) {
+    for (const auto& [g, h] : {std::pair{a, a}, std::pair{b, b}, std::pair{a, b}, std::pair{b, a}}) {
       const PairSums got = cache.get(g, h), want = pair_sums(allan_noises(), g, h);
       for (std::size_t k = 0; k < 5; ++k) {
         worst = std::fmax(worst, std::fabs(got.cc[k][k] / want.cc[k][k] - 1));

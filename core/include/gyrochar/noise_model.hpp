@@ -124,6 +124,17 @@ NoiseSet allan_noises();
 /// the coarser grid's terms until either grid has grown by 2 % (10 % for grids of different taus,
 /// whose covariance only weights the IEEE-952 fit). A full table is not an error: the sums are
 /// then computed afresh. No allocation; Allan and modified Allan only.
+/// Where a PairSumSource is attached, get() asks it first: sums it gives are neither kept nor computed.
+class PairSumSource {
+ public:
+  /// True, with the sums in `out`, when this source has pair_sums(allan_noises(), a, b) (or an
+  /// approximation its owner vouches for).
+  virtual bool find(const TermGrid& a, const TermGrid& b, PairSums& out) const = 0;
+
+ protected:
+  ~PairSumSource() = default;
+};
+
 class PairSumCache {
  public:
   struct Entry {
@@ -138,16 +149,15 @@ class PairSumCache {
   explicit PairSumCache(std::span<Entry> storage) : entries_(storage) {}
   /// pair_sums(allan_noises(), a, b), from the cache where it can. O(1) once cached.
   PairSums get(const TermGrid& a, const TermGrid& b);
-  /// Remembers `sums` as those of grids a and b (Allan and modified Allan), for get() to return
-  /// while neither grid grows (the analyzer's interpolated sums of dense taus). Ignored when the
-  /// table is full. O(1) expected.
-  void put(const TermGrid& a, const TermGrid& b, const PairSums& sums);
+  /// Asks `source` first from now on (null: none); it must outlive its use here.
+  void attach(const PairSumSource* source) { source_ = source; }
   /// Forgets everything (a new configuration). O(capacity).
   void clear();
 
  private:
   Entry* slot(const TermGrid& a, const TermGrid& b);  // null: not kept
   std::span<Entry> entries_;
+  const PairSumSource* source_ = nullptr;
 };
 
 }  // namespace gyrochar
