@@ -350,9 +350,37 @@ class Characterizer {
   }
 
   /// The block API: add_increment() for each value of `block`, in order. O(S) amortized per value.
+  /// Counts inside a segment go straight to the staged block (the phase as their running sum).
   template <class T>
   void add_increments(std::span<const T> block) {
-    for (const T v : block) add_increment(static_cast<typename Arith::Increment>(v));
+    std::size_t i = 0;
+    if constexpr (Arith::exact) {
+      while (i < block.size()) {
+        if (phase_points() == run_.segment_start) {  // a segment's first point: add_increment() stages it
+          add_increment(static_cast<typename Arith::Increment>(block[i++]));
+          continue;
+        }
+        const std::size_t k = staged_count_;
+        const std::size_t room = block_points - ((run_.next_e + k) & (block_points - 1));
+        const std::size_t n = block.size() - i < room ? block.size() - i : room;
+        std::int64_t x = run_.x;
+        bool overflow = false;
+        for (std::size_t j = 0; j < n; ++j) {
+          overflow |= __builtin_add_overflow(x, std::int64_t{static_cast<typename Arith::Increment>(block[i + j])}, &x);
+          staged_[k + j] = x;
+        }
+        if (overflow) {  // the phase passes 2^63 in this run: add_increment() starts the new segment
+          for (std::size_t j = 0; j < n; ++j) add_increment(static_cast<typename Arith::Increment>(block[i + j]));
+        } else {
+          run_.x = x;
+          run_.increments += n;
+          staged_count_ = k + n;
+          if (n == room) flush();
+        }
+        i += n;
+      }
+    }
+    for (; i < block.size(); ++i) add_increment(static_cast<typename Arith::Increment>(block[i]));
   }
 
   /// Starts a new segment at the next phase point: no term and no difference of a decimated series
