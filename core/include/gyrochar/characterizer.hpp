@@ -332,21 +332,20 @@ class Characterizer {
   /// frequency data. O(S) amortized. CountArith: if the accumulated phase would pass 2^63 pulses, a
   /// new segment starts from 0 and phase_overflowed() turns true.
   void add_increment(typename Arith::Increment dx) {
-    ++run_.increments;
-    if (phase_points() == run_.segment_start) stage(run_.x);
-    if constexpr (!Arith::exact) {
-      if (run_.increments == 1) run_.first_increment = dx;
-      run_.x += dx - run_.first_increment;
-    } else {
-      if (__builtin_add_overflow(run_.x, std::int64_t{dx}, &run_.x)) {
-        run_.phase_overflow = true;
-        mark_gap();
-        run_.x = 0;
-        stage(run_.x);
-        run_.x = dx;
+    if constexpr (Arith::exact) {  // inside a segment: the running sum staged, fields loaded once
+      const std::size_t k = staged_count_;
+      const std::uint64_t e = run_.next_e + k;  // the new point's index
+      std::int64_t x = 0;
+      if (e != run_.segment_start && !__builtin_add_overflow(run_.x, std::int64_t{dx}, &x)) {
+        run_.x = x;
+        ++run_.increments;
+        staged_count_ = k + 1;
+        staged_[k] = x;
+        if (((e + 1) & (block_points - 1)) == 0) flush();
+        return;
       }
     }
-    stage(run_.x);
+    add_increment_general(dx);
   }
 
   /// The block API: add_increment() for each value of `block`, in order. O(S) amortized per value.
@@ -518,6 +517,25 @@ class Characterizer {
   static const std::byte* get(const std::byte* p, void* to, std::size_t n) {
     std::memcpy(to, p, n);
     return p + n;
+  }
+
+  // add_increment() at a segment's start or a phase overflow, and for floating increments.
+  void add_increment_general(typename Arith::Increment dx) {
+    ++run_.increments;
+    if (phase_points() == run_.segment_start) stage(run_.x);
+    if constexpr (!Arith::exact) {
+      if (run_.increments == 1) run_.first_increment = dx;
+      run_.x += dx - run_.first_increment;
+    } else {
+      if (__builtin_add_overflow(run_.x, std::int64_t{dx}, &run_.x)) {
+        run_.phase_overflow = true;
+        mark_gap();
+        run_.x = 0;
+        stage(run_.x);
+        run_.x = dx;
+      }
+    }
+    stage(run_.x);
   }
 
   // Staging. Points wait in staged_ until a block is full or the state is read, then go through
