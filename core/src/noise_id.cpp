@@ -2,6 +2,11 @@
 
 #include <cmath>
 
+#if defined(__aarch64__) && defined(__ARM_NEON)
+#include <arm_neon.h>
+#define GYROCHAR_NOISE_NEON 1
+#endif
+
 namespace gyrochar {
 
 double Lag1Sums::r1() const {
@@ -131,6 +136,64 @@ void IntegerNoiseIdAccumulator::add(const std::int64_t* z, std::size_t count, st
   }
 }
 
+namespace {
+
+// A run's sums over w[i], i = from .. end - 1 (w[i-4 .. i-1] valid): s0 = sum of v0 = w - base, q[k] =
+// sum of vk^2 for the differences of order k, each value formed in 32-bit modular arithmetic.
+struct RunSums {
+  std::int64_t s0 = 0;
+  std::int64_t q[5] = {};
+};
+[[gnu::always_inline]] inline void run_sums(const std::uint32_t* w, std::size_t from, std::size_t end,
+                                            std::uint32_t base, RunSums& r) {
+  for (std::size_t i = from; i < end; ++i) {
+    const auto v0 = static_cast<std::int32_t>(w[i] - base);
+    const auto v1 = static_cast<std::int32_t>(w[i] - w[i - 1]);
+    const auto v2 = static_cast<std::int32_t>(w[i] - 2 * w[i - 1] + w[i - 2]);
+    const auto v3 = static_cast<std::int32_t>(w[i] - 3 * w[i - 1] + 3 * w[i - 2] - w[i - 3]);
+    const auto v4 = static_cast<std::int32_t>(w[i] - 4 * w[i - 1] + 6 * w[i - 2] - 4 * w[i - 3] + w[i - 4]);
+    r.s0 += v0;
+    r.q[0] += std::int64_t{v0} * v0;
+    r.q[1] += std::int64_t{v1} * v1;
+    r.q[2] += std::int64_t{v2} * v2;
+    r.q[3] += std::int64_t{v3} * v3;
+    r.q[4] += std::int64_t{v4} * v4;
+  }
+}
+
+#if defined(GYROCHAR_NOISE_NEON)
+// Four values a step: the differences of each order from those of the order below at the four
+// values and the four before (no multiplies), every square by smlal/smlal2.
+RunSums run_sums_neon(const std::uint32_t* w, std::size_t n, std::uint32_t base) {
+  const std::size_t end = 4 + n / 4 * 4;
+  const uint32x4_t b = vdupq_n_u32(base);
+  int64x2_t s0 = vdupq_n_s64(0), q0 = s0, q1 = s0, q2 = s0, q3 = s0, q4 = s0;
+  const auto square = [](int64x2_t& q, uint32x4_t v) {
+    const int32x4_t s = vreinterpretq_s32_u32(v);
+    q = vmlal_high_s32(vmlal_s32(q, vget_low_s32(s), vget_low_s32(s)), s, s);
+  };
+  for (std::size_t i = 4; i < end; i += 4) {
+    const uint32x4_t w0 = vld1q_u32(w + i), w1 = vld1q_u32(w + i - 1), w2 = vld1q_u32(w + i - 2);
+    const uint32x4_t w3 = vld1q_u32(w + i - 3), w4 = vld1q_u32(w + i - 4);
+    const uint32x4_t v0 = vsubq_u32(w0, b);
+    const uint32x4_t d0 = vsubq_u32(w0, w1), d1 = vsubq_u32(w1, w2), d2 = vsubq_u32(w2, w3), d3 = vsubq_u32(w3, w4);
+    const uint32x4_t e0 = vsubq_u32(d0, d1), e1 = vsubq_u32(d1, d2), e2 = vsubq_u32(d2, d3);
+    const uint32x4_t f0 = vsubq_u32(e0, e1), f1 = vsubq_u32(e1, e2);
+    s0 = vpadalq_s32(s0, vreinterpretq_s32_u32(v0));
+    square(q0, v0);
+    square(q1, d0);
+    square(q2, e0);
+    square(q3, f0);
+    square(q4, vsubq_u32(f0, f1));
+  }
+  RunSums r{vaddvq_s64(s0), {vaddvq_s64(q0), vaddvq_s64(q1), vaddvq_s64(q2), vaddvq_s64(q3), vaddvq_s64(q4)}};
+  run_sums(w, end, 4 + n, base, r);
+  return r;
+}
+#endif
+
+}  // namespace
+
 // Up to 64 values of a segment with at least 5 points. With |z[k] - z[k-1]| <= B, every difference
 // of order j <= 4 is at most 8B and z[k] - base (base: the point before the run) at most 64B, so
 // when 64B < 2^28 they are computed exactly in 32-bit modular arithmetic from the points' low
@@ -147,20 +210,13 @@ bool IntegerNoiseIdAccumulator::add_run(const std::int64_t* z, std::size_t n, st
   for (std::size_t i = 0; i < 4; ++i) w[i] = static_cast<std::uint32_t>(last_[3 - i]);
   for (std::size_t i = 0; i < n; ++i) w[4 + i] = static_cast<std::uint32_t>(z[i * step]);
   const std::uint32_t base = w[3];
-  std::int64_t s0 = 0, q0 = 0, q1 = 0, q2 = 0, q3 = 0, q4 = 0;
-  for (std::size_t i = 4; i < n + 4; ++i) {
-    const auto v0 = static_cast<std::int32_t>(w[i] - base);
-    const auto v1 = static_cast<std::int32_t>(w[i] - w[i - 1]);
-    const auto v2 = static_cast<std::int32_t>(w[i] - 2 * w[i - 1] + w[i - 2]);
-    const auto v3 = static_cast<std::int32_t>(w[i] - 3 * w[i - 1] + 3 * w[i - 2] - w[i - 3]);
-    const auto v4 = static_cast<std::int32_t>(w[i] - 4 * w[i - 1] + 6 * w[i - 2] - 4 * w[i - 3] + w[i - 4]);
-    s0 += v0;
-    q0 += std::int64_t{v0} * v0;
-    q1 += std::int64_t{v1} * v1;
-    q2 += std::int64_t{v2} * v2;
-    q3 += std::int64_t{v3} * v3;
-    q4 += std::int64_t{v4} * v4;
-  }
+#if defined(GYROCHAR_NOISE_NEON)
+  const RunSums r = run_sums_neon(w, n, base);
+#else
+  RunSums r;
+  run_sums(w, 4, n + 4, base, r);
+#endif
+  const std::int64_t s0 = r.s0, q0 = r.q[0], q1 = r.q[1], q2 = r.q[2], q3 = r.q[3], q4 = r.q[4];
   const std::int64_t b = last_[0];
   const auto count = static_cast<std::uint64_t>(n);
   sum_ = sum_ + mul_signed(b, static_cast<std::int64_t>(count)) + widen(s0);
