@@ -829,7 +829,9 @@ class Characterizer {
   // |t| <= m^2 D (t sums m consecutive AVAR terms). The bounds go to `terms` (their sums are the
   // caller's to fill). terms_fit(m) holds: m^2 D < 2^62.
   bool proved_small(std::uint64_t m, std::size_t n, BlockTerms& terms) const {
-    const auto span = static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min);
+    const std::uint64_t span = run_.increment_max >= run_.increment_min
+                                   ? static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min)
+                                   : 0;
     terms.avar.magnitude_bits = m * span;
     terms.hvar.magnitude_bits = 2 * m * span;
     terms.mvar.magnitude_bits = m * m * span;
