@@ -331,7 +331,7 @@ class Characterizer {
   /// segment is a phase point too, so N increments give N + 1 phase points, as Stable32 treats
   /// frequency data. O(S) amortized. CountArith: if the accumulated phase would pass 2^63 pulses, a
   /// new segment starts from 0 and phase_overflowed() turns true.
-  void add_increment(typename Arith::Increment dx) {
+  [[gnu::always_inline]] void add_increment(typename Arith::Increment dx) {
     if constexpr (Arith::exact) {  // inside a segment: the running sum staged, fields loaded once
       const std::size_t k = staged_count_;
       const std::uint64_t e = run_.next_e + k;  // the new point's index
@@ -520,7 +520,7 @@ class Characterizer {
   }
 
   // add_increment() at a segment's start or a phase overflow, and for floating increments.
-  void add_increment_general(typename Arith::Increment dx) {
+  [[gnu::noinline]] void add_increment_general(typename Arith::Increment dx) {
     ++run_.increments;
     if (phase_points() == run_.segment_start) stage(run_.x);
     if constexpr (!Arith::exact) {
@@ -552,7 +552,7 @@ class Characterizer {
     if (full) flush();
   }
   void flush() const { const_cast<Characterizer*>(this)->process_staged(); }
-  void process_staged() {
+  [[gnu::noinline]] void process_staged() {
     const std::size_t n = staged_count_;
     if (n == 0) return;
     staged_count_ = 0;
