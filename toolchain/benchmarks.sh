@@ -222,7 +222,7 @@ echo
 analyzer_targets() {
 row() { awk -v n="$1" -v o="$2" '$1 == n && $2 == o' "$data/rows.txt"; }
 ratio() { row "$1" "$2" | awk '$3 != "-" && $5 != "-" { printf "%.1fx by wall time (%s s against %s s), %.1fx by CPU time (%s s against %s s)", $5 / $3, $3, $5, $6 / $4, $4, $6 }'; }
-met_at() { row "$1" "$2" | awk -v t="$3" '$3 != "-" && $5 != "-" { print ($5 / $3 >= t && $6 / $4 >= t) ? "met" : ($5 / $3 >= t ? "met by wall time, **missed** by CPU time" : "**missed**") }'; }
+met_at() { row "$1" "$2" | awk -v t="$3" '$3 != "-" && $5 != "-" { print (($5 / $3 >= t && $6 / $4 >= t) ? "met" : ($5 / $3 >= t ? "met by wall time, **missed** by CPU time" : "**missed**")) }'; }
 mbs=$(awk '/^ReadCounts /{ for (i = 1; i <= NF; ++i) if ($i ~ /^bytes_per_second=/) { sub(/bytes_per_second=/, "", $i); print $i } }' "$data/reader.txt")
 echo "## Against the targets (issue 11, the analyzer)"
 echo
