@@ -426,7 +426,10 @@ void BatchTau::add(const PhaseSegment<R>& segment) {
   if (segments_++ > 0) noise_.reset_segment();
   const std::uint64_t m = result_.m;
   const bool fits = terms_fit(m, segment.spread);
-  decimate(segment, fits);
+  // At m = 1 with stride 1 the decimated series is the whole segment: its Allan and Hadamard
+  // terms are the overlapping ones, whose sums are taken below instead of forming them twice.
+  const bool every_point = m == 1 && result_.stride == 1 && fits;
+  decimate(segment, fits, !every_point);
   if (segment.r.size() <= 2 * m) return;  // no term (and m fits in size_t below)
   if (!fits) {
     checked_terms(segment);
@@ -434,6 +437,13 @@ void BatchTau::add(const PhaseSegment<R>& segment) {
   }
   Totals tot{{result_.sum[0], result_.sum[1], result_.sum[2]}, {result_.n[0], result_.n[1], result_.n[2]}, sticky_};
   overlapping_of(segment.r.data(), segment.r.size(), static_cast<std::size_t>(m), segment.first_e, result_.stride, tot);
+  for (const std::size_t k : {std::size_t{0}, std::size_t{2}}) {
+    if (!every_point) break;
+    const auto d = static_cast<std::size_t>(k == 0 ? SumKind::avar_nonoverlapped : SumKind::hvar_nonoverlapped);
+    const UInt128 after = tot.sum[k], before = result_.sum[k];  // this segment's sum, modulo 2^128
+    tot.sticky |= add_high_word(result_.sum[d], {after.lo - before.lo, after.hi - before.hi - (after.lo < before.lo)});
+    result_.n[d] += tot.n[k] - result_.n[k];
+  }
   for (std::size_t k = 0; k < 3; ++k) {
     result_.sum[k] = tot.sum[k];
     result_.n[k] = tot.n[k];
@@ -444,9 +454,9 @@ void BatchTau::add(const PhaseSegment<R>& segment) {
 // The decimated series x[k m] of the segment: the non-overlapped Allan and Hadamard sums and the
 // noise sums, as Characterizer::decimate() forms them, a chunk of points at a time. When the tau's
 // terms fit (they are among the overlapping ones), in modular arithmetic with partial sums of
-// squares; otherwise each checked as the characterizer does.
+// squares; otherwise each checked as the characterizer does. Without `terms`, the noise sums only.
 template <class R>
-void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits) {
+void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits, bool terms) {
   const std::uint64_t m = result_.m;
   const std::uint64_t size = segment.r.size();
   std::uint64_t s = (m - segment.first_e % m) % m;
@@ -470,7 +480,7 @@ void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits) {
     const std::size_t from = have > 0 ? 0 : 1;
     DecimatedChunk c;
     if (small_steps) {
-      c = decimated_chunk(v, n, from, fits, first_a, first_h, a, h);
+      c = decimated_chunk(v, n, from, fits && terms, first_a, first_h, a, h);
     } else {
       c.step = 0;  // the largest |x[k m] - x[(k-1) m]| here (all ones: beyond int64)
       for (std::size_t k = from; k < n; ++k) {
@@ -479,14 +489,14 @@ void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits) {
         const auto mag = wide ? ~std::uint64_t{0} : d < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(d) : static_cast<std::uint64_t>(d);
         if (mag > c.step) c.step = mag;
       }
-      if (fits) {
+      if (fits && terms) {
         const DecimatedChunk t = decimated_chunk(v, n, n, true, first_a, first_h, a, h);
         c.a = t.a;
         c.h = t.h;
       }
     }
     noise_.add(v + 3, n, 1, c.step);
-    if (fits) {
+    if (fits && terms) {
       const Squares& sa = c.a;
       const Squares& sh = c.h;
       Totals tot{{result_.sum[avar_d], {}, result_.sum[hvar_d]}, {0, 0, 0}, sticky_};
@@ -497,7 +507,7 @@ void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits) {
       result_.n[avar_d] += tot.n[0];
       result_.n[hvar_d] += tot.n[2];
       sticky_ = tot.sticky;
-    } else {
+    } else if (!fits) {
       for (std::size_t k = 0; k < n; ++k) {
         std::int64_t av = 0, hv = 0;
         if (k >= first_a && CountArith::x_term2(v[3 + k], v[2 + k], v[1 + k], av)) {

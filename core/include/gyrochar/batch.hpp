@@ -102,7 +102,7 @@ class BatchTau {
   template <class R>
   void add(const PhaseSegment<R>& segment);
   template <class R>
-  void decimate(const PhaseSegment<R>& segment, bool fits);
+  void decimate(const PhaseSegment<R>& segment, bool fits, bool terms);
   template <class R>
   void checked_terms(const PhaseSegment<R>& segment);
 
