@@ -50,17 +50,30 @@ measure() {
 }
 
 # One row: gyrochar-analyze with $3 beside allantools with taus $4 on n = $1 samples, limit $2 s.
+# The run of median wall time among `runs` lines of "wall cpu rss_mib" on stdin ("- - -": not finished).
+median_run() { sort -n | awk '{ line[NR] = $0 } END { print line[int((NR + 1) / 2)] }'; }
+
+# One row: gyrochar-analyze with $3 beside allantools with taus $4 on n = $1 samples, limit $2 s,
+# each run $5 times (default 1; the two alternate) and the median run of each kept: this
+# machine's speed moves by tens of percent from one minute to the next.
 side_by_side() {
-  local n=$1 limit=$2 ours=$3 taus=$4 f g a
+  local n=$1 limit=$2 ours=$3 taus=$4 runs=${5:-1} f g a k
   f=$(counts_file "$n")
-  read -r gw gc gr <<< "$(measure "$limit" "$data/ours.txt" build/perf/host_tools/gyrochar-analyze --type counts \
-      --tau0 0.01 --pulse-weight 1 --stats oadev,mdev,ohdev $ours --format csv "$f")"
+  # allantools once per file and tau list (its median run, kept for the other rows of that file),
+  # with at most 16 GiB of address space, so that it stops with MemoryError rather than take the machine.
+  local theirs=$data/theirs_${n}_$taus fresh=no
+  [ -f "$theirs.time" ] || fresh=yes
+  : > "$data/ours.runs"
+  [ $fresh = yes ] && : > "$theirs.runs"
+  for ((k = 0; k < runs; ++k)); do
+    measure "$limit" "$data/ours.txt" build/perf/host_tools/gyrochar-analyze --type counts \
+        --tau0 0.01 --pulse-weight 1 --stats oadev,mdev,ohdev $ours --format csv "$f" >> "$data/ours.runs"
+    [ $fresh = yes ] && measure "$limit" "$theirs.txt" bash -c "ulimit -v 16777216; exec /usr/bin/python3 \
+        toolchain/allantools_job.py $peers $f 0.01 oadev,mdev,ohdev $taus" >> "$theirs.runs"
+  done
+  [ $fresh = yes ] && median_run < "$theirs.runs" > "$theirs.time"
+  read -r gw gc gr <<< "$(median_run < "$data/ours.runs")"
   if [ "$gw" = - ]; then g="did not finish in $limit s"; else g="$gw s, CPU $gc s, $gr MiB, $(($(wc -l < "$data/ours.txt") - 1)) rows"; fi
-  # allantools once per file and tau list, with at most 16 GiB of address space, so that it stops
-  # with MemoryError rather than take the machine.
-  local theirs=$data/theirs_${n}_$taus
-  [ -f "$theirs.time" ] || measure "$limit" "$theirs.txt" bash -c "ulimit -v 16777216; exec /usr/bin/python3 \
-      toolchain/allantools_job.py $peers $f 0.01 oadev,mdev,ohdev $taus" > "$theirs.time"
   read -r aw ac ar < "$theirs.time"
   cp "$theirs.txt" "$data/theirs.txt"
   if [ "$aw" = - ]; then a="did not finish in $limit s: $(sed 's/^allantools: //' "$data/theirs.txt")"; else a="$aw s, CPU $ac s, $ar MiB"; fi
@@ -104,23 +117,25 @@ echo "(\`toolchain/allantools_job.py\`: np.loadtxt, phase as the cumulative sum 
 echo "and ohdev on it). Process wall time, CPU time (user + sys) and peak RSS; the ratio is allantools'"
 echo "time over gyrochar-analyze's. The default stride factor is full: every tau up to N/4 fully"
 echo "overlapped, as allantools; its taus are summed on every core ($(nproc) here; \`--threads 1\`: one)."
-echo "The machine is shared: CPU times are the steadier figures."
+echo "Each figure is the median run of five (10^7 samples; allantools' five alternate with the default"
+echo "row's), three (10^8, and --taus all up to 10^5) or one: this machine's speed moves by tens of"
+echo "percent from one minute to the next."
 echo
 echo "| samples | file | options | gyrochar-analyze | allantools | ratio |"
 echo "|---|---|---|---|---|---|"
-side_by_side 10000000 1800 "" octave
-side_by_side 10000000 1800 "--threads 1" octave
-side_by_side 10000000 1800 "--stride-factor 8" octave
-side_by_side 100000000 3600 "" octave
-side_by_side 100000000 3600 "--threads 1" octave
-side_by_side 100000000 3600 "--stride-factor 8" octave
+side_by_side 10000000 1800 "" octave 5
+side_by_side 10000000 1800 "--threads 1" octave 5
+side_by_side 10000000 1800 "--stride-factor 8" octave 5
+side_by_side 100000000 3600 "" octave 3
+side_by_side 100000000 3600 "--threads 1" octave 3
+side_by_side 100000000 3600 "--stride-factor 8" octave 3
 echo
 echo "Every m (\`--taus all\`, Stable32's \"all tau\"; allantools' taus=\"all\"), at most 10 minutes each:"
 echo
 echo "| samples | file | options | gyrochar-analyze | allantools | ratio |"
 echo "|---|---|---|---|---|---|"
-side_by_side 10000 600 "--taus all" all
-side_by_side 100000 600 "--taus all" all
+side_by_side 10000 600 "--taus all" all 3
+side_by_side 100000 600 "--taus all" all 3
 side_by_side 1000000 600 "--taus all" all
 }
 
