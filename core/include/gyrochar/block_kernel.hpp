@@ -1,7 +1,9 @@
 #pragma once
 // The block kernel of the exact counts path: the overlapping Allan, modified Allan and Hadamard
 // terms of one tau over a block of consecutive phase points, and their sums of squares in 64-bit
-// partial sums whose exactness is proved per block from the block's largest term.
+// partial sums whose exactness is proved per block: from the block's largest term (block_terms()),
+// or beforehand from the segment's increment spread (proved_terms(), proved_running_terms(),
+// which then form no bound at all: the usual case of a gyro).
 //
 // Inputs are the phase points at ages 0, m, 2m and 3m of each of the n newest points (x as
 // int64, P as its low 64-bit word): the caller gathers them from its history. Terms are formed in
