@@ -215,6 +215,12 @@ static_assert(chunk <= 1024, "2 * 27 + bit_width(chunk) <= 64");
 [[gnu::target("avx512f")]] inline __m512i load8(const std::int32_t* p) {
   return _mm512_cvtepi32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
 }
+// The lanes' sum modulo 2^64 (the header's _mm512_reduce_add_epi64 adds them as signed: UB on wrap).
+[[gnu::target("avx512f")]] inline std::uint64_t lane_sum(__m512i v) {
+  alignas(64) std::uint64_t q[8];
+  _mm512_store_si512(q, v);
+  return q[0] + q[1] + q[2] + q[3] + q[4] + q[5] + q[6] + q[7];
+}
 [[gnu::target("avx512f")]] ChunkSquares3 all_terms_avx512(const std::int32_t* x0, std::size_t m, std::size_t n,
                                                           std::uint64_t& previous) {
   const std::size_t n8 = n / 8 * 8;
@@ -242,9 +248,7 @@ static_assert(chunk <= 1024, "2 * 27 + bit_width(chunk) <= 64");
   }
   const bool in_range = static_cast<std::uint64_t>(_mm512_reduce_or_epi64(bound)) < 2 * square_range;
   const std::uint64_t b = in_range ? square_range - 1 : ~std::uint64_t{0};
-  ChunkSquares3 sq{{b, static_cast<std::uint64_t>(_mm512_reduce_add_epi64(sa))},
-                   {b, static_cast<std::uint64_t>(_mm512_reduce_add_epi64(sh))},
-                   {b, static_cast<std::uint64_t>(_mm512_reduce_add_epi64(st))}};
+  ChunkSquares3 sq{{b, lane_sum(sa)}, {b, lane_sum(sh)}, {b, lane_sum(st)}};
   std::uint64_t t = n8 > 0 ? static_cast<std::uint64_t>(_mm_extract_epi64(_mm512_extracti32x4_epi32(tv, 3), 1)) : previous;
   for (std::size_t j = n8; j < n; ++j) {  // the tail, as avar_hvar() and running_sum()
     const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
