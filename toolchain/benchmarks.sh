@@ -49,9 +49,12 @@ measure() {
   fi
 }
 
-# One row: gyrochar-analyze with $3 beside allantools with taus $4 on n = $1 samples, limit $2 s.
-# The run of median wall time among `runs` lines of "wall cpu rss_mib" on stdin ("- - -": not finished).
-median_run() { sort -n | awk '{ line[NR] = $0 } END { print line[int((NR + 1) / 2)] }'; }
+# The run of median wall time among `runs` lines of "wall cpu rss_mib" on stdin ("- - -": not
+# finished, counted as the slowest).
+median_run() {
+  awk '{ print ($1 == "-" ? "inf" : $1), $0 }' | sort -g | cut -d' ' -f2- |
+    awk '{ line[NR] = $0 } END { print line[int((NR + 1) / 2)] }'
+}
 
 # One row: gyrochar-analyze with $3 beside allantools with taus $4 on n = $1 samples, limit $2 s,
 # each run $5 times (default 1; the two alternate) and the median run of each kept: this

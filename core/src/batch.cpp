@@ -441,13 +441,14 @@ void BatchTau::add(const PhaseSegment<R>& segment) {
   }
   Totals tot{{result_.sum[0], result_.sum[1], result_.sum[2]}, {result_.n[0], result_.n[1], result_.n[2]}, sticky_};
   overlapping_of(segment.r.data(), segment.r.size(), static_cast<std::size_t>(m), segment.first_e, result_.stride, tot);
-  for (const std::size_t k : {std::size_t{0}, std::size_t{2}}) {
-    if (!every_point) break;
-    const auto d = static_cast<std::size_t>(k == 0 ? SumKind::avar_nonoverlapped : SumKind::hvar_nonoverlapped);
-    const UInt128 after = tot.sum[k], before = result_.sum[k];  // this segment's sum, modulo 2^128
-    tot.sticky |= add_high_word(result_.sum[d], {after.lo - before.lo, after.hi - before.hi - (after.lo < before.lo)});
-    result_.n[d] += tot.n[k] - result_.n[k];
-  }
+  if (every_point)
+    for (const SumKind kind : {SumKind::avar, SumKind::hvar}) {
+      const auto k = static_cast<std::size_t>(kind);
+      const auto d = static_cast<std::size_t>(kind == SumKind::avar ? SumKind::avar_nonoverlapped : SumKind::hvar_nonoverlapped);
+      const Int128 segment_sum = Int128{tot.sum[k].lo, tot.sum[k].hi} - Int128{result_.sum[k].lo, result_.sum[k].hi};
+      tot.sticky |= add_high_word(result_.sum[d], {segment_sum.lo, segment_sum.hi});
+      result_.n[d] += tot.n[k] - result_.n[k];
+    }
   for (std::size_t k = 0; k < 3; ++k) {
     result_.sum[k] = tot.sum[k];
     result_.n[k] = tot.n[k];
