@@ -28,9 +28,14 @@ const char* name(FitStatus s) {
 
 namespace {
 
-constexpr std::size_t terms = 5;    // Q N B K R
-constexpr std::size_t noises = 4;   // Q N B K: the random ones
+constexpr std::size_t power_terms = 5;  // Q N B K R
+constexpr std::size_t noises = 4;       // Q N B K: the random ones
+constexpr std::size_t max_terms = power_terms + max_markov + max_sinusoids;
+constexpr std::size_t width = max_terms + 3;  // a row: the design, y, Sigma's diagonal, y less the held terms
+constexpr std::size_t y_slot = max_terms, diag_slot = max_terms + 1, offset_slot = max_terms + 2;
 constexpr std::array<int, noises> alphas{2, 0, -1, -2};  // Q N B K
+using Terms = std::array<double, max_terms>;
+using Flags = std::array<bool, max_terms>;
 // Two estimates keep a noise's part of their covariance when they lie at most band_octaves apart
 // and double precision evaluates it: pair_sums_rounding() bounds the rounding of its correlation
 // at covariance_rounding_kept. Far apart, the closed forms of the flicker and random-walk FM sums
@@ -46,6 +51,20 @@ constexpr std::array<int, noises> alphas{2, 0, -1, -2};  // Q N B K
 constexpr double covariance_rounding_kept = 0.1;
 constexpr int band_octaves = 10;
 constexpr double quantization_left_out = 0.01;  // share of a point that makes it unusable (non-white)
+constexpr double bandwidth_left_out = 0.01;     // change of white rate noise by the sensor's filter, likewise
+constexpr double pi = 3.14159265358979323846;
+
+// The terms of one candidate model beyond the five: columns 5.. are its Markov terms, then its
+// sinusoids; the filter changes N's column.
+struct Model {
+  std::size_t markov = 0;
+  std::array<double, max_markov> a{};  // tau0 / Tc of each Markov term
+  std::size_t sinusoids = 0;
+  std::array<double, max_sinusoids> hz{};
+  double band = 0;  // tau0 / Tf of the filter on N's white noise; 0: none
+  std::size_t columns() const { return power_terms + markov + sinusoids; }
+  std::size_t nonlinear() const { return markov + sinusoids + (band > 0 ? 1 : 0); }
+};
 
 // Innovation variance of term t per unit squared parameter: tau0^k.
 double innovation_scale(std::size_t t, double tau0) { return t == 0 ? 1.0 : std::pow(tau0, static_cast<double>(t)); }
@@ -56,14 +75,41 @@ double normalization(Stat s, std::uint64_t m, double tau0) {
   return s == Stat::mvar ? 2 * mm * mm * mm * mm * tau0 * tau0 : 2 * mm * mm * tau0 * tau0;
 }
 
-// The model's expected variance of a point per unit squared parameter: the design matrix row.
-std::array<double, terms> design(Stat s, std::uint64_t m, double tau0) {
-  std::array<double, terms> x{};
+// Expected variance of a Markov term of unit sigma^2 (a = tau0 / Tc).
+double markov_column(double a, Stat s, std::uint64_t m, double tau0) {
+  return markov_term_covariance(a, s, m, s, m, 0) * tau0 * tau0 / normalization(s, m, tau0);
+}
+
+// Expected variance of a sinusoid of unit A^2 at hz.
+double sinusoid_column(double hz, Stat s, std::uint64_t m, double tau0) {
+  const double x = pi * hz * static_cast<double>(m) * tau0;
+  const double sx = std::sin(x);
+  if (s == Stat::avar) return sx * sx * sx * sx / (x * x);
+  const double s0 = std::sin(pi * hz * tau0), mm = static_cast<double>(m);
+  return sx * sx * sx * sx * sx * sx / (x * x * mm * mm * s0 * s0);
+}
+
+// The five terms' expected variance of a point per unit squared parameter.
+std::array<double, power_terms> power_design(Stat s, std::uint64_t m, double tau0) {
+  std::array<double, power_terms> x{};
   const double nrm = normalization(s, m, tau0);
   for (std::size_t t = 0; t < noises; ++t)
     x[t] = term_covariance(alphas[t], s, m, s, m, 0) * innovation_scale(t, tau0) / nrm;
   const double tau = static_cast<double>(m) * tau0;
   x[4] = tau * tau / 2;
+  return x;
+}
+
+// The design row of a point under a model: the expected variance per unit squared parameter.
+Terms design(const Model& model, Stat s, std::uint64_t m, double tau0) {
+  Terms x{};
+  const auto p = power_design(s, m, tau0);
+  for (std::size_t t = 0; t < power_terms; ++t) x[t] = p[t];
+  // Filtered white rate noise of long-tau level N^2 / tau: a Markov term of sigma^2 = N^2 tanh(a/2) / tau0.
+  if (model.band > 0) x[1] = markov_column(model.band, s, m, tau0) * std::tanh(model.band / 2) / tau0;
+  for (std::size_t j = 0; j < model.markov; ++j) x[power_terms + j] = markov_column(model.a[j], s, m, tau0);
+  for (std::size_t j = 0; j < model.sinusoids; ++j)
+    x[power_terms + model.markov + j] = sinusoid_column(model.hz[j], s, m, tau0);
   return x;
 }
 
@@ -96,10 +142,11 @@ void forward(const double* a, std::size_t n, double* b, std::size_t stride_b) {
   }
 }
 
+using Matrix = std::array<std::array<double, max_terms>, max_terms>;
+
 // Solves the small symmetric system a x = b (Gauss-Jordan, partial pivoting) and inverts a.
-bool solve_small(std::array<std::array<double, terms>, terms> a, std::array<double, terms> b, std::size_t n,
-                 std::array<double, terms>& x, std::array<std::array<double, terms>, terms>& inv) {
-  std::array<std::array<double, terms>, terms> id{};
+bool solve_small(Matrix a, Terms b, std::size_t n, Terms& x, Matrix& inv) {
+  Matrix id{};
   for (std::size_t i = 0; i < n; ++i) id[i][i] = 1.0;
   for (std::size_t c = 0; c < n; ++c) {
     std::size_t pivot = c;
@@ -129,14 +176,16 @@ bool solve_small(std::array<std::array<double, terms>, terms> a, std::array<doub
 // The points in use, with their design rows and the workspace views.
 struct Problem {
   std::size_t n = 0;
-  const FitPoint* point[128];
+  const FitPoint* point[max_fit_points];
+  double white[max_fit_points][noises];  // each point's power-law design (the covariance's basis)
   double tau0 = 1;
   std::uint64_t n_phase = 0;
   double spread = 0;
+  Model model;              // the model the rows are made for
   double* pair = nullptr;   // per pair (i <= j): 10 sums c_t c_u, then 4 sums c_t
   double* sigma = nullptr;  // n x n
-  double* rows = nullptr;   // per point: x[5], y, spare
-  double* row(std::size_t i) const { return rows + i * 8; }
+  double* rows = nullptr;   // per point: the design, y, Sigma's diagonal, y less the held terms
+  double* row(std::size_t i) const { return rows + i * width; }
   double* pair_at(std::size_t i, std::size_t j) const {
     if (i > j) {
       const std::size_t t = i;
@@ -156,17 +205,53 @@ std::size_t cc_index(std::size_t t, std::size_t u) {
   return t * (t + 1) / 2 + u;  // 0..9
 }
 
+// The rows of the points under the problem's model.
+void set_rows(Problem& pr) {
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    const FitPoint& a = *pr.point[i];
+    const Terms x = design(pr.model, a.stat, a.m, pr.tau0);
+    for (std::size_t t = 0; t < max_terms; ++t) pr.row(i)[t] = x[t];
+    pr.row(i)[y_slot] = a.variance;
+  }
+}
+
+// Each noise's innovation variance at point i under theta, the model's other terms mapped onto
+// them (the header says how): the filter's N at its filtered level; a Markov term's variance
+// split between white rate noise and rate random walk by its local slope on the Allan scale.
+std::array<double, noises> local_noise(const Problem& pr, const Terms& theta, std::size_t i) {
+  std::array<double, noises> h{};
+  const double* x = pr.row(i);
+  const double* w = pr.white[i];
+  for (std::size_t t = 0; t < noises; ++t) h[t] = (theta[t] > 0 ? theta[t] : 0) * innovation_scale(t, pr.tau0);
+  if (pr.model.band > 0 && w[1] > 0) h[1] *= x[1] / w[1];
+  const FitPoint& p = *pr.point[i];
+  for (std::size_t j = 0; j < pr.model.markov; ++j) {
+    const double th = theta[power_terms + j];
+    if (!(th > 0)) continue;
+    const double v = th * x[power_terms + j];
+    const double next = markov_column(pr.model.a[j], p.stat, 2 * p.m, pr.tau0);
+    const double slope = std::log2(next / x[power_terms + j]) + (p.stat == Stat::mvar ? 0.0 : 0.0);
+    double white_share = (1 - slope) / 2;
+    white_share = white_share < 0 ? 0 : white_share > 1 ? 1 : white_share;
+    if (w[1] > 0) h[1] += white_share * v / w[1] * innovation_scale(1, pr.tau0);
+    if (w[3] > 0) h[3] += (1 - white_share) * v / w[3] * innovation_scale(3, pr.tau0);
+  }
+  return h;
+}
+
 // The covariance of the points under squared parameters theta (the random terms and the ramp's
 // cross term 4 D_p D_q sum c, D the ramp's deterministic term value).
-void covariance_of_points(const Problem& pr, const std::array<double, terms>& theta) {
-  std::array<double, noises> h{};
-  for (std::size_t t = 0; t < noises; ++t) h[t] = (theta[t] > 0 ? theta[t] : 0) * innovation_scale(t, pr.tau0);
+void covariance_of_points(const Problem& pr, const Terms& theta) {
   const double ramp = theta[4] > 0 ? theta[4] : 0;
+  std::array<std::array<double, noises>, max_fit_points> local{};
+  for (std::size_t i = 0; i < pr.n; ++i) local[i] = local_noise(pr, theta, i);
   for (std::size_t i = 0; i < pr.n; ++i) {
     for (std::size_t j = 0; j <= i; ++j) {
       const FitPoint& a = *pr.point[i];
       const FitPoint& b = *pr.point[j];
       const double* g = pr.pair_at(i, j);
+      std::array<double, noises> h{};
+      for (std::size_t t = 0; t < noises; ++t) h[t] = std::sqrt(local[i][t] * local[j][t]);
       double v = 0;
       for (std::size_t t = 0; t < noises; ++t)
         for (std::size_t u = 0; u < noises; ++u) v += h[t] * h[u] * g[cc_index(t, u)];
@@ -202,10 +287,10 @@ bool factor(const Problem& pr) {
   double* a = pr.sigma;
   for (double raise = 0; raise < 1; raise = raise == 0 ? 1e-6 : 2 * raise) {
     // Cholesky writes the lower triangle and the diagonal; the upper triangle keeps Sigma, the
-    // rows' slot 6 its diagonal.
+    // rows' diagonal slot its diagonal.
     for (std::size_t i = 0; i < n; ++i) {
       for (std::size_t j = 0; j < i; ++j) a[i * n + j] = a[j * n + i];
-      a[i * n + i] = pr.row(i)[6] * (1 + raise);
+      a[i * n + i] = pr.row(i)[diag_slot] * (1 + raise);
     }
     if (cholesky(a, n)) return true;
   }
@@ -213,84 +298,89 @@ bool factor(const Problem& pr) {
 }
 
 struct Solution {
-  std::array<double, terms> theta{};
-  std::array<std::array<double, terms>, terms> cov{};
-  std::array<bool, terms> active{};
-  std::array<double, terms> free_variance{};  // of each free term in the model with every free term
+  Terms theta{};
+  Matrix cov{};
+  Flags active{};
+  Terms free_variance{};  // of each free term in the model with every free term
   double chi2 = 0;
   bool ok = false;
+  bool feasible = false;  // a non-negative solution with every term beyond the five in it was found
 };
 
-// Non-negative least squares on the whitened system by trying every subset of the free terms.
-Solution solve(const Problem& pr, const std::array<bool, terms>& free, const std::array<double, terms>& fixed) {
+// Non-negative least squares on the whitened system: every subset of the free power-law terms is
+// tried, the model's other terms always in (a candidate that needs one of them negative is not
+// feasible).
+Solution solve(const Problem& pr, const Flags& free, const Terms& fixed) {
   Solution best;
   const std::size_t n = pr.n;
-  // Whitened design (columns 0..4) and data (column 5): L^-1 [X y].
-  for (std::size_t c = 0; c < 6; ++c) {
-    for (std::size_t i = 0; i < n; ++i) {
-      double v = pr.row(i)[c];
-      if (c == 5) {
-        for (std::size_t t = 0; t < terms; ++t)
-          if (!free[t]) v -= fixed[t] * pr.row(i)[t];  // held terms are a known offset
-      }
-      pr.row(i)[c == 5 ? 7 : c] = v;  // y offset kept in slot 7 during whitening
-    }
+  const std::size_t columns = pr.model.columns();
+  // y less the held terms (a known offset).
+  for (std::size_t i = 0; i < n; ++i) {
+    double v = pr.row(i)[y_slot];
+    for (std::size_t t = 0; t < columns; ++t)
+      if (!free[t]) v -= fixed[t] * pr.row(i)[t];
+    pr.row(i)[offset_slot] = v;
   }
-  // Column scales: the basis spans many decades.
-  std::array<double, terms> scale{};
-  double whitened[128][6];
-  for (std::size_t c = 0; c < 6; ++c) {
-    double col[128];
-    for (std::size_t i = 0; i < n; ++i) col[i] = pr.row(i)[c == 5 ? 7 : c];
+  // Whitened design and data: L^-1 [X y]. Column scales: the basis spans many decades.
+  Terms scale{};
+  double whitened[max_fit_points][max_terms + 1];
+  for (std::size_t c = 0; c <= columns; ++c) {
+    double col[max_fit_points];
+    const std::size_t from = c == columns ? offset_slot : c;
+    for (std::size_t i = 0; i < n; ++i) col[i] = pr.row(i)[from];
     forward(pr.sigma, n, col, 1);
-    for (std::size_t i = 0; i < n; ++i) whitened[i][c] = col[i];
+    for (std::size_t i = 0; i < n; ++i) whitened[i][c == columns ? max_terms : c] = col[i];
   }
-  for (std::size_t t = 0; t < terms; ++t) {
+  for (std::size_t t = 0; t < columns; ++t) {
     double s = 0;
     for (std::size_t i = 0; i < n; ++i) s += whitened[i][t] * whitened[i][t];
     scale[t] = s > 0 ? 1 / std::sqrt(s) : 1;
   }
   std::size_t n_free = 0;
-  for (bool f : free) n_free += f;
-  std::array<double, terms> free_variance{};
-  for (unsigned mask = 1; mask < (1u << terms); ++mask) {
-    std::size_t idx[terms];
+  for (std::size_t t = 0; t < columns; ++t) n_free += free[t];
+  Terms free_variance{};
+  const unsigned extra = ((1u << columns) - 1) & ~((1u << power_terms) - 1);
+  for (unsigned power_mask = 0; power_mask < (1u << power_terms); ++power_mask) {
+    const unsigned mask = power_mask | extra;
+    if (mask == 0) continue;
+    std::size_t idx[max_terms];
     std::size_t k = 0;
     bool allowed = true;
-    for (std::size_t t = 0; t < terms; ++t) {
+    for (std::size_t t = 0; t < columns; ++t) {
       if (!(mask & (1u << t))) continue;
       if (!free[t]) allowed = false;
       idx[k++] = t;
     }
     if (!allowed || k > n) continue;
-    std::array<std::array<double, terms>, terms> ata{};
-    std::array<double, terms> atb{};
+    Matrix ata{};
+    Terms atb{};
     for (std::size_t i = 0; i < n; ++i) {
       for (std::size_t a = 0; a < k; ++a) {
         const double xa = whitened[i][idx[a]] * scale[idx[a]];
-        atb[a] += xa * whitened[i][5];
+        atb[a] += xa * whitened[i][max_terms];
         for (std::size_t b = 0; b < k; ++b) ata[a][b] += xa * whitened[i][idx[b]] * scale[idx[b]];
       }
     }
-    std::array<double, terms> x{};
-    std::array<std::array<double, terms>, terms> inv{};
+    Terms x{};
+    Matrix inv{};
     if (!solve_small(ata, atb, k, x, inv)) continue;
-    if (static_cast<std::size_t>(__builtin_popcount(mask)) == n_free)  // every free term: its variances
+    if (k == n_free)  // every free term: its variances
       for (std::size_t a = 0; a < k; ++a) free_variance[idx[a]] = inv[a][a] * scale[idx[a]] * scale[idx[a]];
     bool feasible = true;
     for (std::size_t a = 0; a < k; ++a) feasible &= x[a] >= 0;
     if (!feasible) continue;
     double chi2 = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      double r = whitened[i][5];
+      double r = whitened[i][max_terms];
       for (std::size_t a = 0; a < k; ++a) r -= whitened[i][idx[a]] * scale[idx[a]] * x[a];
       chi2 += r * r;
     }
     if (best.ok && chi2 >= best.chi2) continue;
     best = Solution{};
     best.ok = true;
+    best.feasible = true;
     best.chi2 = chi2;
-    for (std::size_t t = 0; t < terms; ++t) best.theta[t] = free[t] ? 0.0 : fixed[t];
+    for (std::size_t t = 0; t < columns; ++t) best.theta[t] = free[t] ? 0.0 : fixed[t];
     for (std::size_t a = 0; a < k; ++a) {
       best.theta[idx[a]] = x[a] * scale[idx[a]];
       best.active[idx[a]] = true;
@@ -301,10 +391,11 @@ Solution solve(const Problem& pr, const std::array<bool, terms>& free, const std
   // With no free term (or none feasible) the held terms alone are the model.
   if (!best.ok) {
     double chi2 = 0;
-    for (std::size_t i = 0; i < n; ++i) chi2 += whitened[i][5] * whitened[i][5];
+    for (std::size_t i = 0; i < n; ++i) chi2 += whitened[i][max_terms] * whitened[i][max_terms];
     best.chi2 = chi2;
-    for (std::size_t t = 0; t < terms; ++t) best.theta[t] = free[t] ? 0.0 : fixed[t];
+    for (std::size_t t = 0; t < columns; ++t) best.theta[t] = free[t] ? 0.0 : fixed[t];
     best.ok = true;
+    best.feasible = extra == 0;
   }
   return best;
 }
@@ -320,9 +411,9 @@ bool rejected(double chi2, std::size_t dof) {
 }  // namespace
 
 double ieee952_variance(const std::array<double, 5>& p, Stat stat, std::uint64_t m, double tau0_s) {
-  const auto x = design(stat, m, tau0_s);
+  const auto x = power_design(stat, m, tau0_s);
   double v = 0;
-  for (std::size_t t = 0; t < terms; ++t) v += p[t] * p[t] * x[t];
+  for (std::size_t t = 0; t < power_terms; ++t) v += p[t] * p[t] * x[t];
   return v;
 }
 
@@ -334,15 +425,46 @@ double ieee952_avar(const std::array<double, 5>& p, double tau) {
 
 namespace {
 
+Model model_of(const Ieee952Fit& fit, double tau0) {
+  Model model;
+  model.markov = fit.n_markov;
+  for (std::size_t j = 0; j < fit.n_markov; ++j) model.a[j] = tau0 / fit.markov[j].tc_s;
+  model.sinusoids = fit.n_sinusoids;
+  for (std::size_t j = 0; j < fit.n_sinusoids; ++j) model.hz[j] = fit.sinusoids[j].frequency_hz;
+  model.band = fit.bandwidth_tc_s > 0 ? tau0 / fit.bandwidth_tc_s : 0;
+  return model;
+}
+
+Terms theta_of(const Ieee952Fit& fit) {
+  Terms theta{};
+  for (std::size_t t = 0; t < power_terms; ++t) theta[t] = fit.p[t].value * fit.p[t].value;
+  for (std::size_t j = 0; j < fit.n_markov; ++j) theta[power_terms + j] = fit.markov[j].sigma.value * fit.markov[j].sigma.value;
+  for (std::size_t j = 0; j < fit.n_sinusoids; ++j)
+    theta[power_terms + fit.n_markov + j] = fit.sinusoids[j].amplitude.value * fit.sinusoids[j].amplitude.value;
+  return theta;
+}
+
+}  // namespace
+
+double fitted_variance(const Ieee952Fit& fit, Stat stat, std::uint64_t m, double tau0_s) {
+  const Model model = model_of(fit, tau0_s);
+  const Terms x = design(model, stat, m, tau0_s);
+  const Terms theta = theta_of(fit);
+  double v = 0;
+  for (std::size_t t = 0; t < model.columns(); ++t) v += theta[t] * x[t];
+  return v;
+}
+
+namespace {
+
 // Leaves out every point whose white-quantization part is quantization_left_out or more of it, and
 // holds Q at the white level: the quantization is not white.
-void leave_out_quantization(Problem& pr, double qw2, std::array<bool, terms>& free, std::array<double, terms>& fixed,
-                            Ieee952Fit& out) {
+void leave_out_quantization(Problem& pr, double qw2, Flags& free, Terms& fixed, Ieee952Fit& out) {
   out.quantization_white = false;
   std::size_t kept = 0;
   for (std::size_t i = 0; i < pr.n; ++i) {
     const FitPoint& p = *pr.point[i];
-    const double white = qw2 * design(p.stat, p.m, pr.tau0)[0];
+    const double white = qw2 * power_design(p.stat, p.m, pr.tau0)[0];
     if (white >= quantization_left_out * p.variance) {
       double& below = out.excluded_below_tau_s[p.stat == Stat::avar ? 0 : 1];
       const double next_octave = 2 * static_cast<double>(p.m) * pr.tau0;
@@ -356,12 +478,30 @@ void leave_out_quantization(Problem& pr, double qw2, std::array<bool, terms>& fr
   fixed[0] = qw2;
 }
 
+// Leaves out every point where a first-order filter of a = tau0 / Tf changes white rate noise by
+// bandwidth_left_out or more: below the sensor's bandwidth, its own filter shapes the curve.
+void leave_out_bandwidth(Problem& pr, double a, Ieee952Fit& out) {
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    const FitPoint& p = *pr.point[i];
+    const double white = power_design(p.stat, p.m, pr.tau0)[1];
+    const double filtered = markov_column(a, p.stat, p.m, pr.tau0) * std::tanh(a / 2) / pr.tau0;
+    if (std::fabs(filtered / white - 1) >= bandwidth_left_out) {
+      const double next_octave = 2 * static_cast<double>(p.m) * pr.tau0;
+      if (next_octave > out.bandwidth_excluded_below_tau_s) out.bandwidth_excluded_below_tau_s = next_octave;
+      continue;
+    }
+    pr.point[kept++] = pr.point[i];
+  }
+  pr.n = kept;
+}
+
 // Before the fit: a point the white quantization alone would dominate lies far below it (three
 // standard deviations and 2 %). Only a pattern can do that: other noise adds.
 bool below_white_quantization(const Problem& pr, double qw2) {
   for (std::size_t i = 0; i < pr.n; ++i) {
     const FitPoint& p = *pr.point[i];
-    const double white = qw2 * design(p.stat, p.m, pr.tau0)[0];
+    const double white = qw2 * power_design(p.stat, p.m, pr.tau0)[0];
     if (white < 0.5 * p.variance) continue;
     const TermGrid grid = unbroken_grid(p.stat, p.m, p.stride, pr.n_phase);
     const double edf = exact_edf(2, grid) * static_cast<double>(p.n) / static_cast<double>(grid.n);
@@ -379,39 +519,23 @@ bool quantization_departs(const Problem& pr, const Solution& sol) {
   for (std::size_t i = 0; i < pr.n; ++i) {
     const double* x = pr.row(i);
     double model = 0;
-    for (std::size_t t = 0; t < terms; ++t) model += sol.theta[t] * x[t];
+    for (std::size_t t = 0; t < pr.model.columns(); ++t) model += sol.theta[t] * x[t];
     if (!(sol.theta[0] * x[0] >= 0.5 * model)) continue;
-    const double gap = std::fabs(x[5] - model);
-    if (gap > 3 * std::sqrt(x[6]) && gap > 0.02 * model) return true;
+    const double gap = std::fabs(x[y_slot] - model);
+    if (gap > 3 * std::sqrt(x[diag_slot]) && gap > 0.02 * model) return true;
   }
   return false;
 }
 
-// The fit of the points in pr: their pair sums, first weights, then the exact covariance until
-// the parameters settle. Fills out's status, chi2 and parameters; leaves the solution in `sol`.
-void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms>& free,
-                const std::array<double, terms>& fixed, std::span<double> workspace, PairSumCache* cache,
-                Ieee952Fit& out, Solution& sol) {
-  out.points = pr.n;
-  std::size_t n_free = 0;
-  for (bool f : free) n_free += f;
-  if (pr.n <= n_free || pr.n == 0) {
-    out.status = FitStatus::too_few_points;
-    return;
-  }
-  pr.pair = workspace.data();
-  pr.sigma = pr.pair + pr.n * (pr.n + 1) / 2 * 14;
-  pr.rows = pr.sigma + pr.n * pr.n;
-
-  // The pair sums of every two points: they depend on the geometry only. Of the
-  // five Allan noises (index 2 - alpha) the model has four.
+// The pair sums of every two points: they depend on the geometry only. Of the five Allan noises
+// (index 2 - alpha) the model has four.
+void pair_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache) {
   constexpr std::array<std::size_t, noises> allan_index{0, 2, 3, 4};
   for (std::size_t i = 0; i < pr.n; ++i) {
     const FitPoint& a = *pr.point[i];
     const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
-    const auto x = design(a.stat, a.m, setup.tau0_s);
-    for (std::size_t t = 0; t < terms; ++t) pr.row(i)[t] = x[t];
-    pr.row(i)[5] = a.variance;
+    const auto w = power_design(a.stat, a.m, setup.tau0_s);
+    for (std::size_t t = 0; t < noises; ++t) pr.white[i][t] = w[t];
     for (std::size_t j = 0; j <= i; ++j) {
       const FitPoint& b = *pr.point[j];
       double* g = pr.pair_at(i, j);
@@ -431,67 +555,309 @@ void fit_points(Problem& pr, const FitSetup& setup, const std::array<bool, terms
       }
     }
   }
+}
 
-  // First weights: each point's own EDF, no correlation.
-  for (std::size_t i = 0; i < pr.n; ++i) {
-    const FitPoint& p = *pr.point[i];
-    const double edf = p.edf > 0 ? p.edf : static_cast<double>(p.n);
-    for (std::size_t j = 0; j < pr.n; ++j) pr.sigma[i * pr.n + j] = 0;
-    pr.sigma[i * pr.n + i] = 2 * p.variance * p.variance / edf + pr.spread * pr.spread * p.variance * p.variance;
+// Where a fit stands: its solution, status and numbers, before they are written out.
+struct Candidate {
+  Model model;
+  Solution sol;
+  FitStatus status = FitStatus::too_few_points;
+  std::size_t dof = 0;
+  std::size_t parameters = 0;
+  double criterion = 0;
+  bool valid = false;
+};
+
+double criterion_of(double chi2, std::size_t parameters, std::size_t points) {
+  return chi2 + static_cast<double>(parameters) * std::log(static_cast<double>(points));
+}
+
+// The fit of the points under pr.model: first weights from each point's own EDF (first = true) or
+// the covariance pr.sigma already holds, then the exact covariance under the current parameters
+// until they settle (at most `iterations` times).
+Candidate fit_model(Problem& pr, const Flags& free, const Terms& fixed, bool first, int iterations) {
+  Candidate c;
+  c.model = pr.model;
+  std::size_t n_free = 0;
+  for (std::size_t t = 0; t < pr.model.columns(); ++t) n_free += free[t];
+  if (pr.n <= n_free || pr.n == 0) return c;
+  set_rows(pr);
+  if (first) {
+    for (std::size_t i = 0; i < pr.n; ++i) {
+      const FitPoint& p = *pr.point[i];
+      const double edf = p.edf > 0 ? p.edf : static_cast<double>(p.n);
+      for (std::size_t j = 0; j < pr.n; ++j) pr.sigma[i * pr.n + j] = 0;
+      pr.sigma[i * pr.n + i] = 2 * p.variance * p.variance / edf + pr.spread * pr.spread * p.variance * p.variance;
+      pr.row(i)[diag_slot] = pr.sigma[i * pr.n + i];
+    }
+    if (!cholesky(pr.sigma, pr.n)) {
+      c.status = FitStatus::singular;
+      return c;
+    }
   }
-  if (!cholesky(pr.sigma, pr.n)) {
-    out.status = FitStatus::singular;
-    return;
-  }
-  sol = solve(pr, free, fixed);
-  // Then the exact covariance under the current parameters, until they settle.
-  for (int iteration = 0; iteration < 12; ++iteration) {
-    covariance_of_points(pr, sol.theta);
-    for (std::size_t i = 0; i < pr.n; ++i) pr.row(i)[6] = pr.sigma[i * pr.n + i];
+  c.sol = solve(pr, free, fixed);
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    covariance_of_points(pr, c.sol.theta);
+    for (std::size_t i = 0; i < pr.n; ++i) pr.row(i)[diag_slot] = pr.sigma[i * pr.n + i];
     if (!factor(pr)) {
-      out.status = FitStatus::singular;
-      return;
+      c.status = FitStatus::singular;
+      return c;
     }
     const Solution next = solve(pr, free, fixed);
     double change = 0;
-    for (std::size_t t = 0; t < terms; ++t) {
+    for (std::size_t t = 0; t < pr.model.columns(); ++t) {
       const double scale = std::fabs(next.theta[t]) + std::sqrt(std::fabs(next.cov[t][t])) + 1e-300;
-      change = std::fmax(change, std::fabs(next.theta[t] - sol.theta[t]) / scale);
+      change = std::fmax(change, std::fabs(next.theta[t] - c.sol.theta[t]) / scale);
     }
-    sol = next;
+    c.sol = next;
     if (change < 1e-6) break;
   }
-
   std::size_t fitted = 0;
-  for (bool a : sol.active) fitted += a;
-  out.chi2 = sol.chi2;
-  out.dof = pr.n > fitted ? pr.n - fitted : 0;
-  out.birge = out.chi2_per_dof() > 1 ? std::sqrt(out.chi2_per_dof()) : 1.0;
-  out.status = rejected(out.chi2, out.dof) ? FitStatus::rejected : FitStatus::ok;
-  for (std::size_t t = 0; t < terms; ++t) {
-    Ieee952Parameter& p = out.p[t];
-    p = Ieee952Parameter{};
-    p.fitted = sol.active[t];
-    const double theta = sol.theta[t];
-    p.value = theta > 0 ? std::sqrt(theta) : 0.0;
-    // A free term the non-negative solution left out: the uncertainty it has in the full model.
-    const double variance = p.fitted ? sol.cov[t][t] : free[t] ? sol.free_variance[t] : 0.0;
-    const double sd = std::sqrt(std::fabs(variance)) * out.birge;
-    p.uncertainty = p.value > 0 ? sd / (2 * p.value) : std::sqrt(sd);
-    if (!p.fitted || !(theta > 2 * sd)) continue;
-    for (std::size_t i = 0; i < pr.n && !p.resolved; ++i) {  // the largest contribution somewhere
-      // The ramp's response is modeled exactly for Allan and modified Allan estimates only: a
-      // total-family point answers a ramp otherwise (TOTVAR's reflection, TheoBR's ratio), so R is
-      // never resolved on one (the recovery study found it resolved there but off by more than
-      // two sigma).
-      if (t == 4 && pr.point[i]->variance_scale != 1) continue;
-      const double mine = theta * pr.row(i)[t];
-      bool largest = true;
-      for (std::size_t u = 0; u < terms; ++u)
-        if (u != t && sol.theta[u] * pr.row(i)[u] > mine) largest = false;
-      p.resolved = largest;
+  for (std::size_t t = 0; t < pr.model.columns(); ++t) fitted += c.sol.active[t];
+  c.dof = pr.n > fitted ? pr.n - fitted : 0;
+  c.status = rejected(c.sol.chi2, c.dof) ? FitStatus::rejected : FitStatus::ok;
+  c.parameters = fitted + pr.model.nonlinear();
+  c.criterion = criterion_of(c.sol.chi2, c.parameters, pr.n);
+  c.valid = c.sol.feasible;
+  return c;
+}
+
+// chi2 of pr.model under the covariance pr.sigma holds (factored): the profile a nonlinear
+// parameter is searched on. Infinite where the model needs a term negative.
+double profile_chi2(Problem& pr, const Flags& free, const Terms& fixed) {
+  set_rows(pr);
+  const Solution s = solve(pr, free, fixed);
+  return s.feasible ? s.chi2 : HUGE_VAL;
+}
+
+// Minimizes profile_chi2 over *value in log space: a grid from lo to hi (`per_octave` a factor of
+// two), then golden section around the best node. Leaves *value at the minimum; returns its chi2
+// and, in curvature_sd, the standard deviation of ln(value) from the profile's curvature (0: flat).
+double search(Problem& pr, const Flags& free, const Terms& fixed, double* value, double lo, double hi,
+              int per_octave, double& curvature_sd) {
+  const double step = std::log(2.0) / per_octave;
+  double best_log = std::log(lo), best = HUGE_VAL;
+  for (double l = std::log(lo); l <= std::log(hi) + 1e-12; l += step) {
+    *value = std::exp(l);
+    const double chi2 = profile_chi2(pr, free, fixed);
+    if (chi2 < best) best = chi2, best_log = l;
+  }
+  double a = best_log - step, b = best_log + step;
+  constexpr double golden = 0.6180339887498949;
+  double x1 = b - golden * (b - a), x2 = a + golden * (b - a);
+  *value = std::exp(x1);
+  double f1 = profile_chi2(pr, free, fixed);
+  *value = std::exp(x2);
+  double f2 = profile_chi2(pr, free, fixed);
+  for (int k = 0; k < 24; ++k) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - golden * (b - a);
+      *value = std::exp(x1);
+      f1 = profile_chi2(pr, free, fixed);
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + golden * (b - a);
+      *value = std::exp(x2);
+      f2 = profile_chi2(pr, free, fixed);
     }
   }
+  const double at = f1 < f2 ? x1 : x2;
+  best = f1 < f2 ? f1 : f2;
+  constexpr double h = 0.05;
+  *value = std::exp(at + h);
+  const double up = profile_chi2(pr, free, fixed);
+  *value = std::exp(at - h);
+  const double down = profile_chi2(pr, free, fixed);
+  const double curvature = (up + down - 2 * best) / (h * h);
+  curvature_sd = curvature > 0 ? std::sqrt(2 / curvature) : 0;
+  *value = std::exp(at);
+  return best;
+}
+
+// True when column t of candidate c is resolved: more than two standard uncertainties above zero
+// (Birge-scaled) and the largest contribution at one point at least (pr's rows are c's).
+bool column_resolved(const Problem& pr, const Candidate& c, std::size_t t) {
+  const double birge = c.dof && c.sol.chi2 > static_cast<double>(c.dof) ? std::sqrt(c.sol.chi2 / static_cast<double>(c.dof)) : 1.0;
+  const double theta = c.sol.theta[t];
+  if (!c.sol.active[t] || !(theta > 2 * std::sqrt(std::fabs(c.sol.cov[t][t])) * birge)) return false;
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    bool largest = true;
+    for (std::size_t u = 0; u < pr.model.columns(); ++u)
+      if (u != t && c.sol.theta[u] * pr.row(i)[u] > theta * pr.row(i)[t]) largest = false;
+    if (largest) return true;
+  }
+  return false;
+}
+
+// The search for the model: the five terms, then the filter, Markov terms and sinusoids while each
+// lowers the criterion. Leaves the winner's covariance in pr; `runner_up` is the next best.
+Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Flags& free, const Terms& fixed,
+                       Candidate& runner_up, std::array<double, max_markov + 1>& nonlinear_sd) {
+  pr.model = Model{};
+  Candidate best = fit_model(pr, free, fixed, true, 12);
+  runner_up = Candidate{};
+  nonlinear_sd = {};
+  if (!setup.select_model || !best.valid || best.status == FitStatus::singular) return best;
+  double tau_lo = 1e300, tau_hi = 0;
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    const double tau = static_cast<double>(pr.point[i]->m) * pr.tau0;
+    tau_lo = std::fmin(tau_lo, tau);
+    tau_hi = std::fmax(tau_hi, tau);
+  }
+  // A candidate wins when it lowers the criterion and the term it adds is resolved (a Markov term or
+  // sinusoid) or determined (the filter's Tf within a factor e^0.5); else it may be the runner-up.
+  auto consider = [&](const Candidate& c, bool added_term_holds) {
+    if (!c.valid || c.status == FitStatus::singular || c.status == FitStatus::too_few_points) return false;
+    if (c.criterion < best.criterion && added_term_holds) {
+      runner_up = best;
+      best = c;
+      return true;
+    }
+    if (!runner_up.valid || c.criterion < runner_up.criterion) runner_up = c;
+    return false;
+  };
+  // Restores the winner's model and covariance (the search overwrote them).
+  auto settle = [&]() {
+    pr.model = best.model;
+    const Candidate again = fit_model(pr, free, fixed, true, 12);
+    best.sol = again.sol;
+  };
+  // The sensor's filter on its white rate noise: Tf from tau0 / 20 to 4 tau0.
+  if (filter) {
+    pr.model = best.model;
+    double sd = 0;
+    search(pr, free, fixed, &pr.model.band, 0.25, 20.0, 4, sd);
+    const Candidate c = fit_model(pr, free, fixed, false, 12);
+    if (consider(c, sd > 0 && sd < 0.5)) nonlinear_sd[max_markov] = sd;
+    settle();
+  }
+  // Markov terms, one at a time: Tc from twice the shortest tau (shorter, the term is white rate
+  // noise over the whole curve: N's double) to half the longest (its Allan peak near 1.89 Tc).
+  for (std::size_t k = 0; k < setup.markov_terms && k < max_markov; ++k) {
+    pr.model = best.model;
+    pr.model.markov = k + 1;
+    double sd = 0;
+    search(pr, free, fixed, &pr.model.a[k], 2 * pr.tau0 / tau_hi, pr.tau0 / (2 * tau_lo), 4, sd);
+    const Candidate c = fit_model(pr, free, fixed, false, 12);
+    // A Markov term that takes white rate noise's place (N fitted before, not after) is N again.
+    const bool better = consider(c, column_resolved(pr, c, power_terms + k) && (!best.sol.active[1] || c.sol.active[1]));
+    if (better) nonlinear_sd[k] = sd;
+    settle();
+    if (!better) break;
+  }
+  // Sinusoids at the frequencies given.
+  for (double hz : setup.sinusoid_hz) {
+    if (!(hz > 0) || best.model.sinusoids >= max_sinusoids) continue;
+    pr.model = best.model;
+    pr.model.hz[pr.model.sinusoids++] = hz;
+    const Candidate c = fit_model(pr, free, fixed, false, 12);
+    consider(c, column_resolved(pr, c, pr.model.columns() - 1));
+    settle();
+  }
+  return best;
+}
+
+ModelSummary summary_of(const Candidate& c) {
+  ModelSummary s;
+  s.valid = c.valid;
+  s.markov = static_cast<std::uint8_t>(c.model.markov);
+  s.sinusoids = static_cast<std::uint8_t>(c.model.sinusoids);
+  s.bandwidth = c.model.band > 0;
+  s.status = c.status;
+  s.chi2 = c.sol.chi2;
+  s.dof = c.dof;
+  s.parameters = c.parameters;
+  s.criterion = c.criterion;
+  return s;
+}
+
+// A term's parameter from its squared value and variance; resolved when fitted, its square more
+// than two standard uncertainties above zero and the largest contribution at some point.
+Ieee952Parameter parameter(const Problem& pr, const Solution& sol, const Flags& free, std::size_t t, double birge,
+                           bool rejected_model) {
+  Ieee952Parameter p;
+  p.fitted = sol.active[t];
+  const double theta = sol.theta[t];
+  p.value = theta > 0 ? std::sqrt(theta) : 0.0;
+  // A free term the non-negative solution left out: the uncertainty it has in the full model.
+  const double variance = p.fitted ? sol.cov[t][t] : free[t] ? sol.free_variance[t] : 0.0;
+  const double sd = std::sqrt(std::fabs(variance)) * birge;
+  p.uncertainty = p.value > 0 ? sd / (2 * p.value) : std::sqrt(sd);
+  if (!p.fitted || !(theta > 2 * sd) || rejected_model) return p;
+  for (std::size_t i = 0; i < pr.n && !p.resolved; ++i) {  // the largest contribution somewhere
+    // The ramp's response is modeled exactly for Allan and modified Allan estimates only: a
+    // total-family point answers a ramp otherwise (TOTVAR's reflection, TheoBR's ratio), so R is
+    // never resolved on one (the recovery study found it resolved there but off by more than
+    // two sigma).
+    if (t == 4 && pr.point[i]->variance_scale != 1) continue;
+    const double mine = theta * pr.row(i)[t];
+    bool largest = true;
+    for (std::size_t u = 0; u < pr.model.columns(); ++u)
+      if (u != t && sol.theta[u] * pr.row(i)[u] > mine) largest = false;
+    p.resolved = largest;
+  }
+  return p;
+}
+
+// Writes the candidate into out: status, chi2, every term, the residuals.
+void write_fit(const Problem& pr, const Candidate& c, const Flags& free, const std::array<double, max_markov + 1>& nl_sd,
+               Ieee952Fit& out) {
+  out.points = pr.n;
+  out.status = c.status;
+  out.chi2 = c.sol.chi2;
+  out.dof = c.dof;
+  out.birge = out.chi2_per_dof() > 1 ? std::sqrt(out.chi2_per_dof()) : 1.0;
+  const bool rejected_model = c.status == FitStatus::rejected;
+  for (std::size_t t = 0; t < power_terms; ++t) out.p[t] = parameter(pr, c.sol, free, t, out.birge, rejected_model);
+  out.n_markov = c.model.markov;
+  for (std::size_t j = 0; j < c.model.markov; ++j) {
+    MarkovTerm& m = out.markov[j];
+    m.sigma = parameter(pr, c.sol, free, power_terms + j, out.birge, rejected_model);
+    m.tc_s = pr.tau0 / c.model.a[j];
+    m.tc_uncertainty_s = m.tc_s * nl_sd[j] * out.birge;
+  }
+  out.n_sinusoids = c.model.sinusoids;
+  for (std::size_t j = 0; j < c.model.sinusoids; ++j) {
+    out.sinusoids[j].amplitude = parameter(pr, c.sol, free, power_terms + c.model.markov + j, out.birge, rejected_model);
+    out.sinusoids[j].frequency_hz = c.model.hz[j];
+  }
+  out.bandwidth_tc_s = c.model.band > 0 ? pr.tau0 / c.model.band : 0;
+  out.bandwidth_tc_uncertainty_s = out.bandwidth_tc_s * nl_sd[max_markov] * out.birge;
+  out.n_residuals = pr.n;
+  for (std::size_t i = 0; i < pr.n; ++i) {
+    double model = 0;
+    for (std::size_t t = 0; t < pr.model.columns(); ++t) model += c.sol.theta[t] * pr.row(i)[t];
+    const double sd = std::sqrt(pr.row(i)[diag_slot]);
+    out.residuals[i] = {pr.point[i]->stat, pr.point[i]->m, pr.point[i]->variance, model,
+                        sd > 0 ? (pr.point[i]->variance - model) / sd : 0.0};
+  }
+}
+
+// The fit of the points in pr with model selection; fills out and leaves the winner's solution in
+// `sol` (pr's rows and covariance are the winner's).
+void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& free, const Terms& fixed,
+                std::span<double> workspace, PairSumCache* cache, Ieee952Fit& out, Solution& sol) {
+  out.points = pr.n;
+  std::size_t n_free = 0;
+  for (std::size_t t = 0; t < power_terms; ++t) n_free += free[t];
+  if (pr.n <= n_free || pr.n == 0) {
+    out.status = FitStatus::too_few_points;
+    return;
+  }
+  pr.pair = workspace.data();
+  pr.sigma = pr.pair + pr.n * (pr.n + 1) / 2 * 14;
+  pr.rows = pr.sigma + pr.n * pr.n;
+  pair_sums_of_points(pr, setup, cache);
+  Candidate runner_up;
+  std::array<double, max_markov + 1> nl_sd{};
+  const Candidate best = select_model(pr, setup, filter, free, fixed, runner_up, nl_sd);
+  if (best.status == FitStatus::singular || best.status == FitStatus::too_few_points) {
+    out.status = best.status;
+    return;
+  }
+  sol = best.sol;
+  write_fit(pr, best, free, nl_sd, out);
+  out.chosen = summary_of(best);
+  out.runner_up = summary_of(runner_up);
 }
 
 }  // namespace
@@ -506,7 +872,8 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
   pr.spread = setup.model_spread;
   for (const FitPoint& p : points) {
     const bool wanted = curve == FitCurve::both || (curve == FitCurve::avar) == (p.stat == Stat::avar);
-    if (!wanted || (p.stat != Stat::avar && p.stat != Stat::mvar) || p.n == 0 || !(p.variance > 0) || pr.n >= 128)
+    if (!wanted || (p.stat != Stat::avar && p.stat != Stat::mvar) || p.n == 0 || !(p.variance > 0) ||
+        pr.n >= max_fit_points)
       continue;
     if (unbroken_grid(p.stat, p.m, p.stride, setup.n_phase).n == 0) continue;
     pr.point[pr.n++] = &p;
@@ -524,15 +891,22 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
 
   // Quantization, where its white level is known (counts): tested before the fit and after it.
   const double qw2 = setup.white_quantization * setup.white_quantization;
-  std::array<bool, terms> free{true, true, true, true, true};
-  std::array<double, terms> fixed{};
+  Flags free{};
+  for (std::size_t t = 0; t < max_terms; ++t) free[t] = true;
+  Terms fixed{};
   if (qw2 > 0 && below_white_quantization(pr, qw2)) leave_out_quantization(pr, qw2, free, fixed, out);
   Solution sol;
-  fit_points(pr, setup, free, fixed, workspace, cache, out, sol);
+  fit_points(pr, setup, true, free, fixed, workspace, cache, out, sol);
   if (qw2 > 0 && out.quantization_white && out.status != FitStatus::too_few_points &&
       out.status != FitStatus::singular && quantization_departs(pr, sol)) {
     leave_out_quantization(pr, qw2, free, fixed, out);
-    fit_points(pr, setup, free, fixed, workspace, cache, out, sol);
+    fit_points(pr, setup, true, free, fixed, workspace, cache, out, sol);
+  }
+  // A sensor's filter that a first-order one does not describe well enough: the taus it reaches
+  // are left out, and the rest fitted without it.
+  if (out.status == FitStatus::rejected && out.bandwidth_tc_s > 0) {
+    leave_out_bandwidth(pr, setup.tau0_s / out.bandwidth_tc_s, out);
+    fit_points(pr, setup, false, free, fixed, workspace, cache, out, sol);
   }
   return out;
 }

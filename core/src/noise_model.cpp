@@ -253,6 +253,63 @@ double term_covariance(int alpha, Stat a, std::uint64_t m_a, Stat b, std::uint64
   return covariance(k, 2 - alpha + 2 * k.level, lag);
 }
 
+namespace {
+
+// e^-s minus its Taylor polynomial of degree < order: sum_{j >= order} (-s)^j / j!, by the series
+// where it would otherwise cancel (s < 1), directly beyond.
+double exp_remainder(int order, double s) {
+  if (s < 1) {
+    double term = 1;
+    for (int j = 1; j <= order; ++j) term *= -s / j;
+    double sum = 0;
+    for (int j = order; j < order + 30; ++j) {
+      sum += term;
+      term *= -s / (j + 1);
+      if (std::fabs(term) <= 1e-18 * std::fabs(sum)) break;
+    }
+    return sum;
+  }
+  double poly = 0, term = 1;
+  for (int j = 0; j < order; ++j) {
+    poly += term;
+    term *= -s / (j + 1);
+  }
+  return std::exp(-s) - poly;
+}
+
+// The generalized autocovariance of the Markov phase (level 0) or its prefix sums (level 1), see
+// noise_model.hpp. Series below a = 0.05 (their last terms are below 1e-16 of the first there).
+double markov_autocovariance(double a, int level, std::int64_t k) {
+  const double ak = static_cast<double>(k < 0 ? -k : k);
+  const double h = std::sinh(a / 2);
+  const double a2 = a * a, a3 = a2 * a, a5 = a3 * a2;
+  if (level == 0) {
+    const double d = a < 0.05 ? a3 * (1.0 / 6 + a2 * (1.0 / 120 + a2 * (1.0 / 5040 + a2 / 362880))) : std::sinh(a) - a;
+    return -(exp_remainder(2, a * ak) + d * ak) / (4 * h * h);
+  }
+  double d1, d3;
+  if (a < 0.05) {
+    d1 = -a5 * (1.0 / 30 + a2 * (1.0 / 252 + a2 * (1.0 / 4320 + a2 * (17.0 / 1995840 + a2 * 31.0 / 141523200))));
+    d3 = a5 * (1.0 / 24 + a2 * (1.0 / 240 + a2 * (17.0 / 72576 + a2 * (31.0 / 3628800 + a2 / 4561920))));
+  } else {
+    d1 = std::sinh(a) * (1 - 2 * h * h / 3) - a;
+    d3 = 2 * std::sinh(a) * h * h / 3 - a3 / 6;
+  }
+  return (exp_remainder(4, a * ak) + d1 * ak + d3 * ak * ak * ak) / (16 * h * h * h * h);
+}
+
+}  // namespace
+
+double markov_term_covariance(double a, Stat a_stat, std::uint64_t m_a, Stat b_stat, std::uint64_t m_b,
+                              std::int64_t lag) {
+  if (!(a > 0)) return 0.0;
+  const Kernel k = kernel(a_stat, m_a, b_stat, m_b);
+  double c = 0;
+  for (int i = 0; i < k.count; ++i)
+    c += k.w[static_cast<std::size_t>(i)] * markov_autocovariance(a, k.level, lag + k.u[static_cast<std::size_t>(i)]);
+  return c;
+}
+
 TermGrid unbroken_grid(Stat stat, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase) {
   TermGrid g{stat, m, stride, 0, 0};
   if (m == 0 || stride == 0) return g;

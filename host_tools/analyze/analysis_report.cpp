@@ -64,7 +64,25 @@ std::string fit_summary(const CurveFit& f) {
     return s + fmt::format(": not identified ({})", name(fit.status));
   s += fmt::format(", chi2/dof {:.3g} on {} dof", fit.chi2_per_dof(), fit.dof);
   if (fit.birge > 1) s += fmt::format(", uncertainties scaled by {:.3g}", fit.birge);
-  if (fit.status == FitStatus::rejected) s += ": MODEL REJECTED, the IEEE-952 terms do not describe this curve";
+  if (fit.status == FitStatus::rejected) s += ": MODEL REJECTED, the model does not describe this curve";
+  return s;
+}
+
+// "5 terms + filter + 1 Markov (criterion 41.2); runner-up 5 terms + filter (criterion 96.3, chi2/dof 2.6)"
+std::string candidate_text(const ModelSummary& m) {
+  std::string s = "five terms";
+  if (m.bandwidth) s += " + filter";
+  if (m.markov) s += fmt::format(" + {} Markov", m.markov);
+  if (m.sinusoids) s += fmt::format(" + {} sinusoid{}", m.sinusoids, m.sinusoids > 1 ? "s" : "");
+  return s;
+}
+
+std::string model_text(const Ieee952Fit& fit) {
+  std::string s = fmt::format("{} (criterion chi2 + p ln n = {:.4g}, p = {})", candidate_text(fit.chosen),
+                              fit.chosen.criterion, fit.chosen.parameters);
+  if (fit.runner_up.valid)
+    s += fmt::format("; runner-up {} (criterion {:.4g}, chi2/dof {:.3g})", candidate_text(fit.runner_up),
+                     fit.runner_up.criterion, fit.runner_up.dof ? fit.runner_up.chi2 / static_cast<double>(fit.runner_up.dof) : 0.0);
   return s;
 }
 
@@ -231,6 +249,16 @@ std::string format_table(const Report& r) {
                          "pulse weight / sqrt(12)\n",
                      excluded_text(f.fit));
     if (f.fit.status == FitStatus::too_few_points || f.fit.status == FitStatus::singular) continue;
+    fmt::format_to(to, "#   model: {}\n", model_text(f.fit));
+    if (f.fit.bandwidth_excluded_below_tau_s > 0)
+      fmt::format_to(to, "#   the sensor's own filter shapes the curve below {:.4g} s (a first-order filter does not describe "
+                         "it there): those points left out\n",
+                     f.fit.bandwidth_excluded_below_tau_s);
+    if (f.fit.status == FitStatus::rejected) {
+      fmt::format_to(to, "#   no term is given as a result: even the best model found does not describe this curve (the "
+                         "residuals per tau are in --format json)\n");
+      continue;
+    }
     for (std::size_t i = 0; i < 5; ++i) {
       const FitUnit& fu = fit_units(u)[i];
       const Ieee952Parameter& p = f.fit.p[i];
@@ -245,6 +273,23 @@ std::string format_table(const Report& r) {
       else
         fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}{}\n", fu.letter, p.value / fu.si, p.uncertainty / fu.si, fu.name,
                        p.resolved ? "" : "  (not resolved)", truth);
+    }
+    const FitUnit& rate = fit_units(u)[2];  // B's unit: a rate
+    if (f.fit.bandwidth_tc_s > 0)
+      fmt::format_to(to, "#   sensor bandwidth: N's white noise through a first-order filter, Tf = {:.3g} +- {:.2g} s "
+                         "(corner {:.4g} Hz)\n",
+                     f.fit.bandwidth_tc_s, f.fit.bandwidth_tc_uncertainty_s, 1 / (2 * std::numbers::pi * f.fit.bandwidth_tc_s));
+    for (std::size_t j = 0; j < f.fit.n_markov; ++j) {
+      const MarkovTerm& m = f.fit.markov[j];
+      fmt::format_to(to, "#   Markov {}: sigma = {:.4g} +- {:.2g} {}, Tc = {:.4g} +- {:.2g} s{}\n", j + 1,
+                     m.sigma.value / rate.si, m.sigma.uncertainty / rate.si, rate.name, m.tc_s, m.tc_uncertainty_s,
+                     m.sigma.resolved ? "" : "  (not resolved)");
+    }
+    for (std::size_t j = 0; j < f.fit.n_sinusoids; ++j) {
+      const SinusoidTerm& sn = f.fit.sinusoids[j];
+      fmt::format_to(to, "#   sinusoid {}: amplitude = {:.4g} +- {:.2g} {} at {:.6g} Hz{}\n", j + 1,
+                     sn.amplitude.value / rate.si, sn.amplitude.uncertainty / rate.si, rate.name, sn.frequency_hz,
+                     sn.amplitude.resolved ? "" : "  (not resolved)");
     }
   }
   return out;
@@ -287,6 +332,54 @@ nlohmann::json units_json(const ReportUnits& u) {
   return {{"input", u.input}, {"dev", u.gyro ? u.rate.name : "1"}, {"tdev", u.gyro ? u.rate.angle : "s"}};
 }
 
+namespace {
+
+nlohmann::json summary_json(const ModelSummary& m) {
+  using nlohmann::json;
+  if (!m.valid) return json(nullptr);
+  return {{"markov", m.markov}, {"sinusoids", m.sinusoids}, {"bandwidth", m.bandwidth}, {"status", name(m.status)},
+          {"chi2", m.chi2}, {"dof", m.dof}, {"parameters", m.parameters}, {"criterion", m.criterion}};
+}
+
+nlohmann::json parameter_json(const Ieee952Parameter& p, double si, const std::string& unit) {
+  return {{"value", p.value / si}, {"uncertainty", p.uncertainty / si}, {"unit", unit}, {"fitted", p.fitted},
+          {"resolved", p.resolved}};
+}
+
+// The terms beyond the five, the model selection and the residuals of a fit.
+void add_model_json(nlohmann::json& one, const Ieee952Fit& fit, const ReportUnits& u) {
+  using nlohmann::json;
+  const FitUnit& rate = fit_units(u)[2];
+  json markov = json::array();
+  for (std::size_t j = 0; j < fit.n_markov; ++j)
+    markov.push_back({{"sigma", parameter_json(fit.markov[j].sigma, rate.si, rate.name)},
+                      {"tc", {{"value", fit.markov[j].tc_s}, {"uncertainty", fit.markov[j].tc_uncertainty_s}, {"unit", "s"}}}});
+  json sinusoids = json::array();
+  for (std::size_t j = 0; j < fit.n_sinusoids; ++j)
+    sinusoids.push_back({{"amplitude", parameter_json(fit.sinusoids[j].amplitude, rate.si, rate.name)},
+                         {"frequency", {{"value", fit.sinusoids[j].frequency_hz}, {"uncertainty", nullptr}, {"unit", "Hz"}}}});
+  one["markov"] = std::move(markov);
+  one["sinusoids"] = std::move(sinusoids);
+  one["bandwidth"] = fit.bandwidth_tc_s > 0 ? json{{"tc", {{"value", fit.bandwidth_tc_s},
+                                                          {"uncertainty", fit.bandwidth_tc_uncertainty_s}, {"unit", "s"}}},
+                                                   {"corner_hz", 1 / (2 * std::numbers::pi * fit.bandwidth_tc_s)}}
+                                            : json(nullptr);
+  one["bandwidth_excluded_below_tau"] = fit.bandwidth_excluded_below_tau_s > 0 ? json(fit.bandwidth_excluded_below_tau_s) : json(nullptr);
+  one["model"] = summary_json(fit.chosen);
+  one["runner_up"] = summary_json(fit.runner_up);
+  const double k = u.factor() / u.phase_unit_si;  // SI deviation -> output unit
+  json residuals = json::array();
+  for (std::size_t i = 0; i < fit.n_residuals; ++i) {
+    const FitResidual& r = fit.residuals[i];
+    residuals.push_back({{"stat", r.stat == Stat::avar ? "oadev" : "mdev"}, {"m", r.m},
+                         {"dev", std::sqrt(r.variance) * k}, {"model", std::sqrt(std::fmax(r.model, 0.0)) * k},
+                         {"residual_sigma", r.normalized}});
+  }
+  one["residuals"] = std::move(residuals);
+}
+
+}  // namespace
+
 nlohmann::json to_json(const Report& r) {
   using nlohmann::json;
   const ReportUnits& u = r.units;
@@ -323,6 +416,7 @@ nlohmann::json to_json(const Report& r) {
         one[fu.letter] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"fitted", p.fitted},
                         {"resolved", p.resolved}, {"unit", fu.name}};
       }
+      add_model_json(one, fit, u);
       fits.push_back(std::move(one));
     }
     j["fit"] = std::move(fits);

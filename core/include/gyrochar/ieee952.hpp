@@ -43,6 +43,27 @@
 // model either way; both by three standard deviations and 2 %. Then every point with a
 // quantization share of 1 % or more is left out, Q is held at Q_w (not fitted) and the rest is
 // fitted again.
+//
+// Beyond the five terms (IEEE 952 has them too; real sensors show them), with model selection:
+//   Markov  first-order Gauss-Markov rate: a sampled AR(1) rate of stationary standard deviation
+//           sigma [r/s] and correlation time Tc [s] (noise_model.hpp, markov_term_covariance());
+//           rate-random-walk-like below Tc, white-rate-like above, ADEV peak near tau = 1.89 Tc
+//   bandwidth the sensor's own first-order filter on its white rate noise: N's term becomes a
+//           Markov term of short correlation time Tf whose long-tau level is N^2 / tau (N keeps
+//           its meaning; the shortest taus bend below the N line)
+//   sinusoid a rate A sin(2 pi f t + random phase) [r/s], f given by the caller (a spectral line):
+//           AVAR A^2 (sin^2 x / x)^2, MVAR A^2 sin^6 x / (x^2 m^2 sin^2(pi f tau0)), x = pi f tau
+// Their expected variances are exact for the sampled estimators. Their part in the covariance of
+// the points is approximate: a Markov term's variance at each point is taken as white rate noise
+// and rate random walk in the proportion its local slope says (-1: white, +1: random walk), the
+// filter as white rate noise of the filtered level, a sinusoid (deterministic) as none; the
+// recovery study measures what that approximation costs (docs/metrology.md).
+// Model selection (FitSetup::select_model): from the five terms, the filter, then one Markov term
+// and a second are added while each lowers the Bayesian information criterion chi2 + p ln(points)
+// (p: the terms fitted plus each correlation time); a correlation time is found on a grid of four
+// per octave (Tc from twice the shortest tau to half the longest), then refined by golden section, both on the covariance of the model
+// before it; given sinusoids are tried last. The model with the least criterion is the fit; the
+// runner-up is reported beside it.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -71,11 +92,18 @@ struct FitPoint {
   double variance_scale = 1; // 1: the Allan-family estimate itself; < 1: a total-family one for it
 };
 
+inline constexpr std::size_t max_markov = 2;      // Markov terms a model may have
+inline constexpr std::size_t max_sinusoids = 2;   // sinusoids a model may have
+inline constexpr std::size_t max_fit_points = 128;
+
 struct FitSetup {
   double tau0_s = 1.0;
   std::uint64_t n_phase = 0;        // phase points of the run (the unbroken grids)
   double white_quantization = 0.0;  // Q_w in r when the data are counts (pulse weight / sqrt 12); 0: unknown
   double model_spread = 0.001;      // how closely the model is taken to describe each point (relative)
+  bool select_model = true;         // false: the five terms only, as IEEE 952's basic model
+  std::size_t markov_terms = max_markov;           // at most this many Markov terms (<= max_markov)
+  std::array<double, max_sinusoids> sinusoid_hz{};  // candidate sinusoid frequencies (0: none)
 };
 
 enum class FitCurve : std::uint8_t { avar, mvar, both };
@@ -96,6 +124,35 @@ struct Ieee952Parameter {
   bool resolved = false;   // see the header
 };
 
+/// A Markov term of the fit: sigma its stationary standard deviation [r/s], Tc its correlation time.
+struct MarkovTerm {
+  Ieee952Parameter sigma;
+  double tc_s = 0;
+  double tc_uncertainty_s = 0;  // from the criterion's curvature in ln Tc, scaled like the rest
+};
+/// A sinusoid of the fit: amplitude [r/s] at a given frequency.
+struct SinusoidTerm {
+  Ieee952Parameter amplitude;
+  double frequency_hz = 0;
+};
+/// One candidate model of the selection and how well it did.
+struct ModelSummary {
+  bool valid = false;  // false: no such candidate was fitted
+  std::uint8_t markov = 0, sinusoids = 0;
+  bool bandwidth = false;
+  FitStatus status = FitStatus::too_few_points;
+  double chi2 = 0;
+  std::size_t dof = 0;
+  std::size_t parameters = 0;  // linear terms fitted plus correlation times and frequencies
+  double criterion = 0;        // chi2 + parameters ln(points)
+};
+/// A point of the fit against its model: (variance - model) / its standard deviation.
+struct FitResidual {
+  Stat stat = Stat::avar;
+  std::uint64_t m = 0;
+  double variance = 0, model = 0, normalized = 0;
+};
+
 struct Ieee952Fit {
   FitCurve curve = FitCurve::both;
   FitStatus status = FitStatus::too_few_points;
@@ -106,13 +163,23 @@ struct Ieee952Fit {
   std::size_t points = 0;               // points used
   bool quantization_white = true;       // false: periodic quantization detected (counts only)
   std::array<double, 2> excluded_below_tau_s{};  // AVAR, MVAR points below these taus left out (non-white)
+  std::array<MarkovTerm, max_markov> markov{};   // the first n_markov are in the model
+  std::size_t n_markov = 0;
+  std::array<SinusoidTerm, max_sinusoids> sinusoids{};
+  std::size_t n_sinusoids = 0;
+  double bandwidth_excluded_below_tau_s = 0;  // points below this tau left out: the sensor's own filter (0: none)
+  double bandwidth_tc_s = 0;               // Tf of the filter on N's white noise (0: none in the model)
+  double bandwidth_tc_uncertainty_s = 0;
+  ModelSummary chosen, runner_up;          // the selected model and the next best candidate
+  std::array<FitResidual, max_fit_points> residuals{};  // every point used, in the fit's order
+  std::size_t n_residuals = 0;
   bool ok() const { return status == FitStatus::ok; }
   double chi2_per_dof() const { return dof ? chi2 / static_cast<double>(dof) : 0.0; }
 };
 
-/// Doubles of workspace fit_ieee952() needs for `points` points: about 7.5 points^2.
+/// Doubles of workspace fit_ieee952() needs for `points` points: about 8 points^2.
 constexpr std::size_t ieee952_workspace_doubles(std::size_t points) {
-  return points * (points + 1) / 2 * 14 + points * points + points * 8;
+  return points * (points + 1) / 2 * 14 + points * points + points * 12;
 }
 
 /// Fits the model to the points of `curve` (points of the other statistic are ignored; any
@@ -125,6 +192,8 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
 /// The model's exact expected AVAR or MVAR at averaging factor m for parameters {Q, N, B, K, R}.
 /// O(1).
 double ieee952_variance(const std::array<double, 5>& qnbkr, Stat stat, std::uint64_t m, double tau0_s);
+/// The same for the whole model of a fit: its five terms, the filter, Markov terms and sinusoids. O(1).
+double fitted_variance(const Ieee952Fit& fit, Stat stat, std::uint64_t m, double tau0_s);
 
 /// IEEE 952's closed form of the AVAR at any tau (the large-m limit of the above), for drawing
 /// the model and reading it off: 3Q^2/tau^2 + N^2/tau + (2 ln 2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2.

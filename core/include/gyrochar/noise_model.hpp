@@ -56,6 +56,19 @@ double generalized_autocovariance(int twice_d, std::int64_t k);
 /// second differences). 0 when either statistic does not converge for alpha. O(1).
 double term_covariance(int alpha, Stat a, std::uint64_t m_a, Stat b, std::uint64_t m_b, std::int64_t lag);
 
+/// First-order Gauss-Markov rate noise, sampled: the rate samples y_k (each the mean rate over one
+/// tau0) form an AR(1) sequence of unit stationary variance and lag-1 correlation phi = e^(-a),
+/// a = tau0 / Tc, and the phase is their running sum (one tau0 a sample: multiply by tau0^2 and the
+/// rate's variance sigma^2). Cov[term (a_stat, m_a) newest e, term (b_stat, m_b) newest e - lag],
+/// as term_covariance(). Exact: the generalized autocovariances of the phase and of its prefix
+/// sums are, up to polynomials the terms annihilate (s = a|k|, h = sinh(a/2)),
+///   level 0 (x): -[e^-s - 1 + s + (sinh a - a)|k|] / (4 h^2)
+///   level 1 (P): [e^-s - 1 + s - s^2/2 + s^3/6 + d1 |k| + d3 |k|^3] / (16 h^4),
+///                d1 = sinh a (1 - 2h^2/3) - a = -a^5/30 - ..., d3 = 2 sinh(a) h^2 / 3 - a^3/6 = a^5/24 + ...
+/// written so that nothing cancels catastrophically when Tc >> tau0 (exponential remainders by
+/// their series, d1 and d3 by theirs). O(1). a > 0.
+double markov_term_covariance(double a, Stat a_stat, std::uint64_t m_a, Stat b_stat, std::uint64_t m_b, std::int64_t lag);
+
 /// The terms of one estimate: newest points first, first + stride, ..., first + (n - 1) stride.
 struct TermGrid {
   Stat stat = Stat::avar;
