@@ -82,7 +82,7 @@ std::int64_t GyroSimulator::next_count() {
   for (Markov& m : markov_) correlated += m.step(terms_normal_(terms_rng_));
   for (const Sinusoid& s : sinusoids_) {
     const long double cycles = (static_cast<long double>(interval) + 0.5L) * s.cycles_per_sample;
-    const double fraction = static_cast<double>(cycles - std::floor(cycles));  // exact phase modulo a cycle
+    const double fraction = static_cast<double>(cycles - std::floor(cycles));  // the phase modulo a cycle
     correlated += s.mean_amplitude_rad_s * std::sin(2.0 * units::pi * fraction + s.phase_rad);
   }
   // Rate held over this interval: input + ramp (R t_mid dt is the exact integral of R t) + rate

@@ -39,6 +39,13 @@ void expect_same_options(const SimOptions& a, const SimOptions& b) {
   EXPECT_EQ(a.sinusoids, b.sinusoids);
 }
 
+// `line` with its first `from` replaced by `to` (a failure when there is none).
+std::string replaced_in(std::string line, const std::string& from, const std::string& to) {
+  const auto at = line.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? line : line.replace(at, from.size(), to);
+}
+
 SimOptions awkward() {
   SimOptions o;
   o.duration_s = 14400.000000000002;
@@ -112,12 +119,7 @@ TEST(SimHeader, RateTermsAreListedOnlyWhenThereAreSome) {
   EXPECT_EQ(t.sinusoids[1].frequency_hz, 4.999);
   // What a reader refuses: a term without its count, a count without its terms, an index beyond
   // the count or beyond 4, a term missing a number, a number twice, terms check_parameters refuses.
-  auto replaced = [&line](const std::string& from, const std::string& to) {
-    std::string s = line;
-    const auto at = s.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    return s.replace(at, from.size(), to);
-  };
+  auto replaced = [&line](const std::string& from, const std::string& to) { return replaced_in(line, from, to); };
   EXPECT_FALSE(parse_sim_truth_line(replaced(" markov_terms=2", "")));
   EXPECT_FALSE(parse_sim_truth_line(plain + " markov_terms=1"));
   EXPECT_FALSE(parse_sim_truth_line(plain + " sinusoid1_amplitude_deg_per_h=1 sinusoid1_frequency_hz=1"));
@@ -224,12 +226,7 @@ TEST(SimHeader, QuantizationWhitenessFlag) {
 
 TEST(SimHeader, RefusesWhatIsNotATruthLine) {
   const std::string good = format_sim_truth_line(SimOptions{});
-  auto replaced = [&good](const std::string& from, const std::string& to) {
-    std::string s = good;
-    const auto at = s.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    return s.replace(at, from.size(), to);
-  };
+  auto replaced = [&good](const std::string& from, const std::string& to) { return replaced_in(good, from, to); };
   EXPECT_FALSE(parse_sim_truth_line(""));
   EXPECT_FALSE(parse_sim_truth_line("# gyrochar-sim counts: tau0 0.01 s"));
   EXPECT_FALSE(parse_sim_truth_line(good.substr(1)));                          // no '#'
@@ -324,12 +321,7 @@ TEST(SimSegments, TheTruthLineSaysFormatTwoAndCarriesEverySegmentExactly) {
   EXPECT_EQ(segment_options(o, 2).rate_deg_per_h, -20.0);
   EXPECT_TRUE(segment_options(o, 2).segments.empty());
   // A format-1 line never has segment keys; a format-2 line needs them all.
-  auto replaced = [&line](const std::string& from, const std::string& to) {
-    std::string s = line;
-    const auto at = s.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    return s.replace(at, from.size(), to);
-  };
+  auto replaced = [&line](const std::string& from, const std::string& to) { return replaced_in(line, from, to); };
   EXPECT_FALSE(parse_sim_truth_line(replaced("format=2", "format=1")));
   EXPECT_FALSE(parse_sim_truth_line(replaced(" segments=2", " segments=3")));
   EXPECT_FALSE(parse_sim_truth_line(replaced(" segment1_start_s=10", "")));
