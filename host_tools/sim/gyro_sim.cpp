@@ -4,11 +4,29 @@
 
 namespace gyrochar {
 
+namespace {
+
+// The Gauss-Markov and sinusoidal terms' stream: the seed's two halves and a tag, through
+// std::seed_seq, so that it shares no state with the first stream (seeded with the seed itself).
+std::mt19937_64 terms_stream(std::uint64_t seed) {
+  constexpr std::uint32_t tag = 0x6d61726b;  // "mark"
+  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), tag};
+  return std::mt19937_64(seq);
+}
+
+}  // namespace
+
+GyroSimulator::Markov GyroSimulator::Markov::stationary(double sigma, double decay, double one_minus_decay2, double z,
+                                                        double corner_hz) {
+  return {decay, sigma * std::sqrt(one_minus_decay2), sigma * z, corner_hz};
+}
+
 GyroSimulator::GyroSimulator(const GyroParameters& p)
     : p_(p),
       rng_(p.seed),
       arw_step_rad_(p.n_rad_sqrt_s * std::sqrt(p.tau0_s)),
-      rrw_step_rad_s_(p.k_rad_s_sqrt_s * std::sqrt(p.tau0_s)) {
+      rrw_step_rad_s_(p.k_rad_s_sqrt_s * std::sqrt(p.tau0_s)),
+      terms_rng_(terms_stream(p.seed)) {
   if (p.b_rad_s > 0) {
     // Each process: variance sigma^2 = B^2 ln 2 / pi, AR(1) coefficient exp(-2 pi f tau0), the
     // exact sampling of an Ornstein-Uhlenbeck rate with corner f; started in its stationary state.
@@ -18,9 +36,22 @@ GyroSimulator::GyroSimulator(const GyroParameters& p)
     const double lowest_hz = 1.0 / (2.0 * units::pi * p.bias_time_s);
     for (double f = flicker_top_corner / p.tau0_s;; f *= 0.5) {
       const double decay = std::exp(-2.0 * units::pi * f * p.tau0_s);
-      flicker_.push_back({decay, sigma * std::sqrt(1.0 - decay * decay), sigma * normal_(rng_), f});
+      const double z = normal_(rng_);
+      flicker_.push_back(Markov::stationary(sigma, decay, 1.0 - decay * decay, z, f));
       if (f <= lowest_hz) break;
     }
+  }
+  // From the terms' own stream, in this order: each Gauss-Markov term's starting rate, then each
+  // sinusoid's phase.
+  for (const MarkovRate& m : p.markov) {  // 1 - phi^2 from expm1: accurate also when Tc spans many samples
+    const double a = p.tau0_s / m.tc_s, z = terms_normal_(terms_rng_);
+    markov_.push_back(Markov::stationary(m.sigma_rad_s, std::exp(-a), -std::expm1(-2.0 * a), z, 1.0 / (2.0 * units::pi * m.tc_s)));
+  }
+  std::uniform_real_distribution<double> phase(0.0, 2.0 * units::pi);
+  for (const SinusoidRate& s : p.sinusoids) {
+    const double half_cycle = units::pi * s.frequency_hz * p.tau0_s;  // pi f tau0
+    sinusoids_.push_back({s.amplitude_rad_s * std::sin(half_cycle) / half_cycle,
+                          static_cast<long double>(s.frequency_hz) * p.tau0_s, phase(terms_rng_)});
   }
 }
 
@@ -41,16 +72,23 @@ void GyroSimulator::retune(const GyroParameters& p) {
 
 std::int64_t GyroSimulator::next_count() {
   const double dt = p_.tau0_s;
-  const double t_mid = (static_cast<double>(k_) + 0.5) * dt;
-  ++k_;
-  double bias = 0.0;
-  for (Markov& m : flicker_) {
-    m.state = m.decay * m.state + m.drive * normal_(rng_);
-    bias += m.state;
+  const std::uint64_t interval = k_++;  // this interval is (interval tau0, (interval + 1) tau0]
+  const double t_mid = (static_cast<double>(interval) + 0.5) * dt;
+  // Bias instability, then the Gauss-Markov terms (their own stream), then the sinusoids' mean
+  // rate over this interval, (A sin(pi f tau0) / (pi f tau0)) sin(2 pi f t_mid + phi0): the exact
+  // integral of the sinusoid divided by tau0. With no such terms nothing is added.
+  double correlated = 0.0;
+  for (Markov& m : flicker_) correlated += m.step(normal_(rng_));
+  for (Markov& m : markov_) correlated += m.step(terms_normal_(terms_rng_));
+  for (const Sinusoid& s : sinusoids_) {
+    const long double cycles = (static_cast<long double>(interval) + 0.5L) * s.cycles_per_sample;
+    const double fraction = static_cast<double>(cycles - std::floor(cycles));  // the phase modulo a cycle
+    correlated += s.mean_amplitude_rad_s * std::sin(2.0 * units::pi * fraction + s.phase_rad);
   }
   // Rate held over this interval: input + ramp (R t_mid dt is the exact integral of R t) + rate
-  // random walk + bias instability; angle random walk adds white rate noise of density N.
-  const double rate = p_.rate_rad_s + p_.r_rad_s2 * t_mid + rrw_rate_ + bias;
+  // random walk + bias instability + Gauss-Markov + sinusoids; angle random walk adds white rate
+  // noise of density N.
+  const double rate = p_.rate_rad_s + p_.r_rad_s2 * t_mid + rrw_rate_ + correlated;
   angle_ += rate * dt + arw_step_rad_ * normal_(rng_);
   // Rate random walk, integrated exactly: with W a Brownian motion over the interval,
   // W(dt) = sqrt(dt) z1 and integral_0^dt W = dt^1.5 (z1 / 2 + z2 / sqrt(12)) (variances dt and

@@ -108,6 +108,18 @@ per sample, or a dither moves it). Bias instability is flicker rate noise (ADEV 
 over the band from 1/(2 pi --bias-time) up to 0.34 / tau0. docs/metrology.md gives each term's
 model and its Allan deviation.
 
+--markov SIGMA,TC adds a first-order Gauss-Markov (exponentially correlated) rate: SIGMA is the
+STATIONARY standard deviation of the rate in deg/h, TC the correlation time in s. The rate over
+sample k (its mean over the tau0 interval) is y_k = phi y_{k-1} + SIGMA sqrt(1 - phi^2) e_k,
+phi = exp(-tau0/TC), e_k standard normal, y_0 drawn from the stationary N(0, SIGMA^2); the angle
+added over the interval is y_k tau0. The driving noise of the continuous model (IEEE 952 q_c) is
+SIGMA sqrt(2/TC); the ADEV peaks at 0.618 SIGMA near tau = 1.89 TC (TC many tau0).
+--sinusoid AMP,FREQ adds a sinusoidal rate AMP sin(2 pi FREQ t + phi0), AMP in deg/h, FREQ in Hz
+below the Nyquist frequency 1/(2 tau0), phi0 uniform from the seed, integrated exactly over each
+interval (ADEV AMP sin^2(pi FREQ tau)/(pi FREQ tau), at most 0.725 AMP near tau = 0.371/FREQ).
+Both repeat, up to 4 of each, last for the whole run, are listed on the truth line, and draw from
+their own random stream: the other terms' noise is the same with or without them.
+
 --segment T:NAME=VALUE[,NAME=VALUE...] changes the gyro from T seconds on (repeatable, in time
 order): NAME is rate (deg/h), white-angle (arcsec), arw (deg/sqrt(h)) or rrw (deg/h/sqrt(h)); the
 other parameters stay, and nothing restarts (the angle and the noise processes carry over). The
@@ -115,7 +127,9 @@ truth line then has format 2 and lists the segments.
 
 Output: two '#' header lines, then one count per line. The first describes the run; the second,
 "# gyrochar-sim truth: key=value ...", repeats every parameter and the IEEE-952 truth (Q arcsec,
-N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h/h, Q_white yes/no) for programs to read.
+N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h/h, Q_white yes/no) and, when there are some, the
+Gauss-Markov and sinusoidal terms (markov_terms=M markov1_sigma_deg_per_h=... markov1_tc_s=...,
+sinusoid_terms=S sinusoid1_amplitude_deg_per_h=... sinusoid1_frequency_hz=...) for programs to read.
 
 With --can the counts also go out as CounterInput frames (0x0CFF50xx, docs/protocol.md section 8)
 from node --can-node, one per tau0 interval, paced on the monotonic clock at tau0 / --speed; the
@@ -128,6 +142,7 @@ Examples:
   gyrochar-sim --duration 3600 --arw 0.002 | gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1 -
   gyrochar-sim --duration 60 --tau0 0.01 --arw 0.003 --can vcan0 --can-node 128 --speed 4 --out counts.txt
   gyrochar-sim --duration 7200 --arw 0.002 --segment 3600:arw=0.004 > doubling.txt   # N doubles halfway
+  gyrochar-sim --duration 36000 --tau0 0.1 --arw 0.002 --markov 0.05,300 --sinusoid 0.02,0.01 > bumps.txt
 
 )" + std::string(exit_code::help));
   SimOptions o;
@@ -158,9 +173,13 @@ Examples:
                        : "must be an integer 0..2^64-1, not '" + text + "'";
           },
           "SEED"));
-  std::vector<std::string> segments;
+  std::vector<std::string> segments, markov, sinusoids;
   app.add_option("--segment", segments, "from T seconds on, change parameters: T:NAME=VALUE[,NAME=VALUE...]")
       ->option_text("T:NAME=VALUE");
+  app.add_option("--markov", markov, "Gauss-Markov rate: stationary sigma in deg/h, correlation time in s (up to 4)")
+      ->option_text("SIGMA,TC");
+  app.add_option("--sinusoid", sinusoids, "sinusoidal rate: amplitude in deg/h, frequency in Hz below 1/(2 tau0) (up to 4)")
+      ->option_text("AMP,FREQ");
   app.add_option("--out", out, "output file, '-' for standard output")->capture_default_str();
   std::string can_interface;
   unsigned can_node = 0x80;
@@ -181,13 +200,20 @@ Examples:
     print_error(program, what, why);
     return exit_code::bad_input;
   };
-  for (const std::string& text : segments) {
-    std::string why;
-    const auto segment = parse_segment_option(text, why);
-    if (!segment) return bad("--segment", why.c_str());
-    o.segments.push_back(*segment);
-  }
-  if (const auto problem = check_parameters(o)) return bad(problem->what, problem->why);
+  // The repeatable options' arguments, in order; `why` says what is wrong with the first bad one.
+  const auto read_each = [](const std::vector<std::string>& texts, auto parse, auto& list, std::string& why) {
+    for (const std::string& text : texts) {
+      const auto item = parse(text, why);
+      if (!item) return false;
+      list.push_back(*item);
+    }
+    return true;
+  };
+  std::string why;
+  if (!read_each(segments, parse_segment_option, o.segments, why)) return bad("--segment", why.c_str());
+  if (!read_each(markov, parse_markov_option, o.markov, why)) return bad("--markov", why.c_str());
+  if (!read_each(sinusoids, parse_sinusoid_option, o.sinusoids, why)) return bad("--sinusoid", why.c_str());
+  if (const auto problem = check_parameters(o)) return bad(problem->what, problem->why.c_str());
   if (can_node > protocol::max_node_address) return bad("--can-node", "must be an address 0..253");
   if (!(speed > 0) || !std::isfinite(speed)) return bad("--speed", "must be positive");
   if (can_interface.empty() && (app.count("--can-node") || app.count("--speed")))

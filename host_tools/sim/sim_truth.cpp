@@ -63,6 +63,25 @@ constexpr std::array<SegmentKey, 4> segment_keys{{
     {"rrw_deg_per_h_sqrt_h", "rrw", &SimSegment::rrw_deg_per_h_sqrt_h, &SimOptions::rrw_deg_per_h_sqrt_h},
 }};
 
+// A run's Gauss-Markov or sinusoidal terms on the truth line: the count key, then for term i the
+// keys <head><i>_<field> of its two numbers. One table per kind for writer and parser.
+template <class Term>
+struct TermKeys {
+  std::string_view head, count;
+  std::array<std::pair<std::string_view, double Term::*>, 2> fields;
+  std::vector<Term> SimOptions::*list;
+};
+constexpr TermKeys<SimMarkov> markov_keys{
+    "markov",
+    "markov_terms",
+    {{{"sigma_deg_per_h", &SimMarkov::sigma_deg_per_h}, {"tc_s", &SimMarkov::tc_s}}},
+    &SimOptions::markov};
+constexpr TermKeys<SimSinusoid> sinusoid_keys{
+    "sinusoid",
+    "sinusoid_terms",
+    {{{"amplitude_deg_per_h", &SimSinusoid::amplitude_deg_per_h}, {"frequency_hz", &SimSinusoid::frequency_hz}}},
+    &SimOptions::sinusoids};
+
 void append_number(std::string& out, double v) {
   char buf[64];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back exactly
@@ -101,6 +120,23 @@ std::optional<ParameterProblem> check_parameters(const SimOptions& o) {
     if (!(v >= 0) || !std::isfinite(v)) return ParameterProblem{"noise parameters", "must be finite and >= 0"};
   if (o.bias_deg_per_h > 0 && !(o.bias_time_s > o.tau0_s && o.bias_time_s <= 1e15 * o.tau0_s))
     return ParameterProblem{"--bias-time", "must exceed tau0 (and stay within 10^15 tau0) for bias instability"};
+  if (o.markov.size() > max_rate_terms) return ParameterProblem{"--markov", "at most 4 Gauss-Markov terms"};
+  for (const SimMarkov& m : o.markov) {
+    if (!(m.sigma_deg_per_h > 0 && m.sigma_deg_per_h <= 1e9))
+      return ParameterProblem{"--markov", "SIGMA must be positive and at most 10^9 deg/h"};
+    if (!(m.tc_s > 0) || !std::isfinite(m.tc_s)) return ParameterProblem{"--markov", "TC must be positive and finite (s)"};
+  }
+  if (o.sinusoids.size() > max_rate_terms) return ParameterProblem{"--sinusoid", "at most 4 sinusoids"};
+  for (const SimSinusoid& g : o.sinusoids) {
+    if (!(g.amplitude_deg_per_h >= 0 && g.amplitude_deg_per_h <= 1e9))
+      return ParameterProblem{"--sinusoid", "AMP must be between 0 and 10^9 deg/h"};
+    if (!(g.frequency_hz > 0 && 2 * g.frequency_hz * o.tau0_s < 1)) {
+      char why[160];
+      std::snprintf(why, sizeof why, "FREQ must be above 0 and below the Nyquist frequency 1/(2 tau0) = %g Hz",
+                    0.5 / o.tau0_s);
+      return ParameterProblem{"--sinusoid", why};
+    }
+  }
   if (o.segments.size() > max_segments) return ParameterProblem{"--segment", "at most 1000 segments"};
   double previous_s = 0;
   for (std::size_t i = 0; i < o.segments.size(); ++i) {
@@ -139,6 +175,8 @@ GyroParameters gyro_parameters(const SimOptions& o) {
   p.dither_amplitude_rad = o.dither_arcsec * units::arcsec;
   p.dither_frequency_hz = o.dither_hz;
   p.seed = o.seed;
+  for (const SimMarkov& m : o.markov) p.markov.push_back({m.sigma_deg_per_h * units::deg_per_h, m.tc_s});
+  for (const SimSinusoid& g : o.sinusoids) p.sinusoids.push_back({g.amplitude_deg_per_h * units::deg_per_h, g.frequency_hz});
   return p;
 }
 
@@ -148,9 +186,15 @@ bool quantization_expected_white(const SimOptions& o) {
   const double arw_arcsec = o.arw_deg_per_sqrt_h * units::deg_per_sqrt_h / units::arcsec;  // arcsec/sqrt(s)
   const double random_step_arcsec =
       std::sqrt(arw_arcsec * arw_arcsec * o.tau0_s + 2.0 * o.white_angle_arcsec * o.white_angle_arcsec);
-  const double dither_step_arcsec = 2.0 * o.dither_arcsec * std::fabs(std::sin(units::pi * o.dither_hz * o.tau0_s));
+  // A dither of angle amplitude A moves the angle by up to 2 A |sin(pi f tau0)| per sample; so does a
+  // sinusoidal rate, whose angle amplitude is A_rate / (2 pi f) (deg/h = arcsec/s).
+  const auto dither_step_arcsec = [&o](double amplitude_arcsec, double f) {
+    return 2.0 * amplitude_arcsec * std::fabs(std::sin(units::pi * f * o.tau0_s));
+  };
   const double pulse = o.pulse_arcsec * (1 - 1e-12);  // a step of exactly one pulse, up to rounding
-  return random_step_arcsec >= pulse || dither_step_arcsec >= pulse;
+  for (const SimSinusoid& g : o.sinusoids)
+    if (dither_step_arcsec(g.amplitude_deg_per_h / (2.0 * units::pi * g.frequency_hz), g.frequency_hz) >= pulse) return true;
+  return random_step_arcsec >= pulse || dither_step_arcsec(o.dither_arcsec, o.dither_hz) >= pulse;
 }
 
 Ieee952Truth ieee952_truth(const SimOptions& o) {
@@ -162,6 +206,8 @@ Ieee952Truth ieee952_truth(const SimOptions& o) {
   t.k_rad_s_sqrt_s = p.k_rad_s_sqrt_s;
   t.r_rad_s2 = p.r_rad_s2;
   t.quantization_white = quantization_expected_white(o);
+  t.markov = p.markov;
+  t.sinusoids = p.sinusoids;
   return t;
 }
 
@@ -175,6 +221,14 @@ std::string format_sim_description_line(const SimOptions& o) {
                 o.bias_deg_per_h, o.bias_time_s, o.rrw_deg_per_h_sqrt_h, o.ramp_deg_per_h2, o.dither_arcsec,
                 o.dither_hz, static_cast<unsigned long long>(o.seed));
   std::string out = buf;
+  for (const SimMarkov& m : o.markov) {
+    std::snprintf(buf, sizeof buf, ", Gauss-Markov rate %g deg/h over %g s", m.sigma_deg_per_h, m.tc_s);
+    out += buf;
+  }
+  for (const SimSinusoid& g : o.sinusoids) {
+    std::snprintf(buf, sizeof buf, ", sinusoidal rate %g deg/h at %g Hz", g.amplitude_deg_per_h, g.frequency_hz);
+    out += buf;
+  }
   for (const SimSegment& g : o.segments) {
     std::snprintf(buf, sizeof buf, "; from %g s:", g.start_s);
     out += buf;
@@ -186,6 +240,32 @@ std::string format_sim_description_line(const SimOptions& o) {
   }
   return out;
 }
+
+namespace {
+
+// " markov_terms=2 markov1_sigma_deg_per_h=... markov1_tc_s=... markov2_...", nothing without terms.
+template <class Term>
+void append_terms(std::string& out, const SimOptions& o, const TermKeys<Term>& keys) {
+  const std::vector<Term>& list = o.*keys.list;
+  if (list.empty()) return;
+  out += ' ';
+  out += keys.count;
+  out += '=';
+  append_integer(out, list.size());
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    for (const auto& [name, field] : keys.fields) {
+      out += ' ';
+      out += keys.head;
+      append_integer(out, i + 1);
+      out += '_';
+      out += name;
+      out += '=';
+      append_number(out, list[i].*field);
+    }
+  }
+}
+
+}  // namespace
 
 std::string format_sim_truth_line(const SimOptions& o) {
   std::string out(truth_prefix);
@@ -207,6 +287,8 @@ std::string format_sim_truth_line(const SimOptions& o) {
     append_number(out, t.*k.field / k.unit);
   }
   out += t.quantization_white ? " Q_white=yes" : " Q_white=no";
+  append_terms(out, o, markov_keys);
+  append_terms(out, o, sinusoid_keys);
   if (o.segments.empty()) return out;
   out += " segments=";
   append_integer(out, o.segments.size());
@@ -227,9 +309,9 @@ std::string format_sim_truth_line(const SimOptions& o) {
 
 namespace {
 
-// A segment key: "segment<i>_<name>" with i >= 1; i and name, or nothing.
-std::optional<std::pair<std::size_t, std::string_view>> segment_key(std::string_view key) {
-  constexpr std::string_view head = "segment";
+// An indexed key "<head><i>_<name>" (segment1_start_s, markov2_tc_s) with i >= 1; i and name, or
+// nothing.
+std::optional<std::pair<std::size_t, std::string_view>> indexed_key(std::string_view key, std::string_view head) {
   if (!key.starts_with(head)) return std::nullopt;
   key.remove_prefix(head.size());
   std::size_t i = 0;
@@ -238,6 +320,52 @@ std::optional<std::pair<std::size_t, std::string_view>> segment_key(std::string_
     return std::nullopt;
   return std::pair{i, key.substr(static_cast<std::size_t>(r.ptr - key.data()) + 1)};
 }
+
+// What TermReader::read made of a key.
+enum class Read { other, ok, bad };
+
+// Reads one kind of rate term (TermKeys) off the truth line, key by key, into the options' list.
+template <class Term>
+class TermReader {
+ public:
+  TermReader(const TermKeys<Term>& keys, SimOptions& o) : keys_(keys), list_(o.*keys.list) {}
+
+  /// ok: the key was this kind's and is read; bad: it was, and is wrong; other: not this kind's
+  /// (a field name it does not know, from a later format, is also other).
+  Read read(std::string_view key, std::string_view value) {
+    if (key == keys_.count) {
+      if (count_ || !read_integer(value, count_.emplace()) || *count_ == 0 || *count_ > max_rate_terms) return Read::bad;
+      return Read::ok;
+    }
+    const auto indexed = indexed_key(key, keys_.head);
+    if (!indexed) return Read::other;
+    const auto [i, name] = *indexed;
+    for (std::size_t f = 0; f < keys_.fields.size(); ++f) {
+      if (name != keys_.fields[f].first) continue;
+      double v = 0;
+      if (i > max_rate_terms || (seen_[i - 1] >> f & 1u) != 0 || !read_number(value, v)) return Read::bad;
+      if (list_.size() < i) list_.resize(i);
+      list_[i - 1].*keys_.fields[f].second = v;
+      seen_[i - 1] |= 1u << f;
+      return Read::ok;
+    }
+    return Read::other;
+  }
+
+  /// Every term up to the count has both its numbers, and there are no terms without a count.
+  bool complete() const {
+    if (list_.size() != count_.value_or(0)) return false;
+    for (std::size_t i = 0; i < list_.size(); ++i)
+      if (seen_[i] != (1u << keys_.fields.size()) - 1) return false;
+    return true;
+  }
+
+ private:
+  const TermKeys<Term>& keys_;
+  std::vector<Term>& list_;
+  std::optional<std::uint64_t> count_;
+  std::array<unsigned, max_rate_terms> seen_{};  // bit f: field f read
+};
 
 }  // namespace
 
@@ -257,6 +385,8 @@ std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
   };
   std::uint64_t format = 0, segments = 0;
   bool has_segments = false;
+  TermReader markov(markov_keys, r.options);
+  TermReader sinusoids(sinusoid_keys, r.options);
   std::size_t at = 0;
   while (true) {
     while (at < line.size() && is_blank(line[at])) ++at;
@@ -282,7 +412,14 @@ std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
       r.truth.*truth_keys[i].field = v * truth_keys[i].unit;
     }
     if (known) continue;
-    if (const auto segment = segment_key(key)) {  // format 2
+    bool wrong = false;
+    for (const auto got : {markov.read(key, value), sinusoids.read(key, value)}) {
+      known = known || got != Read::other;
+      wrong = wrong || got == Read::bad;
+    }
+    if (wrong) return std::nullopt;
+    if (known) continue;
+    if (const auto segment = indexed_key(key, "segment")) {  // format 2
       const auto [i, name] = *segment;
       if (i > max_segments) return std::nullopt;
       if (r.options.segments.size() < i) r.options.segments.resize(i);
@@ -318,8 +455,11 @@ std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
     // Any other key belongs to a later format: ignored.
   }
   if (seen != all || format != (has_segments ? segmented_format : truth_format) ||
-      r.options.segments.size() != segments || check_parameters(r.options))
+      r.options.segments.size() != segments || !markov.complete() || !sinusoids.complete() || check_parameters(r.options))
     return std::nullopt;
+  const GyroParameters p = gyro_parameters(r.options);  // the terms' truth: as written, in SI
+  r.truth.markov = p.markov;
+  r.truth.sinusoids = p.sinusoids;
   return r;
 }
 
@@ -352,6 +492,33 @@ std::optional<SimSegment> parse_segment_option(std::string_view text, std::strin
     rest = rest.substr(comma + 1);
   }
   return g;
+}
+
+namespace {
+
+// "A,B" with A and B finite numbers; `form` names them for the message ("SIGMA,TC (deg/h, s)").
+std::optional<std::pair<double, double>> parse_pair(std::string_view text, const char* form, std::string& why) {
+  const std::size_t comma = text.find(',');
+  std::pair<double, double> v;
+  if (comma != std::string_view::npos && read_number(text.substr(0, comma), v.first) &&
+      read_number(text.substr(comma + 1), v.second))
+    return v;
+  why = std::string("'").append(text).append("' is not ").append(form);
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<SimMarkov> parse_markov_option(std::string_view text, std::string& why) {
+  const auto v = parse_pair(text, "SIGMA,TC: two numbers, deg/h and s", why);
+  if (!v) return std::nullopt;
+  return SimMarkov{v->first, v->second};
+}
+
+std::optional<SimSinusoid> parse_sinusoid_option(std::string_view text, std::string& why) {
+  const auto v = parse_pair(text, "AMP,FREQ: two numbers, deg/h and Hz", why);
+  if (!v) return std::nullopt;
+  return SimSinusoid{v->first, v->second};
 }
 
 SimRun::SimRun(const SimOptions& o)

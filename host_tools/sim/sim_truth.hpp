@@ -16,6 +16,15 @@
 // it does not know: adding keys keeps format=1; only a change in the meaning of a key raises it,
 // and a reader refuses a format it does not know.
 //
+// Gauss-Markov and sinusoidal rate terms (gyrochar-sim --markov, --sinusoid; IEEE Std 952 Annex C's
+// exponentially correlated and sinusoidal noise) are written only when there are some:
+// `markov_terms=M` followed, for i = 1..M, by markov<i>_sigma_deg_per_h (the stationary standard
+// deviation) and markov<i>_tc_s (the correlation time), and `sinusoid_terms=S` followed by
+// sinusoid<i>_amplitude_deg_per_h and sinusoid<i>_frequency_hz. They are parameters and truth at
+// once (Ieee952Truth carries them in SI); a line without them has none, so older lines read as
+// before. They add keys, so the format stays 1 (2 with segments): a reader that predates them
+// ignores them, as it ignores the dither, and reads the other terms' truth, which stays true.
+//
 // A run with segments (gyrochar-sim --segment: the gyro changes during the run, e.g. its angle
 // random walk doubles halfway) writes format=2: the keys above then describe the run before the
 // first change, and `segments=S` is followed, for i = 1..S, by segment<i>_start_s and the keys of
@@ -45,6 +54,24 @@ struct SimSegment {
   bool operator==(const SimSegment&) const = default;
 };
 
+/// A Gauss-Markov rate term (gyrochar-sim --markov SIGMA,TC): stationary standard deviation of the
+/// rate in deg/h, correlation time in s (gyro_sim.hpp states the convention).
+struct SimMarkov {
+  double sigma_deg_per_h = 0;
+  double tc_s = 0;
+  bool operator==(const SimMarkov&) const = default;
+};
+
+/// A sinusoidal rate term (gyrochar-sim --sinusoid AMP,FREQ): amplitude in deg/h, frequency in Hz.
+struct SimSinusoid {
+  double amplitude_deg_per_h = 0;
+  double frequency_hz = 0;
+  bool operator==(const SimSinusoid&) const = default;
+};
+
+/// At most this many Gauss-Markov terms, and as many sinusoids, in a run.
+inline constexpr std::size_t max_rate_terms = 4;
+
 /// gyrochar-sim's simulation options, in the units of its command line (defaults included).
 struct SimOptions {
   double duration_s = 3600;
@@ -61,6 +88,8 @@ struct SimOptions {
   double dither_hz = 0;
   std::uint64_t seed = 1;
   std::vector<SimSegment> segments;  // in increasing start_s; empty: the gyro never changes
+  std::vector<SimMarkov> markov;      // Gauss-Markov rate terms, for the whole run
+  std::vector<SimSinusoid> sinusoids; // sinusoidal rate terms, for the whole run
 };
 
 /// The options in force in segment i of `o` (0: before the first change, up to o.segments.size()),
@@ -75,6 +104,8 @@ struct Ieee952Truth {
   double k_rad_s_sqrt_s = 0;   // rate random walk
   double r_rad_s2 = 0;         // rate ramp
   bool quantization_white = false;  // the pulse quantization is expected to be white (below)
+  std::vector<MarkovRate> markov;         // Gauss-Markov rate terms (sigma rad/s, tc s)
+  std::vector<SinusoidRate> sinusoids;    // sinusoidal rate terms (amplitude rad/s, frequency Hz)
 };
 
 struct SimTruth {
@@ -82,18 +113,21 @@ struct SimTruth {
   Ieee952Truth truth;  // as written, converted to SI
 };
 
-/// A parameter gyrochar-sim refuses: `what` names the option ("--tau0"), `why` says why. Static
-/// strings.
+/// A parameter gyrochar-sim refuses: `what` names the option ("--tau0", a static string), `why`
+/// says why, with the limit.
 struct ParameterProblem {
   const char* what = "";
-  const char* why = "";
+  std::string why;
 };
 
 /// The first problem with `o`, or nothing: tau0 > 0; duration >= tau0 and at most 10^12 samples;
 /// a finite rate within 10^9 deg/h; pulse weight > 0; noise levels, dither and its frequency
 /// finite and >= 0; with bias instability, tau0 < bias_time <= 10^15 tau0; segments starting in
 /// increasing order inside the run (tau0 <= start < duration), each changing something, each
-/// segment's options as valid. O(segments).
+/// segment's options as valid; at most max_rate_terms Gauss-Markov terms, each with
+/// 0 < sigma <= 10^9 deg/h and 0 < Tc finite, and at most max_rate_terms sinusoids, each with
+/// 0 <= amplitude <= 10^9 deg/h and 0 < frequency < 1 / (2 tau0) (the Nyquist frequency).
+/// O(segments + terms). Allocates the message.
 std::optional<ParameterProblem> check_parameters(const SimOptions& o);
 
 /// The simulator's parameters (SI) for `o`. O(1).
@@ -103,13 +137,16 @@ GyroParameters gyro_parameters(const SimOptions& o);
 /// instants moves at random by at least one pulse between samples, sqrt(N^2 tau0 + 2 q^2) >= pulse
 /// (the correlation of two quantization errors is then below 0.61 exp(-2 pi^2) = 2e-9), or when
 /// the dither moves it by at least a pulse per sample, 2 A |sin(pi f tau0)| >= pulse (a
-/// deterministic whitening: docs/metrology.md gives the residual departures); in every segment.
-/// O(segments).
+/// deterministic whitening: docs/metrology.md gives the residual departures), or when a sinusoidal
+/// rate term does, as a dither of angle amplitude A / (2 pi f) would; in every segment. The
+/// Gauss-Markov terms, like the rate random walk and the bias instability, are not counted.
+/// O(segments + terms).
 bool quantization_expected_white(const SimOptions& o);
 
 /// The IEEE-952 truth of `o`: Q = sqrt(q^2 + pulse^2 / 12), N, B, K, R, in SI, before the first
-/// segment (segment_options() gives each segment's). The dither is not an IEEE-952 term (its AVAR,
-/// 4 A^2 sin^4(pi f tau) / tau^2, is not in the truth). O(segments).
+/// segment (segment_options() gives each segment's), and the Gauss-Markov and sinusoidal terms in
+/// SI. The dither is not an IEEE-952 term (its AVAR, 4 A^2 sin^4(pi f tau) / tau^2, is not in the
+/// truth). O(segments + terms); allocates the terms' lists.
 Ieee952Truth ieee952_truth(const SimOptions& o);
 
 /// The human-readable first header line ("# gyrochar-sim counts: tau0 0.01 s, ..."), no newline.
@@ -119,7 +156,8 @@ std::string format_sim_truth_line(const SimOptions& o);
 
 /// Reads a truth line (trailing blanks, '\r' or '\n' allowed). Nothing when the line is not one:
 /// wrong prefix, a token without '=', a repeated key, a value that is not a complete number of its
-/// kind (or not finite), a missing key, format other than 1 (2 with segments), or parameters
+/// kind (or not finite), a missing key, format other than 1 (2 with segments), a Gauss-Markov or
+/// sinusoid key without its count or beyond it, a term missing one of its two keys, or parameters
 /// check_parameters refuses. O(line length); allocates nothing beyond the result.
 std::optional<SimTruth> parse_sim_truth_line(std::string_view line);
 
@@ -127,6 +165,13 @@ std::optional<SimTruth> parse_sim_truth_line(std::string_view line);
 /// rate (deg/h), white-angle (arcsec), arw (deg/sqrt(h)), rrw (deg/h/sqrt(h)). Nothing, with `why`,
 /// when it is not one. O(text length).
 std::optional<SimSegment> parse_segment_option(std::string_view text, std::string& why);
+
+/// Reads one --markov argument, "SIGMA,TC" (deg/h, s). Nothing, with `why`, when it is not two
+/// finite numbers; their ranges are check_parameters' business. O(text length).
+std::optional<SimMarkov> parse_markov_option(std::string_view text, std::string& why);
+
+/// Reads one --sinusoid argument, "AMP,FREQ" (deg/h, Hz), as parse_markov_option does.
+std::optional<SimSinusoid> parse_sinusoid_option(std::string_view text, std::string& why);
 
 /// A simulated run as gyrochar-sim makes it: the simulator with the options' segments applied at
 /// their samples. Reproducible from the options alone.

@@ -1,7 +1,8 @@
 // gyrochar-sim's truth line: what the writer formats, the parser reads back (every parameter
 // exactly, the IEEE-952 truth to the last bits of its unit conversion), what it refuses, and what
 // the program itself writes. Oracles: the options given (round trip), the closed-form truth
-// Q = sqrt(q^2 + pulse^2 / 12) in arcsec and the identity of N, B, K, R in the fit's units.
+// Q = sqrt(q^2 + pulse^2 / 12) in arcsec, the identity of N, B, K, R in the fit's units and of the
+// Gauss-Markov and sinusoidal terms in SI (deg/h times units::deg_per_h).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -34,6 +35,15 @@ void expect_same_options(const SimOptions& a, const SimOptions& b) {
   EXPECT_EQ(a.dither_hz, b.dither_hz);
   EXPECT_EQ(a.seed, b.seed);
   EXPECT_EQ(a.segments, b.segments);
+  EXPECT_EQ(a.markov, b.markov);
+  EXPECT_EQ(a.sinusoids, b.sinusoids);
+}
+
+// `line` with its first `from` replaced by `to` (a failure when there is none).
+std::string replaced_in(std::string line, const std::string& from, const std::string& to) {
+  const auto at = line.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? line : line.replace(at, from.size(), to);
 }
 
 SimOptions awkward() {
@@ -54,8 +64,16 @@ SimOptions awkward() {
   return o;
 }
 
+// awkward() with two Gauss-Markov terms and two sinusoids (tau0 0.1 s: below 5 Hz).
+SimOptions with_rate_terms() {
+  SimOptions o = awkward();
+  o.markov = {{0.05, 300}, {1.0 / 3, 0.07}};
+  o.sinusoids = {{0.02, 0.01}, {2e-3, 4.999}};
+  return o;
+}
+
 TEST(SimHeader, RoundTripKeepsEveryParameterExactly) {
-  for (const SimOptions& o : {SimOptions{}, awkward()}) {
+  for (const SimOptions& o : {SimOptions{}, awkward(), with_rate_terms()}) {
     const std::string line = format_sim_truth_line(o);
     ASSERT_EQ(line.rfind("# gyrochar-sim truth: format=1 ", 0), 0u) << line;
     const auto t = parse_sim_truth_line(line);
@@ -68,8 +86,96 @@ TEST(SimHeader, RoundTripKeepsEveryParameterExactly) {
     EXPECT_NEAR(t->truth.k_rad_s_sqrt_s, want.k_rad_s_sqrt_s, 1e-15 * want.k_rad_s_sqrt_s);
     EXPECT_NEAR(t->truth.r_rad_s2, want.r_rad_s2, 1e-15 * want.r_rad_s2);
     EXPECT_EQ(t->truth.quantization_white, want.quantization_white);
+    EXPECT_EQ(t->truth.markov, want.markov);
+    EXPECT_EQ(t->truth.sinusoids, want.sinusoids);
     EXPECT_TRUE(parse_sim_truth_line(line + "\r\n"));
   }
+}
+
+TEST(SimHeader, RateTermsAreListedOnlyWhenThereAreSome) {
+  // Without terms the line is what it always was (no key added), and it reads back without terms.
+  const std::string plain = format_sim_truth_line(awkward());
+  EXPECT_EQ(plain.find("markov"), std::string::npos);
+  EXPECT_EQ(plain.find("sinusoid"), std::string::npos);
+  const auto old = parse_sim_truth_line(plain);
+  ASSERT_TRUE(old);
+  EXPECT_TRUE(old->options.markov.empty() && old->truth.markov.empty());
+  EXPECT_TRUE(old->options.sinusoids.empty() && old->truth.sinusoids.empty());
+  // With terms: counts and indexed keys in the options' units, the truth in SI.
+  const SimOptions o = with_rate_terms();
+  const std::string line = format_sim_truth_line(o);
+  EXPECT_NE(line.find(" Q_white=yes markov_terms=2 markov1_sigma_deg_per_h=0.05 markov1_tc_s=300"
+                      " markov2_sigma_deg_per_h=0.3333333333333333 markov2_tc_s=0.07 sinusoid_terms=2"
+                      " sinusoid1_amplitude_deg_per_h=0.02 sinusoid1_frequency_hz=0.01"
+                      " sinusoid2_amplitude_deg_per_h=0.002 sinusoid2_frequency_hz=4.999"),
+            std::string::npos)
+      << line;
+  const Ieee952Truth t = ieee952_truth(o);
+  ASSERT_EQ(t.markov.size(), 2u);
+  EXPECT_DOUBLE_EQ(t.markov[0].sigma_rad_s, 0.05 * units::deg_per_h);
+  EXPECT_EQ(t.markov[0].tc_s, 300);
+  ASSERT_EQ(t.sinusoids.size(), 2u);
+  EXPECT_DOUBLE_EQ(t.sinusoids[1].amplitude_rad_s, 2e-3 * units::deg_per_h);
+  EXPECT_EQ(t.sinusoids[1].frequency_hz, 4.999);
+  // What a reader refuses: a term without its count, a count without its terms, an index beyond
+  // the count or beyond 4, a term missing a number, a number twice, terms check_parameters refuses.
+  auto replaced = [&line](const std::string& from, const std::string& to) { return replaced_in(line, from, to); };
+  EXPECT_FALSE(parse_sim_truth_line(replaced(" markov_terms=2", "")));
+  EXPECT_FALSE(parse_sim_truth_line(plain + " markov_terms=1"));
+  EXPECT_FALSE(parse_sim_truth_line(plain + " sinusoid1_amplitude_deg_per_h=1 sinusoid1_frequency_hz=1"));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("markov_terms=2", "markov_terms=1")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("markov_terms=2", "markov_terms=3")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("markov_terms=2", "markov_terms=0")));
+  EXPECT_FALSE(parse_sim_truth_line(line + " markov_terms=2"));
+  EXPECT_FALSE(parse_sim_truth_line(replaced(" markov2_tc_s=0.07", "")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced(" sinusoid1_frequency_hz=0.01", "")));
+  EXPECT_FALSE(parse_sim_truth_line(line + " markov1_tc_s=300"));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("markov_terms=2", "markov_terms=5") +
+                                    " markov3_sigma_deg_per_h=1 markov3_tc_s=1 markov4_sigma_deg_per_h=1 markov4_tc_s=1"
+                                    " markov5_sigma_deg_per_h=1 markov5_tc_s=1"));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("markov1_tc_s=300", "markov1_tc_s=0")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("markov1_tc_s=300", "markov1_tc_s=x")));
+  EXPECT_FALSE(parse_sim_truth_line(replaced("sinusoid2_frequency_hz=4.999", "sinusoid2_frequency_hz=5")));  // Nyquist
+  // A field of a later format is ignored, as any unknown key.
+  const auto later = parse_sim_truth_line(line + " markov1_phase_rad=1");
+  ASSERT_TRUE(later);
+  EXPECT_EQ(later->options.markov, o.markov);
+}
+
+TEST(SimHeader, RateTermOptionsAndTheirLimits) {
+  std::string why;
+  const auto m = parse_markov_option("0.05,300", why);
+  ASSERT_TRUE(m) << why;
+  EXPECT_EQ(*m, (SimMarkov{0.05, 300}));
+  const auto g = parse_sinusoid_option("2e-3,4.999", why);
+  ASSERT_TRUE(g) << why;
+  EXPECT_EQ(*g, (SimSinusoid{2e-3, 4.999}));
+  for (const char* bad : {"", "1", "1,", ",1", "1,2,3", "1;2", "x,1", "1,nan", "inf,1", "1 ,2"}) {
+    why.clear();
+    EXPECT_FALSE(parse_markov_option(bad, why)) << bad;
+    EXPECT_NE(why.find("SIGMA,TC"), std::string::npos) << why;
+    EXPECT_FALSE(parse_sinusoid_option(bad, why)) << bad;
+  }
+  // check_parameters: each limit, naming the option (tau0 0.01 s: the Nyquist frequency is 50 Hz).
+  const auto problem = [](auto change) {
+    SimOptions o;
+    change(o);
+    const auto p = check_parameters(o);
+    return p ? std::string(p->what) + ": " + p->why : std::string();
+  };
+  EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{1, 10}, {1, 10}, {1, 10}, {1, 10}}; }), "");
+  EXPECT_EQ(problem([](SimOptions& o) { o.markov.assign(5, {1, 10}); }), "--markov: at most 4 Gauss-Markov terms");
+  EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{0, 10}}; }), "--markov: SIGMA must be positive and at most 10^9 deg/h");
+  EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{2e9, 10}}; }), "--markov: SIGMA must be positive and at most 10^9 deg/h");
+  EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{1, 0}}; }), "--markov: TC must be positive and finite (s)");
+  EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{1, -1}}; }), "--markov: TC must be positive and finite (s)");
+  EXPECT_EQ(problem([](SimOptions& o) { o.sinusoids = {{0, 49.99}}; }), "");
+  EXPECT_EQ(problem([](SimOptions& o) { o.sinusoids.assign(5, {1, 1}); }), "--sinusoid: at most 4 sinusoids");
+  EXPECT_EQ(problem([](SimOptions& o) { o.sinusoids = {{-1, 1}}; }), "--sinusoid: AMP must be between 0 and 10^9 deg/h");
+  for (double f : {0.0, -1.0, 50.0, 1e300})
+    EXPECT_EQ(problem([f](SimOptions& o) { o.sinusoids = {{1, f}}; }),
+              "--sinusoid: FREQ must be above 0 and below the Nyquist frequency 1/(2 tau0) = 50 Hz")
+        << f;
 }
 
 TEST(SimHeader, TruthIsTheIeee952Model) {
@@ -107,16 +213,20 @@ TEST(SimHeader, QuantizationWhitenessFlag) {
   EXPECT_FALSE(quantization_expected_white(o));
   o.dither_hz = 100.3;  // 0.003 cycle per sample: 0.09 pulse per sample
   EXPECT_FALSE(quantization_expected_white(o));
+  // A sinusoidal rate moves the angle as a dither of angle amplitude A / (2 pi f) would.
+  o = SimOptions{};
+  o.sinusoids = {{2 * units::pi * 37.3 * 5, 37.3}};  // 5 arcsec at 0.373 cycle per sample: 9 pulses
+  EXPECT_TRUE(quantization_expected_white(o));
+  o.sinusoids = {{1, 0.01}};  // 16 arcsec at 1e-4 cycle per sample: 0.01 pulse per sample
+  EXPECT_FALSE(quantization_expected_white(o));
+  o.sinusoids = {};
+  o.markov = {{1e6, 10}};  // a Gauss-Markov rate, however large, is not counted (as RRW and B are not)
+  EXPECT_FALSE(quantization_expected_white(o));
 }
 
 TEST(SimHeader, RefusesWhatIsNotATruthLine) {
   const std::string good = format_sim_truth_line(SimOptions{});
-  auto replaced = [&good](const std::string& from, const std::string& to) {
-    std::string s = good;
-    const auto at = s.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    return s.replace(at, from.size(), to);
-  };
+  auto replaced = [&good](const std::string& from, const std::string& to) { return replaced_in(good, from, to); };
   EXPECT_FALSE(parse_sim_truth_line(""));
   EXPECT_FALSE(parse_sim_truth_line("# gyrochar-sim counts: tau0 0.01 s"));
   EXPECT_FALSE(parse_sim_truth_line(good.substr(1)));                          // no '#'
@@ -145,7 +255,8 @@ TEST(SimHeader, TheProgramWritesTheTruthLine) {
   const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_sim_header.txt";
   const std::string command = GYROCHAR_BINARY_DIR
       "/host_tools/gyrochar-sim --duration 2 --tau0 0.1 --pulse-weight 0.5 --rate -3 --white-angle 0.25 --arw 0.005 "
-      "--rrw 0.15 --bias-instability 0.05 --bias-time 2000 --ramp 0.01 --dither 7 --dither-hz 437.3 --seed 99 --out " +
+      "--rrw 0.15 --bias-instability 0.05 --bias-time 2000 --ramp 0.01 --dither 7 --dither-hz 437.3 --seed 99 "
+      "--markov 0.05,300 --sinusoid 0.02,0.01 --markov 1,0.3 --out " +
       out;
   ASSERT_EQ(std::system(command.c_str()), 0);
   std::ifstream in(out);
@@ -172,7 +283,13 @@ TEST(SimHeader, TheProgramWritesTheTruthLine) {
   want.dither_arcsec = 7;
   want.dither_hz = 437.3;
   want.seed = 99;
+  want.markov = {{0.05, 300}, {1, 0.3}};  // in the order given
+  want.sinusoids = {{0.02, 0.01}};
   expect_same_options(t->options, want);
+  EXPECT_NE(first.find(", seed 99, Gauss-Markov rate 0.05 deg/h over 300 s, Gauss-Markov rate 1 deg/h over 0.3 s, "
+                       "sinusoidal rate 0.02 deg/h at 0.01 Hz"),
+            std::string::npos)
+      << first;
   EXPECT_EQ(second, format_sim_truth_line(want));
   EXPECT_EQ(values, 20);
 }
@@ -204,12 +321,7 @@ TEST(SimSegments, TheTruthLineSaysFormatTwoAndCarriesEverySegmentExactly) {
   EXPECT_EQ(segment_options(o, 2).rate_deg_per_h, -20.0);
   EXPECT_TRUE(segment_options(o, 2).segments.empty());
   // A format-1 line never has segment keys; a format-2 line needs them all.
-  auto replaced = [&line](const std::string& from, const std::string& to) {
-    std::string s = line;
-    const auto at = s.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    return s.replace(at, from.size(), to);
-  };
+  auto replaced = [&line](const std::string& from, const std::string& to) { return replaced_in(line, from, to); };
   EXPECT_FALSE(parse_sim_truth_line(replaced("format=2", "format=1")));
   EXPECT_FALSE(parse_sim_truth_line(replaced(" segments=2", " segments=3")));
   EXPECT_FALSE(parse_sim_truth_line(replaced(" segment1_start_s=10", "")));
@@ -292,6 +404,27 @@ TEST(SimSegments, ARunChangesAtItsSegmentAndNowhereElse) {
     if (k < 1000) {
       ASSERT_EQ(c, u) << k;
     }
+  }
+}
+
+TEST(SimSegments, RateTermsLastTheWholeRun) {
+  // Oracle: the simulator retuned by hand (as above): the Gauss-Markov and sinusoidal terms carry
+  // over every change, on the format-2 line and in the run.
+  SimOptions o = doubling();
+  o.markov = {{2, 0.5}};
+  o.sinusoids = {{3, 0.7}};
+  const std::string line = format_sim_truth_line(o);
+  const auto t = parse_sim_truth_line(line);
+  ASSERT_TRUE(t) << line;
+  expect_same_options(t->options, o);
+  EXPECT_EQ(segment_options(o, 2).markov, o.markov);
+  EXPECT_EQ(segment_options(o, 2).sinusoids, o.sinusoids);
+  SimRun run(o);
+  GyroSimulator by_hand(gyro_parameters(o));
+  for (std::uint64_t k = 0; k < run.samples(); ++k) {
+    if (k == 1000) by_hand.retune(gyro_parameters(segment_options(o, 1)));
+    if (k == 1500) by_hand.retune(gyro_parameters(segment_options(o, 2)));
+    ASSERT_EQ(run.next_count(), by_hand.next_count()) << k;
   }
 }
 

@@ -64,6 +64,14 @@ TEST(ToolErrors, SimulatorNamesWhatIsWrong) {
   expect("gyrochar-sim", "--arw inf --duration 1", bad, "noise parameters:");
   expect("gyrochar-sim", "--bias-instability 0.05 --bias-time 0.001 --duration 1", bad, "--bias-time:");
   expect("gyrochar-sim", "--duration 1 --speed 2", bad, "--can-node, --speed:");
+  expect("gyrochar-sim", "--duration 1 --markov 0.1", bad, "--markov: '0.1' is not SIGMA,TC");
+  expect("gyrochar-sim", "--duration 1 --markov 0.1,0", bad, "--markov: TC must be positive");
+  expect("gyrochar-sim", "--duration 1 --markov 1,1 --markov 1,1 --markov 1,1 --markov 1,1 --markov 1,1", bad,
+         "--markov: at most 4");
+  expect("gyrochar-sim", "--duration 1 --sinusoid 1,50", bad,
+         "--sinusoid: FREQ must be above 0 and below the Nyquist frequency 1/(2 tau0) = 50 Hz");
+  expect("gyrochar-sim", "--duration 1 --tau0 0.1 --sinusoid 1,5", bad, "--sinusoid: FREQ must be above 0 and below "
+         "the Nyquist frequency 1/(2 tau0) = 5 Hz");
   expect("gyrochar-sim", "--duration 1 --seed -1", bad, "options: --seed: must be an integer 0..2^64-1");
   expect("gyrochar-sim", "--duration 1 --seed 18446744073709551616", bad, "options: --seed: must be an integer 0..2^64-1");
   expect("gyrochar-sim", "--duration 1 --out /nonexistent-dir/counts.txt", exit_code::output_failed,
