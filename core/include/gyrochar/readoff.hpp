@@ -27,13 +27,13 @@
 // Intervals. A value's interval is the chosen point's own confidence interval (from that point's
 // EDF, as the caller formed it), scaled by the same factor as the value: sqrt(tau) for N,
 // 1/0.664 for B, sqrt(3/tau) for K. It is the sampling uncertainty of that one point; it knows
-// nothing of the choice of the point (the minimum over several noisy points is biased low by a
-// fraction of an interval) nor of the terms mixed in at that tau.
+// nothing of the choice of the point (the minimum over several scattered points is biased low, most
+// where they scatter most: the longest taus) nor of the terms mixed in at that tau.
 //
 // What the read-off is NOT: a separation of the terms. Every point holds all of them. The floor
 // includes the N and K contributions (and any hump's) at its tau: N and K alone already make a
-// floor, the minimum over tau of N^2/tau + K^2 tau/3 being 2 N K / sqrt(3), so B read off is an
-// upper bound of the flicker term. N and K are read where their line is only nearly tangent, so
+// floor, the minimum over tau of N^2/tau + K^2 tau/3 being 2 N K / sqrt(3), so B read off is, but
+// for the floor's own sampling error, an upper bound of the flicker term. N and K are read where their line is only nearly tangent, so
 // they too carry the other terms (upper bounds as far as the curve lies above the line), except
 // where a filter or a correlated term bends the curve below the line (then lower). The IEEE-952
 // fit (ieee952.hpp) separates the terms; where it disagrees with the read-off, one of the two
