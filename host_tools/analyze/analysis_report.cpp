@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iterator>
+#include <limits>
 #include <numbers>
 
 #include "gyrochar/greenhall_edf.hpp"
@@ -222,6 +223,113 @@ std::array<double, 5> truth_values(const Ieee952Truth& t) {
 
 }  // namespace
 
+std::optional<Readoff> readoff_of(const Analysis& a, const ReportUnits& units) {
+  if (!units.gyro) return std::nullopt;
+  constexpr double none = std::numeric_limits<double>::quiet_NaN();
+  const double k = units.phase_unit_si;  // engine deviations -> rad/s
+  std::vector<AdevPoint> points;
+  for (const AnalysisRow& r : a.rows)
+    if (r.stat == DevStat::oadev)
+      points.push_back({r.tau_s, r.dev * k, r.ci.valid ? r.ci.low * k : none, r.ci.valid ? r.ci.high * k : none});
+  if (points.empty()) return std::nullopt;
+  return read_off(points);
+}
+
+std::optional<bool> readoff_agrees(const ReadoffValue& v, const Ieee952Fit* fit, std::size_t term) {
+  if (fit == nullptr || !fit->ok() || !v.valid || term >= fit->p.size() || !fit->p[term].fitted) return std::nullopt;
+  const double half_width = (v.ci_high - v.ci_low) / 2;
+  if (!std::isfinite(half_width)) return std::nullopt;
+  const Ieee952Parameter& p = fit->p[term];
+  return std::fabs(v.value - p.value) <= std::hypot(p.uncertainty, half_width);
+}
+
+namespace {
+
+// The recommended fit (both curves), or nullptr when none was made.
+const Ieee952Fit* recommended_fit(const Report& r) {
+  const auto both = std::find_if(r.fits.begin(), r.fits.end(), [](const CurveFit& f) { return f.curve == FitCurve::both; });
+  return both == r.fits.end() ? nullptr : &both->fit;
+}
+
+// The read-off values that are IEEE-952 terms: the fit's term index (Q N B K R), the member.
+struct ReadoffTerm {
+  std::size_t term;
+  const ReadoffValue Readoff::*value;
+  const char* above;  // why a read-off above the fit need not be an error
+  const char* below;  // and one below it
+};
+constexpr std::array<ReadoffTerm, 3> readoff_terms{{
+    {1, &Readoff::n, "the read-off N carries the other terms at its tau",
+     "a filter or correlated noise bends the curve below the line, or the read-off took the lowest of scattered points"},
+    {2, &Readoff::b, "the read-off B is an upper bound when other terms add at the floor (N, K, correlated noise)",
+     "the read-off B is an upper bound when other terms add at the floor, but the floor is the lowest of scattered "
+     "points, which biases it low"},
+    {3, &Readoff::k, "the read-off K carries the other terms at its tau",
+     "the read-off takes the lowest of scattered points, which biases it low"},
+}};
+
+// "2.313 [2.31, 2.316] deg/sqrt(h)": a value and its interval in a unit of `si` SI units.
+std::string readoff_text(const ReadoffValue& v, double si, const char* unit) {
+  const bool ci = std::isfinite(v.ci_low) && std::isfinite(v.ci_high);
+  return fmt::format("{:.4g}{} {}", v.value / si, ci ? fmt::format(" [{:.4g}, {:.4g}]", v.ci_low / si, v.ci_high / si)
+                                                     : std::string(" (no interval)"), unit);
+}
+
+void format_readoff(std::string& out, const Report& r) {
+  const Readoff& ro = *r.readoff;
+  const FitUnit* fu = fit_units(r.units);
+  const RateUnit& rate = r.units.rate;
+  const std::string n = ro.n.valid ? fmt::format("N = {} at tau {:.4g} s", readoff_text(ro.n, fu[1].si, fu[1].name), ro.n.tau_s)
+                                   : "N not read (no point up to the floor follows slope -1/2)";
+  const std::string floor =
+      fmt::format("bias floor {} at tau {:.4g} s{}, B = floor/0.664 = {}", readoff_text(ro.floor, rate.rad_per_s, rate.name),
+                  ro.floor.tau_s, ro.floor_at_end ? " (an end of the curve: it has not turned there)" : "",
+                  readoff_text(ro.b, fu[2].si, fu[2].name));
+  const std::string k = ro.k.valid ? fmt::format("K = {} at tau {:.4g} s", readoff_text(ro.k, fu[3].si, fu[3].name), ro.k.tau_s)
+                                   : "K not read (the curve never rises at slope +1/2 after its floor)";
+  fmt::format_to(std::back_inserter(out), "# read-off (IEEE-952 graphical, data-sheet style): {}; {}; {}\n", n, floor, k);
+  const Ieee952Fit* fit = recommended_fit(r);
+  for (const ReadoffTerm& t : readoff_terms) {
+    const std::optional<bool> agrees = readoff_agrees(ro.*t.value, fit, t.term);
+    if (!agrees || *agrees) continue;
+    const Ieee952Parameter& p = fit->p[t.term];
+    const ReadoffValue& v = ro.*t.value;
+    const double si = fu[t.term].si;
+    fmt::format_to(std::back_inserter(out),
+                   "#   read-off {} disagrees with the recommended fit's {:.4g} +- {:.2g} {}: they differ by {:.3g}, more "
+                   "than their combined uncertainty {:.3g} (the fit's standard uncertainty and the read-off's half "
+                   "interval in quadrature); {}\n",
+                   fu[t.term].letter, p.value / si, p.uncertainty / si, fu[t.term].name, std::fabs(v.value - p.value) / si,
+                   std::hypot(p.uncertainty, (v.ci_high - v.ci_low) / 2) / si, v.value > p.value ? t.above : t.below);
+  }
+}
+
+nlohmann::json readoff_json(const Report& r) {
+  using nlohmann::json;
+  const Readoff& ro = *r.readoff;
+  const FitUnit* fu = fit_units(r.units);
+  const auto entry = [](const ReadoffValue& v, double si, const char* unit) {
+    const auto number = [&](double x) { return v.valid && std::isfinite(x) ? json(x / si) : json(nullptr); };
+    return json{{"value", number(v.value)}, {"ci_low", number(v.ci_low)}, {"ci_high", number(v.ci_high)},
+                {"tau", v.valid ? json(v.tau_s) : json(nullptr)}, {"unit", unit}};
+  };
+  json j = {{"method", "IEEE-952 graphical read-off of the OADEV curve (data-sheet style)"},
+            {"slope_band", ReadoffOptions{}.slope_band}};
+  const Ieee952Fit* fit = recommended_fit(r);
+  for (const ReadoffTerm& t : readoff_terms) {
+    json e = entry(ro.*t.value, fu[t.term].si, fu[t.term].name);
+    const std::optional<bool> agrees = readoff_agrees(ro.*t.value, fit, t.term);
+    e["agrees_with_fit"] = agrees ? json(*agrees) : json(nullptr);
+    j[fu[t.term].letter] = std::move(e);
+  }
+  json floor = entry(ro.floor, r.units.rate.rad_per_s, r.units.rate.name);
+  floor["at_end"] = ro.floor_at_end;
+  j["floor"] = std::move(floor);
+  return j;
+}
+
+}  // namespace
+
 std::string format_table(const Report& r) {
   const Analysis& a = r.analysis;
   const ReportUnits& u = r.units;
@@ -292,6 +400,7 @@ std::string format_table(const Report& r) {
                      sn.amplitude.resolved ? "" : "  (not resolved)");
     }
   }
+  if (r.readoff) format_readoff(out, r);
   return out;
 }
 
@@ -429,6 +538,7 @@ nlohmann::json to_json(const Report& r) {
     }
     j["simulated"] = std::move(truth);
   }
+  if (r.readoff) j["readoff"] = readoff_json(r);
   return j;
 }
 
@@ -496,17 +606,17 @@ std::optional<std::string> kalibr_yaml(const Report& r, std::string& why) {
     why = "needs gyro data: counts, or --unit with an angle or a rate";
     return std::nullopt;
   }
-  const auto both = std::find_if(r.fits.begin(), r.fits.end(), [](const CurveFit& f) { return f.curve == FitCurve::both; });
-  if (both == r.fits.end()) {
+  const Ieee952Fit* both = recommended_fit(r);
+  if (both == nullptr) {
     why = "needs the IEEE-952 fit (--fit ieee952)";
     return std::nullopt;
   }
-  if (!both->fit.ok()) {
-    why = fmt::format("the IEEE-952 fit of both curves is {}: no noise parameters to give", name(both->fit.status));
+  if (!both->ok()) {
+    why = fmt::format("the IEEE-952 fit of both curves is {}: no noise parameters to give", name(both->status));
     return std::nullopt;
   }
   const auto term = [&](std::size_t k) {
-    const Ieee952Parameter& p = both->fit.p[k];
+    const Ieee952Parameter& p = both->p[k];
     return KalibrTerm{p.value, p.value > 0 ? p.uncertainty / p.value : 0.0, p.fitted, p.resolved};
   };
   return kalibr_imu_yaml(term(1), term(3), 1.0 / r.tau0_s, fmt::format("{} ({})", r.source, r.units.input), why);

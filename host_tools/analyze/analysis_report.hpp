@@ -19,6 +19,7 @@
 
 #include "analysis.hpp"
 #include "gyrochar/ieee952.hpp"
+#include "gyrochar/readoff.hpp"
 #include "sim_truth.hpp"
 #include "kalibr.hpp"
 #include "units.hpp"
@@ -65,6 +66,12 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
 std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s,
                                  LongTau long_tau = LongTau::oadev, const PhaseRecord& record = {});
 
+/// The IEEE-952 graphical read-off (readoff.hpp: N on the -1/2 line at 1 s, the ADEV floor and
+/// B = floor / 0.664, K on the +1/2 line at 3 s) of every OADEV row of the analysis (not only the
+/// octaves), in SI: N rad/s^0.5, floor and B rad/s, K rad/s^1.5; a row without an interval gives
+/// NaN bounds. Empty for clock data or without OADEV rows. O(rows), allocates the points.
+std::optional<Readoff> readoff_of(const Analysis& a, const ReportUnits& units);
+
 /// The truth a simulated input carries (gyrochar-sim's header, sim_truth.hpp), shown beside the
 /// fitted terms when the data are counts with the simulator's own tau0 and pulse weight, and the
 /// simulated gyro did not change during the run (no segments). Nothing otherwise. O(header lines).
@@ -91,11 +98,14 @@ struct Report {
   std::optional<Ieee952Truth> truth;  // a simulation's truth, shown beside the fits
   std::string source;                 // the input's name, for Stable32's header
   DataRange range;                    // the values read (after --nominal-hz), for Stable32's header
+  std::optional<Readoff> readoff;     // gyro data with OADEV rows: the read-off, beside the fits
 };
 
 /// Aligned table for people: a header line (data, units, stride factor, confidence), one line per
 /// row with its unit, then the fits (parameters in gyro units: Q arcsec, N deg/sqrt(h), B deg/h,
-/// K deg/h/sqrt(h), R deg/h/h; clock data: s-based units). O(rows), allocates the text.
+/// K deg/h/sqrt(h), R deg/h/h; clock data: s-based units), then the read-off in the same units (the
+/// floor in the deviations' unit), with a line for each value that disagrees with the recommended
+/// fit (readoff_agrees()). O(rows), allocates the text.
 std::string format_table(const Report& r);
 /// CSV: header csv_header, numbers shortest round-trip, empty fields where not available. Fits are
 /// not in the CSV. O(rows).
@@ -105,11 +115,19 @@ inline constexpr const char* csv_header = "stat,m,tau,n,dev,unit,alpha,edf,ci_lo
 std::string csv_fields(const AnalysisRow& row, const ReportUnits& units);
 /// JSON: {"tau0", "n_samples", "type", "results": [{"stat", "m", "tau", "n", "dev", "alpha", "edf",
 /// "ci_low", "ci_high", "unit", "stride"}], "units", "stride_factor", "confidence", "fit" (only
-/// with fits)}; null where not available. O(rows).
+/// with fits), "readoff" (only with one: "N", "B", "K" as {"value", "ci_low", "ci_high", "tau",
+/// "unit", "agrees_with_fit"}, "floor" as {"value", "ci_low", "ci_high", "tau", "unit", "at_end"})};
+/// null where not available. O(rows).
 nlohmann::json to_json(const Report& r);
 /// One element of "results", and the "units" object. O(1).
 nlohmann::json row_json(const AnalysisRow& row, const ReportUnits& units);
 nlohmann::json units_json(const ReportUnits& units);
+/// Whether read-off value `v` (SI) agrees with term `p` of the recommended fit (SI): |v - p| within
+/// sqrt(u^2 + h^2), u the fit's standard uncertainty, h the half-width of the read-off's interval.
+/// Empty when there is nothing to compare: no read-off value, no interval, or the term not fitted
+/// by an ok fit. O(1).
+std::optional<bool> readoff_agrees(const ReadoffValue& v, const Ieee952Fit* fit, std::size_t term);
+
 /// Stable32's result table, one block per statistic (in the order asked), each as Stable32 writes
 /// it: the header ("# STATISTICS FOR FILE:", data points, maximum, minimum, average of the values,
 /// "# Sigma Type: Overlapping Allan", confidence factor, dead time, the column line) and rows

@@ -56,6 +56,9 @@ Formats: table (people), csv, json, stable32 (Stable32's result table: AF Tau # 
 Sigma MaxSigma, one block per statistic; values in the output unit). --kalibr FILE also writes the
 IEEE-952 fit's N and K as the gyroscope part of a Kalibr imu.yaml (N in rad/s/sqrt(Hz) = rad/s^0.5,
 K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill).
+Gyro data with OADEV rows also get the IEEE-952 graphical read-off that data sheets print (table
+and json): N on the -1/2 line at tau = 1 s, the ADEV floor and B = floor/0.664, K on the +1/2 line
+at 3 s, each with the interval of the point it was read at and, beside --fit, whether they agree.
 
 Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' starts a comment),
 plain or gzip (recognized by content), '-' for standard input; read once. Every data line has as
@@ -586,6 +589,7 @@ int main(int argc, char** argv) {
     if (!fit_text.empty())
       fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
                         long_tau, analyzer->record());
+    std::optional<Readoff> readoff = readoff_of(a, units);  // every OADEV row, shown or computed for the fit
     Analysis displayed = std::move(a);  // (a --taus all run has millions of rows: not copied)
     std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
     // A tau asked for by number but too long for the data has no row: say so. (The octave,
@@ -607,7 +611,8 @@ int main(int argc, char** argv) {
         bad(source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) overflows a double",
                                 name(r.stat), r.tau_s, r.m, r.ci.valid ? r.ci.high : r.dev, units.factor(),
                                 units.unit(r.stat)));
-    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt, source, range};
+    Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt, source, range,
+                  std::move(readoff)};
     if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);
     std::string yaml;  // made before anything is written: a refusal loses no output
     if (!kalibr_path.empty()) {

@@ -1,7 +1,9 @@
 // gyrochar-analyze as a user meets it: every kind of bad input gets one line
 // 'gyrochar-analyze: what: why' on stderr, nothing on stdout and exit code 2; good input gives the
 // documented formats and units. Oracles: the exit codes of hal/exit_codes.hpp; unit identities; the
-// closed-form angle random walk of white rate noise (values themselves: test_analyze_reference).
+// closed-form angle random walk of white rate noise (values themselves: test_analyze_reference);
+// for the IEEE-952 read-off, the ADIS16405 data sheet (../shared/refdata/real-imu/README.md), the
+// measured curve itself and the agreement rule of analysis_report.hpp recomputed from the JSON.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -186,6 +188,99 @@ TEST(AnalyzeCli, KalibrYamlHoldsTheFitsNAndKInSI) {
                    "--kalibr: needs gyro data");
 }
 
+// The read-off of a real gyro (ADIS16405, run 1, x; 2.78 h at 100 Hz in deg/s). Oracles: its data
+// sheet's angle random walk, 2.0 deg/sqrt(h) typical (N within 20 %); the measured OADEV curve
+// itself (the floor is its smallest point, at or below that point's upper bound; N is the point it
+// names read at 1 s on the -1/2 line: adev sqrt(tau), deg/h x sqrt(s) / 60 = deg/sqrt(h)); the
+// closed form B = floor / sqrt(2 ln 2 / pi). Its last octave rises at slope 0.13, never +1/2: no K.
+TEST(AnalyzeCli, ReadoffOfARealGyroIsWhatADataSheetPrints) {
+  const std::string record = GYROCHAR_REFDATA "/real-imu/adis16405_run1_gyro_x.txt.gz";
+  const Outcome r = run("--type freq --unit deg/s --tau0 0.01 --format json " + record);
+  ASSERT_EQ(r.code, exit_code::ok) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("readoff"));
+  const auto& ro = j["readoff"];
+  const auto& n = ro["N"];
+  ASSERT_TRUE(n["value"].is_number());
+  EXPECT_EQ(n["unit"], "deg/sqrt(h)");
+  EXPECT_NEAR(n["value"].get<double>() / 2.0, 1.0, 0.2);
+  EXPECT_LE(n["ci_low"].get<double>(), n["value"].get<double>());
+  EXPECT_GE(n["ci_high"].get<double>(), n["value"].get<double>());
+  EXPECT_TRUE(n["agrees_with_fit"].is_null());  // no --fit
+  const nlohmann::json* smallest = nullptr;
+  const nlohmann::json* at_n = nullptr;
+  for (const auto& row : j["results"]) {
+    if (row["stat"] != "oadev") continue;
+    if (smallest == nullptr || row["dev"].get<double>() < (*smallest)["dev"].get<double>()) smallest = &row;
+    if (row["tau"] == n["tau"]) at_n = &row;
+  }
+  ASSERT_NE(smallest, nullptr);
+  ASSERT_NE(at_n, nullptr) << "N is read at an OADEV point";
+  const auto& floor = ro["floor"];
+  EXPECT_EQ(floor["unit"], "deg/h");
+  EXPECT_LE(floor["value"].get<double>(), (*smallest)["ci_high"].get<double>());
+  EXPECT_DOUBLE_EQ(floor["value"].get<double>(), (*smallest)["dev"].get<double>());
+  EXPECT_DOUBLE_EQ(floor["tau"].get<double>(), (*smallest)["tau"].get<double>());
+  EXPECT_NEAR(n["value"].get<double>(), (*at_n)["dev"].get<double>() * std::sqrt(n["tau"].get<double>()) / 60, 1e-12);
+  const double pi = 3.14159265358979323846;
+  EXPECT_NEAR(ro["B"]["value"].get<double>(), floor["value"].get<double>() / std::sqrt(2 * std::log(2.0) / pi), 1e-9);
+  EXPECT_EQ(ro["B"]["unit"], "deg/h");
+  EXPECT_TRUE(ro["K"]["value"].is_null());
+  EXPECT_TRUE(ro["K"]["tau"].is_null());
+  EXPECT_EQ(ro["K"]["unit"], "deg/h/sqrt(h)");
+  // The table says it in one line; the CSV holds rows only.
+  const Outcome table = run("--type freq --unit deg/s --tau0 0.01 " + record);
+  ASSERT_EQ(table.code, exit_code::ok) << table.err;
+  EXPECT_NE(table.out.find("\n# read-off (IEEE-952 graphical, data-sheet style): N = "), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("B = floor/0.664 = "), std::string::npos);
+  EXPECT_NE(table.out.find("K not read"), std::string::npos);
+  const Outcome csv = run("--type freq --unit deg/s --tau0 0.01 --format csv " + record);
+  EXPECT_EQ(csv.out.find("read-off"), std::string::npos);
+  // Without OADEV rows there is nothing to read.
+  const Outcome mdev = run("--type freq --unit deg/s --tau0 0.01 --stats mdev --format json " + record);
+  EXPECT_FALSE(nlohmann::json::parse(mdev.out).contains("readoff"));
+}
+
+// Beside an ok recommended fit, agrees_with_fit is |read-off - fit| <= sqrt(u^2 + h^2) (u the fit's
+// standard uncertainty, h the read-off's half interval: the rule of analysis_report.hpp, recomputed
+// here), null where either side has no value; a disagreement gets its line in the table. The
+// simulated gyro (white angle 2 arcsec, ARW 0.003 deg/sqrt(h), RRW 0.5 deg/h/sqrt(h)) has no
+// stretch of slope -1/2 to read N on, and the floor read as B holds N and K's share.
+TEST(AnalyzeCli, ReadoffSaysWhereItDisagreesWithTheFit) {
+  const std::string counts = temp("sim_readoff.txt");
+  ASSERT_EQ(std::system((GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim --duration 2000 --tau0 0.01 --arw 0.003 "
+                         "--rrw 0.5 --white-angle 2 --seed 3 --out " + counts).c_str()), 0);
+  const std::string args = "--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 ";
+  const Outcome r = run(args + "--format json " + counts);
+  ASSERT_EQ(r.code, exit_code::ok) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& fit = j["fit"][0];
+  ASSERT_EQ(fit["curve"], "both");
+  ASSERT_TRUE(fit["ok"].get<bool>());
+  const Outcome table = run(args + counts);
+  ASSERT_EQ(table.code, exit_code::ok) << table.err;
+  int judged = 0;
+  for (const char* term : {"N", "B", "K"}) {
+    const auto& ro = j["readoff"][term];
+    const auto& agrees = ro["agrees_with_fit"];
+    const bool line = table.out.find(std::string("#   read-off ") + term + " disagrees") != std::string::npos;
+    if (ro["value"].is_null() || !fit[term]["fitted"].get<bool>()) {
+      EXPECT_TRUE(agrees.is_null()) << term;
+      EXPECT_FALSE(line) << term;
+      continue;
+    }
+    ++judged;
+    const double diff = std::fabs(ro["value"].get<double>() - fit[term]["value"].get<double>());
+    const double h = (ro["ci_high"].get<double>() - ro["ci_low"].get<double>()) / 2;
+    ASSERT_TRUE(agrees.is_boolean()) << term;
+    EXPECT_EQ(agrees.get<bool>(), diff <= std::hypot(fit[term]["uncertainty"].get<double>(), h)) << term;
+    EXPECT_EQ(line, !agrees.get<bool>()) << term << "\n" << table.out;
+  }
+  EXPECT_GE(judged, 1);
+  EXPECT_FALSE(j["readoff"]["B"]["agrees_with_fit"].get<bool>());
+  EXPECT_NE(table.out.find("the read-off B is an upper bound when other terms add at the floor"), std::string::npos);
+}
+
 // --format stable32 against the layout of Stable32's own file for PHASE.DAT (../shared/refdata):
 // the same header lines but the file's name, the same column line, every row in the same columns
 // with AF, Tau and # equal, Sigma within Stable32's 5 printed digits. (Min/Max Sigma: gyrochar's
@@ -293,6 +388,7 @@ TEST(AnalyzeCli, JsonHasTheDocumentedShape) {
   EXPECT_EQ(j["n_samples"], 200);
   EXPECT_EQ(j["type"], "phase");
   EXPECT_FALSE(j.contains("fit"));  // only when asked
+  EXPECT_FALSE(j.contains("readoff"));  // gyro data only
   ASSERT_FALSE(j["results"].empty());
   for (const auto& row : j["results"]) {
     for (const char* key : {"stat", "m", "tau", "n", "dev", "alpha", "edf", "ci_low", "ci_high"})
