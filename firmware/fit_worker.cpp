@@ -34,6 +34,9 @@ void FitWorker::request(std::span<const FitPoint> points, const FitSetup& setup,
     n_points_ = std::min(points.size(), points_.size());
     std::copy_n(points.begin(), n_points_, points_.begin());
     setup_ = setup;
+    // The five terms only on the board for now: the CAN protocol does not yet carry Markov terms,
+    // the filter or sinusoids, and the selection's time on the board is not yet measured.
+    setup_.select_model = false;
     job_samples_ = samples;
     busy_ = true;
   }
