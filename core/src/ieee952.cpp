@@ -230,7 +230,7 @@ std::array<double, noises> local_noise(const Problem& pr, const Terms& theta, st
     if (!(th > 0)) continue;
     const double v = th * x[power_terms + j];
     const double next = markov_column(pr.model.a[j], p.stat, 2 * p.m, pr.tau0);
-    const double slope = std::log2(next / x[power_terms + j]) + (p.stat == Stat::mvar ? 0.0 : 0.0);
+    const double slope = std::log2(next / x[power_terms + j]);
     double white_share = (1 - slope) / 2;
     white_share = white_share < 0 ? 0 : white_share > 1 ? 1 : white_share;
     if (w[1] > 0) h[1] += white_share * v / w[1] * innovation_scale(1, pr.tau0);
@@ -295,6 +295,13 @@ bool factor(const Problem& pr) {
     if (cholesky(a, n)) return true;
   }
   return false;
+}
+
+// The covariance of the points under theta, factored in place (the rows keep its diagonal).
+bool weigh(const Problem& pr, const Terms& theta) {
+  covariance_of_points(pr, theta);
+  for (std::size_t i = 0; i < pr.n; ++i) pr.row(i)[diag_slot] = pr.sigma[i * pr.n + i];
+  return factor(pr);
 }
 
 struct Solution {
@@ -597,9 +604,7 @@ Candidate fit_model(Problem& pr, const Flags& free, const Terms& fixed, bool fir
   }
   c.sol = solve(pr, free, fixed);
   for (int iteration = 0; iteration < iterations; ++iteration) {
-    covariance_of_points(pr, c.sol.theta);
-    for (std::size_t i = 0; i < pr.n; ++i) pr.row(i)[diag_slot] = pr.sigma[i * pr.n + i];
-    if (!factor(pr)) {
+    if (!weigh(pr, c.sol.theta)) {
       c.status = FitStatus::singular;
       return c;
     }
@@ -631,10 +636,11 @@ double profile_chi2(Problem& pr, const Flags& free, const Terms& fixed) {
 }
 
 // Minimizes profile_chi2 over *value in log space: a grid from lo to hi (`per_octave` a factor of
-// two), then golden section around the best node. Leaves *value at the minimum; returns its chi2
-// and, in curvature_sd, the standard deviation of ln(value) from the profile's curvature (0: flat).
-double search(Problem& pr, const Flags& free, const Terms& fixed, double* value, double lo, double hi,
-              int per_octave, double& curvature_sd) {
+// two), then golden section around the best node. Leaves *value at the minimum and returns whether
+// it lies inside the range (at an end, the data want the term where the search does not allow it);
+// curvature_sd: the standard deviation of ln(value) from the profile's curvature (0: flat).
+bool search(Problem& pr, const Flags& free, const Terms& fixed, double* value, double lo, double hi, int per_octave,
+            double& curvature_sd) {
   const double step = std::log(2.0) / per_octave;
   double best_log = std::log(lo), best = HUGE_VAL;
   for (double l = std::log(lo); l <= std::log(hi) + 1e-12; l += step) {
@@ -642,7 +648,7 @@ double search(Problem& pr, const Flags& free, const Terms& fixed, double* value,
     const double chi2 = profile_chi2(pr, free, fixed);
     if (chi2 < best) best = chi2, best_log = l;
   }
-  double a = best_log - step, b = best_log + step;
+  double a = std::fmax(best_log - step, std::log(lo)), b = std::fmin(best_log + step, std::log(hi));
   constexpr double golden = 0.6180339887498949;
   double x1 = b - golden * (b - a), x2 = a + golden * (b - a);
   *value = std::exp(x1);
@@ -670,22 +676,15 @@ double search(Problem& pr, const Flags& free, const Terms& fixed, double* value,
   const double curvature = (up + down - 2 * best) / (h * h);
   curvature_sd = curvature > 0 ? std::sqrt(2 / curvature) : 0;
   *value = std::exp(at);
-  return best;
+  return at > std::log(lo) + h && at < std::log(hi) - h;
 }
 
-// True when column t of candidate c is resolved: more than two standard uncertainties above zero
-// (Birge-scaled) and the largest contribution at one point at least (pr's rows are c's).
-bool column_resolved(const Problem& pr, const Candidate& c, std::size_t t) {
+// True when column t of candidate c lies more than two standard uncertainties (Birge-scaled) above
+// zero. Not "resolved": a Markov term shares its rising side with K and its falling side with N,
+// and need not be the largest anywhere to be there (the fit still says whether it is resolved).
+bool column_significant(const Candidate& c, std::size_t t) {
   const double birge = c.dof && c.sol.chi2 > static_cast<double>(c.dof) ? std::sqrt(c.sol.chi2 / static_cast<double>(c.dof)) : 1.0;
-  const double theta = c.sol.theta[t];
-  if (!c.sol.active[t] || !(theta > 2 * std::sqrt(std::fabs(c.sol.cov[t][t])) * birge)) return false;
-  for (std::size_t i = 0; i < pr.n; ++i) {
-    bool largest = true;
-    for (std::size_t u = 0; u < pr.model.columns(); ++u)
-      if (u != t && c.sol.theta[u] * pr.row(i)[u] > theta * pr.row(i)[t]) largest = false;
-    if (largest) return true;
-  }
-  return false;
+  return c.sol.active[t] && c.sol.theta[t] > 2 * std::sqrt(std::fabs(c.sol.cov[t][t])) * birge;
 }
 
 // The search for the model: the five terms, then the filter, Markov terms and sinusoids while each
@@ -697,17 +696,27 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
   runner_up = Candidate{};
   nonlinear_sd = {};
   if (!setup.select_model || !best.valid || best.status == FitStatus::singular) return best;
+  // The taus a Markov term is sought among: from the shortest where white angle noise (Q) makes up
+  // less than half the five terms' model (below, a Markov term cannot be told from a quantization
+  // pattern: a steady 1.5 pulses a sample made one "appear" at Tc = 0.17 s) to the longest.
   double tau_lo = 1e300, tau_hi = 0;
   for (std::size_t i = 0; i < pr.n; ++i) {
     const double tau = static_cast<double>(pr.point[i]->m) * pr.tau0;
-    tau_lo = std::fmin(tau_lo, tau);
+    double model = 0;
+    for (std::size_t t = 0; t < power_terms; ++t) model += best.sol.theta[t] * pr.row(i)[t];
+    if (best.sol.theta[0] * pr.row(i)[0] < 0.5 * model) tau_lo = std::fmin(tau_lo, tau);
     tau_hi = std::fmax(tau_hi, tau);
   }
-  // A candidate wins when it lowers the criterion and the term it adds is resolved (a Markov term or
-  // sinusoid) or determined (the filter's Tf within a factor e^0.5); else it may be the runner-up.
+  // A candidate wins when it lowers the criterion and the term it adds is significant (a Markov term
+  // or sinusoid) or determined (the filter's Tf within a factor e^0.5); else it may be the runner-up.
+  // Both are compared on the candidate's covariance (pr holds it): under its own, a model that
+  // overshoots the long taus predicts their variance too large and is hardly charged for it.
   auto consider = [&](const Candidate& c, bool added_term_holds) {
     if (!c.valid || c.status == FitStatus::singular || c.status == FitStatus::too_few_points) return false;
-    if (c.criterion < best.criterion && added_term_holds) {
+    pr.model = best.model;
+    const double incumbent = criterion_of(profile_chi2(pr, free, fixed), best.parameters, pr.n);
+    pr.model = c.model;
+    if (c.criterion < incumbent && added_term_holds) {
       runner_up = best;
       best = c;
       return true;
@@ -715,31 +724,41 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
     if (!runner_up.valid || c.criterion < runner_up.criterion) runner_up = c;
     return false;
   };
-  // Restores the winner's model and covariance (the search overwrote them).
+  // Restores the winner's rows and covariance (the search overwrote them).
   auto settle = [&]() {
     pr.model = best.model;
-    const Candidate again = fit_model(pr, free, fixed, true, 12);
-    best.sol = again.sol;
+    set_rows(pr);
+    weigh(pr, best.sol.theta);
   };
-  // The sensor's filter on its white rate noise: Tf from tau0 / 20 to 4 tau0.
-  if (filter) {
+  // The sensor's filter on its white rate noise: Tf from tau0 / 20 to 4 tau0. Only where that
+  // noise dominates the shortest tau: under white angle noise a filter on N cannot be told from
+  // Q's own shape, nor from a quantization pattern (a steady rate of 1.5 pulses a sample made it
+  // "find" a 3 Hz filter on a simulated gyro that has none).
+  std::size_t shortest = 0;
+  for (std::size_t i = 1; i < pr.n; ++i)
+    if (pr.point[i]->m < pr.point[shortest]->m) shortest = i;
+  const bool white_rate_first = best.sol.theta[1] * pr.row(shortest)[1] > best.sol.theta[0] * pr.row(shortest)[0];
+  if (filter && white_rate_first) {
     pr.model = best.model;
     double sd = 0;
-    search(pr, free, fixed, &pr.model.band, 0.25, 20.0, 4, sd);
+    const bool inside = search(pr, free, fixed, &pr.model.band, 0.25, 20.0, 4, sd);
     const Candidate c = fit_model(pr, free, fixed, false, 12);
-    if (consider(c, sd > 0 && sd < 0.5)) nonlinear_sd[max_markov] = sd;
+    if (consider(c, inside && sd > 0 && sd < 0.5)) nonlinear_sd[max_markov] = sd;
     settle();
   }
   // Markov terms, one at a time: Tc from twice the shortest tau (shorter, the term is white rate
   // noise over the whole curve: N's double) to half the longest (its Allan peak near 1.89 Tc).
-  for (std::size_t k = 0; k < setup.markov_terms && k < max_markov; ++k) {
+  for (std::size_t k = 0; k < setup.markov_terms && k < max_markov && 4 * tau_lo <= tau_hi; ++k) {
     pr.model = best.model;
     pr.model.markov = k + 1;
     double sd = 0;
-    search(pr, free, fixed, &pr.model.a[k], 2 * pr.tau0 / tau_hi, pr.tau0 / (2 * tau_lo), 4, sd);
+    const bool inside = search(pr, free, fixed, &pr.model.a[k], 2 * pr.tau0 / tau_hi, pr.tau0 / (2 * tau_lo), 4, sd);
     const Candidate c = fit_model(pr, free, fixed, false, 12);
-    // A Markov term that takes white rate noise's place (N fitted before, not after) is N again.
-    const bool better = consider(c, column_resolved(pr, c, power_terms + k) && (!best.sol.active[1] || c.sol.active[1]));
+    // Every Markov term significant (a second one that splits the first in two is not), and none
+    // taking white rate noise's place (N fitted before, not after: that is N again).
+    bool holds = inside && (!best.sol.active[1] || c.sol.active[1]);
+    for (std::size_t j = 0; j <= k; ++j) holds &= column_significant(c, power_terms + j);
+    const bool better = consider(c, holds);
     if (better) nonlinear_sd[k] = sd;
     settle();
     if (!better) break;
@@ -750,7 +769,14 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
     pr.model = best.model;
     pr.model.hz[pr.model.sinusoids++] = hz;
     const Candidate c = fit_model(pr, free, fixed, false, 12);
-    consider(c, column_resolved(pr, c, pr.model.columns() - 1));
+    consider(c, column_significant(c, pr.model.columns() - 1));
+    settle();
+  }
+  // The runner-up's figures on the chosen model's covariance (pr holds it), comparable with its own.
+  if (runner_up.valid) {
+    pr.model = runner_up.model;
+    runner_up.sol.chi2 = profile_chi2(pr, free, fixed);
+    runner_up.criterion = criterion_of(runner_up.sol.chi2, runner_up.parameters, pr.n);
     settle();
   }
   return best;
@@ -895,13 +921,20 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
   for (std::size_t t = 0; t < max_terms; ++t) free[t] = true;
   Terms fixed{};
   if (qw2 > 0 && below_white_quantization(pr, qw2)) leave_out_quantization(pr, qw2, free, fixed, out);
+  // The test after the fit is made on the five terms: the filter or a Markov term would otherwise
+  // take up a quantization pattern's departure at the short taus.
+  const bool check_quantization = qw2 > 0 && out.quantization_white;
+  FitSetup first = setup;
+  if (check_quantization) first.select_model = false;
   Solution sol;
-  fit_points(pr, setup, true, free, fixed, workspace, cache, out, sol);
-  if (qw2 > 0 && out.quantization_white && out.status != FitStatus::too_few_points &&
-      out.status != FitStatus::singular && quantization_departs(pr, sol)) {
+  fit_points(pr, first, true, free, fixed, workspace, cache, out, sol);
+  bool again = first.select_model != setup.select_model;
+  if (check_quantization && out.status != FitStatus::too_few_points && out.status != FitStatus::singular &&
+      quantization_departs(pr, sol)) {
     leave_out_quantization(pr, qw2, free, fixed, out);
-    fit_points(pr, setup, true, free, fixed, workspace, cache, out, sol);
+    again = true;
   }
+  if (again) fit_points(pr, setup, true, free, fixed, workspace, cache, out, sol);
   // A sensor's filter that a first-order one does not describe well enough: the taus it reaches
   // are left out, and the rest fitted without it.
   if (out.status == FitStatus::rejected && out.bandwidth_tc_s > 0) {

@@ -82,8 +82,12 @@ std::string model_text(const Ieee952Fit& fit) {
   std::string s = fmt::format("{} (criterion chi2 + p ln n = {:.4g}, p = {})", candidate_text(fit.chosen),
                               fit.chosen.criterion, fit.chosen.parameters);
   if (fit.runner_up.valid)
-    s += fmt::format("; runner-up {} (criterion {:.4g}, chi2/dof {:.3g})", candidate_text(fit.runner_up),
-                     fit.runner_up.criterion, fit.runner_up.dof ? fit.runner_up.chi2 / static_cast<double>(fit.runner_up.dof) : 0.0);
+    s += fmt::format("; runner-up {} (criterion {:.4g} on the same covariance{})", candidate_text(fit.runner_up),
+                     fit.runner_up.criterion,
+                     fit.runner_up.criterion < fit.chosen.criterion
+                         ? ": lower, but a term it adds is not two standard uncertainties above zero, its time lies "
+                           "at the end of its search range, or it takes N's place"
+                         : "");
   return s;
 }
 

@@ -39,7 +39,7 @@
 // draw from a second std::mt19937_64 (seeded with `seed` and a tag through std::seed_seq) with its
 // own normal distribution (a distribution caches its second value, so sharing one would shift the
 // first stream): adding them leaves every other term's draws, and the counts of a run without
-// them, exactly as they were. docs/metrology.md and sim_closed_forms.hpp give their AVAR and MVAR.
+// them, exactly as they were. docs/metrology.md and tests/oracle/sim_closed_forms.hpp give their AVAR and MVAR.
 #include <cstdint>
 #include <random>
 #include <vector>

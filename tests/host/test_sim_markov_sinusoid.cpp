@@ -1,5 +1,5 @@
 // gyrochar-sim's Gauss-Markov and sinusoidal rate terms (--markov, --sinusoid): their exact AVAR and
-// MVAR (host_tools/sim/sim_closed_forms.hpp) and the simulator against them, each term alone.
+// MVAR (tests/oracle/sim_closed_forms.hpp) and the simulator against them, each term alone.
 // docs/metrology.md ("The simulator and its conventions") has the derivations and the figures.
 //
 // Oracles, never a hand-picked tolerance:
@@ -26,7 +26,7 @@
 #include "gyro_sim.hpp"
 #include "host/sim_truth_support.hpp"
 #include "oracle/brute_force.hpp"
-#include "sim_closed_forms.hpp"
+#include "oracle/sim_closed_forms.hpp"
 #include "sim_truth.hpp"
 
 namespace gyrochar {

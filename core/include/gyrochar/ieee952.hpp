@@ -61,9 +61,15 @@
 // Model selection (FitSetup::select_model): from the five terms, the filter, then one Markov term
 // and a second are added while each lowers the Bayesian information criterion chi2 + p ln(points)
 // (p: the terms fitted plus each correlation time); a correlation time is found on a grid of four
-// per octave (Tc from twice the shortest tau to half the longest), then refined by golden section, both on the covariance of the model
-// before it; given sinusoids are tried last. The model with the least criterion is the fit; the
-// runner-up is reported beside it.
+// per octave (Tc from twice the shortest usable tau to half the longest), then refined by golden
+// section, both on the covariance of the model before it; given sinusoids are tried last. A candidate is compared with the model before it on its
+// own covariance (under the other's, a model that overshoots the long taus predicts their variance
+// too large and is hardly charged for it) and wins when its criterion is lower and the term it adds
+// lies two standard uncertainties above zero with its time inside the search range (a Markov term:
+// every Markov term, and N kept if it was in; the filter: Tf within a factor e^0.5). The filter is tried only where white rate noise
+// dominates the shortest tau, Markov terms only among the taus where white angle noise does not
+// (there either could stand in for a quantization pattern). The runner-up's figures are given on
+// the chosen model's covariance.
 #include <array>
 #include <cstddef>
 #include <cstdint>
