@@ -637,10 +637,8 @@ double profile_chi2(Problem& pr, const Flags& free, const Terms& fixed) {
 
 // Minimizes profile_chi2 over *value in log space: a grid from lo to hi (`per_octave` a factor of
 // two), then golden section around the best node. Leaves *value at the minimum and returns whether
-// it lies inside the range (at an end, the data want the term where the search does not allow it);
-// curvature_sd: the standard deviation of ln(value) from the profile's curvature (0: flat).
-bool search(Problem& pr, const Flags& free, const Terms& fixed, double* value, double lo, double hi, int per_octave,
-            double& curvature_sd) {
+// it lies inside the range (at an end, the data want the term where the search does not allow it).
+bool search(Problem& pr, const Flags& free, const Terms& fixed, double* value, double lo, double hi, int per_octave) {
   const double step = std::log(2.0) / per_octave;
   double best_log = std::log(lo), best = HUGE_VAL;
   for (double l = std::log(lo); l <= std::log(hi) + 1e-12; l += step) {
@@ -667,16 +665,26 @@ bool search(Problem& pr, const Flags& free, const Terms& fixed, double* value, d
     }
   }
   const double at = f1 < f2 ? x1 : x2;
-  best = f1 < f2 ? f1 : f2;
-  constexpr double h = 0.05;
-  *value = std::exp(at + h);
-  const double up = profile_chi2(pr, free, fixed);
-  *value = std::exp(at - h);
-  const double down = profile_chi2(pr, free, fixed);
-  const double curvature = (up + down - 2 * best) / (h * h);
-  curvature_sd = curvature > 0 ? std::sqrt(2 / curvature) : 0;
   *value = std::exp(at);
-  return at > std::log(lo) + h && at < std::log(hi) - h;
+  constexpr double margin = 0.05;
+  return at > std::log(lo) + margin && at < std::log(hi) - margin;
+}
+
+// The standard deviation of ln(*value) from the curvature of chi2 on the fitted model's own
+// covariance (pr holds it), the linear terms solved again at each point: ln(value) +- h with
+// h = 0.2, where the profile is a parabola to a few percent (0: no curvature).
+double log_sd(Problem& pr, const Flags& free, const Terms& fixed, double* value) {
+  constexpr double h = 0.2;
+  const double at = *value;
+  const double mid = profile_chi2(pr, free, fixed);
+  *value = at * std::exp(h);
+  const double up = profile_chi2(pr, free, fixed);
+  *value = at * std::exp(-h);
+  const double down = profile_chi2(pr, free, fixed);
+  *value = at;
+  set_rows(pr);
+  const double curvature = up + down - 2 * mid;
+  return curvature > 0 && std::isfinite(curvature) ? h * std::sqrt(2 / curvature) : 0.0;
 }
 
 // True when column t of candidate c lies more than two standard uncertainties (Birge-scaled) above
@@ -740,9 +748,9 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
   const bool white_rate_first = best.sol.theta[1] * pr.row(shortest)[1] > best.sol.theta[0] * pr.row(shortest)[0];
   if (filter && white_rate_first) {
     pr.model = best.model;
-    double sd = 0;
-    const bool inside = search(pr, free, fixed, &pr.model.band, 0.25, 20.0, 4, sd);
+    const bool inside = search(pr, free, fixed, &pr.model.band, 0.25, 20.0, 4);
     const Candidate c = fit_model(pr, free, fixed, false, 12);
+    const double sd = log_sd(pr, free, fixed, &pr.model.band);
     if (consider(c, inside && sd > 0 && sd < 0.5)) nonlinear_sd[max_markov] = sd;
     settle();
   }
@@ -751,9 +759,9 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
   for (std::size_t k = 0; k < setup.markov_terms && k < max_markov && 4 * tau_lo <= tau_hi; ++k) {
     pr.model = best.model;
     pr.model.markov = k + 1;
-    double sd = 0;
-    const bool inside = search(pr, free, fixed, &pr.model.a[k], 2 * pr.tau0 / tau_hi, pr.tau0 / (2 * tau_lo), 4, sd);
+    const bool inside = search(pr, free, fixed, &pr.model.a[k], 2 * pr.tau0 / tau_hi, pr.tau0 / (2 * tau_lo), 4);
     const Candidate c = fit_model(pr, free, fixed, false, 12);
+    const double sd = log_sd(pr, free, fixed, &pr.model.a[k]);
     // Every Markov term significant (a second one that splits the first in two is not), and none
     // taking white rate noise's place (N fitted before, not after: that is N again).
     bool holds = inside && (!best.sol.active[1] || c.sol.active[1]);

@@ -221,6 +221,15 @@ std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, Dat
 
 namespace {
 
+// "   simulated sigma 0.5 deg/h, Tc 300 s": the simulated Markov term nearest in ln Tc, if any.
+std::string simulated_markov(const std::optional<Ieee952Truth>& truth, double tc_s, const units::Ieee952Unit& rate) {
+  if (!truth || truth->markov.empty()) return "";
+  const MarkovRate* nearest = &truth->markov.front();
+  for (const MarkovRate& m : truth->markov)
+    if (std::fabs(std::log(m.tc_s / tc_s)) < std::fabs(std::log(nearest->tc_s / tc_s))) nearest = &m;
+  return fmt::format("   simulated sigma {:.4g} {}, Tc {:.4g} s", nearest->sigma_rad_s / rate.si, rate.name, nearest->tc_s);
+}
+
 std::array<double, 5> truth_values(const Ieee952Truth& t) {
   return {t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2};
 }
@@ -393,10 +402,14 @@ std::string format_table(const Report& r) {
                      f.fit.bandwidth_tc_s, f.fit.bandwidth_tc_uncertainty_s, 1 / (2 * std::numbers::pi * f.fit.bandwidth_tc_s));
     for (std::size_t j = 0; j < f.fit.n_markov; ++j) {
       const MarkovTerm& m = f.fit.markov[j];
-      fmt::format_to(to, "#   Markov {}: sigma = {:.4g} +- {:.2g} {}, Tc = {:.4g} +- {:.2g} s{}\n", j + 1,
+      fmt::format_to(to, "#   Markov {}: sigma = {:.4g} +- {:.2g} {}, Tc = {:.4g} +- {:.2g} s{}{}\n", j + 1,
                      m.sigma.value / rate.si, m.sigma.uncertainty / rate.si, rate.name, m.tc_s, m.tc_uncertainty_s,
-                     m.sigma.resolved ? "" : "  (not resolved)");
+                     m.sigma.resolved ? "" : "  (not resolved)", simulated_markov(r.truth, m.tc_s, rate));
     }
+    if (r.truth && f.fit.n_markov == 0)
+      for (const MarkovRate& m : r.truth->markov)
+        fmt::format_to(to, "#   no Markov term in the model   simulated sigma {:.4g} {}, Tc {:.4g} s\n", m.sigma_rad_s / rate.si,
+                       rate.name, m.tc_s);
     for (std::size_t j = 0; j < f.fit.n_sinusoids; ++j) {
       const SinusoidTerm& sn = f.fit.sinusoids[j];
       fmt::format_to(to, "#   sinusoid {}: amplitude = {:.4g} +- {:.2g} {} at {:.6g} Hz{}\n", j + 1,

@@ -20,7 +20,6 @@ namespace {
 
 using namespace gyrochar::test_support;
 
-constexpr const char* term_names[5] = {"Q", "N", "B", "K", "R"};
 
 std::string share(std::size_t k, std::size_t n) { return n ? fmt::format("{:.1f}", 100.0 * static_cast<double>(k) / static_cast<double>(n)) : "-"; }
 
@@ -36,6 +35,7 @@ std::string describe(const gyrochar::SimOptions& o) {
   if (o.bias_deg_per_h > 0) s += fmt::format(", B {:g} deg/h", o.bias_deg_per_h);
   if (o.rrw_deg_per_h_sqrt_h > 0) s += fmt::format(", K {:g} deg/h/sqrt(h)", o.rrw_deg_per_h_sqrt_h);
   if (o.ramp_deg_per_h2 > 0) s += fmt::format(", R {:g} deg/h/h", o.ramp_deg_per_h2);
+  for (const gyrochar::SimMarkov& m : o.markov) s += fmt::format(", Markov {:g} deg/h at Tc {:g} s", m.sigma_deg_per_h, m.tc_s);
   return s;
 }
 
@@ -118,16 +118,20 @@ Examples:
                    share(c.quantization_white, c.runs), c.mean_chi2_per_dof);
     fmt::format_to(to, "| term | truth | resolved (%) | within 1 sigma (%) | within 2 sigma (%) | false resolved (%) |\n");
     fmt::format_to(to, "|---|---|---:|---:|---:|---:|\n");
-    for (std::size_t k = 0; k < 5; ++k) {
+    for (std::size_t k = 0; k < tallied_terms; ++k) {
       const TermTally& t = c.terms[k];
       const std::size_t real = t.resolved - t.false_resolved;
       const bool present = t.present > 0;
       std::string resolved = share(t.resolved, t.runs);
       if (t.held) resolved += fmt::format(" (held in {} %)", share(t.held, t.runs));
-      fmt::format_to(to, "| {} | {} | {} | {} | {} | {} |\n", term_names[k], present ? "present" : "zero", resolved,
+      fmt::format_to(to, "| {} | {} | {} | {} | {} | {} |\n", tallied_names[k], present ? "present" : "zero", resolved,
                      present ? share(t.within1, real) : "-", present ? share(t.within2, real) : "-",
                      present ? "-" : share(t.false_resolved, t.runs));
     }
+    const TermTally& markov = c.terms[5];
+    if (markov.present == 0)
+      fmt::format_to(to, "A Markov term in the model (resolved or not) where none was simulated: {} % of the runs.\n",
+                     share(markov.fitted, markov.runs));
     fmt::format_to(to, "\n");
     if (!c.long_tau) continue;
     fmt::format_to(to, "The same runs fitted with the Allan curve's long taus from the total family (docs/total.md): "
@@ -143,7 +147,7 @@ Examples:
         const TermTally& t = c.by_long_tau[in][k];
         const std::size_t real = t.resolved - t.false_resolved;
         const double n = static_cast<double>(real);
-        fmt::format_to(to, "| {} | {} | {} | {} | {} | {} | {} |\n", term_names[k], long_tau_names[in], share(t.resolved, t.runs),
+        fmt::format_to(to, "| {} | {} | {} | {} | {} | {} | {} |\n", tallied_names[k], long_tau_names[in], share(t.resolved, t.runs),
                        share(t.within1, real), share(t.within2, real),
                        real ? fmt::format("{:.3f}", t.sum_relative_uncertainty / n) : "-",
                        real ? fmt::format("{:.3f}", std::sqrt(t.sum_squared_relative_error / n)) : "-");

@@ -80,6 +80,19 @@ std::vector<Scenario> standard_scenarios() {
              o.bias_deg_per_h = 0.05;
              o.rrw_deg_per_h_sqrt_h = 0.15;
            }),
+      // Issue 18's Markov gyro as gyrochar-sim makes it (1.5 pulses of earth rate a sample: periodic
+      // quantization), and two Markov terms far apart in Tc over a whitened quantization.
+      make("ARW + Markov, periodic quantization", 8, 0.1,
+           [](SimOptions& o) {
+             o.arw_deg_per_sqrt_h = 0.02;
+             o.markov = {{0.5, 300}};
+           }),
+      make("ARW + two Markov terms", 8, 0.1,
+           [](SimOptions& o) {
+             o.white_angle_arcsec = 1;
+             o.arw_deg_per_sqrt_h = 0.02;
+             o.markov = {{0.5, 20}, {0.4, 1500}};
+           }),
       // Long runs, the seed paper's length and a day: N/B cross at 80 s, B/K at 760 s, K/R at 17 h.
       long_run("long-run RLG, 24 h", 24, 0.01), long_run("long-run RLG, 120 h", 120, 0.01),
       long_run("long-run RLG without ramp, 24 h", 24, 0),
@@ -125,7 +138,7 @@ std::uint64_t splitmix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
-void tally_terms(std::array<TermTally, 5>& terms, const Ieee952Fit& f, const Ieee952Truth& truth_si);
+void tally_terms(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit& f, const Ieee952Truth& truth_si);
 
 void tally(RecoveryCell& cell, const Recovery& r, bool long_tau) {
   const Ieee952Fit& f = r.fit();
@@ -146,30 +159,56 @@ void tally(RecoveryCell& cell, const Recovery& r, bool long_tau) {
     }
 }
 
-void tally_terms(std::array<TermTally, 5>& terms, const Ieee952Fit& f, const Ieee952Truth& truth_si) {
+// One value against its truth (zero: a resolved value is false).
+void tally_value(TermTally& t, double truth, bool usable, bool fitted, bool resolved, double value, double uncertainty) {
+  ++t.runs;
+  const bool present = truth > 0;
+  t.present += present;
+  t.fitted += usable && fitted;
+  if (!usable || !resolved) return;
+  ++t.resolved;
+  if (!present) {
+    ++t.false_resolved;
+    return;
+  }
+  const double off = std::fabs(value - truth);
+  t.within1 += off <= uncertainty;
+  t.within2 += off <= 2 * uncertainty;
+  t.sum_relative_uncertainty += uncertainty / truth;
+  t.sum_squared_relative_error += (off / truth) * (off / truth);
+}
+
+void tally_markov(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit& f, const Ieee952Truth& truth_si) {
+  if (truth_si.markov.empty()) {  // any resolved Markov term is false; "fitted": one in the model
+    bool resolved = false;
+    for (std::size_t j = 0; j < f.n_markov; ++j) resolved |= f.markov[j].sigma.resolved;
+    tally_value(terms[5], 0, f.ok(), f.n_markov > 0, resolved, 0, 0);
+    tally_value(terms[6], 0, f.ok(), f.n_markov > 0, resolved, 0, 0);
+    return;
+  }
+  for (const MarkovRate& m : truth_si.markov) {
+    std::size_t nearest = f.n_markov;
+    for (std::size_t j = 0; j < f.n_markov; ++j)
+      if (nearest == f.n_markov || std::fabs(std::log(f.markov[j].tc_s / m.tc_s)) <
+                                       std::fabs(std::log(f.markov[nearest].tc_s / m.tc_s)))
+        nearest = j;
+    const bool found = nearest < f.n_markov;
+    const MarkovTerm fitted = found ? f.markov[nearest] : MarkovTerm{};
+    tally_value(terms[5], m.sigma_rad_s, f.ok(), found, found && fitted.sigma.resolved, fitted.sigma.value,
+                fitted.sigma.uncertainty);
+    tally_value(terms[6], m.tc_s, f.ok(), found, found && fitted.sigma.resolved, fitted.tc_s, fitted.tc_uncertainty_s);
+  }
+}
+
+void tally_terms(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit& f, const Ieee952Truth& truth_si) {
   const std::array<double, 5> truth{truth_si.q_rad, truth_si.n_rad_sqrt_s, truth_si.b_rad_s, truth_si.k_rad_s_sqrt_s,
                                     truth_si.r_rad_s2};
   for (std::size_t k = 0; k < 5; ++k) {
-    TermTally& t = terms[k];
     const Ieee952Parameter& p = f.p[k];
-    ++t.runs;
-    const bool present = truth[k] > 0;
-    t.present += present;
-    const bool usable = f.ok();
-    t.fitted += usable && p.fitted;
-    t.held += usable && !p.fitted && k == 0 && !f.quantization_white;
-    if (!usable || !p.resolved) continue;
-    ++t.resolved;
-    if (!present) {
-      ++t.false_resolved;
-      continue;
-    }
-    const double off = std::fabs(p.value - truth[k]);
-    t.within1 += off <= p.uncertainty;
-    t.within2 += off <= 2 * p.uncertainty;
-    t.sum_relative_uncertainty += p.uncertainty / truth[k];
-    t.sum_squared_relative_error += (off / truth[k]) * (off / truth[k]);
+    tally_value(terms[k], truth[k], f.ok(), p.fitted, p.resolved, p.value, p.uncertainty);
+    terms[k].held += f.ok() && !p.fitted && k == 0 && !f.quantization_white;
   }
+  tally_markov(terms, f, truth_si);
 }
 
 }  // namespace

@@ -39,7 +39,7 @@ inline constexpr std::array<const char*, 3> long_tau_names{"OADEV", "TOTDEV", "T
 /// periodic (no dither), angle random walk, bias instability, rate random walk and rate ramp in
 /// the combinations of the issue's reports and a complete RLG; then one long-run gyro (every term
 /// but Q dominating somewhere, the ramp only after 17 h) over 24 h and 120 h, and the same gyro
-/// without the ramp over 24 h, with long_tau set.
+/// without the ramp over 24 h, with long_tau set; and gyros with one and two Markov terms.
 std::vector<Scenario> standard_scenarios();
 
 /// One run: the fits (by LongTau; only OADEV's unless long_tau) and the truth (SI units).
@@ -53,6 +53,11 @@ struct Recovery {
 /// with long_tau also with TOTDEV and TheoH on the Allan curve (holding the run's phase, 8 bytes a
 /// sample). O(samples). Throws what the analyzer throws.
 Recovery recover(const SimOptions& sim, bool long_tau = false);
+
+/// The terms tallied: Q N B K R, then a Markov term's sigma and its Tc (each simulated Markov term
+/// against the fitted one nearest in ln Tc; with none simulated, a resolved one is "false").
+inline constexpr std::size_t tallied_terms = 7;
+inline constexpr std::array<const char*, tallied_terms> tallied_names{"Q", "N", "B", "K", "R", "Markov sigma", "Markov Tc"};
 
 /// The tally of one term over the runs of a scenario.
 struct TermTally {
@@ -73,9 +78,9 @@ struct RecoveryCell {
   std::size_t ok = 0, rejected = 0, too_few = 0, singular = 0;  // fit status counts
   std::size_t quantization_white = 0;                            // runs that found it white
   double mean_chi2_per_dof = 0;
-  std::array<TermTally, 5> terms{};                              // Q N B K R, the OADEV fit
+  std::array<TermTally, tallied_terms> terms{};                  // the OADEV fit
   bool long_tau = false;
-  std::array<std::array<TermTally, 5>, 3> by_long_tau{};         // long_tau: every fit by LongTau
+  std::array<std::array<TermTally, tallied_terms>, 3> by_long_tau{};  // long_tau: every fit by LongTau
   std::array<std::size_t, 3> long_tau_ok{};                      // ... its fits with status ok
   std::array<double, 3> long_tau_chi2{};                         // ... their mean chi2/dof
 };

@@ -134,7 +134,7 @@ struct Ieee952Parameter {
 struct MarkovTerm {
   Ieee952Parameter sigma;
   double tc_s = 0;
-  double tc_uncertainty_s = 0;  // from the criterion's curvature in ln Tc, scaled like the rest
+  double tc_uncertainty_s = 0;  // from the curvature of chi2 in ln Tc on the model's covariance, Birge-scaled
 };
 /// A sinusoid of the fit: amplitude [r/s] at a given frequency.
 struct SinusoidTerm {
