@@ -100,10 +100,10 @@ std::array<double, power_terms> power_design(Stat s, std::uint64_t m, double tau
   return x;
 }
 
-// The design row of a point under a model: the expected variance per unit squared parameter.
-Terms design(const Model& model, Stat s, std::uint64_t m, double tau0) {
+// The design row of a point under a model: the expected variance per unit squared parameter, from
+// the five terms' row p (power_design()).
+Terms design(const Model& model, const std::array<double, power_terms>& p, Stat s, std::uint64_t m, double tau0) {
   Terms x{};
-  const auto p = power_design(s, m, tau0);
   for (std::size_t t = 0; t < power_terms; ++t) x[t] = p[t];
   // Filtered white rate noise of long-tau level N^2 / tau: a Markov term of sigma^2 = N^2 tanh(a/2) / tau0.
   if (model.band > 0) x[1] = markov_column(model.band, s, m, tau0) * std::tanh(model.band / 2) / tau0;
@@ -177,7 +177,7 @@ bool solve_small(Matrix a, Terms b, std::size_t n, Terms& x, Matrix& inv) {
 struct Problem {
   std::size_t n = 0;
   const FitPoint* point[max_fit_points];
-  double white[max_fit_points][noises];  // each point's power-law design (the covariance's basis)
+  std::array<double, power_terms> power[max_fit_points];  // each point's five-term design (power_design())
   double tau0 = 1;
   std::uint64_t n_phase = 0;
   double spread = 0;
@@ -209,7 +209,7 @@ std::size_t cc_index(std::size_t t, std::size_t u) {
 void set_rows(Problem& pr) {
   for (std::size_t i = 0; i < pr.n; ++i) {
     const FitPoint& a = *pr.point[i];
-    const Terms x = design(pr.model, a.stat, a.m, pr.tau0);
+    const Terms x = design(pr.model, pr.power[i], a.stat, a.m, pr.tau0);
     for (std::size_t t = 0; t < max_terms; ++t) pr.row(i)[t] = x[t];
     pr.row(i)[y_slot] = a.variance;
   }
@@ -221,7 +221,7 @@ void set_rows(Problem& pr) {
 std::array<double, noises> local_noise(const Problem& pr, const Terms& theta, std::size_t i) {
   std::array<double, noises> h{};
   const double* x = pr.row(i);
-  const double* w = pr.white[i];
+  const double* w = pr.power[i].data();
   for (std::size_t t = 0; t < noises; ++t) h[t] = (theta[t] > 0 ? theta[t] : 0) * innovation_scale(t, pr.tau0);
   if (pr.model.band > 0 && w[1] > 0) h[1] *= x[1] / w[1];
   const FitPoint& p = *pr.point[i];
@@ -455,7 +455,7 @@ Terms theta_of(const Ieee952Fit& fit) {
 
 double fitted_variance(const Ieee952Fit& fit, Stat stat, std::uint64_t m, double tau0_s) {
   const Model model = model_of(fit, tau0_s);
-  const Terms x = design(model, stat, m, tau0_s);
+  const Terms x = design(model, power_design(stat, m, tau0_s), stat, m, tau0_s);
   const Terms theta = theta_of(fit);
   double v = 0;
   for (std::size_t t = 0; t < model.columns(); ++t) v += theta[t] * x[t];
@@ -541,8 +541,7 @@ void pair_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache
   for (std::size_t i = 0; i < pr.n; ++i) {
     const FitPoint& a = *pr.point[i];
     const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
-    const auto w = power_design(a.stat, a.m, setup.tau0_s);
-    for (std::size_t t = 0; t < noises; ++t) pr.white[i][t] = w[t];
+    pr.power[i] = power_design(a.stat, a.m, setup.tau0_s);
     for (std::size_t j = 0; j <= i; ++j) {
       const FitPoint& b = *pr.point[j];
       double* g = pr.pair_at(i, j);
