@@ -8,6 +8,7 @@
 #   toolchain/benchmarks.sh              (about 50 minutes on 2 cores, most of it allantools)
 #   toolchain/benchmarks.sh --analyzer   only the analyzer sections, on stdout
 #   toolchain/benchmarks.sh --core       only the core sections and targets, on stdout
+#   toolchain/benchmarks.sh --fit        only the IEEE-952 fit's section, on stdout
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # allantools runs on Debian's numpy and scipy (Debian's python3, not another one on PATH);
@@ -20,6 +21,8 @@ done
 cmake -S . -B build/perf -G Ninja -DCMAKE_BUILD_TYPE=Release -DGYROCHAR_BENCHMARKS=ON >/dev/null
 if [ "${1:-}" = --analyzer ]; then
   cmake --build build/perf --target gyrochar-analyze gyrochar-sim bench_datafile >/dev/null
+elif [ "${1:-}" = --fit ]; then
+  cmake --build build/perf --target gyrochar-analyze >/dev/null
 elif [ "${1:-}" = --core ]; then
   cmake --build build/perf --target bench_pyramid bench_per_sample core_test_characterizer_alloc >/dev/null
 else
@@ -48,6 +51,9 @@ measure() {
     echo "- - -"
   fi
 }
+
+# Instructions a command executes (callgrind; its standard output discarded).
+callgrind() { valgrind --tool=callgrind --callgrind-out-file=/dev/null "$@" 2>&1 >/dev/null | awk '/refs/{gsub(",","",$4); print $4}'; }
 
 # The run of median wall time among `runs` lines of "wall cpu rss_mib" on stdin ("- - -": not
 # finished, counted as the slowest).
@@ -147,6 +153,33 @@ echo "does not compute): 96 % of the instructions by callgrind, the sums 2 %. At
 echo "tau over the whole record, on every core) take most of the time."
 }
 
+# The IEEE-952 fit with model selection on a real 10^6-sample record: the analyzer with and without
+# --fit ieee952 (median of three runs; instructions by callgrind, repeatable).
+fit_section() {
+local record=../shared/refdata/real-imu/adis16405_run1_gyro_x.txt.gz
+local args=(--type freq --unit deg/s --tau0 0.01)
+echo "## The IEEE-952 fit with model selection"
+echo
+echo "\`gyrochar-analyze ${args[*]} [--fit ieee952]\` on a real record of 10^6 samples"
+echo "(../shared/refdata/real-imu/adis16405_run1_gyro_x.txt.gz): the fit of both curves and of each"
+echo "alone, each with its model selection (docs/metrology.md). Median run of three; instructions by"
+echo "callgrind (one thread)."
+echo
+echo "| job | wall (s) | CPU (s) | instructions |"
+echo "|---|---:|---:|---:|"
+local plain fitted
+for fit in "" "--fit ieee952"; do
+  local runs
+  runs=$(for r in 1 2 3; do measure 600 /dev/null build/perf/host_tools/gyrochar-analyze "${args[@]}" $fit "$record"; done | median_run)
+  local instructions
+  instructions=$(callgrind build/perf/host_tools/gyrochar-analyze "${args[@]}" --threads 1 $fit "$record")
+  echo "| analyze${fit:+ $fit} | $(echo "$runs" | cut -d' ' -f1) | $(echo "$runs" | cut -d' ' -f2) | $instructions |"
+  if [ -z "$fit" ]; then plain="$runs $instructions"; else fitted="$runs $instructions"; fi
+done
+echo
+echo "$plain $fitted" | awk '{ printf "The fit adds %.2f s of wall time, %.2f s of CPU time and %.3g instructions (target: at most 1 s).\n", $5 - $1, $6 - $2, $8 - $4 }'
+}
+
 core_sections() {
 echo "## Accumulator throughput (Google Benchmark)"
 echo
@@ -171,7 +204,6 @@ echo "Cortex-M4 cycles: each executed instruction costed by tests/benchmarks/cor
 echo
 isa=build/isa
 mkdir -p "$isa"
-callgrind() { valgrind --tool=callgrind --callgrind-out-file=/dev/null "$@" 2>&1 | awk '/refs/{gsub(",","",$4); print $4}'; }
 qemu_trace() { "$1" -singlestep -d exec,nochain "${@:2}" 2>&1 >/dev/null | grep -c '^Trace'; }
 # The presets' flags; the kernels' loops vectorized as core/CMakeLists.txt asks.
 kernels="block_kernel noise_id"
@@ -266,6 +298,10 @@ if [ "${1:-}" = --core ]; then
   core_targets
   exit 0
 fi
+if [ "${1:-}" = --fit ]; then
+  fit_section
+  exit 0
+fi
 if [ "${1:-}" = --analyzer ]; then
   analyzer_sections
   analyzer_targets
@@ -283,6 +319,8 @@ echo
 core_sections
 echo
 analyzer_sections
+echo
+fit_section
 echo
 echo "## Decoder (gyrochar-decode's pipeline)"
 echo

@@ -60,7 +60,7 @@
 // recovery study measures what that approximation costs (docs/metrology.md).
 // Model selection (FitSetup::select_model): from the five terms, the filter, then one Markov term
 // and a second are added while each lowers the Bayesian information criterion chi2 + p ln(points)
-// (p: the terms fitted plus each correlation time); a correlation time is found on a grid of four
+// (p: the terms fitted plus twice each correlation time or frequency); a correlation time is found on a grid of four
 // per octave (Tc from twice the shortest usable tau to half the longest), then refined by golden
 // section, both on the covariance of the model before it; given sinusoids are tried last. A candidate is compared with the model before it on its
 // own covariance (under the other's, a model that overshoots the long taus predicts their variance
