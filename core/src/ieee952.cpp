@@ -764,9 +764,10 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
     const bool inside = search(pr, free, fixed, &pr.model.a[k], 2 * pr.tau0 / tau_hi, pr.tau0 / (2 * tau_lo), 4);
     const Candidate c = fit_model(pr, free, fixed, false, 12);
     const double sd = log_sd(pr, free, fixed, &pr.model.a[k]);
-    // Every Markov term significant (a second one that splits the first in two is not), and none
-    // taking white rate noise's place (N fitted before, not after: that is N again).
-    bool holds = inside && (!best.sol.active[1] || c.sol.active[1]);
+    // Its Tc inside the range and determined (chi2 curves around it), every Markov term significant
+    // (a second one that splits the first in two is not), and none taking white rate noise's place
+    // (N fitted before, not after: that is N again).
+    bool holds = inside && sd > 0 && (!best.sol.active[1] || c.sol.active[1]);
     for (std::size_t j = 0; j <= k; ++j) holds &= column_significant(c, power_terms + j);
     const bool better = consider(c, holds);
     if (better) nonlinear_sd[k] = sd;

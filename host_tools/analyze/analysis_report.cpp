@@ -69,6 +69,11 @@ std::string fit_summary(const CurveFit& f) {
   return s;
 }
 
+// "+- 61 s", or why there is no uncertainty (a time whose chi2 has no curvature).
+std::string with_uncertainty(double sd_s) {
+  return sd_s > 0 ? fmt::format("+- {:.2g} s", sd_s) : std::string("s (uncertainty not determined)");
+}
+
 // "5 terms + filter + 1 Markov (criterion 41.2); runner-up 5 terms + filter (criterion 96.3, chi2/dof 2.6)"
 std::string candidate_text(const ModelSummary& m) {
   std::string s = "five terms";
@@ -397,13 +402,14 @@ std::string format_table(const Report& r) {
     }
     const FitUnit& rate = fit_units(u)[2];  // B's unit: a rate
     if (f.fit.bandwidth_tc_s > 0)
-      fmt::format_to(to, "#   sensor bandwidth: N's white noise through a first-order filter, Tf = {:.3g} +- {:.2g} s "
+      fmt::format_to(to, "#   sensor bandwidth: N's white noise through a first-order filter, Tf = {:.3g} {} "
                          "(corner {:.4g} Hz)\n",
-                     f.fit.bandwidth_tc_s, f.fit.bandwidth_tc_uncertainty_s, 1 / (2 * std::numbers::pi * f.fit.bandwidth_tc_s));
+                     f.fit.bandwidth_tc_s, with_uncertainty(f.fit.bandwidth_tc_uncertainty_s),
+                     1 / (2 * std::numbers::pi * f.fit.bandwidth_tc_s));
     for (std::size_t j = 0; j < f.fit.n_markov; ++j) {
       const MarkovTerm& m = f.fit.markov[j];
-      fmt::format_to(to, "#   Markov {}: sigma = {:.4g} +- {:.2g} {}, Tc = {:.4g} +- {:.2g} s{}{}\n", j + 1,
-                     m.sigma.value / rate.si, m.sigma.uncertainty / rate.si, rate.name, m.tc_s, m.tc_uncertainty_s,
+      fmt::format_to(to, "#   Markov {}: sigma = {:.4g} +- {:.2g} {}, Tc = {:.4g} {}{}{}\n", j + 1,
+                     m.sigma.value / rate.si, m.sigma.uncertainty / rate.si, rate.name, m.tc_s, with_uncertainty(m.tc_uncertainty_s),
                      m.sigma.resolved ? "" : "  (not resolved)", simulated_markov(r.truth, m.tc_s, rate));
     }
     if (r.truth && f.fit.n_markov == 0)
@@ -460,6 +466,8 @@ nlohmann::json units_json(const ReportUnits& u) {
 
 namespace {
 
+nlohmann::json positive_or_null(double v) { return v > 0 ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
 nlohmann::json summary_json(const ModelSummary& m) {
   using nlohmann::json;
   if (!m.valid) return json(nullptr);
@@ -479,7 +487,7 @@ void add_model_json(nlohmann::json& one, const Ieee952Fit& fit, const ReportUnit
   json markov = json::array();
   for (std::size_t j = 0; j < fit.n_markov; ++j)
     markov.push_back({{"sigma", parameter_json(fit.markov[j].sigma, rate.si, rate.name)},
-                      {"tc", {{"value", fit.markov[j].tc_s}, {"uncertainty", fit.markov[j].tc_uncertainty_s}, {"unit", "s"}}}});
+                      {"tc", {{"value", fit.markov[j].tc_s}, {"uncertainty", positive_or_null(fit.markov[j].tc_uncertainty_s)}, {"unit", "s"}}}});
   json sinusoids = json::array();
   for (std::size_t j = 0; j < fit.n_sinusoids; ++j)
     sinusoids.push_back({{"amplitude", parameter_json(fit.sinusoids[j].amplitude, rate.si, rate.name)},
@@ -487,7 +495,7 @@ void add_model_json(nlohmann::json& one, const Ieee952Fit& fit, const ReportUnit
   one["markov"] = std::move(markov);
   one["sinusoids"] = std::move(sinusoids);
   one["bandwidth"] = fit.bandwidth_tc_s > 0 ? json{{"tc", {{"value", fit.bandwidth_tc_s},
-                                                          {"uncertainty", fit.bandwidth_tc_uncertainty_s}, {"unit", "s"}}},
+                                                          {"uncertainty", positive_or_null(fit.bandwidth_tc_uncertainty_s)}, {"unit", "s"}}},
                                                    {"corner_hz", 1 / (2 * std::numbers::pi * fit.bandwidth_tc_s)}}
                                             : json(nullptr);
   one["bandwidth_excluded_below_tau"] = fit.bandwidth_excluded_below_tau_s > 0 ? json(fit.bandwidth_excluded_below_tau_s) : json(nullptr);
