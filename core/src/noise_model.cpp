@@ -298,16 +298,20 @@ double markov_autocovariance(double a, int level, std::int64_t k) {
   return (exp_remainder(4, a * ak) + d1 * ak + d3 * ak * ak * ak) / (16 * h * h * h * h);
 }
 
+// c of Markov rate a (unit stationary variance) at `lag` under kernel k.
+double markov_covariance(const Kernel& k, double a, std::int64_t lag) {
+  double c = 0;
+  for (int i = 0; i < k.count; ++i)
+    c += k.w[static_cast<std::size_t>(i)] * markov_autocovariance(a, k.level, lag + k.u[static_cast<std::size_t>(i)]);
+  return c;
+}
+
 }  // namespace
 
 double markov_term_covariance(double a, Stat a_stat, std::uint64_t m_a, Stat b_stat, std::uint64_t m_b,
                               std::int64_t lag) {
   if (!(a > 0)) return 0.0;
-  const Kernel k = kernel(a_stat, m_a, b_stat, m_b);
-  double c = 0;
-  for (int i = 0; i < k.count; ++i)
-    c += k.w[static_cast<std::size_t>(i)] * markov_autocovariance(a, k.level, lag + k.u[static_cast<std::size_t>(i)]);
-  return c;
+  return markov_covariance(kernel(a_stat, m_a, b_stat, m_b), a, lag);
 }
 
 TermGrid unbroken_grid(Stat stat, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase) {
@@ -320,49 +324,51 @@ TermGrid unbroken_grid(Stat stat, std::uint64_t m, std::uint64_t stride, std::ui
   return g;
 }
 
-PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
-  PairSums out;
-  if (a.n == 0 || b.n == 0 || a.stride == 0 || b.stride == 0) return out;
+namespace {
+
+// What pair_sums() and markov_pair_sums() share: the kernel of the two statistics, the noises' R,
+// the pair counter and the lags that have pairs (on the finer stride's lattice).
+struct PairSetup {
+  Kernel k;
+  ManyR many;
+  PairCounter pairs{};
+  std::int64_t step = 1, extent_lo = 0, extent_hi = 0;
+};
+
+// False when either grid has no term, the strides do not nest or a noise of `set` does not
+// converge for either statistic.
+bool pair_setup(const NoiseSet& set, const TermGrid& a, const TermGrid& b, PairSetup& s) {
+  if (a.n == 0 || b.n == 0 || a.stride == 0 || b.stride == 0) return false;
   const std::uint64_t fine = a.stride < b.stride ? a.stride : b.stride;
   const std::uint64_t coarse = a.stride < b.stride ? b.stride : a.stride;
-  if (coarse % fine != 0) return out;  // strides must nest (powers of two always do)
-  const Kernel k = kernel(a.stat, a.m, b.stat, b.m);
-  ManyR many;
+  if (coarse % fine != 0) return false;  // strides must nest (powers of two always do)
+  s.k = kernel(a.stat, a.m, b.stat, b.m);
   for (std::size_t t = 0; t < set.count && t < max_noises; ++t) {
-    if (!noise_supported(a.stat, set.alpha[t]) || !noise_supported(b.stat, set.alpha[t])) return out;
-    many.twice_d[t] = 2 - set.alpha[t] + 2 * k.level;
-    many.flicker |= many.twice_d[t] % 2 != 0;
-    many.count = t + 1;
+    if (!noise_supported(a.stat, set.alpha[t]) || !noise_supported(b.stat, set.alpha[t])) return false;
+    s.many.twice_d[t] = 2 - set.alpha[t] + 2 * s.k.level;
+    s.many.flicker |= s.many.twice_d[t] % 2 != 0;
+    s.many.count = t + 1;
   }
-  const auto& twice_d = many.twice_d;
-  const bool flicker = many.flicker;
-  const std::size_t noises = many.count;
-  const auto step = static_cast<std::int64_t>(fine);
-  const PairCounter pairs{static_cast<std::int64_t>(a.first),
-                          static_cast<std::int64_t>(a.first + (a.n - 1) * a.stride),
-                          static_cast<std::int64_t>(b.first),
-                          static_cast<std::int64_t>(b.first + (b.n - 1) * b.stride),
-                          static_cast<std::int64_t>(a.stride),
-                          static_cast<std::int64_t>(b.stride),
-                          static_cast<std::int64_t>(a.n),
-                          static_cast<std::int64_t>(b.n)};
-  // Lags with pairs, and the reach of c: (-u_max, -u_min) for polynomial noises. Flicker noises
-  // reach further, with c ~ lag^-p (p = the kernel's difference order minus the leading power of
-  // R): summed directly out to three kernel widths, beyond which the sum is the integral of that
-  // power law (its share there is below 1 %, the power law's own error a few percent of it). Far
-  // out, c is a difference of huge nearly equal values and could not be evaluated directly.
-  const std::int64_t extent_lo = pairs.first_a - pairs.last_b, extent_hi = pairs.last_a - pairs.first_b;
-  const std::int64_t width = k.u_max() - k.u_min() + 1;
-  const std::int64_t reach = flicker ? 3 * width : 0;
-  std::int64_t lo = extent_lo, hi = extent_hi;
-  if (lo < -k.u_max() - reach) lo = ceil_div(-k.u_max() - reach, step) * step;
-  if (hi > -k.u_min() + reach) hi = floor_div(-k.u_min() + reach, step) * step;
-  if (lo > hi) return out;
-  // Breakpoints: where an R argument crosses 0, and where the pair count has a kink.
-  std::array<std::int64_t, 72> breaks{};
+  s.step = static_cast<std::int64_t>(fine);
+  s.pairs = PairCounter{static_cast<std::int64_t>(a.first),
+                        static_cast<std::int64_t>(a.first + (a.n - 1) * a.stride),
+                        static_cast<std::int64_t>(b.first),
+                        static_cast<std::int64_t>(b.first + (b.n - 1) * b.stride),
+                        static_cast<std::int64_t>(a.stride),
+                        static_cast<std::int64_t>(b.stride),
+                        static_cast<std::int64_t>(a.n),
+                        static_cast<std::int64_t>(b.n)};
+  s.extent_lo = s.pairs.first_a - s.pairs.last_b;
+  s.extent_hi = s.pairs.last_a - s.pairs.first_b;
+  return true;
+}
+
+// Breakpoints in [lo, hi], sorted: where an R argument crosses 0, and where the pair count has a
+// kink. Returns their number.
+int pair_breaks(const PairSetup& s, std::int64_t lo, std::int64_t hi, std::array<std::int64_t, 72>& breaks) {
   int n_breaks = 0;
   auto add_break = [&](std::int64_t v) {
-    v = floor_div(v, step) * step;
+    v = floor_div(v, s.step) * s.step;
     if (v < lo || v > hi) return;
     int p = 0;
     while (p < n_breaks && breaks[static_cast<std::size_t>(p)] < v) ++p;
@@ -371,17 +377,63 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
     breaks[static_cast<std::size_t>(p)] = v;
     ++n_breaks;
   };
-  for (int i = 0; i < k.count; ++i) {
-    add_break(-k.u[static_cast<std::size_t>(i)]);
-    add_break(-k.u[static_cast<std::size_t>(i)] + step);  // the lattice point just past it
+  for (int i = 0; i < s.k.count; ++i) {
+    add_break(-s.k.u[static_cast<std::size_t>(i)]);
+    add_break(-s.k.u[static_cast<std::size_t>(i)] + s.step);  // the lattice point just past it
   }
-  for (const std::int64_t v : {pairs.first_a - pairs.first_b, pairs.last_a - pairs.last_b, pairs.first_a - pairs.last_b,
-                               pairs.last_a - pairs.first_b})
+  const PairCounter& p = s.pairs;
+  for (const std::int64_t v : {p.first_a - p.first_b, p.last_a - p.last_b, p.first_a - p.last_b, p.last_a - p.first_b})
     add_break(v);
-  // Away from the breakpoints c varies on the scale of the longer term: at least 256 nodes there.
+  return n_breaks;
+}
+
+// Away from the breakpoints c varies on the scale of the longer term: at least 256 nodes there.
+std::int64_t smooth_step(const TermGrid& a, const TermGrid& b, std::int64_t step) {
   const std::uint64_t m_max = a.m > b.m ? a.m : b.m;
-  std::int64_t max_step = static_cast<std::int64_t>(m_max / 256) / step * step;
-  if (max_step < step) max_step = step;
+  const std::int64_t max_step = static_cast<std::int64_t>(m_max / 256) / step * step;
+  return max_step < step ? step : max_step;
+}
+
+// Beyond three kernel widths a flicker noise's c falls as lag^-p from the kernel's centre: p for
+// each noise of s (0 for the others).
+std::array<double, max_noises> tail_powers(const PairSetup& s, const TermGrid& a, const TermGrid& b) {
+  const int level = s.k.level;
+  const int order = difference_order(a.stat) + difference_order(b.stat) + (a.stat == Stat::mvar ? 0 : level) +
+                    (b.stat == Stat::mvar ? 0 : level) + (a.stat == Stat::mvar) + (b.stat == Stat::mvar);
+  std::array<double, max_noises> p{};
+  for (std::size_t t = 0; t < s.many.count; ++t)
+    if (s.many.twice_d[t] % 2 != 0) p[t] = order - (s.many.twice_d[t] - 1);
+  return p;
+}
+
+}  // namespace
+
+PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
+  PairSums out;
+  PairSetup setup;
+  if (!pair_setup(set, a, b, setup)) return out;
+  const Kernel& k = setup.k;
+  const ManyR& many = setup.many;
+  const auto& twice_d = many.twice_d;
+  const bool flicker = many.flicker;
+  const std::size_t noises = many.count;
+  const std::int64_t step = setup.step;
+  const PairCounter& pairs = setup.pairs;
+  // Lags with pairs, and the reach of c: (-u_max, -u_min) for polynomial noises. Flicker noises
+  // reach further, with c ~ lag^-p (p = the kernel's difference order minus the leading power of
+  // R): summed directly out to three kernel widths, beyond which the sum is the integral of that
+  // power law (its share there is below 1 %, the power law's own error a few percent of it). Far
+  // out, c is a difference of huge nearly equal values and could not be evaluated directly.
+  const std::int64_t extent_lo = setup.extent_lo, extent_hi = setup.extent_hi;
+  const std::int64_t width = k.u_max() - k.u_min() + 1;
+  const std::int64_t reach = flicker ? 3 * width : 0;
+  std::int64_t lo = extent_lo, hi = extent_hi;
+  if (lo < -k.u_max() - reach) lo = ceil_div(-k.u_max() - reach, step) * step;
+  if (hi > -k.u_min() + reach) hi = floor_div(-k.u_min() + reach, step) * step;
+  if (lo > hi) return out;
+  std::array<std::int64_t, 72> breaks{};
+  const int n_breaks = pair_breaks(setup, lo, hi, breaks);
+  const std::int64_t max_step = smooth_step(a, b, step);
   auto accumulate = [&](double w, const std::array<double, max_noises>& c) {
     for (std::size_t t = 0; t < noises; ++t) {
       out.c[t] += w * c[t];
@@ -398,8 +450,7 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
               });
   if (flicker) {  // the power-law tails beyond lo and hi, out to the lags that have pairs
     const double center = -0.5 * static_cast<double>(k.u_min() + k.u_max());
-    const int order = difference_order(a.stat) + difference_order(b.stat) + (a.stat == Stat::mvar ? 0 : k.level) +
-                      (b.stat == Stat::mvar ? 0 : k.level) + (a.stat == Stat::mvar) + (b.stat == Stat::mvar);
+    const std::array<double, max_noises> p = tail_powers(setup, a, b);
     for (const std::int64_t edge : {lo, hi}) {
       const bool left = edge == lo;
       if (left ? extent_lo >= lo : extent_hi <= hi) continue;
@@ -407,9 +458,8 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
       if (pairs_at == 0) continue;
       const double L = std::fabs(static_cast<double>(edge) - center);
       const double L_max = std::fabs(static_cast<double>(left ? extent_lo : extent_hi) - center);
-      std::array<double, max_noises> c{}, p{};
+      std::array<double, max_noises> c{};
       covariances(k, many, edge, c);
-      for (std::size_t t = 0; t < noises; ++t) p[t] = order - (twice_d[t] - 1);  // c ~ lag^-p
       // sum over the lattice beyond the edge = integral / step - f(edge) / 2 (Euler-Maclaurin),
       // with f = pairs(edge) c_t c_u (L / x)^(p_t + p_u) and the pair count taken as constant.
       for (std::size_t t = 0; t < noises; ++t) {
@@ -427,6 +477,80 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
   }
   for (std::size_t t = 0; t < noises; ++t)
     for (std::size_t u = 0; u < t; ++u) out.cc[u][t] = out.cc[t][u];
+  return out;
+}
+
+MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rates, const TermGrid& a,
+                                const TermGrid& b) {
+  MarkovPairSums out;
+  PairSetup setup;
+  const std::size_t markov = rates.size() < max_markov_rates ? rates.size() : max_markov_rates;
+  if (markov == 0 || !pair_setup(set, a, b, setup)) return out;
+  double slowest = rates[0];
+  for (std::size_t j = 0; j < markov; ++j) {
+    if (!(rates[j] > 0)) return out;
+    slowest = std::fmin(slowest, rates[j]);
+  }
+  const Kernel& k = setup.k;
+  const ManyR& many = setup.many;
+  const std::int64_t step = setup.step;
+  // Inside [span_lo, span_hi] the R arguments have both signs. Beyond, every R argument has one
+  // sign, the kernel annihilates R's polynomial part, and a Markov rate's c is the exponential
+  // alone: c(edge) e^(-a |lag - edge|), summed out to e^-27 (2e-12) of its edge value. The
+  // power-law noises' c is zero there, but for flicker noises: direct to three kernel widths, then
+  // the power law pair_sums() integrates (its edge value times (L / |lag - centre|)^p).
+  const std::int64_t span_lo = -k.u_max(), span_hi = -k.u_min();
+  const double reach_lags = 27 / slowest;
+  const std::int64_t reach = reach_lags < 4e15 ? static_cast<std::int64_t>(reach_lags) + 1 : std::int64_t{4000000000000000};
+  std::int64_t lo = setup.extent_lo, hi = setup.extent_hi;
+  if (lo < span_lo - reach) lo = ceil_div(span_lo - reach, step) * step;
+  if (hi > span_hi + reach) hi = floor_div(span_hi + reach, step) * step;
+  if (lo > hi) return out;
+  std::array<std::int64_t, 72> breaks{};
+  const int n_breaks = pair_breaks(setup, lo, hi, breaks);
+  std::array<double, max_markov_rates> edge_lo{}, edge_hi{};
+  for (std::size_t j = 0; j < markov; ++j) {
+    edge_lo[j] = markov_covariance(k, rates[j], span_lo);
+    edge_hi[j] = markov_covariance(k, rates[j], span_hi);
+  }
+  const std::int64_t width = span_hi - span_lo + 1;
+  const std::int64_t flicker_lo = span_lo - 3 * width, flicker_hi = span_hi + 3 * width;
+  const double center = -0.5 * static_cast<double>(k.u_min() + k.u_max());
+  const std::array<double, max_noises> p = tail_powers(setup, a, b);
+  std::array<double, max_noises> tail_lo{}, tail_hi{};
+  if (many.flicker) {
+    covariances(k, many, flicker_lo, tail_lo);
+    covariances(k, many, flicker_hi, tail_hi);
+  }
+  visit_nodes(lo, hi, step, smooth_step(a, b, step), span_lo, span_hi, breaks.data(), n_breaks,
+              [&](std::int64_t lag, double weight) {
+                const double w = weight * static_cast<double>(setup.pairs(lag));
+                if (w == 0) return;
+                std::array<double, max_noises> c{};
+                std::array<double, max_markov_rates> cm{};
+                const bool inside = lag >= span_lo && lag <= span_hi;
+                if (inside || (many.flicker && lag >= flicker_lo && lag <= flicker_hi)) covariances(k, many, lag, c);
+                for (std::size_t t = 0; t < many.count && !inside; ++t) {
+                  if (many.twice_d[t] % 2 == 0) {
+                    c[t] = 0;  // beyond the span: zero but for rounding
+                  } else if (lag < flicker_lo || lag > flicker_hi) {
+                    const bool left = lag < flicker_lo;
+                    const double L = std::fabs(static_cast<double>(left ? flicker_lo : flicker_hi) - center);
+                    c[t] = (left ? tail_lo[t] : tail_hi[t]) * std::pow(L / std::fabs(static_cast<double>(lag) - center), p[t]);
+                  }
+                }
+                for (std::size_t j = 0; j < markov; ++j)
+                  cm[j] = inside          ? markov_covariance(k, rates[j], lag)
+                          : lag < span_lo ? edge_lo[j] * std::exp(-rates[j] * static_cast<double>(span_lo - lag))
+                                          : edge_hi[j] * std::exp(-rates[j] * static_cast<double>(lag - span_hi));
+                for (std::size_t j = 0; j < markov; ++j) {
+                  out.c[j] += w * cm[j];
+                  for (std::size_t t = 0; t < many.count; ++t) out.cm[j][t] += w * cm[j] * c[t];
+                  for (std::size_t l = 0; l <= j; ++l) out.mm[j][l] += w * cm[j] * cm[l];
+                }
+              });
+  for (std::size_t j = 0; j < markov; ++j)
+    for (std::size_t l = 0; l < j; ++l) out.mm[l][j] = out.mm[j][l];
   return out;
 }
 

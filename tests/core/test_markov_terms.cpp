@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include "gyrochar/ieee952.hpp"
@@ -61,6 +62,61 @@ TEST(MarkovTerms, CovarianceMatchesBruteForceFromShortToVeryLongCorrelation) {
                   1e-9 * std::fabs(static_cast<double>(brute_covariance(a, Stat::mvar, 8, Stat::mvar, 8, 0))))
           << "a " << a << " lag " << lag;
     }
+}
+
+// markov_pair_sums() against the double sums over every pair of terms, each c from
+// markov_term_covariance() and term_covariance() (both exact and checked above and in
+// test_noise_model): the sums' quadrature and the exponential tails beyond the kernel's span.
+TEST(MarkovTerms, PairSumsMatchTheDoubleSumOverEveryPairOfTerms) {
+  NoiseSet set;
+  set.alpha = {2, 0, -1, -2, 0};
+  set.count = 4;
+  struct Case {
+    Stat sa;
+    std::uint64_t ma, stride_a;
+    Stat sb;
+    std::uint64_t mb, stride_b;
+    double a0, a1;
+  };
+  const Case cases[] = {{Stat::avar, 8, 1, Stat::avar, 8, 1, 0.05, 0.004},
+                        {Stat::avar, 4, 1, Stat::avar, 32, 2, 0.3, 0.01},
+                        {Stat::mvar, 16, 1, Stat::mvar, 16, 1, 0.02, 0.2},
+                        {Stat::mvar, 8, 1, Stat::mvar, 64, 4, 0.002, 0.05},
+                        {Stat::avar, 600, 1, Stat::avar, 600, 1, 0.1, 0.001}};
+  constexpr std::uint64_t n_phase = 3000;
+  for (const Case& c : cases) {
+    const TermGrid ga = unbroken_grid(c.sa, c.ma, c.stride_a, n_phase), gb = unbroken_grid(c.sb, c.mb, c.stride_b, n_phase);
+    const double rates[] = {c.a0, c.a1};
+    const MarkovPairSums got = markov_pair_sums(set, rates, ga, gb);
+    // The pairs at each lag, counted one by one; then every c once per lag.
+    std::map<std::int64_t, double> pairs;
+    for (std::uint64_t i = 0; i < ga.n; ++i)
+      for (std::uint64_t j = 0; j < gb.n; ++j)
+        pairs[static_cast<std::int64_t>(ga.first + i * ga.stride) - static_cast<std::int64_t>(gb.first + j * gb.stride)] += 1;
+    MarkovPairSums want;
+    for (const auto& [lag, count] : pairs) {
+      double cm[2], ct[4];
+      for (int r = 0; r < 2; ++r) cm[r] = markov_term_covariance(rates[r], c.sa, c.ma, c.sb, c.mb, lag);
+      for (int t = 0; t < 4; ++t) ct[t] = term_covariance(set.alpha[static_cast<std::size_t>(t)], c.sa, c.ma, c.sb, c.mb, lag);
+      for (std::size_t r = 0; r < 2; ++r) {
+        want.c[r] += count * cm[r];
+        for (std::size_t t = 0; t < 4; ++t) want.cm[r][t] += count * cm[r] * ct[t];
+        for (std::size_t l = 0; l < 2; ++l) want.mm[r][l] += count * cm[r] * cm[l];
+      }
+    }
+    // Relative to the scale sqrt(sum c_r^2 sum c_t^2) of each sum (a cross sum may cancel to ~0).
+    for (std::size_t r = 0; r < 2; ++r) {
+      for (std::size_t l = 0; l < 2; ++l) {
+        const double scale = std::sqrt(want.mm[r][r] * want.mm[l][l]);
+        EXPECT_NEAR(got.mm[r][l], want.mm[r][l], 2e-4 * scale) << "m " << c.ma << "/" << c.mb << " mm " << r << l;
+      }
+      for (std::size_t t = 0; t < 4; ++t) {
+        const PairSums own = pair_sums(set, ga, gb);
+        const double scale = std::sqrt(want.mm[r][r] * std::fabs(own.cc[t][t]));
+        EXPECT_NEAR(got.cm[r][t], want.cm[r][t], 2e-4 * scale + 1e-300) << "m " << c.ma << "/" << c.mb << " cm " << r << t;
+      }
+    }
+  }
 }
 
 TEST(MarkovTerms, AllanVarianceIsZhangsClosedForm) {

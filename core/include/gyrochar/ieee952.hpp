@@ -183,9 +183,11 @@ struct Ieee952Fit {
   double chi2_per_dof() const { return dof ? chi2 / static_cast<double>(dof) : 0.0; }
 };
 
-/// Doubles of workspace fit_ieee952() needs for `points` points: about 8 points^2.
+/// Doubles of workspace fit_ieee952() needs for `points` points: about 15 points^2.
 constexpr std::size_t ieee952_workspace_doubles(std::size_t points) {
-  return points * (points + 1) / 2 * 14 + points * points + points * 12;
+  // per pair: 14 power-law sums and the Markov terms' (4 noises, each other, alone); Sigma; rows
+  return points * (points + 1) / 2 * (14 + max_markov * 4 + max_markov * max_markov + max_markov) + points * points +
+         points * 12;
 }
 
 /// Fits the model to the points of `curve` (points of the other statistic are ignored; any

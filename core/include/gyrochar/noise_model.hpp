@@ -99,6 +99,21 @@ struct PairSums {
 };
 PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b);
 
+/// The same sums with first-order Gauss-Markov rates beside the noises of `set` (the IEEE-952
+/// fit's exact covariance of a model with Markov terms): c_j the term covariance of Markov rate j
+/// (markov_term_covariance() with a = rates[j], unit stationary variance),
+///   cm[j][t] = sum c_j c_t,   mm[j][l] = sum c_j c_l,   c[j] = sum c_j.
+/// Beyond the kernel's span c_j is exactly c_j(edge) e^(-a |lag - edge|) and is summed to e^-27 of
+/// that; inside, the nodes of pair_sums(). Flicker noises beyond three kernel widths take the
+/// power law pair_sums() integrates there. O(nodes x (taps + noises)); empty on a rate <= 0.
+inline constexpr std::size_t max_markov_rates = 2;
+struct MarkovPairSums {
+  std::array<std::array<double, max_noises>, max_markov_rates> cm{};
+  std::array<std::array<double, max_markov_rates>, max_markov_rates> mm{};
+  std::array<double, max_markov_rates> c{};
+};
+MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rates, const TermGrid& a, const TermGrid& b);
+
 /// How far the correlation of the estimates over grids a and b under noise alpha, as pair_sums()
 /// computes it in double precision, can be off through rounding (a bound, typically far above the
 /// actual error). The closed forms of c are sums of R at arguments as wide as the kernel, nearly
