@@ -18,6 +18,7 @@
 
 #include "hal/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
+#include "output_paths.hpp"
 #include "plot.hpp"
 #include "session.hpp"
 #include "view.hpp"
@@ -294,7 +295,9 @@ int main(int argc, char** argv) {
       "  gyrochar-decode --interface can0 --node 0x10 --duration 86400 --kalibr imu.yaml\n"
       "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
       "Malformed lines and rejected frames are counted and reported, not fatal; a log that is missing,\n"
-      "unreadable, empty or without any candump line is bad input.\n" +
+      "unreadable, empty or without any candump line is bad input, and so is an output (--csv, --jsonl,\n"
+      "--kalibr, --plot's files) that is the same file as LOG or as another output, through links too:\n"
+      "refused before anything is written.\n" +
       std::string(exit_code::help));
   Options o;
   app.add_option("log", o.log, "candump log file, or '-' for stdin")->option_text("LOG");
@@ -345,6 +348,10 @@ int main(int argc, char** argv) {
     view = View::none;
   else if (!o.view.empty())
     fail(exit_code::bad_input, "--view", "'" + o.view + "' is not live, final or none");
+  std::vector<NamedPath> outputs = plot_outputs("--plot", o.plot);
+  outputs.insert(outputs.begin(), {{"--csv", o.csv}, {"--jsonl", o.jsonl}, {"--kalibr", o.kalibr}});
+  if (const auto conflict = output_conflict({{"LOG", o.log}}, outputs))
+    fail(exit_code::bad_input, conflict->what, conflict->why);
   if (!o.plot.empty()) {
     if (const std::string missing = plot_devices_missing(); !missing.empty()) fail(exit_code::bad_input, "--plot", missing);
     std::fclose(open_output(o.plot + ".svg.part"));  // fail now, not after hours of decoding
