@@ -294,6 +294,8 @@ int main(int argc, char** argv) {
       "  gyrochar-decode capture.log --node 0x10 --rate-unit deg/s --view final\n"
       "  gyrochar-decode --interface can0 --node 0x10 --duration 86400 --kalibr imu.yaml\n"
       "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
+      "The table shows one report per row: a value whose frame that report lost reads 'missing', as in\n"
+      "the CSV (one still awaited 'pending'), never the report before's.\n"
       "Malformed lines and rejected frames are counted and reported, not fatal; a log that is missing,\n"
       "unreadable, empty or without any candump line is bad input, and so is an output (--csv, --jsonl,\n"
       "--kalibr, --plot's files) that is the same file as LOG or as another output, through links too:\n"

@@ -150,6 +150,44 @@ TEST(DecodeOutput, TheDecodersSlotTableAndRowsTellMissingFromInvalidFromOk) {
   EXPECT_EQ(decoder.report(0x99), nullptr);  // never heard
 }
 
+// viewed_row's rule (rows.hpp), case by case: a row shows one report's values; the other is
+// missing (the report closed without it) or pending (the report is still being received).
+// Oracle: the rule as rows.hpp states it.
+TEST(DecodeOutput, ARowOfTheViewsShowsTheValuesOfOneReport) {
+  NodeView v = node_in(AngleUnit::arcsec);
+  v.status.tau_count = 1;
+  const auto row = [&](std::uint64_t adev_report, std::uint64_t mdev_report, std::uint64_t latest, bool open) {
+    v.taus[0].adev = {true, 1.0f, 0.0, NoiseType::white_fm, true, adev_report};
+    v.taus[0].mdev = {true, 1.0f, 0.0, NoiseType::white_fm, true, mdev_report};
+    v.report = latest;
+    v.report_open = open;
+    const ViewedRow r = viewed_row(v, 0);
+    return std::string(name(r.adev)) + "," + name(r.mdev);
+  };
+  EXPECT_EQ(row(3, 3, 3, false), "shown,shown");
+  EXPECT_EQ(row(3, 2, 3, false), "shown,missing");  // the MDEV frame of report 3 was lost
+  EXPECT_EQ(row(2, 3, 3, false), "missing,shown");
+  EXPECT_EQ(row(2, 2, 3, false), "missing,missing");  // both lost: report 2's values are not shown
+  EXPECT_EQ(row(3, 2, 3, true), "shown,pending");     // report 3's MDEV may still come
+  EXPECT_EQ(row(2, 2, 3, true), "shown,shown");       // report 3 has none of them yet: report 2's
+  EXPECT_EQ(row(2, 1, 3, true), "shown,missing");     // report 2 lost its MDEV
+  v.taus[0].mdev.received = false;                    // never received: nothing to show yet
+  v.report = 1;
+  v.report_open = true;
+  v.taus[0].adev.report = 1;
+  EXPECT_EQ(name(viewed_row(v, 0).mdev), std::string("pending"));
+  v.taus[0].adev.received = false;
+  EXPECT_EQ(name(viewed_row(v, 0).adev), std::string("shown"));  // shown as "-"
+  // The plot leaves a stale value out: report 3 closed without tau 0's MDEV.
+  v.sampling = MetaSamplingMsg{0, 0.125f, 8};
+  v.taus[0].m = 1;
+  row(3, 2, 3, false);
+  ConfidenceIntervals intervals(0.683);
+  const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals);
+  EXPECT_EQ(p.adev.size(), 1u);
+  EXPECT_EQ(p.mdev.size(), 0u);
+}
+
 TEST(DecodeOutput, PlotDrawsEachIeeeTermAsItsOwnLineAndReadsItOff) {
   // Parameters in arcsec and s; the rate unit deg/h is numerically arcsec/s, so every closed form
   // below is in the wire's numbers.
