@@ -296,7 +296,9 @@ int main(int argc, char** argv) {
       "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
       "The table shows one report per row: a value whose frame that report lost reads 'missing', as in\n"
       "the CSV (one still awaited 'pending'), never the report before's.\n"
-      "Malformed lines and rejected frames are counted and reported, not fatal; a log that is missing,\n"
+      "Malformed lines (among them lines longer than " + std::to_string(max_candump_line_bytes) +
+      " bytes), remote request (RTR) frames and rejected\n"
+      "frames are counted and reported, not fatal; a log that is missing,\n"
       "unreadable, empty or without any candump line is bad input, and so is an output (--csv, --jsonl,\n"
       "--kalibr, --plot's files) that is the same file as LOG or as another output, through links too:\n"
       "refused before anything is written.\n" +

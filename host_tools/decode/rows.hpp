@@ -109,6 +109,7 @@ struct InputCounters {
   std::uint64_t lines = 0;            // log lines read (a live interface has none)
   std::uint64_t malformed_lines = 0;  // lines that are not candump log lines (skipped)
   std::uint64_t frames = 0;           // frames given to the decoder
+  std::uint64_t remote_frames = 0;    // remote requests (RTR) in a log: no data, not decoded
   std::uint64_t time_backwards = 0;   // timestamps earlier than the latest (decoded at the latest)
   bool started = false;               // a frame has arrived
   double first_s = 0.0, now_s = 0.0;  // time of the first frame and the latest time

@@ -37,6 +37,7 @@ std::string input_text(const Decoder& decoder, const InputCounters& in) {
   if (in.lines > 0) s += fmt::format("{} lines, {} malformed line(s); ", in.lines, in.malformed_lines);
   s += fmt::format("{} frames: {} other traffic, {} rejected frames", in.frames, decoder.other_frames(),
                    decoder.rejected_frames());
+  if (in.remote_frames > 0) s += fmt::format(", {} remote requests (RTR: no data, not decoded)", in.remote_frames);
   if (in.time_backwards > 0) s += fmt::format(", {} timestamps backwards", in.time_backwards);
   if (in.started) s += fmt::format(", {:.1f} s", in.now_s - in.first_s);
   return s;

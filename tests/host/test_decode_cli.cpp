@@ -644,6 +644,28 @@ TEST(DecodeCli, MalformedLinesAndRejectedFramesAreCountedAndReportedWithExitZero
   for (const auto& row : csv.rows) expect_row(csv, row, log, {{n.address, n}}, 1.0);
 }
 
+// A remote request (RTR) with a node's Status identifier carries no data: counted and skipped, never
+// decoded as a report frame (it would read as a Status of TauCount 0: a restart). A line longer
+// than the limit is one malformed line, whatever its length. Oracle: the frames the test wrote.
+TEST(DecodeCli, RemoteRequestsAndOverlongLinesAreCountedAndSkipped) {
+  const NodeSpec n{0x33, 3, AngleUnit::arcsec, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 4; ++seq) log.report(n, seq, 20.0 + seq, 100u * (seq + 1));
+  log.raw(21.5, "(21.500000) can0 14FF4033#R8");
+  log.raw(22.5, "(22.500000) can0 18FF4133#" + std::string(3 << 20, '0'));  // 3 MB of "data"
+  const std::string path = log.write("remote.log"), csv_path = temp("remote.csv");
+  const Outcome r = run(path + " --view final --rate-unit native --csv " + csv_path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "malformed line: longer than 1024 bytes\n")) << r.err;
+  EXPECT_TRUE(contains(r.err, "1 malformed line(s)")) << r.err;
+  EXPECT_TRUE(contains(r.err, "1 remote requests (RTR: no data, not decoded)")) << r.err;
+  EXPECT_TRUE(contains(r.err, "reports 4 complete, 0 incomplete, 0 lost; frames missing 0; restarts 0;")) << r.err;
+  EXPECT_TRUE(contains(r.err, "rejected 0")) << r.err;
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 4u * 3);
+  for (const auto& row : csv.rows) expect_row(csv, row, log, {{n.address, n}}, 1.0);
+}
+
 TEST(DecodeCli, TruncatedLogClosesItsLastReportWithTheMissingFramesShown) {
   const NodeSpec n{0x41, 4, AngleUnit::arcsec, 0.01f};
   LogWriter log;

@@ -4,9 +4,11 @@
 // 1 h = 3600 s; the IEEE Std 952 AVAR terms of the design brief section 3), confidence.hpp
 // (Boost.Math chi-squared, NIST SP 1065 eq. 45) and values the test encodes with the codec.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -361,7 +363,7 @@ TEST(DecodeOutput, LineReaderGivesWholeLinesWhateverTheReads) {
   const std::string text = "a\r\nbb\n\n0123456789abcdefXY\nlast";
   ASSERT_EQ(write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
   close(fds[1]);
-  LineReader reader(fds[0], 8);  // lines longer than 8 bytes come in pieces
+  LineReader reader(fds[0], 8);  // a line longer than 8 bytes: its first 9 bytes, the rest skipped
   std::vector<std::string> lines;
   std::string_view line;
   for (LineReader::Result r; (r = reader.next(line)) != LineReader::Result::end;) {
@@ -369,8 +371,37 @@ TEST(DecodeOutput, LineReaderGivesWholeLinesWhateverTheReads) {
     if (r == LineReader::Result::line) lines.emplace_back(line);
   }
   close(fds[0]);
-  const std::vector<std::string> want{"a", "bb", "", "01234567", "89abcdef", "XY", "last"};
+  const std::vector<std::string> want{"a", "bb", "", "012345678", "last"};
   EXPECT_EQ(lines, want);
+}
+
+// A line of 5 MB, far longer than the reader's buffer, is skipped across many reads: the reader
+// returns its first max_candump_line_bytes + 1 bytes once, then the next line whole.
+TEST(DecodeOutput, LineReaderSkipsAnOverlongLineAcrossReads) {
+  const std::string path = ::testing::TempDir() + std::to_string(getpid()) + "_long_line.txt";
+  {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    const std::string chunk(1 << 20, 'x');
+    for (int k = 0; k < 5; ++k) std::fputs(chunk.c_str(), f);
+    std::fputs("\r\nnext\nlast", f);
+    std::fclose(f);
+  }
+  const int fd = open(path.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  LineReader reader(fd);
+  std::vector<std::string> lines;
+  std::string_view line;
+  for (LineReader::Result r; (r = reader.next(line)) != LineReader::Result::end;) {
+    ASSERT_NE(r, LineReader::Result::error);
+    if (r == LineReader::Result::line) lines.emplace_back(line);
+  }
+  close(fd);
+  std::remove(path.c_str());
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], std::string(max_candump_line_bytes + 1, 'x'));
+  EXPECT_EQ(lines[1], "next");
+  EXPECT_EQ(lines[2], "last");
 }
 
 }  // namespace
