@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "can_interface.hpp"
 #include "hal/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
 #include "output_paths.hpp"
@@ -335,6 +336,9 @@ int main(int argc, char** argv) {
   }
   if (o.log.empty() == o.interface.empty())
     fail(exit_code::bad_input, "options", "give either a LOG or --interface (see --help)");
+  if (!o.interface.empty())  // a name no interface can have is bad input; a missing one is hardware
+    if (const std::string problem = interface_name_problem(o.interface); !problem.empty())
+      fail(exit_code::bad_input, "--interface", "'" + o.interface + "': " + problem);
   const DisplayRate rate_unit = gyrochar::rate_unit(o.rate_unit);
   if (!rate_unit && o.rate_unit != "native")
     fail(exit_code::bad_input, "--rate-unit", "'" + o.rate_unit + "' is not deg/h, deg/s, rad/s or native");

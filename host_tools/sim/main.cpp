@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "can_interface.hpp"
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
 #include "gyrochar/protocol.hpp"
@@ -218,6 +219,9 @@ Examples:
   if (!(speed > 0) || !std::isfinite(speed)) return bad("--speed", "must be positive");
   if (can_interface.empty() && (app.count("--can-node") || app.count("--speed")))
     return bad("--can-node, --speed", "only apply with --can");
+  if (!can_interface.empty())  // a name no interface can have is bad input; a missing one is hardware
+    if (const std::string problem = interface_name_problem(can_interface); !problem.empty())
+      exit_with(exit_code::bad_input, program, "--can", "'" + can_interface + "': " + problem);
   if (!can_interface.empty() && !app.count("--out")) out.clear();  // frames only
   const GyroParameters p = gyro_parameters(o);
   std::unique_ptr<CounterInputSender> sender;

@@ -82,6 +82,21 @@ TEST(ToolErrors, SimulatorNamesWhatIsWrong) {
   EXPECT_EQ(run(bin + "gyrochar-sim --duration 1 --seed 18446744073709551615").code, exit_code::ok);
 }
 
+// A name Linux can never give an interface (17 characters > IFNAMSIZ - 1 = 15, '/', a space,
+// "..") is bad input; a possible name no interface has is missing hardware.
+TEST(ToolErrors, AnImpossibleInterfaceNameIsBadInputAMissingOneIsHardware) {
+  const int bad = exit_code::bad_input;
+  expect("gyrochar-sim", "--duration 1 --can abcdefghijklmnopq", bad,
+         "--can: 'abcdefghijklmnopq': an interface name has at most 15 characters, this one 17");
+  expect("gyrochar-sim", "--duration 1 --can can/0", bad, "--can: 'can/0': an interface name cannot hold '/'");
+  expect("gyrochar-sim", "--duration 1 --can ..", bad, "--can: '..': '.' and '..' are not interface names");
+  expect("gyrochar-decode", "--interface abcdefghijklmnopq", bad,
+         "--interface: 'abcdefghijklmnopq': an interface name has at most 15 characters, this one 17");
+  expect("gyrochar-decode", "--interface 'can 0'", bad, "--interface: 'can 0': an interface name cannot hold");
+  expect("gyrochar-sim", "--duration 1 --can abcdefghijklmno", exit_code::no_hardware, "abcdefghijklmno: ");
+  expect("gyrochar-decode", "--interface abcdefghijklmno", exit_code::no_hardware, "abcdefghijklmno: ");
+}
+
 TEST(ToolErrors, DemoGivesEachOptionRuleItsOwnMessage) {
   const int bad = exit_code::bad_input;
   expect("gyrochar-demo", "--bogus", bad, "options:");
