@@ -97,6 +97,21 @@ TEST(ToolErrors, AnImpossibleInterfaceNameIsBadInputAMissingOneIsHardware) {
   expect("gyrochar-decode", "--interface abcdefghijklmno", exit_code::no_hardware, "abcdefghijklmno: ");
 }
 
+// The reproducers, refused before any count is written, naming the term and the limit.
+// Oracle: the angle each term adds (sim_truth.hpp, worst_case_pulses) against 2^53 pulses.
+TEST(ToolErrors, SimulatorRefusesParametersBeyondItsCountRange) {
+  const int bad = exit_code::bad_input;
+  for (const std::string& args : {std::string("--duration 5 --tau0 1 --arw 1e20"),
+                                  std::string("--rate 1e9 --pulse-weight 1e-9")}) {
+    const Outcome r = run(bin + "gyrochar-sim " + args);
+    EXPECT_EQ(r.code, bad) << args << ": " << r.err;
+    const std::string option = args.find("--arw") != std::string::npos ? "--arw" : "--rate";
+    EXPECT_EQ(r.err.rfind("gyrochar-sim: " + option + ": the counted angle could reach ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("limit of 2^53"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "") << args << ": nothing written";
+  }
+}
+
 TEST(ToolErrors, DemoGivesEachOptionRuleItsOwnMessage) {
   const int bad = exit_code::bad_input;
   expect("gyrochar-demo", "--bogus", bad, "options:");
