@@ -297,12 +297,12 @@ int main(int argc, char** argv) {
       "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
       "The table shows one report per row: a value whose frame that report lost reads 'missing', as in\n"
       "the CSV (one still awaited 'pending'), never the report before's.\n"
-      "Malformed lines (among them lines longer than " + std::to_string(max_candump_line_bytes) +
-      " bytes), remote request (RTR) frames and rejected\n"
-      "frames are counted and reported, not fatal; a log that is missing,\n"
-      "unreadable, empty or without any candump line is bad input, and so is an output (--csv, --jsonl,\n"
-      "--kalibr, --plot's files) that is the same file as LOG or as another output, through links too:\n"
-      "refused before anything is written.\n" +
+      "Malformed lines (lines longer than " + std::to_string(max_candump_line_bytes) +
+      " bytes among them), remote request (RTR) frames and\n"
+      "rejected frames are counted and reported, not fatal. A log that is missing, unreadable, empty or\n"
+      "without any candump line is bad input, and so is an output (--csv, --jsonl, --kalibr, --plot's\n"
+      "files) that is the same file as LOG or as another output, through links too: refused before\n"
+      "anything is written.\n" +
       std::string(exit_code::help));
   Options o;
   app.add_option("log", o.log, "candump log file, or '-' for stdin")->option_text("LOG");
