@@ -26,6 +26,7 @@
 #include "datafile.hpp"
 #include "dynamic.hpp"
 #include "heat_map.hpp"
+#include "output_paths.hpp"
 #include "hal/exit_codes.hpp"
 
 namespace {
@@ -348,6 +349,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     bad("options", std::string(e.what()) + " (see --help)");
   }
+  std::vector<NamedPath> outputs = plot_outputs("--plot", plot_prefix);
+  outputs.insert(outputs.begin(), {"--kalibr", kalibr_path});
+  if (const auto conflict = output_conflict({{"file", path}}, outputs)) bad(conflict->what, conflict->why);
 
   try {
     // Options, checked before any data is read.

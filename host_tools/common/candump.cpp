@@ -40,6 +40,10 @@ bool parse_bytes(std::string_view hex, CanFrame& frame, std::size_t max_len, std
 
 bool parse_candump_line(std::string_view line, CandumpLine& out, std::string& why) {
   out = CandumpLine{};
+  if (line.size() > max_candump_line_bytes) {
+    why = fmt::format("longer than {} bytes", max_candump_line_bytes);
+    return false;
+  }
   while (!line.empty() && (line.back() == '\n' || line.back() == '\r' || line.back() == ' ')) line.remove_suffix(1);
   if (line.size() < 3 || line.front() != '(') {
     why = "does not start with a '(timestamp)'";

@@ -5,6 +5,7 @@
 //   (1436509052.249713) can0 18FF4101##1<up to 64 bytes>    CAN FD, first nibble = flags
 //   (1436509052.249713) can0 20000004#0004000000000000      error frame (CAN_ERR_FLAG in the id)
 // One parser for the decoder and the tests; malformed lines are rejected with a reason.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -13,6 +14,10 @@
 
 namespace gyrochar {
 
+/// The longest candump log line accepted, in bytes (without its newline): far above the longest
+/// line candump writes (a CAN FD frame of 64 bytes with a 15-character interface, about 180).
+inline constexpr std::size_t max_candump_line_bytes = 1024;
+
 struct CandumpLine {
   double time_s = 0.0;   // timestamp in seconds (as printed)
   std::string interface;
@@ -20,8 +25,10 @@ struct CandumpLine {
   bool remote = false;
 };
 
-/// Parses one line (no trailing newline needed). Returns false and sets `why` for a malformed line.
-/// O(line length); allocates only the interface name.
+/// Parses one line (no trailing newline needed). Returns false and sets `why` for a malformed line,
+/// a line longer than max_candump_line_bytes among them. A remote request (`123#R`, `#R8`) sets
+/// `remote` and the frame's length to its DLC, with no data. O(line length); allocates only the
+/// interface name.
 bool parse_candump_line(std::string_view line, CandumpLine& out, std::string& why);
 
 /// Formats a frame as a candump log line.

@@ -104,7 +104,7 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
           mark_slot(v, a, Slot::faults, 0);
         } else if constexpr (std::is_same_v<M, TauDevMsg>) {
           TauView::Dev& dev = msg.kind == DevKind::adev ? v.taus[msg.tau_index].adev : v.taus[msg.tau_index].mdev;
-          dev = {true, msg.dev_angle_per_s, msg.edf, msg.noise, msg.valid};
+          dev = {true, msg.dev_angle_per_s, msg.edf, msg.noise, msg.valid, v.report};
           mark_slot(v, a, msg.kind == DevKind::adev ? Slot::adev : Slot::mdev, msg.tau_index);
         } else if constexpr (std::is_same_v<M, TauTermsMsg>) {
           v.taus[msg.tau_index].n = msg.n;
@@ -204,6 +204,8 @@ void Decoder::open_report(NodeView& v, Assembly& a, std::uint8_t seq) {
       v.health.reports_lost += lost;
     }
   }
+  ++v.report;
+  v.report_open = true;
   a.open = true;
   a.seen = true;
   a.seq = seq;
@@ -237,6 +239,7 @@ void Decoder::layout(Assembly& a) {
 void Decoder::close_report(NodeView& v, Assembly& a) {
   if (!a.open) return;
   a.open = false;
+  v.report_open = false;
   const std::size_t frames = report_frame_count(a.seq, a.tau_count, a.version, a.window_taus);
   std::uint64_t missing = 0;
   for (std::size_t k = 0; k < frames && k < a.arrived.size(); ++k) missing += a.arrived[k] ? 0 : 1;

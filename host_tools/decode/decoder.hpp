@@ -30,6 +30,7 @@ struct TauView {
     double edf = 0.0;           // 0: not available
     protocol::NoiseType noise = protocol::NoiseType::not_identified;
     bool valid = false;
+    std::uint64_t report = 0;   // NodeView::report of the report it arrived in
   };
   Dev adev, mdev;
 };
@@ -77,6 +78,10 @@ struct NodeView {
   bool online = false;
   double last_frame_s = 0.0;
   std::uint32_t session = 0;            // +1 at every restart detected
+  /// The node's latest report of this session: its number (1 for the first, 0 before any) and
+  /// whether it is still being received. TauView::Dev::report says which report a value is from.
+  std::uint64_t report = 0;
+  bool report_open = false;
   // Latest status (fast cycle)
   bool have_status = false;
   protocol::StatusMsg status;

@@ -16,8 +16,10 @@
 #include <string>
 #include <vector>
 
+#include "can_interface.hpp"
 #include "hal/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
+#include "output_paths.hpp"
 #include "plot.hpp"
 #include "session.hpp"
 #include "view.hpp"
@@ -293,8 +295,14 @@ int main(int argc, char** argv) {
       "  gyrochar-decode capture.log --node 0x10 --rate-unit deg/s --view final\n"
       "  gyrochar-decode --interface can0 --node 0x10 --duration 86400 --kalibr imu.yaml\n"
       "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
-      "Malformed lines and rejected frames are counted and reported, not fatal; a log that is missing,\n"
-      "unreadable, empty or without any candump line is bad input.\n" +
+      "The table shows one report per row: a value whose frame that report lost reads 'missing', as in\n"
+      "the CSV (one still awaited 'pending'), never the report before's.\n"
+      "Malformed lines (lines longer than " + std::to_string(max_candump_line_bytes) +
+      " bytes among them), remote request (RTR) frames and\n"
+      "rejected frames are counted and reported, not fatal. A log that is missing, unreadable, empty or\n"
+      "without any candump line is bad input, and so is an output (--csv, --jsonl, --kalibr, --plot's\n"
+      "files) that is the same file as LOG or as another output, through links too: refused before\n"
+      "anything is written.\n" +
       std::string(exit_code::help));
   Options o;
   app.add_option("log", o.log, "candump log file, or '-' for stdin")->option_text("LOG");
@@ -328,6 +336,9 @@ int main(int argc, char** argv) {
   }
   if (o.log.empty() == o.interface.empty())
     fail(exit_code::bad_input, "options", "give either a LOG or --interface (see --help)");
+  if (!o.interface.empty())  // a name no interface can have is bad input; a missing one is hardware
+    if (const std::string problem = interface_name_problem(o.interface); !problem.empty())
+      fail(exit_code::bad_input, "--interface", "'" + o.interface + "': " + problem);
   const DisplayRate rate_unit = gyrochar::rate_unit(o.rate_unit);
   if (!rate_unit && o.rate_unit != "native")
     fail(exit_code::bad_input, "--rate-unit", "'" + o.rate_unit + "' is not deg/h, deg/s, rad/s or native");
@@ -345,6 +356,10 @@ int main(int argc, char** argv) {
     view = View::none;
   else if (!o.view.empty())
     fail(exit_code::bad_input, "--view", "'" + o.view + "' is not live, final or none");
+  std::vector<NamedPath> outputs = plot_outputs("--plot", o.plot);
+  outputs.insert(outputs.begin(), {{"--csv", o.csv}, {"--jsonl", o.jsonl}, {"--kalibr", o.kalibr}});
+  if (const auto conflict = output_conflict({{"LOG", o.log}}, outputs))
+    fail(exit_code::bad_input, conflict->what, conflict->why);
   if (!o.plot.empty()) {
     if (const std::string missing = plot_devices_missing(); !missing.empty()) fail(exit_code::bad_input, "--plot", missing);
     std::fclose(open_output(o.plot + ".svg.part"));  // fail now, not after hours of decoding

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include "gyrochar/ieee952.hpp"
 
@@ -63,8 +64,10 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
   for (std::size_t i = 0; i < node.status.tau_count && i < max_taus; ++i) {
     const double tau = node.tau_s(i);
     if (!(tau > 0)) continue;
-    for (auto [dev, series] : {std::pair{&node.taus[i].adev, &p.adev}, std::pair{&node.taus[i].mdev, &p.mdev}}) {
-      if (!dev->received || !dev->valid) continue;
+    const ViewedRow viewed = viewed_row(node, i);  // a stale value (its frame lost) is not drawn
+    for (auto [dev, series, shown] : {std::tuple{&node.taus[i].adev, &p.adev, viewed.adev == Viewed::shown},
+                                      std::tuple{&node.taus[i].mdev, &p.mdev, viewed.mdev == Viewed::shown}}) {
+      if (!shown || !dev->received || !dev->valid) continue;
       const double value = static_cast<double>(dev->dev) * u.rate;
       series->push_back({tau, value, intervals(value, dev->edf)});
       lo = std::min(lo, tau);

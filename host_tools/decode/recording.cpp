@@ -252,6 +252,7 @@ void JsonlWriter::summary(const Decoder& decoder, const InputCounters& input, co
             {"lines", input.lines},
             {"malformed_lines", input.malformed_lines},
             {"frames", input.frames},
+            {"remote_frames", input.remote_frames},
             {"other_frames", decoder.other_frames()},
             {"rejected_frames", decoder.rejected_frames()},
             {"time_backwards", input.time_backwards},

@@ -23,6 +23,28 @@ const char* name(DevCell::Status s) {
   return "invalid";
 }
 
+ViewedRow viewed_row(const NodeView& node, std::size_t i) {
+  const TauView& t = node.taus[i];
+  const std::uint64_t latest = node.report;
+  const auto from = [](const TauView::Dev& d, std::uint64_t report) { return d.received && d.report == report; };
+  const bool in_latest = from(t.adev, latest) || from(t.mdev, latest);
+  const std::uint64_t row = in_latest || !node.report_open || latest == 0 ? latest : latest - 1;
+  const auto viewed = [&](const TauView::Dev& d) {
+    if (row == 0 || from(d, row)) return Viewed::shown;
+    return row == latest && node.report_open ? Viewed::pending : Viewed::missing;
+  };
+  return {viewed(t.adev), viewed(t.mdev)};
+}
+
+const char* name(Viewed v) {
+  switch (v) {
+    case Viewed::shown: return "shown";
+    case Viewed::missing: return "missing";
+    case Viewed::pending: return "pending";
+  }
+  return "invalid";
+}
+
 namespace {
 
 DevCell dev_cell(const TauView::Dev& d, bool received, double rate, ConfidenceIntervals& intervals) {

@@ -44,6 +44,19 @@ struct DevCell {
 };
 const char* name(DevCell::Status s);
 
+/// How the views (the table, the plot) show one of tau i's ADEV and MDEV. A tau's row shows the
+/// values of one report, never two: the node's latest report once one of the row's values arrived
+/// in it, else (that report still being received) the report before. A value that is not from the
+/// row's report is not shown: `missing` (its frame was lost, as the CSV says) or, while the row's
+/// report is still being received, `pending`. `shown` includes a value never received (nothing
+/// to show yet). O(1).
+enum class Viewed : std::uint8_t { shown, missing, pending };
+struct ViewedRow {
+  Viewed adev = Viewed::shown, mdev = Viewed::shown;
+};
+ViewedRow viewed_row(const NodeView& node, std::size_t i);
+const char* name(Viewed v);
+
 struct TauRow {
   double time_s = 0.0;  // time of the report's first frame (log timestamp or clock)
   std::uint8_t node = 0;
@@ -96,6 +109,7 @@ struct InputCounters {
   std::uint64_t lines = 0;            // log lines read (a live interface has none)
   std::uint64_t malformed_lines = 0;  // lines that are not candump log lines (skipped)
   std::uint64_t frames = 0;           // frames given to the decoder
+  std::uint64_t remote_frames = 0;    // remote requests (RTR) in a log: no data, not decoded
   std::uint64_t time_backwards = 0;   // timestamps earlier than the latest (decoded at the latest)
   bool started = false;               // a frame has arrived
   double first_s = 0.0, now_s = 0.0;  // time of the first frame and the latest time

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -10,19 +11,29 @@ namespace gyrochar::decoding {
 // ---------------------------------------------------------------------------------------------
 // LineReader
 
-LineReader::LineReader(int fd, std::size_t buffer_bytes) : fd_(fd), buffer_(buffer_bytes) {}
+LineReader::LineReader(int fd, std::size_t max_line_bytes)
+    : fd_(fd), max_line_(max_line_bytes), buffer_(std::max<std::size_t>(max_line_bytes + 2, std::size_t{1} << 16)) {}
 
 LineReader::Result LineReader::next(std::string_view& line) {
   for (bool have_read = false;; have_read = true) {
+    if (skipping_) {  // the rest of an overlong line, up to its '\n': dropped
+      const auto* newline = static_cast<const char*>(std::memchr(buffer_.data() + begin_, '\n', end_ - begin_));
+      skipping_ = newline == nullptr;
+      begin_ = newline != nullptr ? static_cast<std::size_t>(newline - buffer_.data()) + 1 : end_;
+    }
     const char* begin = buffer_.data() + begin_;
     const std::size_t available = end_ - begin_;
-    const auto* newline = static_cast<const char*>(std::memchr(begin, '\n', available));
-    const bool full = begin_ == 0 && end_ == buffer_.size();
-    if (newline != nullptr || full || (eof_ && available > 0)) {
-      const std::size_t length = newline != nullptr ? static_cast<std::size_t>(newline - begin) : available;
+    const std::size_t whole = max_line_ + 1;  // a line and its '\n'
+    const auto* newline = static_cast<const char*>(std::memchr(begin, '\n', std::min(available, whole)));
+    const bool overlong = newline == nullptr && available > max_line_;
+    if (!skipping_ && (newline != nullptr || overlong || (eof_ && available > 0))) {
+      const std::size_t length = newline != nullptr ? static_cast<std::size_t>(newline - begin)
+                                 : overlong         ? whole
+                                                    : available;
       line = std::string_view(begin, length);
-      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      if (!overlong && !line.empty() && line.back() == '\r') line.remove_suffix(1);
       begin_ += newline != nullptr ? length + 1 : length;
+      skipping_ = overlong;
       return Result::line;
     }
     if (eof_) return Result::end;
@@ -58,6 +69,10 @@ bool Session::feed_line(std::string_view line, std::string& why) {
   if (!parse_candump_line(line, parsed_, why)) {
     ++input_.malformed_lines;
     return false;
+  }
+  if (parsed_.remote) {  // a request for data, not data: its DLC is not a payload to decode
+    ++input_.remote_frames;
+    return true;
   }
   feed(parsed_.frame, parsed_.time_s);
   return true;

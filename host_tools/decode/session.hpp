@@ -19,9 +19,10 @@ namespace gyrochar::decoding {
 /// Reads lines from a file descriptor it does not own, in large blocks (no per-line system call).
 class LineReader {
  public:
-  /// `fd` open for reading; `buffer_bytes` is the longest line kept whole (longer lines come out
-  /// cut in pieces, which the candump parser rejects). Allocates the buffer once.
-  explicit LineReader(int fd, std::size_t buffer_bytes = std::size_t{1} << 20);
+  /// `fd` open for reading; `max_line_bytes` is the longest line returned whole: a longer one
+  /// comes out once, as its first max_line_bytes + 1 bytes (so the caller sees it is too long),
+  /// and the rest of it up to its '\n' is skipped, never held. Allocates the buffer once.
+  explicit LineReader(int fd, std::size_t max_line_bytes = max_candump_line_bytes);
   enum class Result { line, again, end, error };
   /// The next line, without its '\n' (and '\r'). `line` stays valid until the next call. Calls
   /// read() at most once, so that the caller can poll() or check a stop flag in between:
@@ -32,9 +33,11 @@ class LineReader {
 
  private:
   int fd_;
+  std::size_t max_line_;
   std::vector<char> buffer_;
   std::size_t begin_ = 0, end_ = 0;
   bool eof_ = false;
+  bool skipping_ = false;  // inside an overlong line, after its first part
 };
 
 struct SessionOptions {
@@ -53,7 +56,7 @@ class Session {
   Session& operator=(const Session&) = delete;
 
   /// One candump log line, decoded at its own timestamp. A malformed line is counted and skipped:
-  /// returns false and says why. Allocates nothing per line once warmed up (rows are reused).
+  /// returns false and says why. A remote request (RTR) frame is counted and skipped. Allocates nothing per line once warmed up (rows are reused).
   bool feed_line(std::string_view line, std::string& why);
   /// One frame at t_s (seconds). A time earlier than the latest is counted and decoded at the
   /// latest (the decoder's time never goes backwards). Amortized O(1) per frame plus O(taus) per

@@ -37,12 +37,14 @@ std::string input_text(const Decoder& decoder, const InputCounters& in) {
   if (in.lines > 0) s += fmt::format("{} lines, {} malformed line(s); ", in.lines, in.malformed_lines);
   s += fmt::format("{} frames: {} other traffic, {} rejected frames", in.frames, decoder.other_frames(),
                    decoder.rejected_frames());
+  if (in.remote_frames > 0) s += fmt::format(", {} remote requests (RTR: no data, not decoded)", in.remote_frames);
   if (in.time_backwards > 0) s += fmt::format(", {} timestamps backwards", in.time_backwards);
   if (in.started) s += fmt::format(", {:.1f} s", in.now_s - in.first_s);
   return s;
 }
 
-std::string dev_text(const TauView::Dev& d, double rate, ConfidenceIntervals& intervals) {
+std::string dev_text(const TauView::Dev& d, Viewed viewed, double rate, ConfidenceIntervals& intervals) {
+  if (viewed != Viewed::shown) return fmt::format("{:>11}  {:24}", name(viewed), "");
   if (!d.received || !d.valid) return fmt::format("{:>11}  {:24}", "-", "");
   const double value = static_cast<double>(d.dev) * rate;
   const Interval ci = intervals(value, d.edf);
@@ -157,13 +159,16 @@ void node_view(std::string& s, const NodeView& v, const DisplayRate& rate, Confi
                  "MDEV", level, "EDF MDEV", "noise");
   for (std::size_t i = 0; i < v.status.tau_count && i < max_taus; ++i) {
     const TauView& t = v.taus[i];
+    const ViewedRow viewed = viewed_row(v, i);
     const std::string tau = t.m && v.sampling ? fmt::format("{:.4g}", v.tau_s(i)) : fmt::format("#{}", i);
     const std::string n = t.n ? fmt::format("{}", t.n) : "-";
-    const std::string edf = t.mdev.received && t.mdev.edf > 0 ? fmt::format("{:.4g}", t.mdev.edf) : "-";
-    std::string noise = t.adev.received ? name(t.adev.noise) : "-";
-    if (t.mdev.received && t.mdev.noise != t.adev.noise) noise += fmt::format(" / {} (MDEV)", name(t.mdev.noise));
-    fmt::format_to(out, "  {:>11} {:>13}  {}  {}  {:>9}  {}\n", tau, n, dev_text(t.adev, u.rate, intervals),
-                   dev_text(t.mdev, u.rate, intervals), edf, noise);
+    const bool adev = t.adev.received && viewed.adev == Viewed::shown;
+    const bool mdev = t.mdev.received && viewed.mdev == Viewed::shown;
+    const std::string edf = mdev && t.mdev.edf > 0 ? fmt::format("{:.4g}", t.mdev.edf) : "-";
+    std::string noise = adev ? name(t.adev.noise) : "-";
+    if (mdev && (!adev || t.mdev.noise != t.adev.noise)) noise += fmt::format(" / {} (MDEV)", name(t.mdev.noise));
+    fmt::format_to(out, "  {:>11} {:>13}  {}  {}  {:>9}  {}\n", tau, n, dev_text(t.adev, viewed.adev, u.rate, intervals),
+                   dev_text(t.mdev, viewed.mdev, u.rate, intervals), edf, noise);
   }
   ieee952_view(s, v, u, truth);
   window_view(s, v, u);

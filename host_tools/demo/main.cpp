@@ -21,6 +21,7 @@
 
 #include "board.hpp"
 #include "candump.hpp"
+#include "output_paths.hpp"
 #include "plot.hpp"
 #include "session.hpp"
 #include "view.hpp"
@@ -60,7 +61,9 @@ int main(int argc, char** argv) {
                "on a virtual clock.",
                "gyrochar-demo"};
   app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n"
-             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n\n" +
+             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n\n"
+             "Two outputs (--csv, --candump, --plot's files) that are the same file, through links too, are\n"
+             "refused (bad input) before anything is written.\n" +
              std::string(exit_code::help));
   double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30, window_min = 30;
   unsigned nodes = 2, octaves = 20;
@@ -99,6 +102,9 @@ int main(int argc, char** argv) {
   if (!plot_prefix.empty()) {
     if (const std::string why = decoding::plot_devices_missing(); !why.empty()) bad("--plot", why);
   }
+  std::vector<NamedPath> outputs = plot_outputs("--plot", plot_prefix);
+  outputs.insert(outputs.begin(), {{"--csv", csv_path}, {"--candump", candump_path}});
+  if (const auto conflict = output_conflict({}, outputs)) bad(conflict->what, conflict->why);
   FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "w");
   if (!csv_path.empty() && csv == nullptr) exit_with(exit_code::output_failed, program, csv_path, std::strerror(errno));
   FILE* candump = nullptr;

@@ -1,6 +1,8 @@
 #include "gyro_sim.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
 
 namespace gyrochar {
 
@@ -105,7 +107,15 @@ std::int64_t GyroSimulator::next_count() {
   double observed = angle_ + p_.q_rad * normal_(rng_);
   if (p_.dither_amplitude_rad != 0)
     observed += p_.dither_amplitude_rad * std::sin(2.0 * units::pi * p_.dither_frequency_hz * static_cast<double>(k_) * dt);
-  const auto total = static_cast<std::int64_t>(std::floor(observed / p_.pulse_weight_rad));
+  const double pulses = std::floor(observed / p_.pulse_weight_rad);
+  if (!(std::fabs(pulses) <= max_pulse_total))
+  {
+    char why[160];
+    std::snprintf(why, sizeof why, "sample %llu: the angle reached %.4g pulses, beyond the simulator's 2^53 (counts "
+                  "exact in a double)", static_cast<unsigned long long>(k_), pulses);
+    throw std::overflow_error(why);
+  }
+  const auto total = static_cast<std::int64_t>(pulses);
   const std::int64_t count = total - pulses_;
   pulses_ = total;
   return count;

@@ -48,6 +48,12 @@
 
 namespace gyrochar {
 
+/// The largest pulse total (the observed angle in pulses, at any sample) the simulator counts:
+/// 2^53, up to which a double holds every whole pulse, so no count is rounded (and far inside the
+/// int64 range of the counts). check_parameters (sim_truth.hpp) refuses runs that could pass it;
+/// next_count throws rather than emit a count beyond it.
+inline constexpr double max_pulse_total = 0x1p53;
+
 /// Top corner of the flicker band times tau0 (0.34 / tau0, below the Nyquist frequency 0.5 / tau0):
 /// the value that keeps the ADEV floor flattest from 4 tau0 on (docs/metrology.md).
 inline constexpr double flicker_top_corner = 0.34;
@@ -91,7 +97,9 @@ class GyroSimulator {
   /// state per Gauss-Markov and sinusoidal term; nothing afterwards. Expects tau0_s > 0, pulse_weight_rad > 0 and bias_time_s > tau0_s when b_rad_s > 0
   /// (gyrochar-sim checks its options; see check_parameters in sim_truth.hpp).
   explicit GyroSimulator(const GyroParameters& p);
-  /// Pulses in the next tau0 interval. O(flicker processes + terms), no allocation.
+  /// Pulses in the next tau0 interval. O(flicker processes + terms), no allocation. Throws
+  /// std::overflow_error, saying at which sample, when the observed angle is not finite or beyond
+  /// max_pulse_total pulses: never a wrapped or rounded count.
   std::int64_t next_count();
   /// From the next interval on: the input rate, white angle noise, angle random walk and rate random
   /// walk of `p` (its other parameters are ignored). The angle, the rate random walk's rate, the

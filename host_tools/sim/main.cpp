@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "can_interface.hpp"
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
 #include "gyrochar/protocol.hpp"
@@ -125,6 +126,11 @@ order): NAME is rate (deg/h), white-angle (arcsec), arw (deg/sqrt(h)) or rrw (de
 other parameters stay, and nothing restarts (the angle and the noise processes carry over). The
 truth line then has format 2 and lists the segments.
 
+Range: the counts are exact integers while the angle stays within 2^53 pulses. Parameters whose
+angle could pass it over the run (the rate and ramp as given, the noise terms at 10 standard
+deviations, e.g. --rate 1e9 --pulse-weight 1e-9) are refused up front, naming the largest term;
+a run that passes it all the same stops with an error, never a wrapped count.
+
 Output: two '#' header lines, then one count per line. The first describes the run; the second,
 "# gyrochar-sim truth: key=value ...", repeats every parameter and the IEEE-952 truth (Q arcsec,
 N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h/h, Q_white yes/no) and, when there are some, the
@@ -218,6 +224,9 @@ Examples:
   if (!(speed > 0) || !std::isfinite(speed)) return bad("--speed", "must be positive");
   if (can_interface.empty() && (app.count("--can-node") || app.count("--speed")))
     return bad("--can-node, --speed", "only apply with --can");
+  if (!can_interface.empty())  // a name no interface can have is bad input; a missing one is hardware
+    if (const std::string problem = interface_name_problem(can_interface); !problem.empty())
+      exit_with(exit_code::bad_input, program, "--can", "'" + can_interface + "': " + problem);
   if (!can_interface.empty() && !app.count("--out")) out.clear();  // frames only
   const GyroParameters p = gyro_parameters(o);
   std::unique_ptr<CounterInputSender> sender;
@@ -236,7 +245,13 @@ Examples:
   SimRun sim(o);
   if (sender) sender->send_next(0);  // the start: Count 0
   for (std::uint64_t k = 0; k < sim.samples(); ++k) {
-    const std::int64_t count = sim.next_count();
+    std::int64_t count = 0;
+    try {
+      count = sim.next_count();
+    } catch (const std::overflow_error& e) {  // beyond what check_parameters allowed for (> 10 sigma)
+      if (f != nullptr && f != stdout) std::fclose(f);
+      exit_with(exit_code::bad_input, program, "counts", std::string(e.what()) + "; the output stops before it");
+    }
     if (f != nullptr) {
       std::fprintf(f, "%lld\n", static_cast<long long>(count));
       if ((k & 0xFFFF) == 0 && std::ferror(f)) break;  // the output is lost: stop now, say so below

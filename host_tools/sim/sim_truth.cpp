@@ -149,7 +149,61 @@ std::optional<ParameterProblem> check_parameters(const SimOptions& o) {
     if (const auto problem = check_parameters(segment_options(o, i + 1)))
       return ParameterProblem{"--segment", problem->why};
   }
+  if (const PulseReach reach = worst_case_pulses(o); !(reach.total <= max_pulse_total)) {
+    char why[400];
+    std::snprintf(why, sizeof why,
+                  "the counted angle could reach %.3g pulses over the run (%.3g from this option; random terms at "
+                  "%g sigma), beyond the simulator's limit of 2^53 = %.4g pulses (counts exact): shorten --duration, "
+                  "raise --pulse-weight or lower the rates and noise",
+                  reach.total, reach.largest, range_sigmas, max_pulse_total);
+    return ParameterProblem{reach.largest_what, why};
+  }
   return std::nullopt;
+}
+
+PulseReach worst_case_pulses(const SimOptions& o) {
+  const double t = std::round(o.duration_s / o.tau0_s) * o.tau0_s, s = range_sigmas;
+  double rate = 0, q = 0, n = 0, k = 0;  // every segment's largest level, SI
+  for (std::size_t i = 0; i <= o.segments.size(); ++i) {
+    const GyroParameters p = gyro_parameters(segment_options(o, i));
+    rate = std::max(rate, std::fabs(p.rate_rad_s));
+    q = std::max(q, p.q_rad);
+    n = std::max(n, p.n_rad_sqrt_s);
+    k = std::max(k, p.k_rad_s_sqrt_s);
+  }
+  const GyroParameters p = gyro_parameters(o);
+  double flicker_variance = 0;  // the octave processes of gyro_sim.cpp, B^2 ln 2 / pi each
+  if (p.b_rad_s > 0)
+    for (double f = flicker_top_corner / p.tau0_s;; f *= 0.5) {
+      flicker_variance += p.b_rad_s * p.b_rad_s * std::log(2.0) / units::pi;
+      if (f <= 1.0 / (2.0 * units::pi * p.bias_time_s)) break;
+    }
+  double markov = 0, sinusoids = 0;
+  for (const MarkovRate& m : p.markov) markov += s * m.sigma_rad_s * t;
+  for (const SinusoidRate& g : p.sinusoids) sinusoids += g.amplitude_rad_s / (units::pi * g.frequency_hz);
+  const std::pair<const char*, double> terms[] = {
+      {"--rate", rate * t},
+      {"--ramp", p.r_rad_s2 * t * t / 2},
+      {"--dither", p.dither_amplitude_rad},
+      {"--white-angle", s * q},
+      {"--arw", s * n * std::sqrt(t)},
+      {"--rrw", s * k * t * std::sqrt(t / 3)},
+      {"--bias-instability", s * std::sqrt(flicker_variance) * t},
+      {"--markov", markov},
+      {"--sinusoid", sinusoids},
+  };
+  PulseReach reach;
+  for (const auto& [what, rad] : terms) {
+    if (std::isnan(rad)) continue;  // 0 x inf: a term that is absent
+    const double pulses = rad / p.pulse_weight_rad;
+    reach.total += pulses;
+    if (!(pulses <= reach.largest)) {  // NaN too
+      reach.largest = pulses;
+      reach.largest_what = what;
+    }
+  }
+  if (reach.largest_what[0] == '\0') reach.largest_what = "--duration";
+  return reach;
 }
 
 SimOptions segment_options(const SimOptions& o, std::size_t i) {

@@ -126,9 +126,26 @@ struct ParameterProblem {
 /// increasing order inside the run (tau0 <= start < duration), each changing something, each
 /// segment's options as valid; at most max_rate_terms Gauss-Markov terms, each with
 /// 0 < sigma <= 10^9 deg/h and 0 < Tc finite, and at most max_rate_terms sinusoids, each with
-/// 0 <= amplitude <= 10^9 deg/h and 0 < frequency < 1 / (2 tau0) (the Nyquist frequency).
-/// O(segments + terms). Allocates the message.
+/// 0 <= amplitude <= 10^9 deg/h and 0 < frequency < 1 / (2 tau0) (the Nyquist frequency); and
+/// the pulse total within reach: worst_case_pulses <= max_pulse_total (2^53), the problem then
+/// naming the largest contribution's option. O(segments + terms). Allocates the message.
 std::optional<ParameterProblem> check_parameters(const SimOptions& o);
+
+/// How far the observed angle of a run of `o` can get from 0, in pulses, term by term, each at
+/// its worst over the whole run (every segment's largest level): the input rate |rate| T, the ramp
+/// R T^2 / 2, the dither amplitude, and at range_sigmas standard deviations the white angle
+/// noise q, the angle random walk N sqrt(T), the rate random walk K T^1.5 / sqrt(3), the bias
+/// instability's rate times T (its octave processes' summed variance) and each Gauss-Markov
+/// term's, sigma T; each sinusoid's angle amplitude A / (pi f). T = samples x tau0.
+struct PulseReach {
+  double total = 0;              // the sum of the terms, in pulses
+  double largest = 0;            // the largest term, in pulses
+  const char* largest_what = "";  // its option ("--rate", "--arw", ...)
+};
+/// Standard deviations of reach for the random terms: a normal draw exceeds 10 sigma with
+/// probability 1.5e-23, so 10^12 samples pass it with probability below 10^-10.
+inline constexpr double range_sigmas = 10.0;
+PulseReach worst_case_pulses(const SimOptions& o);
 
 /// The simulator's parameters (SI) for `o`. O(1).
 GyroParameters gyro_parameters(const SimOptions& o);

@@ -85,5 +85,22 @@ TEST(Candump, MalformedLinesAreRejectedWithAReason) {
   EXPECT_FALSE(parse_error("(1e300) can0 18FF4101#00").empty());                     // absurd time
 }
 
+TEST(Candump, RemoteRequestsCarryALengthAndNoData) {
+  const auto r = parse_ok("(1.5) can0 14FF4010#R8");  // the reproducer: a DLC, no data
+  EXPECT_TRUE(r.remote);
+  EXPECT_EQ(r.frame.len, 8);
+  EXPECT_TRUE(r.frame.extended);
+  EXPECT_FALSE(parse_ok("(1.5) can0 14FF4010#0000000000000000").remote);
+}
+
+// A line longer than max_candump_line_bytes is malformed whatever it holds (here a valid frame
+// and trailing spaces); one of exactly the limit is parsed.
+TEST(Candump, LinesLongerThanTheLimitAreRejected) {
+  const std::string frame = "(1.0) can0 18FF4101#00";
+  EXPECT_EQ(parse_error(frame + std::string(max_candump_line_bytes + 1 - frame.size(), ' ')),
+            "longer than 1024 bytes");
+  parse_ok(frame + std::string(max_candump_line_bytes - frame.size(), ' '));
+}
+
 }  // namespace
 }  // namespace gyrochar

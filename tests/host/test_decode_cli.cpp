@@ -552,6 +552,55 @@ TEST(DecodeCli, LostFramesAndReportsAreShownNeverPaperedOver) {
   EXPECT_EQ(health.at("frames_missing"), 1);
 }
 
+// The row of tau `tau` (as the view prints it) in a node's section of the view; empty if none.
+std::string view_row(const std::string& section, const std::string& tau) {
+  std::stringstream ss(section);
+  for (std::string line; std::getline(ss, line);) {
+    std::stringstream words(line);
+    std::string first;
+    if (words >> first && first == tau) return line;
+  }
+  return "";
+}
+
+std::string e4(double value) {  // the view's format of a deviation: {:.4e}
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4e", value);
+  return b;
+}
+
+TEST(DecodeCli, TheTableNeverShowsValuesOfTwoReportsInOneRow) {
+  // The MDEV frame of tau 1 of the last report is lost: the table shows that report's ADEV beside
+  // "missing", as the CSV says, never the report before's MDEV.
+  const NodeSpec n{0x32, 4, AngleUnit::arcsec, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 6; ++seq)
+    log.report(n, seq, 10.0 + seq, 100u * (seq + 1),
+               [&](const ReportSlot& s) { return seq == 5 && s.slot == Slot::mdev && s.index == 1; });
+  const std::string csv_path = temp("row.csv");
+  const Outcome r = run(log.write("row.log") + " --view final --rate-unit native --csv " + csv_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string section = node_section(r.out, n.address);
+  // Oracle: the values the test encoded (adev_of, mdev_of); tau of index i is tau0 2^i.
+  const std::string row = view_row(section, "0.02");
+  ASSERT_FALSE(row.empty()) << section;
+  EXPECT_TRUE(contains(row, e4(adev_of(n, 5, 1)))) << row;
+  EXPECT_TRUE(contains(row, "missing")) << row;
+  EXPECT_FALSE(contains(row, e4(mdev_of(n, 4, 1)))) << "the previous report's MDEV:\n" << row;
+  for (const std::string tau : {"0.01", "0.04", "0.08"}) {  // the other rows: the last report, whole
+    const std::string other = view_row(section, tau);
+    const std::size_t i = tau == "0.01" ? 0 : tau == "0.04" ? 2 : 3;
+    EXPECT_TRUE(contains(other, e4(adev_of(n, 5, i))) && contains(other, e4(mdev_of(n, 5, i)))) << other;
+    EXPECT_FALSE(contains(other, "missing")) << other;
+  }
+  const Csv csv = read_csv(csv_path);
+  for (const auto& line : csv.rows) {
+    if (csv.get(line, "seq") == "5" && csv.get(line, "tau_index") == "1") {
+      EXPECT_EQ(csv.get(line, "mdev_status"), "missing");
+    }
+  }
+}
+
 TEST(DecodeCli, MalformedLinesAndRejectedFramesAreCountedAndReportedWithExitZero) {
   const NodeSpec n{0x40, 3, AngleUnit::arcsec, 0.01f};
   LogWriter log;
@@ -592,6 +641,28 @@ TEST(DecodeCli, MalformedLinesAndRejectedFramesAreCountedAndReportedWithExitZero
   EXPECT_TRUE(contains(r.out, "4 malformed line(s)")) << "the view shows them too:\n" << r.out;
   const Csv csv = read_csv(csv_path);
   ASSERT_EQ(csv.rows.size(), 4u * 3);  // every report decoded despite the bad lines
+  for (const auto& row : csv.rows) expect_row(csv, row, log, {{n.address, n}}, 1.0);
+}
+
+// A remote request (RTR) with a node's Status identifier carries no data: counted and skipped, never
+// decoded as a report frame (it would read as a Status of TauCount 0: a restart). A line longer
+// than the limit is one malformed line, whatever its length. Oracle: the frames the test wrote.
+TEST(DecodeCli, RemoteRequestsAndOverlongLinesAreCountedAndSkipped) {
+  const NodeSpec n{0x33, 3, AngleUnit::arcsec, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 4; ++seq) log.report(n, seq, 20.0 + seq, 100u * (seq + 1));
+  log.raw(21.5, "(21.500000) can0 14FF4033#R8");
+  log.raw(22.5, "(22.500000) can0 18FF4133#" + std::string(3 << 20, '0'));  // 3 MB of "data"
+  const std::string path = log.write("remote.log"), csv_path = temp("remote.csv");
+  const Outcome r = run(path + " --view final --rate-unit native --csv " + csv_path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "malformed line: longer than 1024 bytes\n")) << r.err;
+  EXPECT_TRUE(contains(r.err, "1 malformed line(s)")) << r.err;
+  EXPECT_TRUE(contains(r.err, "1 remote requests (RTR: no data, not decoded)")) << r.err;
+  EXPECT_TRUE(contains(r.err, "reports 4 complete, 0 incomplete, 0 lost; frames missing 0; restarts 0;")) << r.err;
+  EXPECT_TRUE(contains(r.err, "rejected 0")) << r.err;
+  const Csv csv = read_csv(csv_path);
+  ASSERT_EQ(csv.rows.size(), 4u * 3);
   for (const auto& row : csv.rows) expect_row(csv, row, log, {{n.address, n}}, 1.0);
 }
 

@@ -4,9 +4,11 @@
 // 1 h = 3600 s; the IEEE Std 952 AVAR terms of the design brief section 3), confidence.hpp
 // (Boost.Math chi-squared, NIST SP 1065 eq. 45) and values the test encodes with the codec.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -148,6 +150,44 @@ TEST(DecodeOutput, TheDecodersSlotTableAndRowsTellMissingFromInvalidFromOk) {
   EXPECT_EQ(decoder.report(0x12)->start_s, 11.0);
   EXPECT_FALSE(decoder.report(0x12)->received(Slot::adev, 0));
   EXPECT_EQ(decoder.report(0x99), nullptr);  // never heard
+}
+
+// viewed_row's rule (rows.hpp), case by case: a row shows one report's values; the other is
+// missing (the report closed without it) or pending (the report is still being received).
+// Oracle: the rule as rows.hpp states it.
+TEST(DecodeOutput, ARowOfTheViewsShowsTheValuesOfOneReport) {
+  NodeView v = node_in(AngleUnit::arcsec);
+  v.status.tau_count = 1;
+  const auto row = [&](std::uint64_t adev_report, std::uint64_t mdev_report, std::uint64_t latest, bool open) {
+    v.taus[0].adev = {true, 1.0f, 0.0, NoiseType::white_fm, true, adev_report};
+    v.taus[0].mdev = {true, 1.0f, 0.0, NoiseType::white_fm, true, mdev_report};
+    v.report = latest;
+    v.report_open = open;
+    const ViewedRow r = viewed_row(v, 0);
+    return std::string(name(r.adev)) + "," + name(r.mdev);
+  };
+  EXPECT_EQ(row(3, 3, 3, false), "shown,shown");
+  EXPECT_EQ(row(3, 2, 3, false), "shown,missing");  // the MDEV frame of report 3 was lost
+  EXPECT_EQ(row(2, 3, 3, false), "missing,shown");
+  EXPECT_EQ(row(2, 2, 3, false), "missing,missing");  // both lost: report 2's values are not shown
+  EXPECT_EQ(row(3, 2, 3, true), "shown,pending");     // report 3's MDEV may still come
+  EXPECT_EQ(row(2, 2, 3, true), "shown,shown");       // report 3 has none of them yet: report 2's
+  EXPECT_EQ(row(2, 1, 3, true), "shown,missing");     // report 2 lost its MDEV
+  v.taus[0].mdev.received = false;                    // never received: nothing to show yet
+  v.report = 1;
+  v.report_open = true;
+  v.taus[0].adev.report = 1;
+  EXPECT_EQ(name(viewed_row(v, 0).mdev), std::string("pending"));
+  v.taus[0].adev.received = false;
+  EXPECT_EQ(name(viewed_row(v, 0).adev), std::string("shown"));  // shown as "-"
+  // The plot leaves a stale value out: report 3 closed without tau 0's MDEV.
+  v.sampling = MetaSamplingMsg{0, 0.125f, 8};
+  v.taus[0].m = 1;
+  row(3, 2, 3, false);
+  ConfidenceIntervals intervals(0.683);
+  const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals);
+  EXPECT_EQ(p.adev.size(), 1u);
+  EXPECT_EQ(p.mdev.size(), 0u);
 }
 
 TEST(DecodeOutput, PlotDrawsEachIeeeTermAsItsOwnLineAndReadsItOff) {
@@ -323,7 +363,7 @@ TEST(DecodeOutput, LineReaderGivesWholeLinesWhateverTheReads) {
   const std::string text = "a\r\nbb\n\n0123456789abcdefXY\nlast";
   ASSERT_EQ(write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
   close(fds[1]);
-  LineReader reader(fds[0], 8);  // lines longer than 8 bytes come in pieces
+  LineReader reader(fds[0], 8);  // a line longer than 8 bytes: its first 9 bytes, the rest skipped
   std::vector<std::string> lines;
   std::string_view line;
   for (LineReader::Result r; (r = reader.next(line)) != LineReader::Result::end;) {
@@ -331,8 +371,37 @@ TEST(DecodeOutput, LineReaderGivesWholeLinesWhateverTheReads) {
     if (r == LineReader::Result::line) lines.emplace_back(line);
   }
   close(fds[0]);
-  const std::vector<std::string> want{"a", "bb", "", "01234567", "89abcdef", "XY", "last"};
+  const std::vector<std::string> want{"a", "bb", "", "012345678", "last"};
   EXPECT_EQ(lines, want);
+}
+
+// A line of 5 MB, far longer than the reader's buffer, is skipped across many reads: the reader
+// returns its first max_candump_line_bytes + 1 bytes once, then the next line whole.
+TEST(DecodeOutput, LineReaderSkipsAnOverlongLineAcrossReads) {
+  const std::string path = ::testing::TempDir() + std::to_string(getpid()) + "_long_line.txt";
+  {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    const std::string chunk(1 << 20, 'x');
+    for (int k = 0; k < 5; ++k) std::fputs(chunk.c_str(), f);
+    std::fputs("\r\nnext\nlast", f);
+    std::fclose(f);
+  }
+  const int fd = open(path.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  LineReader reader(fd);
+  std::vector<std::string> lines;
+  std::string_view line;
+  for (LineReader::Result r; (r = reader.next(line)) != LineReader::Result::end;) {
+    ASSERT_NE(r, LineReader::Result::error);
+    if (r == LineReader::Result::line) lines.emplace_back(line);
+  }
+  close(fd);
+  std::remove(path.c_str());
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], std::string(max_candump_line_bytes + 1, 'x'));
+  EXPECT_EQ(lines[1], "next");
+  EXPECT_EQ(lines[2], "last");
 }
 
 }  // namespace

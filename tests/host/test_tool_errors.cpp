@@ -82,6 +82,36 @@ TEST(ToolErrors, SimulatorNamesWhatIsWrong) {
   EXPECT_EQ(run(bin + "gyrochar-sim --duration 1 --seed 18446744073709551615").code, exit_code::ok);
 }
 
+// A name Linux can never give an interface (17 characters > IFNAMSIZ - 1 = 15, '/', a space,
+// "..") is bad input; a possible name no interface has is missing hardware.
+TEST(ToolErrors, AnImpossibleInterfaceNameIsBadInputAMissingOneIsHardware) {
+  const int bad = exit_code::bad_input;
+  expect("gyrochar-sim", "--duration 1 --can abcdefghijklmnopq", bad,
+         "--can: 'abcdefghijklmnopq': an interface name has at most 15 characters, this one 17");
+  expect("gyrochar-sim", "--duration 1 --can can/0", bad, "--can: 'can/0': an interface name cannot hold '/'");
+  expect("gyrochar-sim", "--duration 1 --can ..", bad, "--can: '..': '.' and '..' are not interface names");
+  expect("gyrochar-decode", "--interface abcdefghijklmnopq", bad,
+         "--interface: 'abcdefghijklmnopq': an interface name has at most 15 characters, this one 17");
+  expect("gyrochar-decode", "--interface 'can 0'", bad, "--interface: 'can 0': an interface name cannot hold");
+  expect("gyrochar-sim", "--duration 1 --can abcdefghijklmno", exit_code::no_hardware, "abcdefghijklmno: ");
+  expect("gyrochar-decode", "--interface abcdefghijklmno", exit_code::no_hardware, "abcdefghijklmno: ");
+}
+
+// The reproducers, refused before any count is written, naming the term and the limit.
+// Oracle: the angle each term adds (sim_truth.hpp, worst_case_pulses) against 2^53 pulses.
+TEST(ToolErrors, SimulatorRefusesParametersBeyondItsCountRange) {
+  const int bad = exit_code::bad_input;
+  for (const std::string& args : {std::string("--duration 5 --tau0 1 --arw 1e20"),
+                                  std::string("--rate 1e9 --pulse-weight 1e-9")}) {
+    const Outcome r = run(bin + "gyrochar-sim " + args);
+    EXPECT_EQ(r.code, bad) << args << ": " << r.err;
+    const std::string option = args.find("--arw") != std::string::npos ? "--arw" : "--rate";
+    EXPECT_EQ(r.err.rfind("gyrochar-sim: " + option + ": the counted angle could reach ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("limit of 2^53"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "") << args << ": nothing written";
+  }
+}
+
 TEST(ToolErrors, DemoGivesEachOptionRuleItsOwnMessage) {
   const int bad = exit_code::bad_input;
   expect("gyrochar-demo", "--bogus", bad, "options:");
@@ -132,6 +162,61 @@ TEST(ToolErrors, DecoderKalibrNeedsOneNodeWithAFit) {
   const Outcome young = run(bin + "gyrochar-decode " + log + " --view none --node 0x10 --kalibr " + yaml);
   EXPECT_EQ(young.code, exit_code::bad_input) << young.err;
   EXPECT_NE(young.err.find("gyrochar-decode: --kalibr: "), std::string::npos) << young.err;
+}
+
+// An output that is the same file as an input (or as another output) is refused before anything
+// is opened for writing: the input keeps every byte, and no output is created.
+// Oracle: the contract of host_tools/common/output_paths.hpp; exit codes of hal/exit_codes.hpp.
+TEST(ToolErrors, NoOutputOverwritesAnInputOrAnotherOutput) {
+  const int bad = exit_code::bad_input;
+  const std::string log = temp("same_file.log"), counts = temp("same_file_counts.txt");
+  ASSERT_EQ(run(bin + "gyrochar-demo --hours 0.01 --plot '' --csv '' --candump " + log).code, exit_code::ok);
+  ASSERT_EQ(run(bin + "gyrochar-sim --duration 100 --out " + counts).code, exit_code::ok);
+  const std::string log_bytes = slurp(log), count_bytes = slurp(counts);
+  ASSERT_FALSE(log_bytes.empty());
+  ASSERT_FALSE(count_bytes.empty());
+  // The same file through a symbolic link, a hard link and another spelling of its path.
+  const std::string symbolic = temp("same_file_symlink.log"), hard = temp("same_file_hard.svg");
+  std::remove(symbolic.c_str());
+  std::remove(hard.c_str());
+  ASSERT_EQ(symlink(log.c_str(), symbolic.c_str()), 0);
+  ASSERT_EQ(link(log.c_str(), hard.c_str()), 0);
+  const std::string respelled = ::testing::TempDir() + "./" + log.substr(::testing::TempDir().size());
+  const std::string prefix = hard.substr(0, hard.size() - 4);  // --plot PREFIX writes PREFIX.svg = the log
+  const std::string fresh = temp("same_file_fresh.csv");
+  std::remove(fresh.c_str());
+  const struct {
+    std::string program, args, what;
+  } cases[] = {
+      {"gyrochar-decode", log + " --view none --csv " + log, "--csv: '" + log + "' is the same file as the input LOG"},
+      {"gyrochar-decode", log + " --view none --jsonl " + symbolic, "--jsonl: '" + symbolic + "' is the same file as the input LOG"},
+      {"gyrochar-decode", log + " --view none --node 0x10 --kalibr " + respelled, "--kalibr: "},
+      {"gyrochar-decode", log + " --view none --plot " + prefix, "--plot: '" + hard + "' is the same file as the input LOG"},
+      {"gyrochar-decode", "- --view none --csv " + hard + " < " + log, "--csv: '" + hard +
+                                                                        "' is the same file as the input LOG (standard input)"},
+      {"gyrochar-decode", log + " --view none --csv " + fresh + " --jsonl " + fresh, "--jsonl: '" + fresh +
+                                                                                        "' is the same file as the output --csv"},
+      {"gyrochar-analyze", "--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --kalibr " + counts + " " + counts,
+       "--kalibr: '" + counts + "' is the same file as the input file"},
+      {"gyrochar-demo", "--hours 0.001 --plot '' --csv " + fresh + " --candump " + fresh, "--candump: '" + fresh +
+                                                                                              "' is the same file as the output --csv"},
+      {"gyrochar-demo", "--hours 0.001 --csv " + prefix + ".png --plot " + prefix, "--plot: '" + prefix + ".png' is the same "
+                                                                                    "file as the output --csv"},
+  };
+  for (const auto& c : cases) {
+    const Outcome r = run(bin + c.program + " " + c.args);
+    EXPECT_EQ(r.code, bad) << c.program << " " << c.args << ": " << r.err;
+    EXPECT_EQ(r.err.rfind(c.program + ": " + c.what, 0), 0u) << c.program << " " << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find("refused before writing anything"), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(log), log_bytes) << c.program << " " << c.args << " changed the log";
+    EXPECT_EQ(slurp(counts), count_bytes) << c.program << " " << c.args << " changed the counts";
+    EXPECT_NE(access(fresh.c_str(), F_OK), 0) << c.program << " " << c.args << " created " << fresh;
+    EXPECT_NE(access((prefix + ".png").c_str(), F_OK), 0) << c.program << " " << c.args << " created a plot";
+  }
+  // Devices are not files to protect: two outputs to /dev/null are fine.
+  const Outcome null = run(bin + "gyrochar-decode " + log + " --view none --csv /dev/null --jsonl /dev/null");
+  EXPECT_EQ(null.code, exit_code::ok) << null.err;
+  for (const std::string& f : {symbolic, hard, log, counts}) std::remove(f.c_str());
 }
 
 TEST(ToolErrors, EveryHelpAndTheReadmeStateTheSameExitCodes) {
