@@ -945,8 +945,8 @@ void write_fit(const Problem& pr, const Candidate& c, const Flags& free, const s
 
 // The chosen model with Markov terms fitted again on the exact covariance (the selection used the
 // approximation local_noise() makes): its terms, its correlation times' uncertainties and the
-// runner-up's figures on it. Keeps the approximate fit where the exact one fails.
-void refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const Terms& fixed, Candidate& chosen,
+// runner-up's figures on it. Keeps the approximate fit where the exact one fails (false).
+bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const Terms& fixed, Candidate& chosen,
                    Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd) {
   pr.model = chosen.model;
   markov_sums_of_points(pr, setup);
@@ -956,7 +956,7 @@ void refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const 
     pr.model = chosen.model;
     set_rows(pr);
     weigh(pr, chosen.sol.theta);
-    return;
+    return false;
   }
   chosen = exact;
   for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = log_sd(pr, free, fixed, &pr.model.a[k]);
@@ -967,6 +967,7 @@ void refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const 
     pr.model = chosen.model;
     set_rows(pr);
   }
+  return true;
 }
 
 // The fit of the points in pr with model selection; fills out and leaves the winner's solution in
@@ -994,7 +995,21 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
     return;
   }
   Candidate chosen = best;
-  if (best.model.markov > 0) refit_exactly(pr, setup, free, fixed, chosen, runner_up, nl_sd);
+  // On the exact covariance the selection is checked once more: where the runner-up with fewer
+  // Markov terms now has the lower criterion, it is the model (fitted on its own covariance).
+  while (chosen.model.markov > 0 && refit_exactly(pr, setup, free, fixed, chosen, runner_up, nl_sd) && runner_up.valid &&
+         runner_up.model.markov < chosen.model.markov && runner_up.criterion < chosen.criterion) {
+    const Candidate more = chosen;
+    pr.exact_markov = false;
+    pr.model = runner_up.model;
+    chosen = fit_model(pr, free, fixed, false, 12);
+    for (std::size_t k = chosen.model.markov; k < max_markov; ++k) nl_sd[k] = 0;
+    runner_up = more;
+    runner_up.sol.chi2 = profile_chi2(pr, free, fixed);  // on the simpler model's covariance
+    runner_up.criterion = criterion_of(runner_up.sol.chi2, runner_up.parameters, pr.n);
+    pr.model = chosen.model;
+    set_rows(pr);
+  }
   sol = chosen.sol;
   Candidate widened = chosen;
   widen_by_nonlinear(pr, free, fixed, nl_sd, widened.sol);
