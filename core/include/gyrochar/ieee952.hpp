@@ -53,11 +53,13 @@
 //           its meaning; the shortest taus bend below the N line)
 //   sinusoid a rate A sin(2 pi f t + random phase) [r/s], f given by the caller (a spectral line):
 //           AVAR A^2 (sin^2 x / x)^2, MVAR A^2 sin^6 x / (x^2 m^2 sin^2(pi f tau0)), x = pi f tau
-// Their expected variances are exact for the sampled estimators. Their part in the covariance of
-// the points is approximate: a Markov term's variance at each point is taken as white rate noise
-// and rate random walk in the proportion its local slope says (-1: white, +1: random walk), the
-// filter as white rate noise of the filtered level, a sinusoid (deterministic) as none; the
-// recovery study measures what that approximation costs (docs/metrology.md).
+// Their expected variances are exact for the sampled estimators. During the model search their
+// part in the covariance of the points is approximate: a Markov term's variance at each point is
+// taken as white rate noise and rate random walk in the proportion its local slope says (-1:
+// white, +1: random walk), the filter as white rate noise of the filtered level, a sinusoid
+// (deterministic) as none. The chosen model's Markov terms are then fitted again on the exact
+// covariance (markov_pair_sums()), where the choice is checked once more; the recovery study
+// measures the result (docs/metrology.md).
 // Model selection (FitSetup::select_model): from the five terms, the filter, then one Markov term
 // and a second are added while each lowers the Bayesian information criterion chi2 + p ln(points)
 // (p: the terms fitted plus twice each correlation time or frequency); a correlation time is found on a grid of four
