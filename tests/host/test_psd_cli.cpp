@@ -141,6 +141,23 @@ TEST(AnalyzePsd, GivenFrequenciesAreOfferedToTheFitAndCheckedFirst) {
   EXPECT_NE(odd.err.find("--psd-segment: must be even"), std::string::npos) << odd.err;
 }
 
+TEST(AnalyzePsd, KalibrGetsNAndKAloneAndSaysWhatItLeavesOut) {
+  // The sinusoid of the target with rate random walk (Kalibr needs K): the chosen model
+  // has the sinusoid, which Kalibr's model has no place for; the file's first comment line and
+  // stderr name it.
+  const std::string counts = temp("sinusoid_rrw.txt"), yaml = temp("imu.yaml");
+  ASSERT_EQ(run_shell(sim + " --duration 7200 --tau0 0.01 --arw 0.02 --rrw 2 --sinusoid 2,0.05 --seed 3 > " + counts).code, 0);
+  const Outcome r = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --kalibr " + yaml + " " + counts);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("gyrochar-analyze: note: --kalibr: gyroscope_noise_density is the fitted white-rate N"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 sinusoid"), std::string::npos) << r.err;
+  const std::string text = slurp(yaml);
+  const std::string first = text.substr(0, text.find('\n'));
+  EXPECT_NE(first.find("N and K alone, without the model's"), std::string::npos) << first;
+  EXPECT_NE(first.find("1 sinusoid"), std::string::npos) << first;
+}
+
 TEST(AnalyzePlot, DrawsValidNonTrivialPngAndSvg) {
   const std::string prefix = temp("static");
   const Outcome r = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --plot " + prefix + " " +
