@@ -72,7 +72,8 @@ one-sided, in the output rate unit^2/Hz (white rate noise: 2 N^2), with its chi-
 their local background (running median) beyond the Bonferroni threshold of a 1 % false-alarm
 chance per record, frequency and amplitude with uncertainties (table; JSON psd.peaks), offered to
 the fit's model selection with any --sinusoid-hz F (at most 2 in all; --no-sinusoid-search: only
-those given). The PSD holds the rate in memory (8 bytes a value).
+those given); with dense taus near 1/f (--taus all or a list) each peak is checked against the
+OADEV's null at tau = 1/f. The PSD holds the rate in memory (8 bytes a value).
 --plot PREFIX (without --dynamic): PREFIX.svg and .png with ADEV and MDEV and their intervals, each
 term of the fitted model and its total, the read-off, the PSD with its band, background and peaks,
 and the fit's residuals in sigma.
@@ -642,7 +643,13 @@ int main(int argc, char** argv) {
         Spectrum sp;
         sp.psd = welch_psd(rate, o.tau0_s, segment, o.confidence);
         sp.searched = !no_sinusoid_search;
-        if (sp.searched) sp.search = find_sinusoids(sp.psd);
+        if (sp.searched) {
+          sp.search = find_sinusoids(sp.psd);
+          std::vector<std::pair<double, double>> oadev;  // the Allan curve's nulls at tau = 1/f, on dense taus
+          for (const AnalysisRow& r : a.rows)
+            if (r.stat == DevStat::oadev) oadev.emplace_back(r.tau_s, r.dev);
+          check_adev_nulls(sp.search, oadev);
+        }
         sp.given_hz = sinusoid_hz;
         sp.factor = units.factor();
         sp.unit = units.unit(DevStat::oadev);

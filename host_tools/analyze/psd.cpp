@@ -162,6 +162,23 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
   return out;
 }
 
+void check_adev_nulls(PeakSearch& search, const std::vector<std::pair<double, double>>& oadev) {
+  for (SpectralPeak& p : search.peaks) {
+    const double null = 1 / p.frequency_hz;
+    std::size_t count = 0;
+    double low = INFINITY, low_tau = 0, high = 0;
+    for (const auto& [tau, dev] : oadev) {
+      if (tau < 0.7 * null || tau > 1.3 * null) continue;
+      ++count;
+      if (dev < low) low = dev, low_tau = tau;
+      high = std::max(high, dev);
+    }
+    if (count < 7) continue;
+    p.adev_null = std::fabs(low_tau / null - 1) <= 0.1 && low < 0.9 * high ? 1 : 0;
+    p.adev_null_tau_s = low_tau;
+  }
+}
+
 void RateRecord::add(std::span<const double> values) {
   rate_.reserve(rate_.size() + values.size());
   for (const double v : values) {
@@ -210,9 +227,12 @@ std::string spectrum_table(const Spectrum& s) {
                      "{:.2g} % of records without a sinusoid): {}\n",
                  r.bins_tested, r.threshold, 100 * r.false_alarm, r.peaks.empty() ? "none found" : fmt::format("{} found", r.peaks.size()));
   for (const SpectralPeak& q : r.peaks)
-    fmt::format_to(to, "#   peak at {:.6g} +- {:.2g} Hz: amplitude {:.4g} +- {:.2g} {} (PSD {:.3g} x its background)\n",
+    fmt::format_to(to, "#   peak at {:.6g} +- {:.2g} Hz: amplitude {:.4g} +- {:.2g} {} (PSD {:.3g} x its background){}\n",
                    q.frequency_hz, q.frequency_uncertainty_hz, q.amplitude * s.factor, q.amplitude_uncertainty * s.factor,
-                   s.unit, q.ratio);
+                   s.unit, q.ratio,
+                   q.adev_null < 0 ? ""
+                                   : fmt::format("; OADEV {} at tau = 1/f = {:.4g} s (smallest at {:.4g} s)",
+                                                 q.adev_null ? "dips" : "does not dip", 1 / q.frequency_hz, q.adev_null_tau_s));
   return out;
 }
 
@@ -239,7 +259,9 @@ nlohmann::json spectrum_json(const Spectrum& s) {
                      {"amplitude", measured(q.amplitude * s.factor, q.amplitude_uncertainty * s.factor, s.unit)},
                      {"power", q.power * k},
                      {"ratio", q.ratio},
-                     {"threshold", q.threshold}});
+                     {"threshold", q.threshold},
+                     {"adev_null", q.adev_null < 0 ? json(nullptr)
+                                                   : json{{"found", q.adev_null == 1}, {"tau", q.adev_null_tau_s}}}});
   return {{"unit", s.psd_unit()},
           {"segment", p.segment},
           {"segments", p.segments},

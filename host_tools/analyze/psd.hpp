@@ -66,6 +66,10 @@ struct SpectralPeak {
   double ratio = 0;         // highest bin's PSD over its background
   double threshold = 0;     // the ratio a bin must exceed (Bonferroni)
   std::size_t bin = 0;      // index of the highest bin in Psd::freq_hz
+  // The Allan curve's cross-check (check_adev_nulls()): -1 not made (taus not dense near 1/f),
+  // 0 no dip near tau = 1/f, 1 the smallest OADEV near 1/f lies within 10 % of it; its tau.
+  int adev_null = -1;
+  double adev_null_tau_s = 0;
 };
 
 struct PeakSearch {
@@ -80,6 +84,12 @@ struct PeakSearch {
 /// Bins below the 8th are not tested (too few neighbours below them). O(bins x 128) with
 /// nth_element; allocates.
 PeakSearch find_sinusoids(const Psd& psd, double false_alarm = 0.01);
+
+/// Cross-checks each peak with the nulls of the Allan deviation of a sinusoid (AVAR A^2 (sin^2 x /
+/// x)^2, x = pi f tau: zero at tau = k/f) on dense taus: among the OADEV points (tau, dev) within
+/// 30 % of tau = 1/f, at least 7 of them, the smallest must lie within 10 % of 1/f and below
+/// 0.9 x the largest. O(peaks x points).
+void check_adev_nulls(PeakSearch& search, const std::vector<std::pair<double, double>>& oadev);
 
 /// Rate values from the analyzer's input: freq values as they are, counts divided by tau0 (pulses
 /// per second), phase points differenced over tau0. The result is in the engine's rate unit

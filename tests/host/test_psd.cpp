@@ -96,6 +96,29 @@ TEST(WelchPsd, ASinusoidsPowerIsHalfItsAmplitudeSquaredAndIsFound) {
   EXPECT_GT(peak.ratio, peak.threshold);
 }
 
+TEST(WelchPsd, APeakIsCrossCheckedWithTheAllanNullAtOneOverF) {
+  // Oracle: a sinusoid's ADEV A sin^2(x) / x, x = pi f tau, is zero at tau = 1/f (IEEE 952).
+  const double f = 0.05, A = 2;
+  PeakSearch s;
+  s.peaks.push_back({});
+  s.peaks[0].frequency_hz = f;
+  std::vector<std::pair<double, double>> dense, flat, sparse;
+  for (double tau = 10; tau <= 30; tau += 0.5) {
+    const double x = std::numbers::pi * f * tau;
+    dense.emplace_back(tau, A * std::sin(x) * std::sin(x) / x + 0.01);
+    flat.emplace_back(tau, 1.0 / std::sqrt(tau));
+  }
+  for (double tau = 1; tau < 1000; tau *= 2) sparse.emplace_back(tau, 1.0);
+  check_adev_nulls(s, dense);
+  EXPECT_EQ(s.peaks[0].adev_null, 1);
+  EXPECT_DOUBLE_EQ(s.peaks[0].adev_null_tau_s, 20.0);
+  check_adev_nulls(s, flat);
+  EXPECT_EQ(s.peaks[0].adev_null, 0);  // falling as 1/sqrt(tau): its smallest at the window's end
+  s.peaks[0].adev_null = -1;
+  check_adev_nulls(s, sparse);
+  EXPECT_EQ(s.peaks[0].adev_null, -1);  // octave taus: no check
+}
+
 TEST(WelchPsd, RefusesASegmentThatDoesNotFit) {
   const std::vector<double> x(100, 1.0);
   EXPECT_THROW(welch_psd(x, 0.1, 128, 0.683), std::invalid_argument);
