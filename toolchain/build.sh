@@ -14,7 +14,7 @@ esac
 
 # Debian packages: the host build, then what only the tests need (cross compilers for the
 # microcontroller build of the core). The host preset configures the tests too, so their own
-# libraries are here (libfftw3-dev: the power-law noise of tests/support).
+# libraries are here (libfftw3-dev: the analyzer's PSD and the power-law noise of tests/support).
 packages=(
   g++ cmake ninja-build pkg-config
   libgtest-dev libgmock-dev libbenchmark-dev libfftw3-dev

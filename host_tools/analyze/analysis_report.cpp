@@ -119,6 +119,8 @@ std::string ReportUnits::unit(DevStat s) const {
   return time ? "s" : "1";
 }
 
+const units::Ieee952Unit& fit_unit(const ReportUnits& u, std::size_t k) { return fit_units(u)[k]; }
+
 const char* name(LongTau l) {
   switch (l) {
     case LongTau::oadev: return "oadev";
@@ -193,7 +195,8 @@ std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, do
 }
 
 std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
-                                 double white_quantization_si, LongTau long_tau, const PhaseRecord& record) {
+                                 double white_quantization_si, LongTau long_tau, const PhaseRecord& record,
+                                 const std::array<double, max_sinusoids>& sinusoid_hz) {
   const std::vector<FitPoint> points = fit_points(a, units, tau0_s, long_tau, record);
   std::vector<CurveFit> fits;
   if (points.empty()) return fits;
@@ -202,7 +205,8 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   // for every pair.
   std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
   PairSumCache cache(entries);
-  const FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
+  FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
+  setup.sinusoid_hz = sinusoid_hz;
   const int used = long_tau != LongTau::oadev && !record.phase.empty() ? static_cast<int>(long_tau) : 0;
   for (const FitCurve curve : {FitCurve::both, FitCurve::avar, FitCurve::mvar})
     fits.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache), curve == FitCurve::mvar ? 0 : used});
@@ -233,6 +237,15 @@ std::string simulated_markov(const std::optional<Ieee952Truth>& truth, double tc
   for (const MarkovRate& m : truth->markov)
     if (std::fabs(std::log(m.tc_s / tc_s)) < std::fabs(std::log(nearest->tc_s / tc_s))) nearest = &m;
   return fmt::format("   simulated sigma {:.4g} {}, Tc {:.4g} s", nearest->sigma_rad_s / rate.si, rate.name, nearest->tc_s);
+}
+
+// "   simulated 2 deg/h at 0.05 Hz": the simulated sinusoid nearest in frequency, if any.
+std::string simulated_sinusoid(const std::optional<Ieee952Truth>& truth, double hz, const units::Ieee952Unit& rate) {
+  if (!truth || truth->sinusoids.empty()) return "";
+  const SinusoidRate* nearest = &truth->sinusoids.front();
+  for (const SinusoidRate& s : truth->sinusoids)
+    if (std::fabs(s.frequency_hz - hz) < std::fabs(nearest->frequency_hz - hz)) nearest = &s;
+  return fmt::format("   simulated {:.4g} {} at {:.6g} Hz", nearest->amplitude_rad_s / rate.si, rate.name, nearest->frequency_hz);
 }
 
 std::array<double, 5> truth_values(const Ieee952Truth& t) {
@@ -418,12 +431,13 @@ std::string format_table(const Report& r) {
                        rate.name, m.tc_s);
     for (std::size_t j = 0; j < f.fit.n_sinusoids; ++j) {
       const SinusoidTerm& sn = f.fit.sinusoids[j];
-      fmt::format_to(to, "#   sinusoid {}: amplitude = {:.4g} +- {:.2g} {} at {:.6g} Hz{}\n", j + 1,
+      fmt::format_to(to, "#   sinusoid {}: amplitude = {:.4g} +- {:.2g} {} at {:.6g} Hz{}{}\n", j + 1,
                      sn.amplitude.value / rate.si, sn.amplitude.uncertainty / rate.si, rate.name, sn.frequency_hz,
-                     sn.amplitude.resolved ? "" : "  (not resolved)");
+                     sn.amplitude.resolved ? "" : "  (not resolved)", simulated_sinusoid(r.truth, sn.frequency_hz, rate));
     }
   }
   if (r.readoff) format_readoff(out, r);
+  if (r.spectrum) out += spectrum_table(*r.spectrum);
   return out;
 }
 
@@ -564,6 +578,10 @@ nlohmann::json to_json(const Report& r) {
     j["simulated"] = std::move(truth);
   }
   if (r.readoff) j["readoff"] = readoff_json(r);
+  if (r.spectrum) {
+    j["psd"] = spectrum_json(*r.spectrum);
+    if (j.contains("fit")) add_frequency_uncertainties(j["fit"], *r.spectrum);
+  }
   return j;
 }
 
@@ -626,6 +644,17 @@ std::string format_stable32(const Report& r) {
   return s;
 }
 
+std::string kalibr_left_out(const Ieee952Fit& fit) {
+  std::string s;
+  const auto add = [&](const std::string& t) { s += (s.empty() ? "" : ", ") + t; };
+  if (fit.bandwidth_tc_s > 0) add("sensor filter");
+  if (fit.n_markov) add(fmt::format("{} Markov term{}", fit.n_markov, fit.n_markov > 1 ? "s" : ""));
+  if (fit.n_sinusoids) add(fmt::format("{} sinusoid{}", fit.n_sinusoids, fit.n_sinusoids > 1 ? "s" : ""));
+  if (fit.p[2].fitted) add("B");
+  if (fit.p[4].fitted) add("R");
+  return s;
+}
+
 std::optional<std::string> kalibr_yaml(const Report& r, std::string& why) {
   if (!r.units.gyro) {
     why = "needs gyro data: counts, or --unit with an angle or a rate";
@@ -644,7 +673,11 @@ std::optional<std::string> kalibr_yaml(const Report& r, std::string& why) {
     const Ieee952Parameter& p = both->p[k];
     return KalibrTerm{p.value, p.value > 0 ? p.uncertainty / p.value : 0.0, p.fitted, p.resolved};
   };
-  return kalibr_imu_yaml(term(1), term(3), 1.0 / r.tau0_s, fmt::format("{} ({})", r.source, r.units.input), why);
+  const std::string beyond = kalibr_left_out(*both);
+  return kalibr_imu_yaml(term(1), term(3), 1.0 / r.tau0_s,
+                         fmt::format("{} ({}){}", r.source, r.units.input,
+                                     beyond.empty() ? "" : "; N and K alone, without the model's " + beyond),
+                         why);
 }
 
 }  // namespace gyrochar

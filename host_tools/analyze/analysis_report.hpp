@@ -22,6 +22,7 @@
 #include "gyrochar/readoff.hpp"
 #include "sim_truth.hpp"
 #include "kalibr.hpp"
+#include "psd.hpp"
 #include "units.hpp"
 
 namespace gyrochar {
@@ -37,6 +38,10 @@ struct ReportUnits {
   /// Unit of a row of statistic s in the output: e.g. "deg/h", "arcsec", "1" (fractional), "s".
   std::string unit(DevStat s) const;
 };
+
+/// The unit a report shows IEEE-952 term k (Q N B K R) in: the gyro units of units::ieee952, or
+/// the s-based ones of clock data. O(1).
+const units::Ieee952Unit& fit_unit(const ReportUnits& u, std::size_t k);
 
 /// An IEEE-952 fit (ieee952.hpp) of the curves an analysis has: the recommended fit of both
 /// curves at once, then the Allan and the modified Allan curve alone (for experts).
@@ -59,9 +64,11 @@ const char* name(LongTau l);
 /// the white-quantization level Q_w = pulse weight / sqrt(12) in rad for counts, 0 otherwise.
 /// O(points^2) covariance sums, allocates the workspace; empty when the analysis has neither
 /// curve. A fit that fails says why in its status.
+/// sinusoid_hz: frequencies of sinusoids the model selection may add (Spectrum::fit_hz(); 0: none).
 std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
                                  double white_quantization_si, LongTau long_tau = LongTau::oadev,
-                                 const PhaseRecord& record = {});
+                                 const PhaseRecord& record = {},
+                                 const std::array<double, max_sinusoids>& sinusoid_hz = {});
 /// The points fit_curves() fits (SI units), for a single fit_ieee952() of one curve. Allocates.
 std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s,
                                  LongTau long_tau = LongTau::oadev, const PhaseRecord& record = {});
@@ -99,6 +106,7 @@ struct Report {
   std::string source;                 // the input's name, for Stable32's header
   DataRange range;                    // the values read (after --nominal-hz), for Stable32's header
   std::optional<Readoff> readoff;     // gyro data with OADEV rows: the read-off, beside the fits
+  std::optional<Spectrum> spectrum;   // the rate's PSD and its sinusoids (psd.hpp), when computed
 };
 
 /// Aligned table for people: a header line (data, units, stride factor, confidence), one line per
@@ -139,5 +147,10 @@ std::string format_stable32(const Report& r);
 /// The Kalibr imu.yaml (kalibr.hpp) of the fit of both curves; nothing, and why, when the data
 /// are not gyro data, the fit was not made or was rejected, or N or K is not in its model. O(1).
 std::optional<std::string> kalibr_yaml(const Report& r, std::string& why);
+/// What of a fitted model a Kalibr file leaves out (Kalibr has white rate noise and rate random
+/// walk only: gyroscope_noise_density is the fitted white-rate N, gyroscope_random_walk the fitted
+/// K, whatever else the model holds): "sensor filter, 1 Markov term, 1 sinusoid, B"; empty when
+/// nothing. O(1).
+std::string kalibr_left_out(const Ieee952Fit& fit);
 
 }  // namespace gyrochar

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <memory>
 #include <new>
 #include <span>
@@ -27,6 +28,8 @@
 #include "dynamic.hpp"
 #include "heat_map.hpp"
 #include "output_paths.hpp"
+#include "psd.hpp"
+#include "static_plot.hpp"
 #include "hal/exit_codes.hpp"
 
 namespace {
@@ -56,10 +59,25 @@ constexpr const char* footer = R"(Data type and units (the type is required: for
 Formats: table (people), csv, json, stable32 (Stable32's result table: AF Tau # Alpha MinSigma
 Sigma MaxSigma, one block per statistic; values in the output unit). --kalibr FILE also writes the
 IEEE-952 fit's N and K as the gyroscope part of a Kalibr imu.yaml (N in rad/s/sqrt(Hz) = rad/s^0.5,
-K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill).
+K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill):
+the fitted white-rate N and rate random walk K alone; a filter, Markov terms, sinusoids, B or R of
+the model have no place in Kalibr's model, and the file and stderr say which were left out.
 Gyro data with OADEV rows also get the IEEE-952 graphical read-off that data sheets print (table
 and json): N on the -1/2 line at tau = 1 s, the ADEV floor and B = floor/0.664, K on the +1/2 line
 at 3 s, each with the interval of the point it was read at and, beside --fit, whether they agree.
+
+The rate's PSD (--psd FILE: freq,psd,ci_low,ci_high; JSON "psd", decimated): Welch, Hann window,
+segments of --psd-segment values overlapping by half (default: the largest power of two <= N/16),
+one-sided, in the output rate unit^2/Hz (white rate noise: 2 N^2), with its chi-squared band (EDF
+36 K^2/(19 K - 1) for K segments). With --fit ieee952 it is searched for sinusoids: peaks above
+their local background (running median) beyond the Bonferroni threshold of a 1 % false-alarm
+chance per record, frequency and amplitude with uncertainties (table; JSON psd.peaks), offered to
+the fit's model selection with any --sinusoid-hz F (at most 2 in all; --no-sinusoid-search: only
+those given); with dense taus near 1/f (--taus all or a list) each peak is checked against the
+OADEV's null at tau = 1/f. The PSD holds the rate in memory (8 bytes a value).
+--plot PREFIX (without --dynamic): PREFIX.svg and .png with ADEV and MDEV and their intervals, each
+term of the fitted model and its total, the read-off, the PSD with its band, background and peaks,
+and the fit's residuals in sigma.
 
 Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' starts a comment),
 plain or gzip (recognized by content), '-' for standard input; read once. Every data line has as
@@ -114,6 +132,7 @@ Examples:
   gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --stats oadev,totdev,theoh run120h.txt
   gyrochar-analyze --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 --fit-long-tau totdev run120h.txt
   zcat run.txt.gz | gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1.5arcsec -
+  gyrochar-analyze --type freq --unit deg/s --tau0 0.01 --fit ieee952 --psd psd.csv --plot imu imu.txt.gz
   gyrochar-analyze --type counts --tau0 0.01 --pulse-weight 1arcsec --dynamic 600,60 --format csv \
                    --plot warmup run.txt > surface.csv
 
@@ -336,8 +355,20 @@ int main(int argc, char** argv) {
       ->option_text("FILE");
   app.add_option("--dynamic", dynamic_text, "dynamic Allan deviation: windows of WINDOW s, one every STEP s")
       ->option_text("WINDOW[,STEP]");
-  app.add_option("--plot", plot_prefix, "with --dynamic: draw the heat maps to PREFIX.svg and PREFIX.png")
+  app.add_option("--plot", plot_prefix,
+                 "draw ADEV, MDEV (with the fit's terms) and the PSD to PREFIX.svg and PREFIX.png; with --dynamic, "
+                 "the heat maps")
       ->option_text("PREFIX");
+  std::string psd_path;
+  std::size_t psd_segment = 0;
+  bool no_sinusoid_search = false;
+  std::vector<double> sinusoid_hz;
+  app.add_option("--psd", psd_path, "write the rate's Welch PSD with its confidence band (CSV: freq,psd,ci_low,ci_high)")
+      ->option_text("FILE");
+  app.add_option("--psd-segment", psd_segment, "values per Welch segment (even; default: largest power of two <= N/16)");
+  app.add_flag("--no-sinusoid-search", no_sinusoid_search, "do not search the PSD for sinusoids to offer the fit");
+  app.add_option("--sinusoid-hz", sinusoid_hz, "offer the fit a sinusoid at this frequency in Hz (repeatable, up to 2)")
+      ->option_text("F");
   unsigned threads = 0;
   app.add_option("--threads", threads, "threads summing the taus of counts at --stride-factor full (default: one per core)")
       ->check(CLI::Range(1u, 1024u));
@@ -351,6 +382,7 @@ int main(int argc, char** argv) {
   }
   std::vector<NamedPath> outputs = plot_outputs("--plot", plot_prefix);
   outputs.insert(outputs.begin(), {"--kalibr", kalibr_path});
+  outputs.insert(outputs.begin(), {"--psd", psd_path});
   if (const auto conflict = output_conflict({{"file", path}}, outputs)) bad(conflict->what, conflict->why);
 
   try {
@@ -455,9 +487,20 @@ int main(int argc, char** argv) {
 
     const bool show_progress = progress || isatty(STDERR_FILENO);
     const std::string source = path == "-" ? "standard input" : path;
-    if (!plot_prefix.empty() && dynamic_text.empty()) bad("--plot", "draws the heat maps of --dynamic only");
+    if (psd_segment != 0 && (psd_segment < 8 || psd_segment % 2 != 0)) bad("--psd-segment", "must be even and at least 8");
+    if (sinusoid_hz.size() > max_sinusoids) bad("--sinusoid-hz", fmt::format("at most {} frequencies", max_sinusoids));
+    for (const double f : sinusoid_hz)
+      if (!(f > 0 && f < 0.5 / tau0_s)) bad("--sinusoid-hz", fmt::format("{} Hz is not between 0 and the Nyquist frequency {} Hz", f, 0.5 / tau0_s));
+    if (!sinusoid_hz.empty() && fit_text.empty()) bad("--sinusoid-hz", "offers sinusoids to --fit ieee952");
+    // The PSD: asked for (--psd, the static --plot) or searched for sinusoids to offer the fit.
+    const bool want_psd = !psd_path.empty() || (!plot_prefix.empty() && dynamic_text.empty()) ||
+                          (!fit_text.empty() && !no_sinusoid_search);
+    if (!plot_prefix.empty() && dynamic_text.empty())  // the static plot draws ADEV and MDEV
+      for (const DevStat st : {DevStat::oadev, DevStat::mdev})
+        if (std::find(o.stats.begin(), o.stats.end(), st) == o.stats.end()) o.stats.push_back(st);
     if (!dynamic_text.empty()) {
       if (!fit_text.empty()) bad("--fit", "fits the whole run's curves: not with --dynamic");
+      if (!psd_path.empty() || psd_segment != 0) bad("--psd", "the PSD is of the whole run: not with --dynamic");
       return analyze_dynamic(o, units, dynamic_text, taus_text, path, column, nominal_hz, format, plot_prefix,
                              show_progress);
     }
@@ -541,10 +584,13 @@ int main(int argc, char** argv) {
       too_big();
     }
     DataRange range;
+    std::optional<RateRecord> rates;  // the rate, held for the PSD (8 bytes a value)
+    if (want_psd) rates.emplace(o.type == DataType::phase, o.type == DataType::counts, o.tau0_s);
     const auto add = [&](std::span<double> values, auto line_of) {
       if (nominal_hz > 0)
         for (double& v : values) v = (v - nominal_hz) / nominal_hz;
       range.add(values);
+      if (rates) rates->add(values);
       try {
         analyzer->add(values);
       } catch (const BadValue& e) {
@@ -589,11 +635,45 @@ int main(int argc, char** argv) {
                                                "{} MiB of history", cut_above, s, budget >> 20));
     const std::vector<std::string>& header = file->header();
 
+    std::optional<Spectrum> spectrum;
+    if (rates) {
+      const std::vector<double>& rate = rates->rate();
+      const std::size_t segment = psd_segment ? psd_segment : default_psd_segment(rate.size());
+      if (segment > rate.size() || segment == 0) {
+        if (!psd_path.empty() || psd_segment != 0)
+          bad(psd_segment ? "--psd-segment" : "--psd",
+              fmt::format("{} rate values are too few for a segment of {}", rate.size(), segment ? segment : 16));
+        print_error(program, "note", fmt::format("no PSD: {} rate values are too few for a spectrum", rate.size()));
+      } else {
+        Spectrum sp;
+        sp.psd = welch_psd(rate, o.tau0_s, segment, o.confidence);
+        sp.searched = !no_sinusoid_search;
+        if (sp.searched) {
+          sp.search = find_sinusoids(sp.psd);
+          std::vector<std::pair<double, double>> oadev;  // the Allan curve's nulls at tau = 1/f, on dense taus
+          for (const AnalysisRow& r : a.rows)
+            if (r.stat == DevStat::oadev) oadev.emplace_back(r.tau_s, r.dev);
+          check_adev_nulls(sp.search, oadev);
+        }
+        sp.given_hz = sinusoid_hz;
+        sp.factor = units.factor();
+        sp.unit = units.unit(DevStat::oadev);
+        spectrum = std::move(sp);
+      }
+      rates.reset();
+    }
+    std::array<double, max_sinusoids> offered_hz{};
+    for (std::size_t k = 0; k < sinusoid_hz.size(); ++k) offered_hz[k] = sinusoid_hz[k];
+    if (spectrum) offered_hz = spectrum->fit_hz();
     std::vector<CurveFit> fits;
     if (!fit_text.empty())
       fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
-                        long_tau, analyzer->record());
+                        long_tau, analyzer->record(), offered_hz);
     std::optional<Readoff> readoff = readoff_of(a, units);  // every OADEV row, shown or computed for the fit
+    std::vector<AnalysisRow> plotted;  // --plot draws OADEV and MDEV, shown or not
+    if (!plot_prefix.empty())
+      std::copy_if(a.rows.begin(), a.rows.end(), std::back_inserter(plotted),
+                   [](const AnalysisRow& r) { return r.stat == DevStat::oadev || r.stat == DevStat::mdev; });
     Analysis displayed = std::move(a);  // (a --taus all run has millions of rows: not copied)
     std::erase_if(displayed.rows, [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) == shown.end(); });
     // A tau asked for by number but too long for the data has no row: say so. (The octave,
@@ -616,20 +696,34 @@ int main(int argc, char** argv) {
                                 name(r.stat), r.tau_s, r.m, r.ci.valid ? r.ci.high : r.dev, units.factor(),
                                 units.unit(r.stat)));
     Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt, source, range,
-                  std::move(readoff)};
+                  std::move(readoff), std::nullopt};
     if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);
+    report.spectrum = std::move(spectrum);
     std::string yaml;  // made before anything is written: a refusal loses no output
     if (!kalibr_path.empty()) {
       std::string why;
       const auto text = kalibr_yaml(report, why);
       if (!text) bad("--kalibr", why);
       yaml = *text;
+      if (const std::string beyond = kalibr_left_out(report.fits.front().fit); !beyond.empty())
+        print_error(program, "note", "--kalibr: gyroscope_noise_density is the fitted white-rate N, gyroscope_random_walk the "
+                                     "fitted rate random walk K; Kalibr's model has no place for the model's " + beyond);
     }
     const std::string text = format == "json"       ? to_json(report).dump(2) + "\n"
                              : format == "csv"      ? format_csv(report)
                              : format == "stable32" ? format_stable32(report)
                                                     : format_table(report);
     std::fwrite(text.data(), 1, text.size(), stdout);
+    if (!psd_path.empty()) {
+      std::FILE* f = std::fopen(psd_path.c_str(), "w");
+      if (f == nullptr) fail(exit_code::output_failed, psd_path, std::strerror(errno));
+      std::fputs(spectrum_csv(*report.spectrum).c_str(), f);
+      if (!close_output(f, program, psd_path)) return finish(program, exit_code::output_failed);
+    }
+    if (!plot_prefix.empty()) {
+      std::string why;
+      if (!write_static_plot(plot_prefix, report, plotted, why)) fail(exit_code::output_failed, "--plot", why);
+    }
     if (!kalibr_path.empty()) {
       std::FILE* f = std::fopen(kalibr_path.c_str(), "w");
       if (f == nullptr) fail(exit_code::output_failed, kalibr_path, std::strerror(errno));

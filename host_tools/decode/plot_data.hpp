@@ -6,15 +6,13 @@
 #include <string>
 #include <vector>
 
+#include "deviation_plot.hpp"
 #include "heat_map.hpp"
 #include "rows.hpp"
 
 namespace gyrochar::decoding {
 
-struct PlotPoint {
-  double tau_s = 0.0, dev = 0.0;
-  Interval ci;  // invalid: no error bar
-};
+using PlotPoint = DevPoint;  // tau, deviation, interval (invalid: no error bar)
 struct PlotLine {
   std::optional<protocol::Ieee952Term> term;  // the term drawn; empty: the model's sum
   std::string label;                          // e.g. "N 0.00212 deg/sqrt(h) (±13%)" (UTF-8)

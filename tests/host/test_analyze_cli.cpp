@@ -678,7 +678,8 @@ TEST(AnalyzeCli, DynamicRefusesWhatItCannotDo) {
   expect_bad_input("--type phase --tau0 1 --dynamic 100,0.4 " + good, "shorter than tau0");
   expect_bad_input("--type phase --tau0 1 --dynamic 500 " + good, "fewer than one window");
   expect_bad_input("--type phase --tau0 1 --dynamic 100 --taus 1,50 " + good, "quarter of the window");
-  expect_bad_input("--type phase --tau0 1 --plot p " + good, "--plot");
+  // (--plot without --dynamic draws the whole record's curves: tests/host/test_psd_cli.cpp.)
+  expect_bad_input("--type phase --tau0 1 --dynamic 100 --psd p.csv " + good, "--psd");
   expect_bad_input("--type counts --tau0 1 --pulse-weight 1arcsec --fit ieee952 --dynamic 100 " + good, "--fit");
 }
 

@@ -1,0 +1,295 @@
+#include "psd.hpp"
+
+#include <fftw3.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <bit>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+#include <iterator>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <stdexcept>
+
+#include "confidence.hpp"
+
+namespace gyrochar {
+
+std::size_t default_psd_segment(std::size_t n) {
+  if (n < 16 * 16) return n < 64 ? 0 : 16;
+  return std::bit_floor(n / 16);
+}
+
+Psd welch_psd(std::span<const double> rate, double tau0_s, std::size_t segment, double confidence) {
+  const std::size_t L = segment;
+  if (L < 8 || L % 2 != 0 || L > rate.size())
+    throw std::invalid_argument("the segment must be an even number of values from 8 to the record's length");
+  Psd out;
+  out.segment = L;
+  out.tau0_s = tau0_s;
+  out.confidence = confidence;
+  std::vector<double> window(L);
+  double window_power = 0;
+  for (std::size_t n = 0; n < L; ++n) {
+    const double s = std::sin(std::numbers::pi * static_cast<double>(n) / static_cast<double>(L));
+    window[n] = s * s;
+    window_power += window[n] * window[n];
+  }
+  const auto free_double = [](double* p) { fftw_free(p); };
+  const auto free_complex = [](fftw_complex* p) { fftw_free(p); };
+  std::unique_ptr<double, decltype(free_double)> in(fftw_alloc_real(L), free_double);
+  std::unique_ptr<fftw_complex, decltype(free_complex)> spectrum(fftw_alloc_complex(L / 2 + 1), free_complex);
+  if (!in || !spectrum) throw std::bad_alloc();
+  const fftw_plan plan = fftw_plan_dft_r2c_1d(static_cast<int>(L), in.get(), spectrum.get(), FFTW_ESTIMATE);
+  std::vector<double> sum(L / 2 + 1, 0.0);
+  std::size_t k_segments = 0;
+  for (std::size_t start = 0; start + L <= rate.size(); start += L / 2, ++k_segments) {
+    double mean = 0;
+    for (std::size_t n = 0; n < L; ++n) mean += rate[start + n];
+    mean /= static_cast<double>(L);
+    for (std::size_t n = 0; n < L; ++n) in.get()[n] = (rate[start + n] - mean) * window[n];
+    fftw_execute(plan);
+    for (std::size_t k = 0; k <= L / 2; ++k) sum[k] += spectrum.get()[k][0] * spectrum.get()[k][0] + spectrum.get()[k][1] * spectrum.get()[k][1];
+  }
+  fftw_destroy_plan(plan);
+  out.segments = k_segments;
+  const double K = static_cast<double>(k_segments);
+  out.edf = 36 * K * K / (19 * K - 1);
+  const Interval unit = confidence_interval(1.0, out.edf, confidence);  // of a deviation: square it
+  const double scale = 2 * tau0_s / (window_power * K);
+  for (std::size_t k = 1; k < L / 2; ++k) {
+    const double p = sum[k] * scale;
+    out.freq_hz.push_back(static_cast<double>(k) / (static_cast<double>(L) * tau0_s));
+    out.psd.push_back(p);
+    out.ci_low.push_back(unit.valid ? p * unit.low * unit.low : std::numeric_limits<double>::quiet_NaN());
+    out.ci_high.push_back(unit.valid ? p * unit.high * unit.high : std::numeric_limits<double>::quiet_NaN());
+  }
+  return out;
+}
+
+namespace {
+
+constexpr std::size_t lobe = 2;      // a Hann main lobe: within 2 bins of the sinusoid's frequency
+constexpr std::size_t span_half = 3; // the bins summed for a peak: its highest +- 3
+constexpr std::size_t max_neighbours = 64;
+constexpr std::size_t first_bin = 7; // index 7: the 8th bin, k = 8
+
+}  // namespace
+
+PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
+  PeakSearch out;
+  out.false_alarm = false_alarm;
+  const std::size_t bins = psd.psd.size();
+  out.background.assign(bins, std::numeric_limits<double>::quiet_NaN());
+  if (bins <= first_bin + span_half || !(psd.edf > 0)) return out;
+  const double nu = psd.edf;
+  const boost::math::chi_squared chi2(nu);
+  const double median_factor = boost::math::quantile(chi2, 0.5) / nu;
+  // The neighbours' count: at most 64 each side, no further than the first bin below, and the same
+  // count above (the last bins test with fewer).
+  std::vector<double> near;
+  std::vector<std::size_t> neighbours(bins, 0);
+  for (std::size_t i = first_bin; i < bins; ++i) {
+    const std::size_t m = std::min({max_neighbours, i, bins - 1 - i});
+    if (m < lobe + 1 + 3) continue;  // at least 4 neighbours each side
+    near.clear();
+    for (std::size_t d = lobe + 1; d <= m; ++d) {
+      near.push_back(psd.psd[i - d]);
+      near.push_back(psd.psd[i + d]);
+    }
+    const auto mid = near.begin() + static_cast<std::ptrdiff_t>(near.size() / 2);
+    std::nth_element(near.begin(), mid, near.end());
+    out.background[i] = *mid / median_factor;
+    neighbours[i] = near.size();
+    ++out.bins_tested;
+  }
+  if (out.bins_tested == 0) return out;
+  out.threshold = boost::math::quantile(boost::math::complement(chi2, false_alarm / static_cast<double>(out.bins_tested))) / nu;
+  const auto above = [&](std::size_t i) {
+    return std::isfinite(out.background[i]) && psd.psd[i] > out.threshold * out.background[i];
+  };
+  const double df = psd.bin_hz();
+  for (std::size_t i = 0; i < bins;) {
+    if (!above(i)) {
+      ++i;
+      continue;
+    }
+    std::size_t top = i, end = i;
+    for (; end < bins && above(end); ++end)
+      if (psd.psd[end] / out.background[end] > psd.psd[top] / out.background[top]) top = end;
+    i = end;
+    // The main lobe's bins around the highest: excess power, its centroid, their variances.
+    const std::size_t lo = top >= span_half ? top - span_half : 0, hi = std::min(bins - 1, top + span_half);
+    const double b = out.background[top];
+    double excess = 0, moment = 0, var_sum = 0;
+    for (std::size_t j = lo; j <= hi; ++j) {
+      const double s = psd.psd[j] - b;
+      excess += s * df;
+      moment += s * df * psd.freq_hz[j];
+      var_sum += (2 * b * b + 4 * std::max(s, 0.0) * b) / nu * df * df;
+    }
+    if (!(excess > 0)) continue;
+    // Neighbouring Hann bins are correlated (periodogram correlation 4/9 at one bin, 1/36 at two):
+    // the variance of their sum is about twice the sum of their variances.
+    var_sum *= 2;
+    const double f = moment / excess;
+    double var_moment = 0;
+    for (std::size_t j = lo; j <= hi; ++j) {
+      const double s = std::max(psd.psd[j] - b, 0.0);
+      const double d = (psd.freq_hz[j] - f) * df / excess;
+      var_moment += d * d * (2 * b * b + 4 * s * b) / nu;
+    }
+    var_moment *= 2;
+    // The background: a median of n neighbours (about n / 2 independent: the bins' correlation)
+    // has relative variance (pi / 2) (2 / nu) / (n / 2), and its error is common to every bin summed.
+    const double rel_b = std::sqrt(std::numbers::pi / 2 * 2 / nu / (static_cast<double>(neighbours[top]) / 2));
+    const double var_excess = var_sum + std::pow(static_cast<double>(hi - lo + 1) * b * rel_b * df, 2);
+    SpectralPeak p;
+    p.bin = top;
+    p.frequency_hz = f;
+    p.frequency_uncertainty_hz = std::sqrt(var_moment);
+    p.power = excess;
+    p.amplitude = std::sqrt(2 * excess);
+    p.amplitude_uncertainty = std::sqrt(var_excess) / p.amplitude;  // dA = dE / A
+    p.background = b;
+    p.ratio = psd.psd[top] / b;
+    p.threshold = out.threshold;
+    out.peaks.push_back(p);
+  }
+  std::sort(out.peaks.begin(), out.peaks.end(), [](const SpectralPeak& a, const SpectralPeak& c) { return a.power > c.power; });
+  return out;
+}
+
+void check_adev_nulls(PeakSearch& search, const std::vector<std::pair<double, double>>& oadev) {
+  for (SpectralPeak& p : search.peaks) {
+    const double null = 1 / p.frequency_hz;
+    std::size_t count = 0;
+    double low = INFINITY, low_tau = 0, high = 0;
+    for (const auto& [tau, dev] : oadev) {
+      if (tau < 0.7 * null || tau > 1.3 * null) continue;
+      ++count;
+      if (dev < low) low = dev, low_tau = tau;
+      high = std::max(high, dev);
+    }
+    if (count < 7) continue;
+    p.adev_null = std::fabs(low_tau / null - 1) <= 0.1 && low < 0.9 * high ? 1 : 0;
+    p.adev_null_tau_s = low_tau;
+  }
+}
+
+void RateRecord::add(std::span<const double> values) {
+  rate_.reserve(rate_.size() + values.size());
+  for (const double v : values) {
+    if (!phase_) {
+      rate_.push_back(counts_ ? v / tau0_s_ : v);
+      continue;
+    }
+    if (have_last_) rate_.push_back((v - last_) / tau0_s_);
+    have_last_ = true;
+    last_ = v;
+  }
+}
+
+std::array<double, max_sinusoids> Spectrum::fit_hz() const {
+  std::array<double, max_sinusoids> hz{};
+  std::size_t n = 0;
+  for (const double f : given_hz)
+    if (n < hz.size()) hz[n++] = f;
+  for (const SpectralPeak& p : search.peaks)
+    if (n < hz.size()) hz[n++] = p.frequency_hz;
+  return hz;
+}
+
+std::string Spectrum::psd_unit() const { return unit == "1" ? "1/Hz" : "(" + unit + ")^2/Hz"; }
+
+std::string spectrum_csv(const Spectrum& s) {
+  std::string out = "freq,psd,ci_low,ci_high\n";
+  const double k = s.factor * s.factor;
+  auto to = std::back_inserter(out);
+  for (std::size_t i = 0; i < s.psd.psd.size(); ++i)
+    fmt::format_to(to, "{},{},{},{}\n", s.psd.freq_hz[i], s.psd.psd[i] * k, s.psd.ci_low[i] * k, s.psd.ci_high[i] * k);
+  return out;
+}
+
+std::string spectrum_table(const Spectrum& s) {
+  std::string out;
+  auto to = std::back_inserter(out);
+  const Psd& p = s.psd;
+  fmt::format_to(to, "# PSD of the rate (Welch, Hann, 50 % overlap): {} segments of {} values, bins of {:.4g} Hz from "
+                     "{:.4g} to {:.4g} Hz, EDF {:.4g} per bin, in {}\n",
+                 p.segments, p.segment, p.bin_hz(), p.freq_hz.front(), p.freq_hz.back(), p.edf, s.psd_unit());
+  for (const double f : s.given_hz) fmt::format_to(to, "#   sinusoid offered to the fit at {:.6g} Hz (--sinusoid-hz)\n", f);
+  if (!s.searched) return out;
+  const PeakSearch& r = s.search;
+  fmt::format_to(to, "#   sinusoid search: {} bins tested, a peak above {:.3g} x the local background (false alarms in "
+                     "{:.2g} % of records without a sinusoid): {}\n",
+                 r.bins_tested, r.threshold, 100 * r.false_alarm, r.peaks.empty() ? "none found" : fmt::format("{} found", r.peaks.size()));
+  for (const SpectralPeak& q : r.peaks)
+    fmt::format_to(to, "#   peak at {:.6g} +- {:.2g} Hz: amplitude {:.4g} +- {:.2g} {} (PSD {:.3g} x its background){}\n",
+                   q.frequency_hz, q.frequency_uncertainty_hz, q.amplitude * s.factor, q.amplitude_uncertainty * s.factor,
+                   s.unit, q.ratio,
+                   q.adev_null < 0 ? ""
+                                   : fmt::format("; OADEV {} at tau = 1/f = {:.4g} s (smallest at {:.4g} s)",
+                                                 q.adev_null ? "dips" : "does not dip", 1 / q.frequency_hz, q.adev_null_tau_s));
+  return out;
+}
+
+nlohmann::json spectrum_json(const Spectrum& s) {
+  using nlohmann::json;
+  const Psd& p = s.psd;
+  const double k = s.factor * s.factor;
+  json freq = json::array(), psd = json::array(), low = json::array(), high = json::array();
+  double next = 0;  // the next frequency on a grid of 20 a decade
+  for (std::size_t i = 0; i < p.psd.size(); ++i) {
+    if (p.freq_hz[i] < next) continue;
+    freq.push_back(p.freq_hz[i]);
+    psd.push_back(p.psd[i] * k);
+    low.push_back(std::isfinite(p.ci_low[i]) ? json(p.ci_low[i] * k) : json(nullptr));
+    high.push_back(std::isfinite(p.ci_high[i]) ? json(p.ci_high[i] * k) : json(nullptr));
+    next = p.freq_hz[i] * std::pow(10.0, 0.05);
+  }
+  const auto measured = [](double value, double uncertainty, const std::string& unit) {
+    return json{{"value", value}, {"uncertainty", uncertainty}, {"unit", unit}};
+  };
+  json peaks = json::array();
+  for (const SpectralPeak& q : s.search.peaks)
+    peaks.push_back({{"frequency", measured(q.frequency_hz, q.frequency_uncertainty_hz, "Hz")},
+                     {"amplitude", measured(q.amplitude * s.factor, q.amplitude_uncertainty * s.factor, s.unit)},
+                     {"power", q.power * k},
+                     {"ratio", q.ratio},
+                     {"threshold", q.threshold},
+                     {"adev_null", q.adev_null < 0 ? json(nullptr)
+                                                   : json{{"found", q.adev_null == 1}, {"tau", q.adev_null_tau_s}}}});
+  return {{"unit", s.psd_unit()},
+          {"segment", p.segment},
+          {"segments", p.segments},
+          {"bin_hz", p.bin_hz()},
+          {"edf", p.edf},
+          {"confidence", p.confidence},
+          {"decimated", "about 20 bins a decade; every bin: --psd FILE"},
+          {"freq", std::move(freq)},
+          {"psd", std::move(psd)},
+          {"ci_low", std::move(low)},
+          {"ci_high", std::move(high)},
+          {"given_hz", s.given_hz},
+          {"search", s.searched ? json{{"false_alarm", s.search.false_alarm},
+                                       {"bins_tested", s.search.bins_tested},
+                                       {"threshold", s.search.threshold}}
+                                : json(nullptr)},
+          {"peaks", std::move(peaks)}};
+}
+
+void add_frequency_uncertainties(nlohmann::json& fits, const Spectrum& s) {
+  for (nlohmann::json& fit : fits) {
+    if (!fit.contains("sinusoids")) continue;
+    for (nlohmann::json& sn : fit["sinusoids"]) {
+      const double f = sn["frequency"]["value"].get<double>();
+      for (const SpectralPeak& q : s.search.peaks)
+        if (q.frequency_hz == f) sn["frequency"]["uncertainty"] = q.frequency_uncertainty_hz;
+    }
+  }
+}
+
+}  // namespace gyrochar

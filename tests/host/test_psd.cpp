@@ -1,0 +1,129 @@
+// The analyzer's Welch PSD and its sinusoid search (host_tools/analyze/psd.hpp) against exact
+// oracles: Parseval's identity for one segment, white noise of known variance (one-sided PSD
+// 2 sigma^2 tau0, each bin distributed as chi2_nu / nu with Welch's nu), a sinusoid's power A^2/2.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "psd.hpp"
+
+namespace {
+
+using namespace gyrochar;
+
+std::vector<double> white(std::size_t n, double sigma, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, sigma);
+  std::vector<double> x(n);
+  for (double& v : x) v = g(rng);
+  return x;
+}
+
+TEST(WelchPsd, OneSegmentObeysParseval) {
+  // Oracle: Parseval for the DFT of the windowed, mean-removed segment, computed here directly:
+  // sum over k = 1 .. L/2-1 of PSD df = (sum (x w)^2 - (X_0^2 + X_{L/2}^2) / L) / sum w^2.
+  const std::size_t L = 256;
+  const double tau0 = 0.1;
+  std::vector<double> x = white(L, 2.0, 7);
+  for (std::size_t n = 0; n < L; ++n) x[n] += 5 + std::sin(0.3 * static_cast<double>(n));
+  const Psd p = welch_psd(x, tau0, L, 0.683);
+  ASSERT_EQ(p.segments, 1u);
+  ASSERT_EQ(p.psd.size(), L / 2 - 1);
+  double mean = 0;
+  for (const double v : x) mean += v / static_cast<double>(L);
+  double energy = 0, w2 = 0, x0 = 0, xn = 0;
+  for (std::size_t n = 0; n < L; ++n) {
+    const double w = std::pow(std::sin(std::numbers::pi * static_cast<double>(n) / static_cast<double>(L)), 2);
+    const double y = (x[n] - mean) * w;
+    energy += y * y;
+    w2 += w * w;
+    x0 += y;
+    xn += n % 2 ? -y : y;
+  }
+  double sum = 0;
+  for (const double v : p.psd) sum += v * p.bin_hz();
+  EXPECT_NEAR(sum, (energy - (x0 * x0 + xn * xn) / static_cast<double>(L)) / w2, 1e-10 * sum);
+}
+
+TEST(WelchPsd, WhiteNoiseIsFlatAt2Sigma2Tau0WithinWelchsBand) {
+  // Oracle: white noise of variance sigma^2 sampled every tau0 has the one-sided PSD 2 sigma^2
+  // tau0; each bin is PSD chi2_nu / nu, nu = 36 K^2 / (19 K - 1) (Percival and Walden eq. 292b).
+  const double sigma = 1.5, tau0 = 0.01, truth = 2 * sigma * sigma * tau0;
+  const std::vector<double> x = white(1 << 18, sigma, 11);
+  const std::size_t L = default_psd_segment(x.size());
+  EXPECT_EQ(L, 16384u);  // 2^18 / 16
+  const Psd p = welch_psd(x, tau0, L, 0.683);
+  EXPECT_EQ(p.segments, 2 * (x.size() / L) - 1);
+  const double K = static_cast<double>(p.segments);
+  EXPECT_DOUBLE_EQ(p.edf, 36 * K * K / (19 * K - 1));
+  double mean = 0, var = 0;
+  std::size_t inside = 0;
+  for (std::size_t k = 0; k < p.psd.size(); ++k) {
+    mean += p.psd[k] / truth;
+    var += std::pow(p.psd[k] / truth - 1, 2);
+    inside += p.ci_low[k] <= truth && truth <= p.ci_high[k];
+  }
+  const double bins = static_cast<double>(p.psd.size());
+  mean /= bins;
+  var /= bins;
+  // The mean of 8191 bins (about 4000 independent: neighbours correlate 4/9) within 1 %.
+  EXPECT_NEAR(mean, 1.0, 0.01);
+  // The spread of a bin is chi2_nu / nu's: variance 2 / nu (within 10 %: the variance of ~4000 draws).
+  EXPECT_NEAR(var, 2 / p.edf, 0.1 * 2 / p.edf);
+  // The 68.3 % band holds the truth in 68.3 % of the bins, within 3 % (about 4 standard errors).
+  EXPECT_NEAR(static_cast<double>(inside) / bins, 0.683, 0.03);
+  // No sinusoid in white noise (the search's false-alarm rate is 1 % per record).
+  EXPECT_TRUE(find_sinusoids(p).peaks.empty());
+}
+
+TEST(WelchPsd, ASinusoidsPowerIsHalfItsAmplitudeSquaredAndIsFound) {
+  // Oracle: a sinusoid of amplitude A has mean power A^2 / 2; its frequency is the one generated.
+  const double A = 3.0, f = 1.2345, tau0 = 0.01, sigma = 0.5;
+  std::vector<double> x = white(1 << 18, sigma, 5);
+  for (std::size_t n = 0; n < x.size(); ++n) x[n] += A * std::sin(2 * std::numbers::pi * f * static_cast<double>(n) * tau0 + 0.4);
+  const Psd p = welch_psd(x, tau0, default_psd_segment(x.size()), 0.683);
+  const PeakSearch s = find_sinusoids(p);
+  ASSERT_EQ(s.peaks.size(), 1u);
+  const SpectralPeak& peak = s.peaks[0];
+  EXPECT_NEAR(peak.power, A * A / 2, 0.01 * A * A / 2);
+  EXPECT_NEAR(peak.amplitude, A, 3 * peak.amplitude_uncertainty);
+  EXPECT_LT(peak.amplitude_uncertainty, 0.01 * A);
+  EXPECT_NEAR(peak.frequency_hz, f, 0.1 * p.bin_hz());
+  EXPECT_GT(peak.ratio, peak.threshold);
+}
+
+TEST(WelchPsd, APeakIsCrossCheckedWithTheAllanNullAtOneOverF) {
+  // Oracle: a sinusoid's ADEV A sin^2(x) / x, x = pi f tau, is zero at tau = 1/f (IEEE 952).
+  const double f = 0.05, A = 2;
+  PeakSearch s;
+  s.peaks.push_back({});
+  s.peaks[0].frequency_hz = f;
+  std::vector<std::pair<double, double>> dense, flat, sparse;
+  for (double tau = 10; tau <= 30; tau += 0.5) {
+    const double x = std::numbers::pi * f * tau;
+    dense.emplace_back(tau, A * std::sin(x) * std::sin(x) / x + 0.01);
+    flat.emplace_back(tau, 1.0 / std::sqrt(tau));
+  }
+  for (double tau = 1; tau < 1000; tau *= 2) sparse.emplace_back(tau, 1.0);
+  check_adev_nulls(s, dense);
+  EXPECT_EQ(s.peaks[0].adev_null, 1);
+  EXPECT_DOUBLE_EQ(s.peaks[0].adev_null_tau_s, 20.0);
+  check_adev_nulls(s, flat);
+  EXPECT_EQ(s.peaks[0].adev_null, 0);  // falling as 1/sqrt(tau): its smallest at the window's end
+  s.peaks[0].adev_null = -1;
+  check_adev_nulls(s, sparse);
+  EXPECT_EQ(s.peaks[0].adev_null, -1);  // octave taus: no check
+}
+
+TEST(WelchPsd, RefusesASegmentThatDoesNotFit) {
+  const std::vector<double> x(100, 1.0);
+  EXPECT_THROW(welch_psd(x, 0.1, 128, 0.683), std::invalid_argument);
+  EXPECT_THROW(welch_psd(x, 0.1, 15, 0.683), std::invalid_argument);
+  EXPECT_EQ(default_psd_segment(63), 0u);
+}
+
+}  // namespace
