@@ -6,6 +6,7 @@
 #include <array>
 #include <atomic>
 #include <bit>
+#include <cfloat>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -27,18 +28,45 @@ namespace gyrochar {
 
 namespace {
 
+// "oadev at tau = 1 s (m = 1)": the start of an estimate's error message.
+std::string where_of(const Estimate& e) { return fmt::format("{} at tau = {:g} s (m = {})", name(e.stat), e.tau_s, e.m); }
+
+// Whether tau0^2 or tau^2 leaves the normal range of a double, and so it says.
+bool tau0_out_of_range(const Estimate& e, double tau0_s, std::string& why) {
+  if (std::isnormal(tau0_s * tau0_s) && std::isnormal(e.tau_s * e.tau_s)) return false;
+  why = where_of(e) + fmt::format(": tau0^2 = ({:g} s)^2 is outside the range of a double: tau0 is too {}", tau0_s,
+                                  tau0_s < 1 ? "small" : "large");
+  return true;
+}
+
 // Why estimate `e` is not a finite number, for an error message. The variance is the sum of the
 // squared differences over tau0^2 (phase data) or over 1 (frequency data), TDEV's times tau^2 / 3.
 std::string non_finite_reason(const Estimate& e, const TauSums& sums, double tau0_s) {
-  const std::string where = fmt::format("{} at tau = {:g} s (m = {})", name(e.stat), e.tau_s, e.m);
+  const std::string where = where_of(e);
   for (const double v : sums.variance)
     if (!std::isfinite(v))
       return where + ": the squared differences of the values overflow a double (largest 1.8e308): the values "
                      "are too large; scale them";
-  if (!std::isnormal(tau0_s * tau0_s) || !std::isnormal(e.tau_s * e.tau_s))
-    return where + fmt::format(": tau0^2 = ({:g} s)^2 is outside the range of a double: tau0 is too {}", tau0_s,
-                               tau0_s < 1 ? "small" : "large");
+  if (std::string why; tau0_out_of_range(e, tau0_s, why)) return why;
   return where + fmt::format(": the squared differences divided by tau0^2 = ({:g} s)^2 overflow a double", tau0_s);
+}
+
+// The other end: why the finite estimate `e` lost its value to underflow (a deviation of 0 or of
+// a few bits that the data do not have), or "" when it did not. Its tau is not finite; the sums'
+// variance (at tau0 = 1) is positive but below the smallest normal double (the squares of the
+// differences underflowed); or the division by tau0^2 takes a positive variance there.
+std::string underflow_reason(const Estimate& e, const TauSums& sums, double tau0_s) {
+  const std::string where = where_of(e);
+  if (!std::isfinite(e.tau_s))
+    return where + fmt::format(": tau = m tau0 = {} x {:g} s is not a finite number: tau0 is too large", e.m, tau0_s);
+  const double v = sums.variance[static_cast<std::size_t>(sum_kind(e.stat))];
+  if (v > 0 && v < DBL_MIN)
+    return where + ": the squared differences of the values underflow a double (smallest normal 2.2e-308): the "
+                   "values are too small; scale them";
+  if (!(v > 0) || e.variance >= DBL_MIN) return {};
+  if (std::string why; tau0_out_of_range(e, tau0_s, why)) return why;
+  return where + fmt::format(": the squared differences divided by tau0^2 = ({:g} s)^2 underflow a double (smallest "
+                             "normal 2.2e-308): the values are too small for this tau0; scale them", tau0_s);
 }
 
 }  // namespace
@@ -213,6 +241,7 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
                                       : estimate(sums[i], a.n_phase, stat, id, options, &cache);
       if (e.n == 0) continue;
       if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
+      if (const std::string why = underflow_reason(e, sums[i], o.tau0_s); !why.empty()) throw std::range_error(why);
       AnalysisRow row;
       row.stat = stat;
       row.m = e.m;

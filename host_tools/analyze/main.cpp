@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -66,6 +67,11 @@ many fields as the first. Without --column a table of two columns whose first on
 (time, value) is read from column 2, and stderr says so; other tables need --column. A comma
 between two digits beside another separator is a decimal comma, refused; with no other separator
 it is ambiguous and needs --column. A number is never half read.
+
+Range: values whose squared differences overflow or underflow a double, a tau0 whose square leaves
+its range, an output unit that takes a deviation out of it, or --nominal-hz rounding the values
+away (fractional frequency given as Hz) are errors naming the cause (exit 2), never infinities or
+silent zeros; a constant input (phase: a straight line) gives deviations of 0, with a note.
 
 Taus (averaging factors m, tau = m tau0) and memory:
   octave        1, 2, 4, ... while a term fits
@@ -171,7 +177,80 @@ double parse_pulse_weight_rad(const std::string& text, const std::string& pulse_
   const auto rad = angle_unit_rad(unit);
   if (!rad) bad("--pulse-weight", "unknown angle unit '" + unit + "' (rad, mrad, urad, deg, arcsec)");
   described = fmt::format("counts of {} {}", value, unit);
+  if (!std::isnormal(value * *rad))  // 1e-320arcsec: every deviation would be 0 in the output unit
+    bad("--pulse-weight", fmt::format("{} {} is {:g} rad, below the smallest normal double (2.2e-308): the deviations "
+                                      "would underflow to 0", value, unit, value * *rad));
   return value * *rad;
+}
+
+// What the values say about numerical collapse, as they are read: --nominal-hz's conversion
+// y = (f - F0) / F0, refused where it loses the values, and whether the input is constant
+// (frequency, counts) or a straight line (phase), whose deviations are all 0 by right.
+class InputShape {
+ public:
+  InputShape(DataType type, double nominal_hz) : phase_(type == DataType::phase), f0_(nominal_hz) {}
+
+  /// Converts `values` in place (--nominal-hz) and takes note of them. Throws BadValue for a value
+  /// f != F0 that the conversion takes to 0 or below the smallest normal double. O(n).
+  void add(std::span<double> values) {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      double& v = values[i];
+      if (f0_ > 0) {
+        const double f = v;
+        v = (f - f0_) / f0_;
+        if (f != f0_ && !std::isnormal(v))
+          throw BadValue(i, fmt::format("(f - F0) / F0 of {:g} Hz with F0 = {:g} Hz is {:g}, below the smallest "
+                                        "normal double (2.2e-308)", f, f0_, v));
+        raw_lo_ = n_ == 0 ? f : std::min(raw_lo_, f);
+        raw_hi_ = n_ == 0 ? f : std::max(raw_hi_, f);
+        converted_vary_ |= n_ > 0 && v != first_;
+      }
+      if (n_ == 0) first_ = lo_ = hi_ = v;
+      lo_ = std::min(lo_, v);
+      hi_ = std::max(hi_, v);
+      // Phase: every step equal to the first; frequency and counts: every value equal to the first.
+      if (phase_ && n_ == 1) step_ = v - last_;
+      bent_ |= phase_ ? n_ > 1 && v - last_ != step_ : v != first_;
+      last_ = v;
+      ++n_;
+    }
+  }
+  /// bad() when --nominal-hz made values that vary all equal: f - F0 rounded them away (values
+  /// far below F0 given as Hz: fractional frequency, whose analysis needs no --nominal-hz).
+  void check_conversion() const {
+    if (f0_ > 0 && raw_lo_ != raw_hi_ && !converted_vary_)
+      bad("--nominal-hz", fmt::format("the values vary from {:g} to {:g} Hz, but (f - F0) / F0 with F0 = {:g} Hz makes "
+                                      "every one {:g}: their differences are below the resolution of a double at F0 "
+                                      "({:.2g} Hz). Are they fractional frequency already (then without --nominal-hz)?",
+                                      raw_lo_, raw_hi_, f0_, first_, std::nextafter(f0_, HUGE_VAL) - f0_));
+  }
+  /// Every deviation of such an input is 0: a constant (frequency, counts), a straight line (phase).
+  bool straight() const { return !bent_; }
+  const char* shape() const { return phase_ ? "a straight line (a constant frequency)" : "constant"; }
+  double lowest() const { return lo_; }
+  double highest() const { return hi_; }
+
+ private:
+  bool phase_;
+  double f0_;
+  std::uint64_t n_ = 0;
+  double first_ = 0, last_ = 0, step_ = 0, lo_ = 0, hi_ = 0;
+  double raw_lo_ = 0, raw_hi_ = 0;
+  bool bent_ = false, converted_vary_ = false;
+};
+
+// After a whole analysis whose every deviation is 0 (all_zero): a note for a constant or straight
+// input, a collapse otherwise (the squares of the differences underflowed to exactly 0).
+void check_zeros(bool all_zero, const InputShape& shape, const std::string& source) {
+  if (!all_zero) return;
+  if (!shape.straight())
+    bad(source, fmt::format("every deviation is 0, but the values (from {:g} to {:g}) are not {}: the squares of their "
+                            "differences underflow a double (smallest normal 2.2e-308): the values are too small; "
+                            "scale them", shape.lowest(), shape.highest(), shape.shape()));
+  print_error(program, "note", fmt::format("every deviation is 0: the values are {}", shape.shape()));
+}
+bool all_zero(const std::vector<AnalysisRow>& rows) {
+  return std::all_of(rows.begin(), rows.end(), [](const AnalysisRow& r) { return r.dev == 0; });
 }
 
 // Prints how far the reading got, about every 2^20 values, when enabled; nothing for short inputs.
@@ -256,15 +335,15 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
   }
   const std::string source = path == "-" ? "standard input" : path;
   std::vector<WindowAnalysis> windows;
+  InputShape shape(o.type, nominal_hz);
   try {
     DataFile file(path, column);
     Progress p(show_progress, file);
     std::vector<double> block(1 << 14);
     while (const std::size_t n = file.read(block)) {
       const std::span<double> values(block.data(), n);
-      if (nominal_hz > 0)
-        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
       try {
+        shape.add(values);
         analyzer->add(values);
       } catch (const BadValue& e) {
         bad(source, fmt::format("line {}: {}", file.line_of(e.index()), e.what()));
@@ -277,8 +356,11 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
   } catch (const DataFileError& e) {
     bad_data(source, e);
   }
+  shape.check_conversion();
   if (windows.empty())
     bad(source, fmt::format("{} values are fewer than one window of {} values", analyzer->values(), window));
+  check_zeros(std::all_of(windows.begin(), windows.end(), [](const WindowAnalysis& w) { return all_zero(w.analysis.rows); }),
+              shape, source);
   const DynamicReport report{windows, o.type, o.tau0_s, o.confidence, units, window, step, analyzer->values(), o.stats};
   const std::string text = format == "json" ? dynamic_to_json(report).dump(2) + "\n"
                            : format == "csv" ? format_dynamic_csv(report)
@@ -537,11 +619,11 @@ int main(int argc, char** argv) {
       too_big();
     }
     DataRange range;
+    InputShape shape(o.type, nominal_hz);
     const auto add = [&](std::span<double> values, auto line_of) {
-      if (nominal_hz > 0)
-        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
-      range.add(values);
       try {
+        shape.add(values);
+        range.add(values);
         analyzer->add(values);
       } catch (const BadValue& e) {
         bad(source, fmt::format("line {}: {}", line_of(e.index()), e.what()));
@@ -566,6 +648,7 @@ int main(int argc, char** argv) {
     } catch (const DataFileError& e) {
       bad_data(source, e);
     }
+    shape.check_conversion();
     Analysis a = [&] {
       try {
         return analyzer->result();
@@ -579,6 +662,7 @@ int main(int argc, char** argv) {
         bad("--taus", fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must be a "
                                   "multiple of its stride (m/S rounded up to a power of two)", m, s));
     if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
+    check_zeros(all_zero(a.rows), shape, source);
     if (!file->layout_note().empty()) print_error(program, source, "values from " + file->layout_note());
     if (cut_above > 0 && cut_above <= a.n_phase / 2)
       print_error(program, source, fmt::format("taus stop below m = {}: with stride factor {} more would need more than "
@@ -606,11 +690,16 @@ int main(int argc, char** argv) {
                     fmt::format("m = {} (tau = {:g} s) left out of {}: {} phase points are too few for a term", m,
                                 static_cast<double>(m) * o.tau0_s, missing, displayed.n_phase));
     }
-    for (const AnalysisRow& r : displayed.rows)  // the output unit must not take a value out of range
+    for (const AnalysisRow& r : displayed.rows) {  // the output unit must not take a value out of range
       if (!std::isfinite(r.dev * units.factor()) || (r.ci.valid && !std::isfinite(r.ci.high * units.factor())))
         bad(source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) overflows a double",
                                 name(r.stat), r.tau_s, r.m, r.ci.valid ? r.ci.high : r.dev, units.factor(),
                                 units.unit(r.stat)));
+      if (r.dev != 0 && !(r.dev * units.factor() >= DBL_MIN))
+        bad(source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) underflows a double "
+                                "(smallest normal 2.2e-308)", name(r.stat), r.tau_s, r.m, r.dev, units.factor(),
+                                units.unit(r.stat)));
+    }
     Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt, source, range,
                   std::move(readoff)};
     if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);

@@ -21,6 +21,7 @@
 #include <random>
 #include <regex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "hal/exit_codes.hpp"
@@ -145,6 +146,62 @@ TEST(AnalyzeCli, NonFiniteResultsAreErrorsWithTheirCause) {
   // Finite deviations, but the output unit takes them out of range (1e308 arcsec pulses in deg/h).
   expect_bad_input("--type counts --pulse-weight 1e308arcsec --tau0 1 " + file_with("c.txt", "100\n-100\n100\n-100\n100\n"),
                    "oadev at tau = 1 s (m = 1): ");
+}
+
+// The other end: a result that underflows (every deviation 0, or a few bits the data do not have)
+// is an error naming the cause, with the exit code of overflow; a constant input, whose deviations
+// are 0 by right, gets a note. Oracle: the range of a double (largest 1.8e308, smallest normal
+// 2.2e-308) and the resolution of a double at 1e7 (2^-29 = 1.9e-9).
+std::string line_of(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g\n", v);
+  return text;
+}
+
+TEST(AnalyzeCli, CollapsedResultsAreErrorsWithTheirCause) {
+  std::string fractional, tiny, subnormal, ramp, constant;
+  for (int i = 0; i < 200; ++i) {
+    const double wobble = (i * 7919 % 101) - 50.0;
+    fractional += line_of(1e-11 * wobble);  // fractional frequency, as a clock's
+    tiny += line_of(1e-209 * wobble);       // squared differences ~1e-418: 0
+    subnormal += line_of(1e-158 * wobble);  // squared differences ~1e-316: subnormal
+    ramp += line_of(3 * i + 1);             // a phase line: a constant frequency
+    constant += "5\n";
+  }
+  // Fractional frequency read as Hz around 10 MHz: f - F0 rounds every value to -F0.
+  expect_bad_input("--type freq --tau0 1 --nominal-hz 10e6 " + file_with("frac.txt", fractional),
+                   "--nominal-hz: the values vary from -5e-10 to 5e-10 Hz, but (f - F0) / F0 with F0 = 1e+07 Hz makes "
+                   "every one -1: their differences are below the resolution of a double at F0 (1.9e-09 Hz)");
+  for (const std::string type : {"phase", "freq"})
+    expect_bad_input("--type " + type + " --tau0 1 " + file_with("tiny.txt", tiny),
+                     "every deviation is 0, but the values (from -5e-208 to 5e-208) are not ");
+  expect_bad_input("--type phase --tau0 1 " + file_with("subnormal.txt", subnormal),
+                   "oadev at tau = 1 s (m = 1): the squared differences of the values underflow a double");
+  // tau0^2 overflows: every variance divided by it would be 0; a tau that is not finite.
+  expect_bad_input("--type phase --tau0 1e160 " + good_phase(),
+                   "oadev at tau = 1e+160 s (m = 1): tau0^2 = (1e+160 s)^2 is outside the range of a double: tau0 is "
+                   "too large");
+  expect_bad_input("--type counts --pulse-weight 1arcsec --tau0 1e160 " + file_with("c.txt", "3\n5\n4\n6\n2\n"),
+                   "tau0 is too large");
+  expect_bad_input("--type phase --tau0 1e308 --taus 2 " + good_phase(),
+                   "oadev at tau = inf s (m = 2): tau = m tau0 = 2 x 1e+308 s is not a finite number: tau0 is too large");
+  // A pulse of 1e-320 arcsec is 0 rad; 1e-300 rad per pulse takes the deviations below 2.2e-308 in deg/h.
+  expect_bad_input("--type counts --tau0 1 --pulse-weight 1e-320arcsec " + file_with("c2.txt", "3\n5\n4\n6\n2\n"),
+                   "--pulse-weight");
+  expect_bad_input("--type counts --tau0 1e10 --pulse-weight 1e-300rad --rate-unit rad/s " +
+                       file_with("c3.txt", "3\n5\n4\n6\n2\n"),
+                   "underflows a double");
+  // Constant inputs: zeros by right, and a note.
+  const char* line = "a straight line (a constant frequency)";
+  for (const auto& [type, values, shape] : {std::tuple{"freq", constant, "constant"}, std::tuple{"phase", constant, line},
+                                            std::tuple{"phase", ramp, line}}) {
+    const Outcome r = run(std::string("--type ") + type + " --tau0 1 --format csv " + file_with("flat.txt", values));
+    EXPECT_EQ(r.code, exit_code::ok) << r.err;
+    EXPECT_EQ(r.err, std::string("gyrochar-analyze: note: every deviation is 0: the values are ") + shape + "\n");
+  }
+  const Outcome counts = run("--type counts --tau0 1 --pulse-weight 1arcsec " + file_with("flat.txt", constant));
+  EXPECT_EQ(counts.code, exit_code::ok) << counts.err;
+  EXPECT_EQ(counts.err, "gyrochar-analyze: note: every deviation is 0: the values are constant\n");
 }
 
 TEST(AnalyzeCli, EachStatisticOnceAndListedTausTooLongForTheDataGetANote) {
