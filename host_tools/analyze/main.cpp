@@ -420,7 +420,7 @@ int main(int argc, char** argv) {
   app.add_option("--plot", plot_prefix, "with --dynamic: draw the heat maps to PREFIX.svg and PREFIX.png")
       ->option_text("PREFIX");
   unsigned threads = 0;
-  app.add_option("--threads", threads, "threads summing the taus of counts at --stride-factor full (default: one per core)")
+  app.add_option("--threads", threads, "threads summing the taus of counts at --stride-factor full and of --taus all (default: one per core)")
       ->check(CLI::Range(1u, 1024u));
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
@@ -579,6 +579,11 @@ int main(int argc, char** argv) {
       };
     o.hold_counts = o.type == DataType::counts && o.stride_factor == 0 && n_phase > 0 &&
                     o.values_hint < memory_budget() / 12;
+    // Phase and frequency under --taus all hold the staged points and their prefix sums (24 bytes
+    // a point) and sum tau by tau (the characterizer would visit every tau at every point).
+    o.hold_phase = o.type != DataType::counts && taus_text == "all" && o.stride_factor == 0 &&
+                   o.values_hint < memory_budget() / 24;
+    const bool held = o.hold_counts || o.hold_phase;
     if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus_text == "all" ? 2 * n_phase : n_phase);
     const std::uint32_t s = o.stride_factor;
     std::vector<std::uint64_t> not_formed;  // decade taus the stride factor cannot form
@@ -598,7 +603,7 @@ int main(int argc, char** argv) {
     // input); a list that does not fit is refused.
     const std::uint64_t budget = memory_budget();
     std::uint64_t cut_above = 0;
-    while (!o.hold_counts && generated && o.m_list.size() > 1 && history_bytes(o.type, s, o.m_list.back()) > budget) {
+    while (!held && generated && o.m_list.size() > 1 && history_bytes(o.type, s, o.m_list.back()) > budget) {
       cut_above = o.m_list.back();
       o.m_list.pop_back();
     }
@@ -607,7 +612,7 @@ int main(int argc, char** argv) {
                                          "process may use: give a smaller stride factor or fewer taus",
                                          s, o.m_list.back(), history_bytes(o.type, s, o.m_list.back()) >> 20, budget >> 20));
     };
-    if (!o.hold_counts && history_bytes(o.type, s, o.m_list.back()) > budget) too_big();
+    if (!held && history_bytes(o.type, s, o.m_list.back()) > budget) too_big();
     o.theo_m_list = theo_taus(generated ? taus_text : "list", o.m_list, n_phase);
 
     std::unique_ptr<Analyzer> analyzer;
