@@ -644,7 +644,7 @@ std::optional<std::string> kalibr_yaml(const Report& r, std::string& why) {
     const Ieee952Parameter& p = both->p[k];
     return KalibrTerm{p.value, p.value > 0 ? p.uncertainty / p.value : 0.0, p.fitted, p.resolved};
   };
-  return kalibr_imu_yaml(term(1), term(3), 1.0 / r.tau0_s, fmt::format("{} ({})", r.source, r.units.input), why);
+  return kalibr_imu_yaml(term(1), term(3), 1.0 / r.tau0_s, fmt::format("{} ({})", r.source, r.units.input), why, true);
 }
 
 }  // namespace gyrochar

@@ -20,6 +20,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "analysis.hpp"
@@ -56,12 +57,13 @@ constexpr const char* footer = R"(Data type and units (the type is required: for
 Formats: table (people), csv, json, stable32 (Stable32's result table: AF Tau # Alpha MinSigma
 Sigma MaxSigma, one block per statistic; values in the output unit). --kalibr FILE also writes the
 IEEE-952 fit's N and K as the gyroscope part of a Kalibr imu.yaml (N in rad/s/sqrt(Hz) = rad/s^0.5,
-K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill).
+K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill, and
+so is N or K when the fit left it out of its model, said on stderr).
 Gyro data with OADEV rows also get the IEEE-952 graphical read-off that data sheets print (table
 and json): N on the -1/2 line at tau = 1 s, the ADEV floor and B = floor/0.664, K on the +1/2 line
 at 3 s, each with the interval of the point it was read at and, beside --fit, whether they agree.
 
-Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' starts a comment),
+Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' or '%' starts a comment),
 plain or gzip (recognized by content), '-' for standard input; read once. Every data line has as
 many fields as the first. Without --column a table of two columns whose first one increases
 (time, value) is read from column 2, and stderr says so; other tables need --column. A comma
@@ -285,15 +287,28 @@ class Progress {
 }
 
 // Memory the history may take: half the machine's memory, or of the process's address space
-// limit when one is set.
-std::uint64_t memory_budget() {
+// limit when one is set; and where that comes from, for a message.
+std::uint64_t machine_budget() {
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  std::uint64_t budget = pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2
-                                               : std::uint64_t{1} << 32;
+  return pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2
+                               : std::uint64_t{1} << 32;
+}
+std::uint64_t memory_budget() {
+  std::uint64_t budget = machine_budget();
   rlimit limit{};
   if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) budget = std::min<std::uint64_t>(budget, limit.rlim_cur / 2);
   return budget;
 }
+std::string memory_budget_reason() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur / 2 < machine_budget())
+    return fmt::format("half of its address-space limit, ulimit -v {} KiB", limit.rlim_cur >> 10);
+  return "half of the machine's memory";
+}
+
+// The longest window or step of --dynamic, in values: longer than any file (10^15 values are
+// petabytes of text), and exact as an integer in a double.
+constexpr double max_dynamic_values = 1e15;
 
 // --dynamic WINDOW[,STEP]: one pass over the file, the surface on stdout, the heat maps to --plot.
 int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::string& dynamic_text,
@@ -309,9 +324,13 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
     bad("--dynamic", "'" + dynamic_text + "' is not WINDOW or WINDOW,STEP in positive seconds");
   if (parts.size() == 1) step_s = window_s;
   const double window_values = std::round(window_s / o.tau0_s), step_values = std::round(step_s / o.tau0_s);
-  if (window_values < 4 || window_values > 1e15)
+  if (window_values < 4)
     bad("--dynamic", fmt::format("a window of {} s holds {} values of tau0: at least 4 are needed", window_s, window_values));
   if (step_values < 1) bad("--dynamic", fmt::format("a step of {} s is shorter than tau0", step_s));
+  for (const auto& [what, seconds_asked, values] : {std::tuple{"window", window_s, window_values}, std::tuple{"step", step_s, step_values}})
+    if (values > max_dynamic_values)
+      bad("--dynamic", fmt::format("a {} of {:g} s is {:g} values of tau0 = {:g} s, more than the {:g} a window or step "
+                                   "may span", what, seconds_asked, values, o.tau0_s, max_dynamic_values));
   const auto window = static_cast<std::uint64_t>(window_values), step = static_cast<std::uint64_t>(step_values);
   // The windows' taus: --taus over the phase points of one window, those with 4 m <= its values.
   const std::uint64_t window_phase = o.type == DataType::phase ? window : window + 1;
@@ -607,10 +626,22 @@ int main(int argc, char** argv) {
       cut_above = o.m_list.back();
       o.m_list.pop_back();
     }
+    // More memory than the process may use, or an allocation that failed: a stride factor given is
+    // the user's choice (bad input); under the default the cause is the memory limit (exit 1).
     const auto too_big = [&] {
-      bad("--stride-factor", fmt::format("{} with taus up to {} needs {} MiB of history, more than the {} MiB this "
-                                         "process may use: give a smaller stride factor or fewer taus",
-                                         s, o.m_list.back(), history_bytes(o.type, s, o.m_list.back()) >> 20, budget >> 20));
+      const std::uint64_t bytes = o.hold_counts  ? 12 * o.values_hint
+                                  : o.hold_phase ? 24 * o.values_hint
+                                                 : history_bytes(o.type, s, o.m_list.back());
+      if (stride_text != "full")
+        bad("--stride-factor", fmt::format("{} with taus up to {} needs {} MiB of history, more than the {} MiB this "
+                                           "process may use: give a smaller stride factor or fewer taus",
+                                           s, o.m_list.back(), bytes >> 20, budget >> 20));
+      fail(exit_code::internal, source,
+           fmt::format("{} values{} need {} MiB of memory with every tau up to N/4 fully overlapped (--stride-factor "
+                       "full, the default), more than the {} MiB this process may use ({}): raise the limit, or give "
+                       "--stride-factor 8 (a few MiB whatever the length)", o.values_hint,
+                       taus_text == "all" ? "" : " (at most, from the file's size)", std::max<std::uint64_t>(bytes >> 20, 1),
+                       budget >> 20, memory_budget_reason()));
     };
     if (!held && history_bytes(o.type, s, o.m_list.back()) > budget) too_big();
     o.theo_m_list = theo_taus(generated ? taus_text : "list", o.m_list, n_phase);
@@ -713,6 +744,7 @@ int main(int argc, char** argv) {
       std::string why;
       const auto text = kalibr_yaml(report, why);
       if (!text) bad("--kalibr", why);
+      if (!why.empty()) print_error(program, "note", kalibr_path + ": " + why);
       yaml = *text;
     }
     const std::string text = format == "json"       ? to_json(report).dump(2) + "\n"
@@ -726,6 +758,9 @@ int main(int argc, char** argv) {
       std::fputs(yaml.c_str(), f);
       if (!close_output(f, program, kalibr_path)) return finish(program, exit_code::output_failed);
     }
+  } catch (const std::bad_alloc&) {  // beyond the plan's own check (too_big): say what limits memory
+    fail(exit_code::internal, "out of memory",
+         fmt::format("an allocation failed: this process may use {} MiB ({})", memory_budget() >> 20, memory_budget_reason()));
   } catch (const std::exception& e) {
     fail(exit_code::internal, "internal error", e.what());
   }

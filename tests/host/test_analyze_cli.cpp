@@ -245,6 +245,32 @@ TEST(AnalyzeCli, KalibrYamlHoldsTheFitsNAndKInSI) {
                    "--kalibr: needs gyro data");
 }
 
+// A gyro with white rate noise alone (the simulator's ARW and white angle noise: no rate random
+// walk): the fit leaves K out of its model. The analysis is printed all the same (exit 0), the
+// Kalibr file holds N (the JSON's N in SI, as above) and K's key commented out with '?' for the
+// user to fill, and stderr says so.
+TEST(AnalyzeCli, KalibrWithoutKWritesWhatTheFitHasAndPrintsTheAnalysis) {
+  const std::string counts = temp("sim_arw.txt"), yaml = temp("imu_arw.yaml");
+  ASSERT_EQ(std::system((GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim --duration 2000 --tau0 0.01 --arw 0.003 "
+                         "--white-angle 2 --seed 3 --out " + counts).c_str()), 0);
+  const Outcome r = run("--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --format json --kalibr " + yaml +
+                        " " + counts);
+  ASSERT_EQ(r.code, exit_code::ok) << r.err;
+  const auto fit = nlohmann::json::parse(r.out)["fit"][0];
+  ASSERT_EQ(fit["curve"], "both");
+  ASSERT_FALSE(fit["K"]["fitted"].get<bool>()) << fit.dump();
+  EXPECT_EQ(r.err, "gyrochar-analyze: note: " + yaml + ": K (rate random walk) is not in the fitted model: its key is "
+                   "written commented out with '?' for you to fill in (Kalibr needs it > 0)\n");
+  std::ifstream in(yaml);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  const auto at = text.find("\ngyroscope_noise_density: ");
+  ASSERT_NE(at, std::string::npos) << text;
+  const double pi = 3.14159265358979323846;
+  EXPECT_NEAR(std::stod(text.substr(at + 26)) / (fit["N"]["value"].get<double>() * pi / 180 / 60), 1.0, 1e-12);
+  EXPECT_NE(text.find("\n#gyroscope_random_walk: ?"), std::string::npos) << text;
+  EXPECT_EQ(text.find("\ngyroscope_random_walk"), std::string::npos) << text;
+}
+
 // The read-off of a real gyro (ADIS16405, run 1, x; 2.78 h at 100 Hz in deg/s). Oracles: its data
 // sheet's angle random walk, 2.0 deg/sqrt(h) typical (N within 20 %); the measured OADEV curve
 // itself (the floor is its smallest point, at or below that point's upper bound; N is the point it
@@ -642,6 +668,32 @@ TEST(AnalyzeCli, HugeStrideFactorOnStandardInputIsNoAllocationFailure) {
   expect_bad_input(args + "< " + good_phase(), "--stride-factor", "ulimit -v 1000000; ");
 }
 
+TEST(AnalyzeCli, AFileBeyondTheMemoryLimitNamesTheLimit) {
+  // Under ulimit -v 524288 (512 MiB) the process may use 256 MiB. A file of 1 GiB (sparse: the plan
+  // reads only its size) may hold 2^29 values, whose default plan (every tau up to N/4 fully
+  // overlapped: S = 2^24, 3 x 2^24 history entries of 24 bytes = 1152 MiB) does not fit: the
+  // message names the limit and the sizes (exit 1: memory exhausted), not a --stride-factor the
+  // user never gave.
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: it cannot run under ulimit -v";
+#endif
+  const std::string big = temp("big.txt");
+  ASSERT_EQ(std::system(("truncate -s 1G " + big).c_str()), 0);
+  for (const std::string type : {"counts --pulse-weight 1arcsec", "phase", "freq"}) {
+    const Outcome r = run_shell("ulimit -v 524288; " + tool + " --type " + type + " --tau0 1 " + big);
+    EXPECT_EQ(r.code, exit_code::internal) << r.err;
+    EXPECT_NE(r.err.find("gyrochar-analyze: " + big + ": 536870912 values (at most, from the file's size) need 1152 MiB "
+                         "of memory with every tau up to N/4 fully overlapped (--stride-factor full, the default), more "
+                         "than the 256 MiB this process may use (half of its address-space limit, ulimit -v 524288 "
+                         "KiB)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("--stride-factor:"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty());
+  }
+  std::remove(big.c_str());
+}
+
 TEST(AnalyzeCli, AllTausEqualTheirBruteForceFromFileStdinAndGzip) {
   // 300 counts (301 phase points): every m up to 150 for oadev, up to 100 for mdev and ohdev. The
   // oracle sums the definitions exactly (tests/oracle/brute_force.hpp); with 1 arcsec pulses and
@@ -732,6 +784,9 @@ TEST(AnalyzeCli, DynamicRefusesWhatItCannotDo) {
   expect_bad_input("--type phase --tau0 1 --dynamic 100,-1 " + good, "--dynamic");
   expect_bad_input("--type phase --tau0 1 --dynamic 100,50,25 " + good, "--dynamic");
   expect_bad_input("--type phase --tau0 1 --dynamic 3 " + good, "at least 4");
+  expect_bad_input("--type phase --tau0 1 --dynamic 1e308 " + good,
+                   "--dynamic: a window of 1e+308 s is 1e+308 values of tau0 = 1 s, more than the 1e+15 a window or step may span");
+  expect_bad_input("--type phase --tau0 1e-9 --dynamic 100,1e7 " + good, "a step of 1e+07 s is 1e+16 values");
   expect_bad_input("--type phase --tau0 1 --dynamic 100,0.4 " + good, "shorter than tau0");
   expect_bad_input("--type phase --tau0 1 --dynamic 500 " + good, "fewer than one window");
   expect_bad_input("--type phase --tau0 1 --dynamic 100 --taus 1,50 " + good, "quarter of the window");
