@@ -75,8 +75,13 @@ void expect_bad_input(const std::string& args, const std::string& what, const st
 }
 
 std::string good_phase() {
+  // (std::to_string's six decimals made these all 0: a constant input, which now gets a note.)
   std::string s = "# phase\n";
-  for (int i = 0; i < 200; ++i) s += std::to_string((i * 7919 % 101) * 1e-9) + "\n";
+  char text[32];
+  for (int i = 0; i < 200; ++i) {
+    std::snprintf(text, sizeof text, "%.9g\n", (i * 7919 % 101) * 1e-9);
+    s += text;
+  }
   return file_with("good.txt", s);
 }
 
@@ -575,7 +580,7 @@ TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
   // stdout still carries only the table.
   std::string s;
   s.reserve(2u << 21);
-  for (int i = 0; i <= (1 << 20); ++i) s += "1\n";
+  for (int i = 0; i <= (1 << 20); ++i) s += i % 2 ? "2\n" : "1\n";  // not constant: no note
   const std::string path = file_with("long.txt", s);
   const Outcome r = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 --progress " + path);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -584,6 +589,13 @@ TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
   EXPECT_EQ(r.out.find("gyrochar-analyze"), std::string::npos);
   const Outcome quiet = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 " + path);
   EXPECT_TRUE(quiet.err.empty()) << quiet.err;  // stderr is a file here, not a terminal
+  // --taus all on phase and frequency sums its taus over the held record too, and says how far
+  // (200 phase points: m = 1 .. 100; 200 frequency values: 201 points, the same taus).
+  for (const std::string type : {"phase", "freq"}) {
+    const Outcome all = run("--type " + type + " --tau0 1 --taus all --progress --format csv " + good_phase());
+    ASSERT_EQ(all.code, 0) << all.err;
+    EXPECT_NE(all.err.find("summing: 100 of 100 taus\n"), std::string::npos) << all.err;
+  }
 }
 
 // The rows of --format csv: stat, m, n, dev.
@@ -670,8 +682,8 @@ TEST(AnalyzeCli, HugeStrideFactorOnStandardInputIsNoAllocationFailure) {
 
 TEST(AnalyzeCli, AFileBeyondTheMemoryLimitNamesTheLimit) {
   // Under ulimit -v 524288 (512 MiB) the process may use 256 MiB. A file of 1 GiB (sparse: the plan
-  // reads only its size) may hold 2^29 values, whose default plan (every tau up to N/4 fully
-  // overlapped: S = 2^24, 3 x 2^24 history entries of 24 bytes = 1152 MiB) does not fit: the
+  // reads only its size) may hold 2^29 + 1 values (its bound), whose default plan (every tau up to
+  // N/4 fully overlapped: S = 2^24, 3 x 2^24 history entries of 24 bytes = 1152 MiB) does not fit: the
   // message names the limit and the sizes (exit 1: memory exhausted), not a --stride-factor the
   // user never gave.
 #if defined(__SANITIZE_ADDRESS__)
@@ -682,7 +694,7 @@ TEST(AnalyzeCli, AFileBeyondTheMemoryLimitNamesTheLimit) {
   for (const std::string type : {"counts --pulse-weight 1arcsec", "phase", "freq"}) {
     const Outcome r = run_shell("ulimit -v 524288; " + tool + " --type " + type + " --tau0 1 " + big);
     EXPECT_EQ(r.code, exit_code::internal) << r.err;
-    EXPECT_NE(r.err.find("gyrochar-analyze: " + big + ": 536870912 values (at most, from the file's size) need 1152 MiB "
+    EXPECT_NE(r.err.find("gyrochar-analyze: " + big + ": 536870913 values (at most, from the file's size) need 1152 MiB "
                          "of memory with every tau up to N/4 fully overlapped (--stride-factor full, the default), more "
                          "than the 256 MiB this process may use (half of its address-space limit, ulimit -v 524288 "
                          "KiB)"),
