@@ -79,8 +79,9 @@ Taus (averaging factors m, tau = m tau0) and memory:
   octave        1, 2, 4, ... while a term fits
   decade        1, 2, 4, 10, 20, 40, ... (Stable32's decade)
   all           every m up to N/2 that the stride factor can form (keeps the values in memory;
-                the sums of every tau make it O(N^2): 10^5 values take seconds; from m = 64 the
-                EDF is interpolated between exact anchors, within 2e-3 of the exact one)
+                the sums of every tau make it O(N^2), on every core, --progress counting them:
+                10^5 values take seconds, 10^6 many minutes; from m = 64 the EDF is
+                interpolated between exact anchors, within 2e-3 of the exact one)
   1,10,100      a list of m (strictly increasing)
   The taus are sized from the file's length (an upper bound: rows the data does not reach are
   left out) and cover any length on standard input. --stride-factor full (the default) makes
