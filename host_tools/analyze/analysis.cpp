@@ -6,6 +6,7 @@
 #include <array>
 #include <atomic>
 #include <bit>
+#include <cfloat>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -21,24 +22,52 @@
 #include "gyrochar/batch.hpp"
 #include "edf_table.hpp"
 #include "gyrochar/characterizer.hpp"
+#include "gyrochar/float_batch.hpp"
 #include "total_analysis.hpp"
 
 namespace gyrochar {
 
 namespace {
 
+// "oadev at tau = 1 s (m = 1)": the start of an estimate's error message.
+std::string where_of(const Estimate& e) { return fmt::format("{} at tau = {:g} s (m = {})", name(e.stat), e.tau_s, e.m); }
+
+// Whether tau0^2 or tau^2 leaves the normal range of a double, and so it says.
+bool tau0_out_of_range(const Estimate& e, double tau0_s, std::string& why) {
+  if (std::isnormal(tau0_s * tau0_s) && std::isnormal(e.tau_s * e.tau_s)) return false;
+  why = where_of(e) + fmt::format(": tau0^2 = ({:g} s)^2 is outside the range of a double: tau0 is too {}", tau0_s,
+                                  tau0_s < 1 ? "small" : "large");
+  return true;
+}
+
 // Why estimate `e` is not a finite number, for an error message. The variance is the sum of the
 // squared differences over tau0^2 (phase data) or over 1 (frequency data), TDEV's times tau^2 / 3.
 std::string non_finite_reason(const Estimate& e, const TauSums& sums, double tau0_s) {
-  const std::string where = fmt::format("{} at tau = {:g} s (m = {})", name(e.stat), e.tau_s, e.m);
+  const std::string where = where_of(e);
   for (const double v : sums.variance)
     if (!std::isfinite(v))
       return where + ": the squared differences of the values overflow a double (largest 1.8e308): the values "
                      "are too large; scale them";
-  if (!std::isnormal(tau0_s * tau0_s) || !std::isnormal(e.tau_s * e.tau_s))
-    return where + fmt::format(": tau0^2 = ({:g} s)^2 is outside the range of a double: tau0 is too {}", tau0_s,
-                               tau0_s < 1 ? "small" : "large");
+  if (std::string why; tau0_out_of_range(e, tau0_s, why)) return why;
   return where + fmt::format(": the squared differences divided by tau0^2 = ({:g} s)^2 overflow a double", tau0_s);
+}
+
+// The other end: why the finite estimate `e` lost its value to underflow (a deviation of 0 or of
+// a few bits that the data do not have), or "" when it did not. Its tau is not finite; the sums'
+// variance (at tau0 = 1) is positive but below the smallest normal double (the squares of the
+// differences underflowed); or the division by tau0^2 takes a positive variance there.
+std::string underflow_reason(const Estimate& e, const TauSums& sums, double tau0_s) {
+  const std::string where = where_of(e);
+  if (!std::isfinite(e.tau_s))
+    return where + fmt::format(": tau = m tau0 = {} x {:g} s is not a finite number: tau0 is too large", e.m, tau0_s);
+  const double v = sums.variance[static_cast<std::size_t>(sum_kind(e.stat))];
+  if (v > 0 && v < DBL_MIN)
+    return where + ": the squared differences of the values underflow a double (smallest normal 2.2e-308): the "
+                   "values are too small; scale them";
+  if (!(v > 0) || e.variance >= DBL_MIN) return {};
+  if (std::string why; tau0_out_of_range(e, tau0_s, why)) return why;
+  return where + fmt::format(": the squared differences divided by tau0^2 = ({:g} s)^2 underflow a double (smallest "
+                             "normal 2.2e-308): the values are too small for this tau0; scale them", tau0_s);
 }
 
 }  // namespace
@@ -213,6 +242,7 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
                                       : estimate(sums[i], a.n_phase, stat, id, options, &cache);
       if (e.n == 0) continue;
       if (!std::isfinite(e.deviation)) throw std::range_error(non_finite_reason(e, sums[i], o.tau0_s));
+      if (const std::string why = underflow_reason(e, sums[i], o.tau0_s); !why.empty()) throw std::range_error(why);
       AnalysisRow row;
       row.stat = stat;
       row.m = e.m;
@@ -249,6 +279,26 @@ struct EngineBase {
   virtual PhaseRecord record(const AnalysisOptions& o) const = 0;
 };
 
+// The record for the total family, in the characterizer's phase representation: phase relative
+// to the first point (the statistics ignore a constant), or the running sum of the increments.
+struct KeptRecord {
+  KeptRecord(DataType data_type, bool keep_it) : type(data_type), on(keep_it) {}
+  void keep(double value) {
+    if (!on) return;
+    if (type == DataType::phase) {
+      if (points.empty()) first = value;
+      points.push_back(value - first);
+    } else {
+      if (points.empty()) points.push_back(0.0);
+      points.push_back(points.back() + value);
+    }
+  }
+  DataType type;
+  bool on;
+  double first = 0.0;
+  std::vector<double> points;
+};
+
 // The characterizer of one arithmetic over heap storage, and its read-out into rows.
 template <class Arith>
 class Engine final : public EngineBase {
@@ -256,7 +306,7 @@ class Engine final : public EngineBase {
 
  public:
   Engine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list, bool keep_record)
-      : type_(type), keep_record_(keep_record), history_(history_entries(stride_factor, m_list.back())),
+      : type_(type), record_(type, keep_record), history_(history_entries(stride_factor, m_list.back())),
         states_(m_list.size()), characterizer_(history_, states_) {
     if (!history_.data()) throw std::bad_alloc();
     if (characterizer_.configure({stride_factor, 0}, m_list) != ConfigureStatus::ok)
@@ -276,7 +326,7 @@ class Engine final : public EngineBase {
       characterizer_.add_increments(std::span<const std::int32_t>(counts_.data(), n));
       if (characterizer_.phase_overflowed()) throw std::range_error("the accumulated count passed 2^63 pulses");
       if (n < values.size()) throw BadValue(n, "a count must be an integer of magnitude below 2^31");
-      for (const double v : values) keep(v);
+      for (const double v : values) record_.keep(v);
     } else {
       for (std::size_t i = 0; i < values.size(); ++i) {
         const double v = values[i];
@@ -285,7 +335,7 @@ class Engine final : public EngineBase {
           characterizer_.add_phase_point(v);
         else
           characterizer_.add_increment(v);  // frequency: phase in units of y tau0
-        keep(v);
+        record_.keep(v);
       }
     }
   }
@@ -297,32 +347,17 @@ class Engine final : public EngineBase {
     a.stride_factor = characterizer_.stride_factor();
     std::vector<TauSums> sums(characterizer_.tau_count());
     take_sums(characterizer_, sums);
-    read_out(a, sums, type_, o, record_);
+    read_out(a, sums, type_, o, record_.points);
     return a;
   }
 
   PhaseRecord record(const AnalysisOptions& o) const override {
-    return {record_, type_ == DataType::freq ? o.tau0_s : 1.0};
+    return {record_.points, type_ == DataType::freq ? o.tau0_s : 1.0};
   }
 
  private:
-  // The record for the total family, in the characterizer's phase representation: phase relative
-  // to the first point (the statistics ignore a constant), or the running sum of the increments.
-  void keep(double value) {
-    if (!keep_record_) return;
-    if (type_ == DataType::phase) {
-      if (record_.empty()) first_ = value;
-      record_.push_back(value - first_);
-    } else {
-      if (record_.empty()) record_.push_back(0.0);
-      record_.push_back(record_.back() + value);
-    }
-  }
-
   DataType type_;
-  bool keep_record_;
-  double first_ = 0.0;
-  std::vector<double> record_;
+  KeptRecord record_;
   ZeroedArray<Entry> history_;
   std::vector<typename Characterizer<Arith>::TauState> states_;
   Characterizer<Arith> characterizer_;
@@ -373,6 +408,28 @@ struct HeldAllocator {
 template <class T>
 using Held = std::vector<T, HeldAllocator<T>>;
 
+// The sums of taus 0 .. taus - 1, each by sum_tau(i) (independent: each thread takes the next one
+// left until none is), on o.threads threads (0: one per core), telling o.on_summed.
+template <class SumTau>
+std::vector<TauSums> sum_every_tau(std::size_t taus, const AnalysisOptions& o, SumTau sum_tau) {
+  std::vector<TauSums> sums(taus);
+  std::atomic<std::size_t> next{0}, done{0};
+  const auto sum_taus = [&](bool tell) {
+    for (std::size_t i = next++; i < taus; i = next++) {
+      sums[i] = sum_tau(i);
+      const std::size_t summed = ++done;
+      if (tell && o.on_summed && summed < taus) o.on_summed(summed, taus);
+    }
+  };
+  const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), taus);
+  std::vector<std::thread> helpers;
+  for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
+  sum_taus(true);
+  for (std::thread& t : helpers) t.join();
+  if (o.on_summed) o.on_summed(taus, taus);
+  return sums;
+}
+
 // Counts with the record held: every tau summed over it by the batch kernel (core/batch.hpp), the
 // same sums to the last bit as the characterizer's, O(N) per tau. The phase is held as residuals
 // from the line of the first count, 4 bytes a point while they fit in int32 (a gyro's phase strays
@@ -404,26 +461,13 @@ class CountBatchEngine final : public EngineBase {
     a.n_phase = counts_ == 0 ? 0 : counts_ + 1;
     a.stride_factor = stride_factor_;
     const std::size_t taus = m_list_.size();
-    std::vector<TauSums> sums(taus);  // each tau's sums kept as the read-out takes them (not its BatchTau)
     const std::uint64_t spread = counts_ == 0 ? 0 : static_cast<std::uint64_t>(std::int64_t{highest_} - lowest_);
-    // The taus are independent: each thread takes the next one left until none is.
-    std::atomic<std::size_t> next{0}, done{0};
-    const auto sum_taus = [&](bool tell) {
-      for (std::size_t i = next++; i < taus; i = next++) {
-        BatchTau tau(m_list_[i], stride_of(m_list_[i], stride_factor_));
-        if (counts_ > 0 && wide_.empty()) tau.add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
-        if (counts_ > 0 && !wide_.empty()) tau.add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
-        sums[i] = tau_sums(tau.result(), tau.noise());
-        const std::size_t summed = ++done;
-        if (tell && o.on_summed && summed < taus) o.on_summed(summed, taus);
-      }
-    };
-    const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), taus);
-    std::vector<std::thread> helpers;
-    for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
-    sum_taus(true);
-    for (std::thread& t : helpers) t.join();
-    if (o.on_summed) o.on_summed(taus, taus);
+    const std::vector<TauSums> sums = sum_every_tau(taus, o, [&](std::size_t i) {
+      BatchTau tau(m_list_[i], stride_of(m_list_[i], stride_factor_));
+      if (counts_ > 0 && wide_.empty()) tau.add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
+      if (counts_ > 0 && !wide_.empty()) tau.add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
+      return tau_sums(tau.result(), tau.noise());
+    });
     read_out(a, sums, DataType::counts, o, record_);
     return a;
   }
@@ -504,6 +548,71 @@ class CountBatchEngine final : public EngineBase {
   std::vector<double> record_;        // the phase for the total family (keep_record)
 };
 
+// Phase or frequency with the record held: the points as the characterizer stages them (relative
+// to the line through the first two phase points, or to the first frequency value) and their
+// double-double prefix sums, every tau summed over them by float_batch_sums() (float_batch.hpp).
+class FloatBatchEngine final : public EngineBase {
+ public:
+  FloatBatchEngine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list,
+                   bool keep_record, std::uint64_t values_hint)
+      : type_(type), stride_factor_(stride_factor), m_list_(m_list), record_(type, keep_record) {
+    for (Held<double>* v : {&x_, &p_hi_, &p_lo_}) v->reserve(values_hint + 1);
+  }
+
+  void add(std::span<const double> values) override {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const double v = values[i];
+      if (!std::isfinite(v)) throw BadValue(i, "not a finite number");
+      if (type_ == DataType::phase) {
+        stage(line_residual(v, x_.size(), line_x0_, line_slope_));
+      } else {  // as the characterizer's add_increment(): x_0 = 0, then the sum of y - y_1
+        if (increments_++ == 0) {
+          first_increment_ = v;
+          stage(0.0);
+        }
+        stage(x_.back() + (v - first_increment_));
+      }
+      record_.keep(v);
+    }
+  }
+
+  Analysis result(const AnalysisOptions& o) const override {
+    Analysis a;
+    a.n_phase = x_.size();
+    a.n_values = type_ == DataType::phase ? a.n_phase : increments_;
+    a.stride_factor = stride_factor_;
+    const FloatRecord held{x_, p_hi_, p_lo_};
+    const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), o, [&](std::size_t i) {
+      NoiseIdAccumulator noise;
+      const TauResult<double> r = float_batch_sums(held, m_list_[i], stride_of(m_list_[i], stride_factor_), noise);
+      return tau_sums(r, noise);
+    });
+    read_out(a, sums, type_, o, record_.points);
+    return a;
+  }
+
+  PhaseRecord record(const AnalysisOptions& o) const override {
+    return {record_.points, type_ == DataType::freq ? o.tau0_s : 1.0};
+  }
+
+ private:
+  void stage(double x) {
+    prefix_ = FloatArith::add_prefix(prefix_, x);
+    x_.push_back(x);
+    p_hi_.push_back(prefix_.hi);
+    p_lo_.push_back(prefix_.lo);
+  }
+
+  DataType type_;
+  std::uint32_t stride_factor_;
+  std::vector<std::uint64_t> m_list_;
+  KeptRecord record_;
+  Held<double> x_, p_hi_, p_lo_;  // the staged points and P_{e+1} = x_0 + ... + x_e
+  FloatArith::Prefix prefix_;
+  double line_x0_ = 0, line_slope_ = 0, first_increment_ = 0;
+  std::uint64_t increments_ = 0;
+};
+
 }  // namespace
 
 struct Analyzer::Impl {
@@ -533,6 +642,8 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   const bool keep_record = o.keep_record || std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
   if (o.type == DataType::counts && o.hold_counts)
     impl_->engine = std::make_unique<CountBatchEngine>(s, o.m_list, keep_record, o.values_hint);
+  else if (o.type != DataType::counts && o.hold_phase)
+    impl_->engine = std::make_unique<FloatBatchEngine>(o.type, s, o.m_list, keep_record, o.values_hint);
   else if (o.type == DataType::counts)
     impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record);
   else

@@ -92,10 +92,16 @@ struct AnalysisOptions {
   // values_hint: an upper bound on the values to reserve the record for (0: unknown).
   bool hold_counts = false;
   std::uint64_t values_hint = 0;
-  // Threads summing the held counts' taus (each tau on one; they are independent); 0: one per
+  // Phase and frequency only: hold the phase points as the characterizer stages them and their
+  // double-double prefix sums (24 bytes a point) and sum every tau over them in turn
+  // (core/include/gyrochar/float_batch.hpp): the characterizer's terms to the last bit, its
+  // overlapping sums in another order (within 2 n u relative, n terms, u = 2^-53), O(N) per tau
+  // in order where the characterizer visits every tau at every point (dense lists: --taus all).
+  bool hold_phase = false;
+  // Threads summing the held record's taus (each tau on one; they are independent); 0: one per
   // core the system offers.
   unsigned threads = 0;
-  // Told, from the thread that calls result(), how many of the held counts' taus are summed, of
+  // Told, from the thread that calls result(), how many of the held record's taus are summed, of
   // how many (the sums of every tau, --taus all, take minutes at 10^6 values). May be empty.
   std::function<void(std::size_t done, std::size_t total)> on_summed;
 };

@@ -677,7 +677,7 @@ std::optional<std::string> kalibr_yaml(const Report& r, std::string& why) {
   return kalibr_imu_yaml(term(1), term(3), 1.0 / r.tau0_s,
                          fmt::format("{} ({}){}", r.source, r.units.input,
                                      beyond.empty() ? "" : "; N and K alone, without the model's " + beyond),
-                         why);
+                         why, true);
 }
 
 }  // namespace gyrochar

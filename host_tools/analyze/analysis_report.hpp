@@ -145,7 +145,9 @@ std::optional<bool> readoff_agrees(const ReadoffValue& v, const Ieee952Fit* fit,
 /// Blocks are separated by a blank line. O(rows).
 std::string format_stable32(const Report& r);
 /// The Kalibr imu.yaml (kalibr.hpp) of the fit of both curves; nothing, and why, when the data
-/// are not gyro data, the fit was not made or was rejected, or N or K is not in its model. O(1).
+/// are not gyro data, the fit was not made or was rejected, or neither N nor K is in its model.
+/// With one of them not in the model the file has its key commented out with '?' and `why`
+/// says so (a note: the text is returned). O(1).
 std::optional<std::string> kalibr_yaml(const Report& r, std::string& why);
 /// What of a fitted model a Kalibr file leaves out (Kalibr has white rate noise and rate random
 /// walk only: gyroscope_noise_density is the fitted white-rate N, gyroscope_random_walk the fitted

@@ -61,8 +61,11 @@ bool parse_number(const char* begin, const char* end, double& value) {
   return ec == std::errc() && ptr == end && std::isfinite(value);
 }
 
+// A comment runs from '#' or '%' (SigmaTheta's .ykt files, MATLAB) to the end of the line.
+bool is_comment(char c) { return c == '#' || c == '%'; }
+
 // One line split into fields: blanks, or ',' or ';' with optional blanks around them, separate
-// fields; '#' ends the line.
+// fields; a comment ends the line.
 struct Fields {
   unsigned count = 0;
   std::string_view first, chosen;  // field 1 and field `column`
@@ -85,11 +88,11 @@ Fields split(std::string_view line, unsigned column) {
   }
   const char* p = b;
   while (p < e && is_blank(*p)) ++p;
-  if (p < e && *p == '#') return f;
+  if (p < e && is_comment(*p)) return f;
   bool expect_field = false;  // a hard separator was seen: a field follows, even an empty one
-  while (p < e && *p != '#') {
+  while (p < e && !is_comment(*p)) {
     const char* start = p;
-    while (p < e && !is_blank(*p) && *p != ',' && *p != ';' && *p != '#') {
+    while (p < e && !is_blank(*p) && *p != ',' && *p != ';' && !is_comment(*p)) {
       if (*p == '.' || *p == 'e' || *p == 'E') f.point = true;
       ++p;
     }
@@ -109,7 +112,7 @@ Fields split(std::string_view line, unsigned column) {
       ++p;
       while (p < e && is_blank(*p)) ++p;
       expect_field = true;
-    } else if (had_blanks && p < e && *p != '#') {
+    } else if (had_blanks && p < e && !is_comment(*p)) {
       f.other_separator = true;
     }
   }

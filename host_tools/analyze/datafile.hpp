@@ -8,9 +8,9 @@
 //
 // The reader never guesses silently. The first data line fixes the layout (how many fields, and
 // which column holds the values) and every later data line must have the same number of fields:
-//   - fields are separated by blanks, or by ',' or ';' (blanks around them allowed); '#' starts
-//     a comment; blank and comment lines are skipped (the '#' lines before the first value are
-//     kept: header());
+//   - fields are separated by blanks, or by ',' or ';' (blanks around them allowed); '#' or '%'
+//     (SigmaTheta's .ykt files) starts a comment; blank and comment lines are skipped (the '#'
+//     lines before the first value are kept: header());
 //   - a comma between two digits on a line that also has another separator is a decimal comma:
 //     refused, never read as two numbers ("0,5;1,5"); on a line of bare commas ("1,288185") it
 //     could be either, so a table like that needs --column (column > 0);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "analysis.hpp"
@@ -59,9 +61,10 @@ constexpr const char* footer = R"(Data type and units (the type is required: for
 Formats: table (people), csv, json, stable32 (Stable32's result table: AF Tau # Alpha MinSigma
 Sigma MaxSigma, one block per statistic; values in the output unit). --kalibr FILE also writes the
 IEEE-952 fit's N and K as the gyroscope part of a Kalibr imu.yaml (N in rad/s/sqrt(Hz) = rad/s^0.5,
-K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill):
-the fitted white-rate N and rate random walk K alone; a filter, Markov terms, sinusoids, B or R of
-the model have no place in Kalibr's model, and the file and stderr say which were left out.
+K in rad/s^2/sqrt(Hz) = rad/s^1.5, update_rate 1/tau0; the accelerometer keys are left to fill, and
+so is N or K when the fit left it out of its model, said on stderr): the fitted white-rate N and
+rate random walk K alone; a filter, Markov terms, sinusoids, B or R of the model have no place in
+Kalibr's model, and the file and stderr say which were left out.
 Gyro data with OADEV rows also get the IEEE-952 graphical read-off that data sheets print (table
 and json): N on the -1/2 line at tau = 1 s, the ADEV floor and B = floor/0.664, K on the +1/2 line
 at 3 s, each with the interval of the point it was read at and, beside --fit, whether they agree.
@@ -79,19 +82,25 @@ OADEV's null at tau = 1/f. The PSD holds the rate in memory (8 bytes a value).
 term of the fitted model and its total, the read-off, the PSD with its band, background and peaks,
 and the fit's residuals in sigma.
 
-Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' starts a comment),
+Input: numbers, one per line or in columns separated by blanks, ',' or ';' ('#' or '%' starts a comment),
 plain or gzip (recognized by content), '-' for standard input; read once. Every data line has as
 many fields as the first. Without --column a table of two columns whose first one increases
 (time, value) is read from column 2, and stderr says so; other tables need --column. A comma
 between two digits beside another separator is a decimal comma, refused; with no other separator
 it is ambiguous and needs --column. A number is never half read.
 
+Range: values whose squared differences overflow or underflow a double, a tau0 whose square leaves
+its range, an output unit that takes a deviation out of it, or --nominal-hz rounding the values
+away (fractional frequency given as Hz) are errors naming the cause (exit 2), never infinities or
+silent zeros; a constant input (phase: a straight line) gives deviations of 0, with a note.
+
 Taus (averaging factors m, tau = m tau0) and memory:
   octave        1, 2, 4, ... while a term fits
   decade        1, 2, 4, 10, 20, 40, ... (Stable32's decade)
   all           every m up to N/2 that the stride factor can form (keeps the values in memory;
-                the sums of every tau make it O(N^2): 10^5 values take seconds; from m = 64 the
-                EDF is interpolated between exact anchors, within 2e-3 of the exact one)
+                the sums of every tau make it O(N^2), on every core, --progress counting them:
+                10^5 values take seconds, 10^6 many minutes; from m = 64 the EDF is
+                interpolated between exact anchors, within 2e-3 of the exact one)
   1,10,100      a list of m (strictly increasing)
   The taus are sized from the file's length (an upper bound: rows the data does not reach are
   left out) and cover any length on standard input. --stride-factor full (the default) makes
@@ -191,7 +200,80 @@ double parse_pulse_weight_rad(const std::string& text, const std::string& pulse_
   const auto rad = angle_unit_rad(unit);
   if (!rad) bad("--pulse-weight", "unknown angle unit '" + unit + "' (rad, mrad, urad, deg, arcsec)");
   described = fmt::format("counts of {} {}", value, unit);
+  if (!std::isnormal(value * *rad))  // 1e-320arcsec: every deviation would be 0 in the output unit
+    bad("--pulse-weight", fmt::format("{} {} is {:g} rad, below the smallest normal double (2.2e-308): the deviations "
+                                      "would underflow to 0", value, unit, value * *rad));
   return value * *rad;
+}
+
+// What the values say about numerical collapse, as they are read: --nominal-hz's conversion
+// y = (f - F0) / F0, refused where it loses the values, and whether the input is constant
+// (frequency, counts) or a straight line (phase), whose deviations are all 0 by right.
+class InputShape {
+ public:
+  InputShape(DataType type, double nominal_hz) : phase_(type == DataType::phase), f0_(nominal_hz) {}
+
+  /// Converts `values` in place (--nominal-hz) and takes note of them. Throws BadValue for a value
+  /// f != F0 that the conversion takes to 0 or below the smallest normal double. O(n).
+  void add(std::span<double> values) {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      double& v = values[i];
+      if (f0_ > 0) {
+        const double f = v;
+        v = (f - f0_) / f0_;
+        if (f != f0_ && !std::isnormal(v))
+          throw BadValue(i, fmt::format("(f - F0) / F0 of {:g} Hz with F0 = {:g} Hz is {:g}, below the smallest "
+                                        "normal double (2.2e-308)", f, f0_, v));
+        raw_lo_ = n_ == 0 ? f : std::min(raw_lo_, f);
+        raw_hi_ = n_ == 0 ? f : std::max(raw_hi_, f);
+        converted_vary_ |= n_ > 0 && v != first_;
+      }
+      if (n_ == 0) first_ = lo_ = hi_ = v;
+      lo_ = std::min(lo_, v);
+      hi_ = std::max(hi_, v);
+      // Phase: every step equal to the first; frequency and counts: every value equal to the first.
+      if (phase_ && n_ == 1) step_ = v - last_;
+      bent_ |= phase_ ? n_ > 1 && v - last_ != step_ : v != first_;
+      last_ = v;
+      ++n_;
+    }
+  }
+  /// bad() when --nominal-hz made values that vary all equal: f - F0 rounded them away (values
+  /// far below F0 given as Hz: fractional frequency, whose analysis needs no --nominal-hz).
+  void check_conversion() const {
+    if (f0_ > 0 && raw_lo_ != raw_hi_ && !converted_vary_)
+      bad("--nominal-hz", fmt::format("the values vary from {:g} to {:g} Hz, but (f - F0) / F0 with F0 = {:g} Hz makes "
+                                      "every one {:g}: their differences are below the resolution of a double at F0 "
+                                      "({:.2g} Hz). Are they fractional frequency already (then without --nominal-hz)?",
+                                      raw_lo_, raw_hi_, f0_, first_, std::nextafter(f0_, HUGE_VAL) - f0_));
+  }
+  /// Every deviation of such an input is 0: a constant (frequency, counts), a straight line (phase).
+  bool straight() const { return !bent_; }
+  const char* shape() const { return phase_ ? "a straight line (a constant frequency)" : "constant"; }
+  double lowest() const { return lo_; }
+  double highest() const { return hi_; }
+
+ private:
+  bool phase_;
+  double f0_;
+  std::uint64_t n_ = 0;
+  double first_ = 0, last_ = 0, step_ = 0, lo_ = 0, hi_ = 0;
+  double raw_lo_ = 0, raw_hi_ = 0;
+  bool bent_ = false, converted_vary_ = false;
+};
+
+// After a whole analysis whose every deviation is 0 (all_zero): a note for a constant or straight
+// input, a collapse otherwise (the squares of the differences underflowed to exactly 0).
+void check_zeros(bool all_zero, const InputShape& shape, const std::string& source) {
+  if (!all_zero) return;
+  if (!shape.straight())
+    bad(source, fmt::format("every deviation is 0, but the values (from {:g} to {:g}) are not {}: the squares of their "
+                            "differences underflow a double (smallest normal 2.2e-308): the values are too small; "
+                            "scale them", shape.lowest(), shape.highest(), shape.shape()));
+  print_error(program, "note", fmt::format("every deviation is 0: the values are {}", shape.shape()));
+}
+bool all_zero(const std::vector<AnalysisRow>& rows) {
+  return std::all_of(rows.begin(), rows.end(), [](const AnalysisRow& r) { return r.dev == 0; });
 }
 
 // Prints how far the reading got, about every 2^20 values, when enabled; nothing for short inputs.
@@ -226,15 +308,28 @@ class Progress {
 }
 
 // Memory the history may take: half the machine's memory, or of the process's address space
-// limit when one is set.
-std::uint64_t memory_budget() {
+// limit when one is set; and where that comes from, for a message.
+std::uint64_t machine_budget() {
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  std::uint64_t budget = pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2
-                                               : std::uint64_t{1} << 32;
+  return pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2
+                               : std::uint64_t{1} << 32;
+}
+std::uint64_t memory_budget() {
+  std::uint64_t budget = machine_budget();
   rlimit limit{};
   if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) budget = std::min<std::uint64_t>(budget, limit.rlim_cur / 2);
   return budget;
 }
+std::string memory_budget_reason() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur / 2 < machine_budget())
+    return fmt::format("half of its address-space limit, ulimit -v {} KiB", limit.rlim_cur >> 10);
+  return "half of the machine's memory";
+}
+
+// The longest window or step of --dynamic, in values: longer than any file (10^15 values are
+// petabytes of text), and exact as an integer in a double.
+constexpr double max_dynamic_values = 1e15;
 
 // --dynamic WINDOW[,STEP]: one pass over the file, the surface on stdout, the heat maps to --plot.
 int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::string& dynamic_text,
@@ -250,9 +345,13 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
     bad("--dynamic", "'" + dynamic_text + "' is not WINDOW or WINDOW,STEP in positive seconds");
   if (parts.size() == 1) step_s = window_s;
   const double window_values = std::round(window_s / o.tau0_s), step_values = std::round(step_s / o.tau0_s);
-  if (window_values < 4 || window_values > 1e15)
+  if (window_values < 4)
     bad("--dynamic", fmt::format("a window of {} s holds {} values of tau0: at least 4 are needed", window_s, window_values));
   if (step_values < 1) bad("--dynamic", fmt::format("a step of {} s is shorter than tau0", step_s));
+  for (const auto& [what, seconds_asked, values] : {std::tuple{"window", window_s, window_values}, std::tuple{"step", step_s, step_values}})
+    if (values > max_dynamic_values)
+      bad("--dynamic", fmt::format("a {} of {:g} s is {:g} values of tau0 = {:g} s, more than the {:g} a window or step "
+                                   "may span", what, seconds_asked, values, o.tau0_s, max_dynamic_values));
   const auto window = static_cast<std::uint64_t>(window_values), step = static_cast<std::uint64_t>(step_values);
   // The windows' taus: --taus over the phase points of one window, those with 4 m <= its values.
   const std::uint64_t window_phase = o.type == DataType::phase ? window : window + 1;
@@ -276,15 +375,15 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
   }
   const std::string source = path == "-" ? "standard input" : path;
   std::vector<WindowAnalysis> windows;
+  InputShape shape(o.type, nominal_hz);
   try {
     DataFile file(path, column);
     Progress p(show_progress, file);
     std::vector<double> block(1 << 14);
     while (const std::size_t n = file.read(block)) {
       const std::span<double> values(block.data(), n);
-      if (nominal_hz > 0)
-        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
       try {
+        shape.add(values);
         analyzer->add(values);
       } catch (const BadValue& e) {
         bad(source, fmt::format("line {}: {}", file.line_of(e.index()), e.what()));
@@ -297,8 +396,11 @@ int analyze_dynamic(AnalysisOptions o, const ReportUnits& units, const std::stri
   } catch (const DataFileError& e) {
     bad_data(source, e);
   }
+  shape.check_conversion();
   if (windows.empty())
     bad(source, fmt::format("{} values are fewer than one window of {} values", analyzer->values(), window));
+  check_zeros(std::all_of(windows.begin(), windows.end(), [](const WindowAnalysis& w) { return all_zero(w.analysis.rows); }),
+              shape, source);
   const DynamicReport report{windows, o.type, o.tau0_s, o.confidence, units, window, step, analyzer->values(), o.stats};
   const std::string text = format == "json" ? dynamic_to_json(report).dump(2) + "\n"
                            : format == "csv" ? format_dynamic_csv(report)
@@ -370,7 +472,7 @@ int main(int argc, char** argv) {
   app.add_option("--sinusoid-hz", sinusoid_hz, "offer the fit a sinusoid at this frequency in Hz (repeatable, up to 2)")
       ->option_text("F");
   unsigned threads = 0;
-  app.add_option("--threads", threads, "threads summing the taus of counts at --stride-factor full (default: one per core)")
+  app.add_option("--threads", threads, "threads summing the taus of counts at --stride-factor full and of --taus all (default: one per core)")
       ->check(CLI::Range(1u, 1024u));
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   try {
@@ -544,6 +646,11 @@ int main(int argc, char** argv) {
       };
     o.hold_counts = o.type == DataType::counts && o.stride_factor == 0 && n_phase > 0 &&
                     o.values_hint < memory_budget() / 12;
+    // Phase and frequency under --taus all hold the staged points and their prefix sums (24 bytes
+    // a point) and sum tau by tau (the characterizer would visit every tau at every point).
+    o.hold_phase = o.type != DataType::counts && taus_text == "all" && o.stride_factor == 0 &&
+                   o.values_hint < memory_budget() / 24;
+    const bool held = o.hold_counts || o.hold_phase;
     if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus_text == "all" ? 2 * n_phase : n_phase);
     const std::uint32_t s = o.stride_factor;
     std::vector<std::uint64_t> not_formed;  // decade taus the stride factor cannot form
@@ -563,16 +670,28 @@ int main(int argc, char** argv) {
     // input); a list that does not fit is refused.
     const std::uint64_t budget = memory_budget();
     std::uint64_t cut_above = 0;
-    while (!o.hold_counts && generated && o.m_list.size() > 1 && history_bytes(o.type, s, o.m_list.back()) > budget) {
+    while (!held && generated && o.m_list.size() > 1 && history_bytes(o.type, s, o.m_list.back()) > budget) {
       cut_above = o.m_list.back();
       o.m_list.pop_back();
     }
+    // More memory than the process may use, or an allocation that failed: a stride factor given is
+    // the user's choice (bad input); under the default the cause is the memory limit (exit 1).
     const auto too_big = [&] {
-      bad("--stride-factor", fmt::format("{} with taus up to {} needs {} MiB of history, more than the {} MiB this "
-                                         "process may use: give a smaller stride factor or fewer taus",
-                                         s, o.m_list.back(), history_bytes(o.type, s, o.m_list.back()) >> 20, budget >> 20));
+      const std::uint64_t bytes = o.hold_counts  ? 12 * o.values_hint
+                                  : o.hold_phase ? 24 * o.values_hint
+                                                 : history_bytes(o.type, s, o.m_list.back());
+      if (stride_text != "full")
+        bad("--stride-factor", fmt::format("{} with taus up to {} needs {} MiB of history, more than the {} MiB this "
+                                           "process may use: give a smaller stride factor or fewer taus",
+                                           s, o.m_list.back(), bytes >> 20, budget >> 20));
+      fail(exit_code::internal, source,
+           fmt::format("{} values{} need {} MiB of memory with every tau up to N/4 fully overlapped (--stride-factor "
+                       "full, the default), more than the {} MiB this process may use ({}): raise the limit, or give "
+                       "--stride-factor 8 (a few MiB whatever the length)", o.values_hint,
+                       taus_text == "all" ? "" : " (at most, from the file's size)", std::max<std::uint64_t>(bytes >> 20, 1),
+                       budget >> 20, memory_budget_reason()));
     };
-    if (!o.hold_counts && history_bytes(o.type, s, o.m_list.back()) > budget) too_big();
+    if (!held && history_bytes(o.type, s, o.m_list.back()) > budget) too_big();
     o.theo_m_list = theo_taus(generated ? taus_text : "list", o.m_list, n_phase);
 
     std::unique_ptr<Analyzer> analyzer;
@@ -586,12 +705,12 @@ int main(int argc, char** argv) {
     DataRange range;
     std::optional<RateRecord> rates;  // the rate, held for the PSD (8 bytes a value)
     if (want_psd) rates.emplace(o.type == DataType::phase, o.type == DataType::counts, o.tau0_s);
+    InputShape shape(o.type, nominal_hz);
     const auto add = [&](std::span<double> values, auto line_of) {
-      if (nominal_hz > 0)
-        for (double& v : values) v = (v - nominal_hz) / nominal_hz;
-      range.add(values);
-      if (rates) rates->add(values);
       try {
+        shape.add(values);
+        range.add(values);
+        if (rates) rates->add(values);
         analyzer->add(values);
       } catch (const BadValue& e) {
         bad(source, fmt::format("line {}: {}", line_of(e.index()), e.what()));
@@ -616,6 +735,7 @@ int main(int argc, char** argv) {
     } catch (const DataFileError& e) {
       bad_data(source, e);
     }
+    shape.check_conversion();
     Analysis a = [&] {
       try {
         return analyzer->result();
@@ -629,6 +749,7 @@ int main(int argc, char** argv) {
         bad("--taus", fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must be a "
                                   "multiple of its stride (m/S rounded up to a power of two)", m, s));
     if (a.rows.empty()) bad(source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
+    check_zeros(all_zero(a.rows), shape, source);
     if (!file->layout_note().empty()) print_error(program, source, "values from " + file->layout_note());
     if (cut_above > 0 && cut_above <= a.n_phase / 2)
       print_error(program, source, fmt::format("taus stop below m = {}: with stride factor {} more would need more than "
@@ -690,11 +811,16 @@ int main(int argc, char** argv) {
                     fmt::format("m = {} (tau = {:g} s) left out of {}: {} phase points are too few for a term", m,
                                 static_cast<double>(m) * o.tau0_s, missing, displayed.n_phase));
     }
-    for (const AnalysisRow& r : displayed.rows)  // the output unit must not take a value out of range
+    for (const AnalysisRow& r : displayed.rows) {  // the output unit must not take a value out of range
       if (!std::isfinite(r.dev * units.factor()) || (r.ci.valid && !std::isfinite(r.ci.high * units.factor())))
         bad(source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) overflows a double",
                                 name(r.stat), r.tau_s, r.m, r.ci.valid ? r.ci.high : r.dev, units.factor(),
                                 units.unit(r.stat)));
+      if (r.dev != 0 && !(r.dev * units.factor() >= DBL_MIN))
+        bad(source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) underflows a double "
+                                "(smallest normal 2.2e-308)", name(r.stat), r.tau_s, r.m, r.dev, units.factor(),
+                                units.unit(r.stat)));
+    }
     Report report{displayed, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt, source, range,
                   std::move(readoff), std::nullopt};
     if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);
@@ -704,6 +830,7 @@ int main(int argc, char** argv) {
       std::string why;
       const auto text = kalibr_yaml(report, why);
       if (!text) bad("--kalibr", why);
+      if (!why.empty()) print_error(program, "note", kalibr_path + ": " + why);
       yaml = *text;
       if (const std::string beyond = kalibr_left_out(report.fits.front().fit); !beyond.empty())
         print_error(program, "note", "--kalibr: gyroscope_noise_density is the fitted white-rate N, gyroscope_random_walk the "
@@ -730,6 +857,9 @@ int main(int argc, char** argv) {
       std::fputs(yaml.c_str(), f);
       if (!close_output(f, program, kalibr_path)) return finish(program, exit_code::output_failed);
     }
+  } catch (const std::bad_alloc&) {  // beyond the plan's own check (too_big): say what limits memory
+    fail(exit_code::internal, "out of memory",
+         fmt::format("an allocation failed: this process may use {} MiB ({})", memory_budget() >> 20, memory_budget_reason()));
   } catch (const std::exception& e) {
     fail(exit_code::internal, "internal error", e.what());
   }

@@ -18,11 +18,27 @@ std::string term_comment(const KalibrTerm& t, std::size_t k) {
   return s;
 }
 
+// The key of one gyroscope term: its value with the comment in gyro units or, not in the fitted
+// model (partial), the placeholder of the accelerometer keys.
+std::string term_line(const char* key, const char* unit, const KalibrTerm& t, std::size_t k) {
+  if (!t.fitted)
+    return fmt::format("#{}: ?   # {}; {} is not in the fitted model: fill it in (from a longer record, or the "
+                       "data sheet)\n", key, unit, units::ieee952[k].letter);
+  return fmt::format("{}: {}   # {}; {}\n", key, t.value_si, unit, term_comment(t, k));
+}
+
 }  // namespace
 
 std::optional<std::string> kalibr_imu_yaml(const KalibrTerm& n, const KalibrTerm& k, double update_rate_hz,
-                                           std::string_view origin, std::string& why) {
+                                           std::string_view origin, std::string& why, bool partial) {
+  why.clear();
+  if (!n.fitted && !k.fitted) partial = false;  // nothing to give
   for (const auto& [term, letter] : {std::pair{&n, "N (angle random walk)"}, std::pair{&k, "K (rate random walk)"}}) {
+    if (!term->fitted && partial) {
+      why = fmt::format("{} is not in the fitted model: its key is written commented out with '?' for you to fill "
+                        "in (Kalibr needs it > 0)", letter);
+      continue;
+    }
     if (!term->fitted) {
       why = fmt::format("{} is not in the fitted model: Kalibr needs it > 0", letter);
       return std::nullopt;
@@ -44,11 +60,11 @@ std::optional<std::string> kalibr_imu_yaml(const KalibrTerm& n, const KalibrTerm
       "# accelerometer's own characterization before giving this file to Kalibr.\n"
       "#accelerometer_noise_density: ?   # m/s^2/sqrt(Hz)\n"
       "#accelerometer_random_walk: ?     # m/s^3/sqrt(Hz)\n"
-      "gyroscope_noise_density: {}   # rad/s/sqrt(Hz); {}\n"
-      "gyroscope_random_walk: {}   # rad/s^2/sqrt(Hz); {}\n"
+      "{}{}"
       "update_rate: {}   # Hz\n"
       "rostopic: /imu0   # the IMU's ROS topic: change to yours\n",
-      origin, n.value_si, term_comment(n, 1), k.value_si, term_comment(k, 3), update_rate_hz);
+      origin, term_line("gyroscope_noise_density", "rad/s/sqrt(Hz)", n, 1),
+      term_line("gyroscope_random_walk", "rad/s^2/sqrt(Hz)", k, 3), update_rate_hz);
 }
 
 }  // namespace gyrochar

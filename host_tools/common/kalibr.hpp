@@ -30,8 +30,11 @@ struct KalibrTerm {
 
 /// The imu.yaml text for N and K at `update_rate_hz`, with `origin` (what was fitted) in its first
 /// comment line. Nothing, and `why`, when N or K is not in the fitted model or not a positive
-/// finite number (Kalibr needs both > 0), or the rate is not. O(1); allocates the text.
+/// finite number (Kalibr needs both > 0), or the rate is not. With `partial`, one term not in the
+/// fitted model is written as the accelerometer keys are, commented out with '?' for the user to
+/// fill in (Kalibr refuses the file until then), and `why` says which: a note, the text is
+/// returned. O(1); allocates the text.
 std::optional<std::string> kalibr_imu_yaml(const KalibrTerm& n, const KalibrTerm& k, double update_rate_hz,
-                                           std::string_view origin, std::string& why);
+                                           std::string_view origin, std::string& why, bool partial = false);
 
 }  // namespace gyrochar

@@ -21,6 +21,7 @@
 #include <random>
 #include <regex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "hal/exit_codes.hpp"
@@ -74,8 +75,13 @@ void expect_bad_input(const std::string& args, const std::string& what, const st
 }
 
 std::string good_phase() {
+  // (std::to_string's six decimals made these all 0: a constant input, which now gets a note.)
   std::string s = "# phase\n";
-  for (int i = 0; i < 200; ++i) s += std::to_string((i * 7919 % 101) * 1e-9) + "\n";
+  char text[32];
+  for (int i = 0; i < 200; ++i) {
+    std::snprintf(text, sizeof text, "%.9g\n", (i * 7919 % 101) * 1e-9);
+    s += text;
+  }
   return file_with("good.txt", s);
 }
 
@@ -147,6 +153,62 @@ TEST(AnalyzeCli, NonFiniteResultsAreErrorsWithTheirCause) {
                    "oadev at tau = 1 s (m = 1): ");
 }
 
+// The other end: a result that underflows (every deviation 0, or a few bits the data do not have)
+// is an error naming the cause, with the exit code of overflow; a constant input, whose deviations
+// are 0 by right, gets a note. Oracle: the range of a double (largest 1.8e308, smallest normal
+// 2.2e-308) and the resolution of a double at 1e7 (2^-29 = 1.9e-9).
+std::string line_of(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g\n", v);
+  return text;
+}
+
+TEST(AnalyzeCli, CollapsedResultsAreErrorsWithTheirCause) {
+  std::string fractional, tiny, subnormal, ramp, constant;
+  for (int i = 0; i < 200; ++i) {
+    const double wobble = (i * 7919 % 101) - 50.0;
+    fractional += line_of(1e-11 * wobble);  // fractional frequency, as a clock's
+    tiny += line_of(1e-209 * wobble);       // squared differences ~1e-418: 0
+    subnormal += line_of(1e-158 * wobble);  // squared differences ~1e-316: subnormal
+    ramp += line_of(3 * i + 1);             // a phase line: a constant frequency
+    constant += "5\n";
+  }
+  // Fractional frequency read as Hz around 10 MHz: f - F0 rounds every value to -F0.
+  expect_bad_input("--type freq --tau0 1 --nominal-hz 10e6 " + file_with("frac.txt", fractional),
+                   "--nominal-hz: the values vary from -5e-10 to 5e-10 Hz, but (f - F0) / F0 with F0 = 1e+07 Hz makes "
+                   "every one -1: their differences are below the resolution of a double at F0 (1.9e-09 Hz)");
+  for (const std::string type : {"phase", "freq"})
+    expect_bad_input("--type " + type + " --tau0 1 " + file_with("tiny.txt", tiny),
+                     "every deviation is 0, but the values (from -5e-208 to 5e-208) are not ");
+  expect_bad_input("--type phase --tau0 1 " + file_with("subnormal.txt", subnormal),
+                   "oadev at tau = 1 s (m = 1): the squared differences of the values underflow a double");
+  // tau0^2 overflows: every variance divided by it would be 0; a tau that is not finite.
+  expect_bad_input("--type phase --tau0 1e160 " + good_phase(),
+                   "oadev at tau = 1e+160 s (m = 1): tau0^2 = (1e+160 s)^2 is outside the range of a double: tau0 is "
+                   "too large");
+  expect_bad_input("--type counts --pulse-weight 1arcsec --tau0 1e160 " + file_with("c.txt", "3\n5\n4\n6\n2\n"),
+                   "tau0 is too large");
+  expect_bad_input("--type phase --tau0 1e308 --taus 2 " + good_phase(),
+                   "oadev at tau = inf s (m = 2): tau = m tau0 = 2 x 1e+308 s is not a finite number: tau0 is too large");
+  // A pulse of 1e-320 arcsec is 0 rad; 1e-300 rad per pulse takes the deviations below 2.2e-308 in deg/h.
+  expect_bad_input("--type counts --tau0 1 --pulse-weight 1e-320arcsec " + file_with("c2.txt", "3\n5\n4\n6\n2\n"),
+                   "--pulse-weight");
+  expect_bad_input("--type counts --tau0 1e10 --pulse-weight 1e-300rad --rate-unit rad/s " +
+                       file_with("c3.txt", "3\n5\n4\n6\n2\n"),
+                   "underflows a double");
+  // Constant inputs: zeros by right, and a note.
+  const char* line = "a straight line (a constant frequency)";
+  for (const auto& [type, values, shape] : {std::tuple{"freq", constant, "constant"}, std::tuple{"phase", constant, line},
+                                            std::tuple{"phase", ramp, line}}) {
+    const Outcome r = run(std::string("--type ") + type + " --tau0 1 --format csv " + file_with("flat.txt", values));
+    EXPECT_EQ(r.code, exit_code::ok) << r.err;
+    EXPECT_EQ(r.err, std::string("gyrochar-analyze: note: every deviation is 0: the values are ") + shape + "\n");
+  }
+  const Outcome counts = run("--type counts --tau0 1 --pulse-weight 1arcsec " + file_with("flat.txt", constant));
+  EXPECT_EQ(counts.code, exit_code::ok) << counts.err;
+  EXPECT_EQ(counts.err, "gyrochar-analyze: note: every deviation is 0: the values are constant\n");
+}
+
 TEST(AnalyzeCli, EachStatisticOnceAndListedTausTooLongForTheDataGetANote) {
   expect_bad_input("--type phase --tau0 1 --stats oadev,oadev " + good_phase(), "--stats: 'oadev' is asked twice");
   // 200 phase points: oadev needs 2m + 1 (m = 90 fits), mdev 3m + 1 (m = 90 does not), m = 1000 neither.
@@ -186,6 +248,32 @@ TEST(AnalyzeCli, KalibrYamlHoldsTheFitsNAndKInSI) {
                    "--kalibr: needs --fit ieee952");
   expect_bad_input("--type phase --tau0 1 --fit ieee952 --kalibr " + yaml + " " + good_phase(),
                    "--kalibr: needs gyro data");
+}
+
+// A gyro with white rate noise alone (the simulator's ARW and white angle noise: no rate random
+// walk): the fit leaves K out of its model. The analysis is printed all the same (exit 0), the
+// Kalibr file holds N (the JSON's N in SI, as above) and K's key commented out with '?' for the
+// user to fill, and stderr says so.
+TEST(AnalyzeCli, KalibrWithoutKWritesWhatTheFitHasAndPrintsTheAnalysis) {
+  const std::string counts = temp("sim_arw.txt"), yaml = temp("imu_arw.yaml");
+  ASSERT_EQ(std::system((GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim --duration 2000 --tau0 0.01 --arw 0.003 "
+                         "--white-angle 2 --seed 3 --out " + counts).c_str()), 0);
+  const Outcome r = run("--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --format json --kalibr " + yaml +
+                        " " + counts);
+  ASSERT_EQ(r.code, exit_code::ok) << r.err;
+  const auto fit = nlohmann::json::parse(r.out)["fit"][0];
+  ASSERT_EQ(fit["curve"], "both");
+  ASSERT_FALSE(fit["K"]["fitted"].get<bool>()) << fit.dump();
+  EXPECT_EQ(r.err, "gyrochar-analyze: note: " + yaml + ": K (rate random walk) is not in the fitted model: its key is "
+                   "written commented out with '?' for you to fill in (Kalibr needs it > 0)\n");
+  std::ifstream in(yaml);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  const auto at = text.find("\ngyroscope_noise_density: ");
+  ASSERT_NE(at, std::string::npos) << text;
+  const double pi = 3.14159265358979323846;
+  EXPECT_NEAR(std::stod(text.substr(at + 26)) / (fit["N"]["value"].get<double>() * pi / 180 / 60), 1.0, 1e-12);
+  EXPECT_NE(text.find("\n#gyroscope_random_walk: ?"), std::string::npos) << text;
+  EXPECT_EQ(text.find("\ngyroscope_random_walk"), std::string::npos) << text;
 }
 
 // The read-off of a real gyro (ADIS16405, run 1, x; 2.78 h at 100 Hz in deg/s). Oracles: its data
@@ -492,7 +580,7 @@ TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
   // stdout still carries only the table.
   std::string s;
   s.reserve(2u << 21);
-  for (int i = 0; i <= (1 << 20); ++i) s += "1\n";
+  for (int i = 0; i <= (1 << 20); ++i) s += i % 2 ? "2\n" : "1\n";  // not constant: no note
   const std::string path = file_with("long.txt", s);
   const Outcome r = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 --progress " + path);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -501,6 +589,13 @@ TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
   EXPECT_EQ(r.out.find("gyrochar-analyze"), std::string::npos);
   const Outcome quiet = run("--type counts --tau0 1 --pulse-weight 1arcsec --taus 1 " + path);
   EXPECT_TRUE(quiet.err.empty()) << quiet.err;  // stderr is a file here, not a terminal
+  // --taus all on phase and frequency sums its taus over the held record too, and says how far
+  // (200 phase points: m = 1 .. 100; 200 frequency values: 201 points, the same taus).
+  for (const std::string type : {"phase", "freq"}) {
+    const Outcome all = run("--type " + type + " --tau0 1 --taus all --progress --format csv " + good_phase());
+    ASSERT_EQ(all.code, 0) << all.err;
+    EXPECT_NE(all.err.find("summing: 100 of 100 taus\n"), std::string::npos) << all.err;
+  }
 }
 
 // The rows of --format csv: stat, m, n, dev.
@@ -583,6 +678,32 @@ TEST(AnalyzeCli, HugeStrideFactorOnStandardInputIsNoAllocationFailure) {
   EXPECT_EQ(fits.code, 0) << fits.err;
   EXPECT_EQ(csv_rows(fits.out).size(), 4u) << fits.out;  // 8 phase points: oadev and mdev at m = 1, 2
   expect_bad_input(args + "< " + good_phase(), "--stride-factor", "ulimit -v 1000000; ");
+}
+
+TEST(AnalyzeCli, AFileBeyondTheMemoryLimitNamesTheLimit) {
+  // Under ulimit -v 524288 (512 MiB) the process may use 256 MiB. A file of 1 GiB (sparse: the plan
+  // reads only its size) may hold 2^29 + 1 values (its bound), whose default plan (every tau up to
+  // N/4 fully overlapped: S = 2^24, 3 x 2^24 history entries of 24 bytes = 1152 MiB) does not fit: the
+  // message names the limit and the sizes (exit 1: memory exhausted), not a --stride-factor the
+  // user never gave.
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: it cannot run under ulimit -v";
+#endif
+  const std::string big = temp("big.txt");
+  ASSERT_EQ(std::system(("truncate -s 1G " + big).c_str()), 0);
+  for (const std::string type : {"counts --pulse-weight 1arcsec", "phase", "freq"}) {
+    const Outcome r = run_shell("ulimit -v 524288; " + tool + " --type " + type + " --tau0 1 " + big);
+    EXPECT_EQ(r.code, exit_code::internal) << r.err;
+    EXPECT_NE(r.err.find("gyrochar-analyze: " + big + ": 536870913 values (at most, from the file's size) need 1152 MiB "
+                         "of memory with every tau up to N/4 fully overlapped (--stride-factor full, the default), more "
+                         "than the 256 MiB this process may use (half of its address-space limit, ulimit -v 524288 "
+                         "KiB)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("--stride-factor:"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty());
+  }
+  std::remove(big.c_str());
 }
 
 TEST(AnalyzeCli, AllTausEqualTheirBruteForceFromFileStdinAndGzip) {
@@ -675,6 +796,9 @@ TEST(AnalyzeCli, DynamicRefusesWhatItCannotDo) {
   expect_bad_input("--type phase --tau0 1 --dynamic 100,-1 " + good, "--dynamic");
   expect_bad_input("--type phase --tau0 1 --dynamic 100,50,25 " + good, "--dynamic");
   expect_bad_input("--type phase --tau0 1 --dynamic 3 " + good, "at least 4");
+  expect_bad_input("--type phase --tau0 1 --dynamic 1e308 " + good,
+                   "--dynamic: a window of 1e+308 s is 1e+308 values of tau0 = 1 s, more than the 1e+15 a window or step may span");
+  expect_bad_input("--type phase --tau0 1e-9 --dynamic 100,1e7 " + good, "a step of 1e+07 s is 1e+16 values");
   expect_bad_input("--type phase --tau0 1 --dynamic 100,0.4 " + good, "shorter than tau0");
   expect_bad_input("--type phase --tau0 1 --dynamic 500 " + good, "fewer than one window");
   expect_bad_input("--type phase --tau0 1 --dynamic 100 --taus 1,50 " + good, "quarter of the window");

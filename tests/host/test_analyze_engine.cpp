@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <random>
 #include <span>
@@ -242,6 +243,62 @@ TEST(AnalyzeEngine, HeldCountsGiveTheCharacterizersRowsBitForBit) {
       EXPECT_TRUE(x.stat == y.stat && x.m == y.m && x.n == y.n && x.dev == y.dev && x.alpha == y.alpha &&
                   x.edf == y.edf && x.skew_dof == y.skew_dof && x.ci.low == y.ci.low && x.ci.high == y.ci.high)
           << name(x.stat) << " m=" << x.m << (step ? " after the step" : "");
+    }
+  }
+}
+
+TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
+  // --taus all on phase and frequency data: the batch path (hold_phase: core/float_batch.hpp over
+  // the held record) against the characterizer (oracle: itself checked against brute force in
+  // tests/core) at the stride factor "full" gives --taus all, every tau of 3000 values. The terms
+  // are the characterizer's to the last bit and their sums of squares are summed in another
+  // order: a deviation within n DBL_EPSILON relative (twice the bound (n - 1) u of two orders of
+  // n non-negative terms, halved by the square root); counts, noise and EDF the same.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g;
+  std::vector<double> clock;  // phase: offset, frequency, random-walk FM, white PM
+  double y = 2e-8, x = 17.0;
+  for (int k = 0; k < 3000; ++k) {
+    y += 1e-11 * g(rng);
+    x += y;
+    clock.push_back(x + 3e-10 * g(rng));
+  }
+  for (const DataType type : {DataType::phase, DataType::freq}) {
+    const std::size_t n_phase = type == DataType::phase ? clock.size() : clock.size() + 1;
+    AnalysisOptions o;
+    o.type = type;
+    o.tau0_s = 0.5;
+    o.stats = {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::tdev, DevStat::hdev, DevStat::ohdev};
+    o.stride_factor = full_stride_factor(2 * n_phase);  // as gyrochar-analyze takes it for --taus all
+    o.m_list = all_taus(n_phase, o.stride_factor);
+    ASSERT_EQ(o.m_list.size(), n_phase / 2);
+    Analyzer pyramid(o);
+    o.hold_phase = true;
+    o.values_hint = clock.size();
+    o.threads = 3;
+    std::size_t told = 0, total = 0;
+    o.on_summed = [&](std::size_t done, std::size_t of) {
+      EXPECT_GT(done, told);
+      told = done;
+      total = of;
+    };
+    Analyzer batch(o);
+    pyramid.add(clock);
+    batch.add(std::span<const double>(clock.data(), 1));
+    batch.add(std::span<const double>(clock.data() + 1, clock.size() - 1));
+    const Analysis a = pyramid.result(), b = batch.result();
+    EXPECT_EQ(told, o.m_list.size());
+    EXPECT_EQ(total, o.m_list.size());
+    EXPECT_EQ(b.n_phase, a.n_phase);
+    EXPECT_EQ(b.n_values, a.n_values);
+    ASSERT_EQ(a.rows.size(), b.rows.size());
+    ASSERT_GT(a.rows.size(), 4000u);
+    for (std::size_t i = 0; i < a.rows.size(); ++i) {
+      const AnalysisRow &p = a.rows[i], &q = b.rows[i];
+      const double tolerance = static_cast<double>(p.n) * DBL_EPSILON * p.dev;
+      EXPECT_TRUE(p.stat == q.stat && p.m == q.m && p.n == q.n && p.alpha == q.alpha && p.edf == q.edf &&
+                  std::fabs(p.dev - q.dev) <= tolerance)
+          << name(type) << " " << name(p.stat) << " m=" << p.m << ": " << p.dev << " vs " << q.dev;
     }
   }
 }

@@ -45,6 +45,13 @@ TEST(DataFile, OneNumberPerLineInEveryNotation) {
   EXPECT_EQ(v, (std::vector<double>{12, -3, 4, 5, 1.5, -2.5e-3, 7, 1e3, 8}));
 }
 
+TEST(DataFile, PercentStartsACommentAsHashDoes) {
+  // SigmaTheta's .ykt files begin with '%' lines; MATLAB writes them too.
+  const auto v = read_all(file_with("ykt.txt", "% SigmaTheta\n%  tau0 = 1 s\n1.5e-12\n  % indented\n-2e-12 % after\n3e-12\n"));
+  EXPECT_EQ(v, (std::vector<double>{1.5e-12, -2e-12, 3e-12}));
+  EXPECT_EQ(read_all(file_with("ykt2.txt", "% t y\n0 1.5\n1 2.5 % late\n2 3.5\n")), (std::vector<double>{1.5, 2.5, 3.5}));
+}
+
 TEST(DataFile, LinesAndHeaderOfEachValue) {
   DataFile file(file_with("lines.txt", "# one\n#two\n\n10\n# later\n20\n"));
   double v[4];

@@ -60,6 +60,27 @@ TEST(Kalibr, RefusesWhatKalibrCannotTake) {
   EXPECT_EQ(why, "the sample rate (1 / tau0) is not known");
 }
 
+TEST(Kalibr, PartialLeavesATermTheFitLeftOutToFillIn) {
+  // The analyzer's file when K is not in the model: N as always, K's key commented out with '?'
+  // as the accelerometer keys are (Kalibr refuses the file until it is filled in), and a note.
+  std::string why;
+  const double n = 8.726646259971648e-07;  // the header's hand-computed value
+  const auto yaml = kalibr_imu_yaml({n, 0.02, true, true}, {0, 0, false, false}, 100.0, "t", why, true);
+  ASSERT_TRUE(yaml) << why;
+  EXPECT_EQ(why, "K (rate random walk) is not in the fitted model: its key is written commented out with '?' for you to "
+                 "fill in (Kalibr needs it > 0)");
+  const auto keys = yaml_keys(*yaml);
+  EXPECT_EQ(std::stod(keys.at("gyroscope_noise_density")), n);
+  EXPECT_EQ(keys.count("gyroscope_random_walk"), 0u);
+  EXPECT_NE(yaml->find("\n#gyroscope_random_walk: ?   # rad/s^2/sqrt(Hz); K is not in the fitted model"), std::string::npos)
+      << *yaml;
+  // Neither term: nothing to give, refused as without `partial`; a bad N still refused.
+  EXPECT_FALSE(kalibr_imu_yaml({0, 0, false, false}, {0, 0, false, false}, 100, "t", why, true));
+  EXPECT_EQ(why, "N (angle random walk) is not in the fitted model: Kalibr needs it > 0");
+  EXPECT_FALSE(kalibr_imu_yaml({-1, 0, true, true}, {0, 0, false, false}, 100, "t", why, true));
+  EXPECT_EQ(why.rfind("N (angle random walk) = -1 is not a positive number", 0), 0u) << why;
+}
+
 NodeView node_in(protocol::AngleUnit unit) {
   using namespace protocol;
   NodeView v;

@@ -1,0 +1,59 @@
+#pragma once
+// The batch path of floating phase: the sums of one tau over phase points the caller holds, O(N)
+// per tau, for the offline analyzer's dense tau lists (--taus all on phase or frequency data),
+// as batch.hpp is for counts. Characterizer<FloatArith> visits every tau at every point, reading
+// its history at three ages per tau; here each tau runs through the record alone, in order, four
+// terms a step.
+//
+// The record is what Characterizer<FloatArith> stages: x_e relative to its reference (the line
+// through the first two phase points, line_residual() below, or the first frequency
+// increment) and the prefix sums P_{e+1} = x_0 + ... + x_e as the double-double of
+// FloatArith::add_prefix(), in two arrays (hi, lo). So every term is the characterizer's to the
+// last bit:
+//   - AVAR a_e = (x_e - x_{e-m}) - (x_{e-m} - x_{e-2m}) for e >= 2m, HVAR h_e = a_e -
+//     ((x_{e-m} - x_{e-2m}) - (x_{e-2m} - x_{e-3m})) for e >= 3m;
+//   - MVAR t_e = diff(P_{e+1}, P_{e+1-3m}) + 3 diff(P_{e+1-2m}, P_{e+1-m}) for e >= 3m - 1 (P_0 = 0);
+//   - the decimated series x_0, x_m, x_2m, ...: its non-overlapped sums and the noise sums, in
+//     the characterizer's order (the same bits).
+// The overlapping sums of squares are summed in another order (four partial sums, then combined):
+// a sum of n non-negative terms in any order is within (n - 1) u of the exact one (u = 2^-53),
+// so the two differ by at most 2 (n - 1) u relative; the deviation by half of it.
+//
+// One segment (no gap), terms every `stride` points (stride_of() of batch.hpp). No allocation.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "gyrochar/characterizer.hpp"
+#include "gyrochar/noise_id.hpp"
+
+namespace gyrochar {
+
+/// Held phase points as Characterizer<FloatArith> stages them: x[e], and p_hi[e] + p_lo[e] =
+/// P_{e+1} = x[0] + ... + x[e] (FloatArith::add_prefix from {0, 0}). The three spans have the same
+/// size.
+struct FloatRecord {
+  std::span<const double> x, p_hi, p_lo;
+};
+
+/// Phase point k (x) of an input relative to the line through its first two points (x0 and
+/// slope, set at k = 0 and k = 1), as Characterizer<FloatArith>::add_phase_point() stages it:
+/// x - x0 formed exactly (as hi + lo), the line taken off by one fused multiply-add. O(1).
+inline double line_residual(double x, std::uint64_t k, double& x0, double& slope) {
+  if (k == 0) x0 = x;
+  const double hi = x - x0;
+  const double b = hi - x;
+  const double lo = (x - (hi - b)) - (x0 + b);
+  if (k == 1) slope = hi;
+  return std::fma(-static_cast<double>(k), slope, hi) + lo;
+}
+
+/// The sums of tau m (terms every `stride` points: 1, or a power of two that divides m) over the
+/// record: what Characterizer<FloatArith> keeps for that tau after the same points (see above for
+/// the summation order), and the lag-1 sums of its decimated series added to `noise` (a fresh
+/// accumulator: Characterizer::noise()). O(N) for N points (O(N / m) for the decimated series).
+TauResult<double> float_batch_sums(const FloatRecord& record, std::uint64_t m, std::uint64_t stride,
+                                   NoiseIdAccumulator& noise);
+
+}  // namespace gyrochar
