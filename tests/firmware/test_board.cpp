@@ -434,6 +434,28 @@ TEST_F(BoardCheckpoint, AnotherGyrosCheckpointIsRefusedSayingWhose) {
   EXPECT_TRUE(exists(c.checkpoint_path + ".bad"));
 }
 
+// A checkpoint path that can never be written (under /proc): every period's failure is counted
+// (gyrochard exits 4 at the end when any failed, firmware/main.cpp), the run goes on.
+TEST(Board, CheckpointsThatCannotBeWrittenAreCounted) {
+  Config c = test_config();
+  c.checkpoint_path = "/proc/gyrochar_cannot_be_written.ckpt";
+  c.checkpoint_period_s = 0.1;
+  const auto counts = test_counts(1000);
+  Rig rig(c);
+  rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+  rig.run_for(1000 * ms);
+  EXPECT_GE(rig.board->checkpoint_failures(), 9u);  // oracle: one attempt per 0.1 s of 1 s (the first at 0.1 s)
+  EXPECT_NE(rig.board->checkpoint(), 0);
+  EXPECT_EQ(rig.board->characterizer().increments(), counts.size());
+  Config fine = c;
+  fine.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_fine.ckpt";
+  Rig ok(fine);
+  ok.run_for(300 * ms);
+  EXPECT_EQ(ok.board->checkpoint(), 0);
+  EXPECT_EQ(ok.board->checkpoint_failures(), 0u);
+  std::remove(fine.checkpoint_path.c_str());
+}
+
 // With counts from CAN the gyro is its electronics too: another --counter-node is another gyro.
 TEST(Board, AnotherCounterNodesCheckpointIsRefused) {
   Config c = test_config();
