@@ -76,17 +76,20 @@ std::uint8_t byte_of(const bool& flag) {
 }
 
 // The windows completed and the latest curve, as complete_window() leaves them: the curve of window
-// windows - 1 (none before the first), flags 0 or 1, variances finite and not negative. The flags
-// are read as bytes first: any byte pattern is safe. Returns the field that fails, or nullptr.
+// windows - 1 (none before the first: all zero), flags 0 or 1, variances finite and not negative,
+// zero beyond the window's taus. The flags are read as bytes first: any byte pattern is safe.
+// Returns the field that fails, or nullptr.
 const char* invalid_curve(std::uint64_t windows, const WindowCurve& c, unsigned taus) {
   const std::uint8_t complete = byte_of(c.complete);
   if (complete > 1 || (complete == 1) != (windows > 0)) return "window: latest.complete";
-  if (complete == 0) return c.window == 0 && c.gaps == 0 ? nullptr : "window: latest.window";
-  if (windows - 1 > UINT32_MAX || c.window != windows - 1) return "window: latest.window (windows completed)";
+  if (complete == 0 ? c.window != 0 || c.gaps != 0 : windows - 1 > UINT32_MAX || c.window != windows - 1)
+    return "window: latest.window (windows completed)";
   for (std::size_t i = 0; i < max_window_taus; ++i) {
+    const bool used = complete == 1 && i < taus;
     const std::uint8_t valid = byte_of(c.valid[i]);
-    if (valid > 1 || (i >= taus && valid != 0)) return "window: latest.valid";
-    if (!(std::isfinite(c.avar[i]) && c.avar[i] >= 0 && std::isfinite(c.mvar[i]) && c.mvar[i] >= 0))
+    if (valid > (used ? 1 : 0)) return "window: latest.valid";
+    if (!(std::isfinite(c.avar[i]) && c.avar[i] >= 0 && std::isfinite(c.mvar[i]) && c.mvar[i] >= 0) ||
+        (!used && (c.avar[i] != 0 || c.mvar[i] != 0)))
       return "window: latest.avar/mvar";
   }
   return nullptr;

@@ -231,6 +231,17 @@ TEST(CheckpointFields, EachBrokenInvariantIsRefusedNamingTheField) {
       {"a sum's high word not in sticky", tau_at(tau3, t0.result.sum[1].hi), 1, 8, "sticky"},
       {"out_of_range above two per point", tau_at(tau3, t0.result.out_of_range), 2 * e + 1, 4, "out_of_range"},
   };
+  // Points without samples: each segment is opened by a sample, however many gaps are counted
+  // (fuzz_checkpoint found a state of points, no sample and about 2^64 gaps accepted).
+  {
+    auto bytes = good;
+    write_at(bytes, run_at(r0.gaps), std::uint64_t{1} << 62);
+    EXPECT_EQ(restore_into_fresh(bytes).status, RestoreStatus::ok);  // at the bound
+    write_at(bytes, run_at(r0.increments), e / 2 - 1);
+    EXPECT_EQ(restore_into_fresh(bytes).field, "increments (samples)");
+    write_at(bytes, run_at(r0.gaps), ones);  // would wrap to 0 at the restart's gap
+    EXPECT_EQ(restore_into_fresh(bytes).field, "gaps");
+  }
   for (const Case& c : cases) {
     auto bytes = good;
     if (c.bytes == 1) write_at(bytes, c.at, static_cast<std::uint8_t>(c.value));

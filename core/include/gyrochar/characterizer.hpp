@@ -416,8 +416,8 @@ class Characterizer {
 
   static constexpr std::uint32_t checkpoint_magic = 0x43525947;  // "GYRC"
   static constexpr std::uint16_t checkpoint_version = 5;  // 5: the identity in the header
-  /// Phase points a checkpoint may count: 2^62 (146 000 years at 1 MHz); indices stay far from
-  /// wrapping around.
+  /// Phase points (and gaps) a checkpoint may count: 2^62 (146 000 years at 1 MHz); indices and
+  /// counts stay far from wrapping around.
   static constexpr std::uint64_t max_phase_points = std::uint64_t{1} << 62;
 
   /// Bytes save() writes for the current configuration. O(1).
@@ -562,11 +562,13 @@ class Characterizer {
     const std::uint64_t e = r.next_e;
     if (e > max_phase_points) return "next_e (phase points)";
     if (r.segment_start > e) return "segment_start";
+    if (r.gaps > max_phase_points) return "gaps";  // as many calls as points can have: the count never wraps
     if (r.steady_from != r.segment_start + 3u * stride_) return "steady_from";
     // Points come from increments, one each plus one at each segment's start (gaps + 1 segments
-    // at most), or (floating phase input) from add_phase_point(), one each.
+    // at most, each opened by an increment), or (floating phase input) from add_phase_point().
     if (Arith::exact || r.line_points == 0) {
-      if (r.increments > e || (e > r.increments && e - r.increments - 1 > r.gaps)) return "increments (samples)";
+      if (r.increments > e || e - r.increments > r.increments || (e > r.increments && e - r.increments - 1 > r.gaps))
+        return "increments (samples)";
     } else if (r.increments != 0 || r.line_points != e) {
       return "line_points";
     }
