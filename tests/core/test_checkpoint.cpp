@@ -5,6 +5,7 @@
 // invariant is refused, naming the field, and every state real accumulation writes is accepted.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -330,6 +331,36 @@ TEST(CheckpointFields, EveryRealStateIsAccepted) {
       if (kind == 6 && step % 50 == 0) c->restart();
     }
     EXPECT_GT(c->phase_points(), 100000u) << "S=" << s;
+  }
+}
+
+// Floating phase data (the analyzer's arithmetic) checkpoints under the same checks: real states of
+// phase points and of frequency increments restore; a state whose prefix sum is NaN does not.
+TEST(CheckpointFields, FloatingStatesAreCheckedToo) {
+  using Phase = StaticCharacterizer<FloatArith, 12, 8>;
+  const auto m_list = octaves(12);
+  for (const bool increments : {false, true}) {
+    auto c = std::make_unique<Phase>();
+    ASSERT_EQ(c->configure({8, 0}, m_list), ConfigureStatus::ok);
+    for (int i = 0; i < 5000; ++i) {
+      if (i == 3000) c->mark_gap();
+      if (increments) {
+        c->add_increment(1e-9 * (i % 13));
+      } else {
+        c->add_phase_point(1e-6 * i + 1e-9 * (i % 17));
+      }
+    }
+    std::vector<std::byte> bytes(c->checkpoint_size());
+    ASSERT_EQ(c->save(bytes), bytes.size());
+    auto d = std::make_unique<Phase>();
+    ASSERT_EQ(d->configure({8, 0}, m_list), ConfigureStatus::ok);
+    EXPECT_EQ(d->restore(bytes), RestoreStatus::ok) << d->restore_field();
+    // RunState::p.hi lies 40 bytes into the run state (five counters before it).
+    const double nan = std::nan("");
+    std::memcpy(bytes.data() + 40 + 12 * 8 + 40, &nan, sizeof nan);
+    reseal(bytes);
+    EXPECT_EQ(d->restore(bytes), RestoreStatus::invalid_state);
+    EXPECT_EQ(std::string(d->restore_field()), "p (prefix sum)");
   }
 }
 
