@@ -100,6 +100,7 @@ const char* invalid_curve(std::uint64_t windows, const WindowCurve& c, unsigned 
 RestoreStatus DynamicWindow::restore(std::span<const std::byte> in) {
   const std::size_t pyramid_bytes = pyramid_.checkpoint_size();
   restore_field_ = nullptr;
+  if (length_ == 0) return RestoreStatus::config_mismatch;  // not configured: no window to restore
   if (in.size() < checkpoint_size()) return RestoreStatus::truncated;
   const std::span<const std::byte> own = in.subspan(pyramid_bytes, sizeof windows_ + sizeof latest_);
   std::uint32_t crc = 0;
