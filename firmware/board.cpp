@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "gyrochar/crc32.hpp"
+#include "hal/exit_codes.hpp"
 
 namespace gyrochar::firmware {
 namespace {
@@ -54,15 +55,43 @@ const char* restore_reason(RestoreStatus s) {
     case RestoreStatus::config_mismatch:
       return "written under another configuration (tau0, pulse weight, stride factor, octaves, source or window "
              "changed)";
+    case RestoreStatus::other_identity: return "written for another gyro";
+    case RestoreStatus::invalid_state: return "invalid state";
   }
   return "invalid";
+}
+
+// The gyro a checkpoint belongs to: the node address (bits 0-7) and, with a CAN counter source,
+// the counter node, i.e. the gyro's electronics (bits 8-15, bit 16 set).
+std::uint32_t gyro_identity(const Config& c) {
+  const std::uint32_t counter = c.source == SourceKind::can_counter ? 0x10000u | (c.counter_node & 0xFFu) << 8 : 0;
+  return counter | c.node;
+}
+
+std::string describe_identity(std::uint32_t id) {
+  char text[64];
+  if ((id & 0x10000u) != 0)
+    std::snprintf(text, sizeof text, "node address 0x%02X, counter node 0x%02X", id & 0xFFu, (id >> 8) & 0xFFu);
+  else
+    std::snprintf(text, sizeof text, "node address 0x%02X, no CAN counter", id & 0xFFu);
+  return text;
+}
+
+// Why a restore failed, with the field or the identities where they say more.
+std::string restore_why(RestoreStatus s, const char* field, std::uint32_t found, std::uint32_t identity) {
+  if (s == RestoreStatus::invalid_state) return std::string("invalid state: ") + field;
+  if (s == RestoreStatus::other_identity)
+    return std::string(restore_reason(s)) + " (" + describe_identity(found) + "; this run: " + describe_identity(identity) +
+           ")";
+  return restore_reason(s);
 }
 
 }  // namespace
 
 Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
     : config_(config), io_(io), can_counter_(static_cast<std::uint8_t>(config.counter_node)),
-      checkpoint_file_(config.checkpoint_path), report_work_(config.octaves, fit_mode) {
+      checkpoint_file_(config.checkpoint_path), report_work_(config.octaves, fit_mode),
+      shown_path_(printable(config.checkpoint_path)) {
   settings_.tau0_s = config.tau0_s;
   settings_.pulse_weight_arcsec = config.pulse_weight_arcsec;
   settings_.stride_factor = config.stride_factor;
@@ -75,9 +104,11 @@ Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
     settings_.window_taus = window_taus(config.octaves, settings_.window_length);
   }
   settings_.config_hash = hash_settings(settings_);
+  settings_.identity = gyro_identity(config);
   if (!configure(characterizer_, settings_)) throw std::invalid_argument("estimator settings out of range");
   if (settings_.window_taus != 0 &&
-      !window_.configure(settings_.stride_factor, settings_.config_hash, settings_.window_taus, settings_.window_length))
+      !window_.configure(settings_.stride_factor, settings_.config_hash, settings_.window_taus, settings_.window_length,
+                         settings_.identity))
     throw std::invalid_argument("window settings out of range");
   checkpoint_buffer_.resize(characterizer_.checkpoint_size() + (settings_.window_taus ? window_.checkpoint_size() : 0));
   checkpoint_period_ns_ = static_cast<std::uint64_t>(config.checkpoint_period_s * 1e9);
@@ -105,26 +136,41 @@ Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
 
 Board::~Board() { close(epoll_); }
 
+std::string restore_checkpoint(std::span<const std::byte> bytes, BoardCharacterizer& cumulative, DynamicWindow& window,
+                               const ReportSettings& s) {
+  std::string why;
+  const std::size_t size = cumulative.checkpoint_size();
+  if (const RestoreStatus c = cumulative.restore(bytes); c != RestoreStatus::ok) {
+    return restore_why(c, cumulative.restore_field(), cumulative.checkpoint_identity(), s.identity);
+  }
+  if (s.window_taus == 0) return why;
+  const RestoreStatus w = window.restore(bytes.subspan(std::min(size, bytes.size())));
+  if (w != RestoreStatus::ok) {
+    why = "window part: " + restore_why(w, window.restore_field(), window.pyramid().checkpoint_identity(), s.identity);
+  } else if (window.samples() != cumulative.increments()) {  // both see every sample
+    why = "window part: invalid state: window: samples (not the cumulative count)";
+  } else {
+    return why;
+  }
+  configure(cumulative, s);  // start afresh: the cumulative part was taken already
+  window.configure(s.stride_factor, s.config_hash, s.window_taus, s.window_length, s.identity);
+  return why;
+}
+
 std::string Board::resume() {
   if (config_.checkpoint_path.empty()) return "no checkpoint file configured";
   const long n = checkpoint_file_.read(checkpoint_buffer_);
   if (n == -ENOENT) return "no checkpoint at " + checkpoint_file_.path() + ": starting fresh";
   std::string why;
-  // The cumulative characterizer's bytes, then (with a window) the window's.
-  const auto bytes = std::span(checkpoint_buffer_).first(n < 0 ? 0 : static_cast<std::size_t>(n));
-  const std::size_t cumulative = characterizer_.checkpoint_size();
   if (n < 0) {
     why = n == -EFBIG ? "larger than any checkpoint of this configuration" : std::strerror(static_cast<int>(-n));
-  } else if (const RestoreStatus s = characterizer_.restore(bytes); s != RestoreStatus::ok) {
-    why = restore_reason(s);
-  } else if (const RestoreStatus w = settings_.window_taus == 0 ? RestoreStatus::ok
-                                                                 : window_.restore(bytes.subspan(std::min(cumulative, bytes.size())));
-             w != RestoreStatus::ok) {
-    why = std::string("window part: ") + restore_reason(w);
-    configure(characterizer_, settings_);  // start afresh: the cumulative part was taken already
   } else {
-    ++faults_.sample_gaps;  // the restart is a gap
-    return "resumed from " + checkpoint_file_.path() + ": " + std::to_string(characterizer_.increments()) + " samples";
+    why = restore_checkpoint(std::span(checkpoint_buffer_).first(static_cast<std::size_t>(n)), characterizer_, window_,
+                             settings_);
+    if (why.empty()) {
+      ++faults_.sample_gaps;  // the restart is a gap
+      return "resumed from " + checkpoint_file_.path() + ": " + std::to_string(characterizer_.increments()) + " samples";
+    }
   }
   const int e = checkpoint_file_.set_aside();
   return "checkpoint " + checkpoint_file_.path() + " not used: " + why + "; starting fresh" +
@@ -137,7 +183,10 @@ int Board::checkpoint() {
   std::size_t n = characterizer_.save(checkpoint_buffer_);
   if (settings_.window_taus != 0) n += window_.save(std::span(checkpoint_buffer_).subspan(n));
   const int e = checkpoint_file_.write(std::span(checkpoint_buffer_).first(n));
-  if (e != 0) BOARD_LOG("3", "checkpoint %s: %s", config_.checkpoint_path.c_str(), std::strerror(e));
+  if (e != 0) {
+    ++checkpoint_failures_;
+    BOARD_LOG("3", "checkpoint %s: %s", shown_path_.c_str(), std::strerror(e));
+  }
   return e;
 }
 

@@ -18,6 +18,14 @@
 
 namespace gyrochar::firmware {
 
+/// Restores a board checkpoint (the cumulative characterizer's bytes, then with a window the
+/// window's) into characterizers configured for `settings`. Every field is checked (Characterizer::
+/// restore(), DynamicWindow::restore(), and the window's sample count against the cumulative one);
+/// any byte pattern is safe. Returns "" when both resumed, else why not (naming the field or the
+/// identities), with both as configured, fresh. O(history + taus); allocates only the message.
+std::string restore_checkpoint(std::span<const std::byte> bytes, BoardCharacterizer& cumulative, DynamicWindow& window,
+                               const ReportSettings& settings);
+
 struct BoardIo {
   hal::CanBus& can;
   hal::CountSource* source = nullptr;  // nullptr: counts come as CounterInput frames on `can`
@@ -44,6 +52,8 @@ class Board final : public hal::CountSink {
   bool run_once(int timeout_ms);
   /// Writes a checkpoint now (run_once also does, every checkpoint period). Returns 0 or errno.
   int checkpoint();
+  /// Checkpoints that could not be written so far (each logged): gyrochard's exit status says so.
+  std::uint64_t checkpoint_failures() const { return checkpoint_failures_; }
 
   void on_sample(const hal::CountSample& sample) override;
   const Characterizer<CountArith>& characterizer() const { return characterizer_; }
@@ -67,6 +77,8 @@ class Board final : public hal::CountSink {
   std::vector<std::byte> checkpoint_buffer_;
   ReportWorkspace report_work_;
   std::uint64_t start_ns_ = 0, next_checkpoint_ns_ = 0, checkpoint_period_ns_ = 0;
+  std::uint64_t checkpoint_failures_ = 0;
+  std::string shown_path_;  // the checkpoint path for the log, control bytes escaped
   std::uint8_t seq_ = 0;
   std::size_t frame_ = 0, frames_ = 1;
   hal::BusState last_state_ = hal::BusState::active;

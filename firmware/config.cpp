@@ -32,13 +32,16 @@ std::unique_ptr<CLI::App> make_app(Config& c, unsigned& node, std::string& confi
   app->footer(
       "Configuration file: one 'key = value' per line, keys as the long options without '--'\n"
       "(tau0 = 0.01); '#' starts a comment. A line without '=', an unknown or repeated key and a\n"
-      "bad value are errors naming the file and line. The whole configuration, and the checkpoint's\n"
-      "directory, are checked before any hardware is opened.\n\n"
+      "bad value are errors naming the file and line. The file may hold at most " +
+      std::to_string(max_config_bytes) + " bytes, a line at\n" + "most " + std::to_string(max_config_line) +
+      " bytes. The whole configuration, and the checkpoint's directory, are checked before any\n"
+      "hardware is opened; control bytes in values are shown as \\xNN in messages.\n\n"
       "Examples:\n"
       "  gyrochard --config /etc/gyrochar/gyrochard.conf\n"
       "  gyrochard --source quadrature --gpio-chip gpiochip0 --line-a 3 --line-b 4 --can-interface can0\n"
       "  gyrochard --source can-counter --can-interface vcan0 --node 7 --tau0 0.01\n\n"
-      "Success (0) is a clean stop on SIGTERM or SIGINT.\n" +
+      "Success (0) is a clean stop on SIGTERM or SIGINT with every checkpoint written; 4 when a\n"
+      "checkpoint could not be written during the run (the error is logged each time).\n" +
       std::string(exit_code::help));
   app->add_option("--config", config_path, "configuration file (key = value lines)");
   app->set_version_flag("--version", "gyrochard 0.1.0");
@@ -88,14 +91,32 @@ std::string_view trim(std::string_view s) {
   return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
 }
 
+// The whole file, read up to max_config_bytes + 1 bytes (so /dev/zero or a huge file costs no more).
+std::optional<ConfigError> read_bounded(const std::string& path, std::string& text) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return ConfigError{"config", path + ": " + std::strerror(errno)};
+  text.resize(max_config_bytes + 1);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) return ConfigError{"config", path + ": " + std::strerror(errno)};
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > max_config_bytes)
+    return ConfigError{"config", path + ": larger than " + std::to_string(max_config_bytes) + " bytes (the limit for a configuration file)"};
+  return std::nullopt;
+}
+
 // The entries of `path`, each key checked against the options and its value parsed alone.
 std::optional<ConfigError> read_file(const std::string& path, std::vector<FileEntry>& entries) {
-  std::ifstream in(path);
-  if (!in) return ConfigError{"config", path + ": " + std::strerror(errno)};
+  std::string whole;
+  if (auto problem = read_bounded(path, whole)) return problem;
   std::map<std::string, unsigned> first_line;
-  std::string text;
-  for (unsigned number = 1; std::getline(in, text); ++number) {
+  std::size_t next = 0;
+  for (unsigned number = 1; next < whole.size(); ++number) {
+    const std::size_t newline = std::min(whole.find('\n', next), whole.size());
+    const std::string text = whole.substr(next, newline - next);
+    next = newline + 1;
     const std::string where = path + ":" + std::to_string(number);
+    if (text.size() > max_config_line)
+      return ConfigError{"config", "line longer than " + std::to_string(max_config_line) + " bytes (the limit)", where};
     // '#' starts a comment, outside double quotes.
     bool quoted = false;
     std::size_t end = 0;
@@ -127,7 +148,6 @@ std::optional<ConfigError> read_file(const std::string& path, std::vector<FileEn
     }
     entries.push_back({key, value, where});
   }
-  if (in.bad()) return ConfigError{"config", path + ": " + std::strerror(errno)};
   return std::nullopt;
 }
 

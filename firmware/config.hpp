@@ -2,6 +2,7 @@
 // gyrochard's configuration: a file of `key = value` lines plus command-line overrides. Every key
 // is also a long option (--tau0 0.001). Invalid values are reported with the key's name (and the
 // file and line when they came from the file); nothing is started.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -10,6 +11,10 @@
 namespace gyrochar::firmware {
 
 enum class SourceKind { quadrature, strobe, can_counter };
+
+/// Bounds on the configuration file: its size and a line's length, in bytes (--help states them).
+inline constexpr std::size_t max_config_bytes = 65536;
+inline constexpr std::size_t max_config_line = 4096;
 
 struct Config {
   // CAN output

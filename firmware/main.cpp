@@ -3,7 +3,9 @@
 // resumes from the checkpoint, and runs the board's event loop until SIGTERM or SIGINT, when it
 // writes a last checkpoint. The whole configuration (and the checkpoint's directory) is checked
 // before any hardware is opened, so an invalid configuration exits 2 even without the hardware;
-// then missing hardware exits 3 naming the device (hal/exit_codes.hpp).
+// then missing hardware exits 3 naming the device (hal/exit_codes.hpp). A run in which a checkpoint
+// could not be written exits 4 (an output failed) at its end. Text from the configuration is
+// logged with control bytes escaped (printable()).
 #include <sys/signalfd.h>
 #include <unistd.h>
 
@@ -11,6 +13,7 @@
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "board.hpp"
 #include "config.hpp"
@@ -27,13 +30,13 @@ using namespace gyrochar;
 constexpr const char* program = "gyrochard";
 
 int config_error(const firmware::ConfigError& e) {
-  print_error(program, e.where.empty() ? e.key : e.where + ": " + e.key, e.why);
+  print_error(program, printable(e.where.empty() ? e.key : e.where + ": " + e.key), printable(e.why));
   return exit_code::bad_input;
 }
 
 // The HAL's messages name the device first ("can0: No such device").
 int no_hardware(const std::exception& e) {
-  print_error(program, e.what());
+  print_error(program, printable(e.what()));
   return exit_code::no_hardware;
 }
 
@@ -96,10 +99,10 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return no_hardware(e);
   }
-  std::fprintf(stderr, "<6>gyrochard: %s\n", board->resume().c_str());
+  std::fprintf(stderr, "<6>gyrochard: %s\n", printable(board->resume()).c_str());
   std::fprintf(stderr, "<6>gyrochard: running: node %u on %s, tau0 %g s, %u octaves, stride factor %u\n",
-               static_cast<unsigned>(config.node), config.can_interface.c_str(), config.tau0_s, config.octaves,
-               config.stride_factor);
+               static_cast<unsigned>(config.node), printable(config.can_interface).c_str(), config.tau0_s,
+               config.octaves, config.stride_factor);
 
   while (board->run_once(1000)) {
   }
@@ -108,5 +111,8 @@ int main(int argc, char** argv) {
                static_cast<unsigned long long>(board->characterizer().increments()),
                config.checkpoint_path.empty() ? "" : e == 0 ? ", checkpoint written" : ", checkpoint NOT written");
   close(stop_fd);
-  return 0;
+  if (board->checkpoint_failures() == 0) return finish(program, exit_code::ok);
+  print_error(program, "checkpoint " + printable(config.checkpoint_path),
+              std::to_string(board->checkpoint_failures()) + " checkpoint(s) could not be written during the run");
+  return finish(program, exit_code::output_failed);
 }

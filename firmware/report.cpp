@@ -14,7 +14,7 @@ bool configure(BoardCharacterizer& c, const ReportSettings& s) {
   if (s.octaves < 1 || s.octaves > max_octaves || s.stride_factor > max_stride_factor || !(s.tau0_s > 0)) return false;
   std::array<std::uint64_t, max_octaves> m_list{};
   for (unsigned k = 0; k < s.octaves; ++k) m_list[k] = std::uint64_t{1} << k;
-  return c.configure({s.stride_factor, s.config_hash}, std::span(m_list.data(), s.octaves)) == ConfigureStatus::ok;
+  return c.configure({s.stride_factor, s.config_hash, s.identity}, std::span(m_list.data(), s.octaves)) == ConfigureStatus::ok;
 }
 
 namespace {

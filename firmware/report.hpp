@@ -27,13 +27,14 @@ struct ReportSettings {
   unsigned octaves = 32;
   protocol::InputSource source = protocol::InputSource::unknown;
   std::uint32_t config_hash = 0;     // also the characterizer's checkpoint tag
+  std::uint32_t identity = 0;        // the gyro the data belongs to (gyro_identity()), in checkpoints
   std::uint16_t report_period_ms = 1000;
   std::uint64_t window_length = 0;   // samples per window of the dynamic Allan deviation (window.hpp)
   unsigned window_taus = 0;          // its taus, window_taus(octaves, window_length); 0: no window
 };
 
 /// Configures `c` for octave taus 1, 2, ..., 2^(octaves-1) with the settings' stride factor and
-/// the config hash as checkpoint tag. False (c unusable) for settings outside the capacities.
+/// the config hash as checkpoint tag and the identity as checkpoint identity. False (c unusable) for settings outside the capacities.
 bool configure(BoardCharacterizer& c, const ReportSettings& s);
 
 struct FaultCounters {

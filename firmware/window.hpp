@@ -38,9 +38,10 @@ struct WindowCurve {
 class DynamicWindow {
  public:
   /// Windows of `length` samples over octave taus 1 .. 2^(taus-1), with stride factor S and the
-  /// checkpoint tag of the cumulative characterizer. False (state unusable) for taus beyond
+  /// checkpoint tag and identity of the cumulative characterizer. False (state unusable) for taus beyond
   /// max_window_taus, length < 4 m_max, or a stride factor the pyramid cannot hold. Resets everything.
-  bool configure(std::uint32_t stride_factor, std::uint32_t tag, unsigned taus, std::uint64_t length);
+  bool configure(std::uint32_t stride_factor, std::uint32_t tag, unsigned taus, std::uint64_t length,
+                 std::uint32_t identity = 0);
 
   /// One sample of counts (pulses per tau0). O(S) amortized as the cumulative characterizer; at the
   /// end of a window O(taus) more, to keep its curve and restart the pyramid.
@@ -59,10 +60,19 @@ class DynamicWindow {
   /// Checkpoints: the current window's pyramid (Characterizer::save(), with its own header and
   /// CRC), then the windows completed and the latest curve, with a CRC-32. O(history + taus); no
   /// allocation. save() returns the bytes written, 0 when `out` is too small. restore() needs the
-  /// same configuration; a restored window goes on after a gap; on failure nothing changes.
+  /// same configuration and checks every field (the pyramid's as Characterizer::restore() does; the
+  /// windows completed and the latest curve against each other and the window length); a restored
+  /// window goes on after a gap; on failure nothing else changes (a pyramid found holding a whole
+  /// window's samples is restarted).
   std::size_t checkpoint_size() const;
   std::size_t save(std::span<std::byte> out) const;
   RestoreStatus restore(std::span<const std::byte> in);
+  /// After restore() returned invalid_state: the field that failed.
+  const char* restore_field() const { return restore_field_ != nullptr ? restore_field_ : pyramid_.restore_field(); }
+  /// Samples since the start: the windows completed and the current one's (the cumulative
+  /// characterizer's count: the board checks a restored window against it).
+  std::uint64_t samples() const { return windows_ * length_ + pyramid_.increments(); }
+  const WindowPyramid& pyramid() const { return pyramid_; }
 
  private:
   void complete_window();
@@ -71,6 +81,7 @@ class DynamicWindow {
   std::uint64_t length_ = 0;
   std::uint64_t windows_ = 0;  // windows completed since the start
   WindowCurve latest_;
+  const char* restore_field_ = nullptr;
 };
 
 }  // namespace gyrochar::firmware

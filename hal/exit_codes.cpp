@@ -35,6 +35,23 @@ void print_error(std::string_view program, std::string_view what, std::string_vi
   }
 }
 
+std::string printable(std::string_view text) {
+  static constexpr char hex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(text.size());
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 0x20 && c < 0x7f) {
+      out += ch;
+    } else {
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out;
+}
+
 void exit_with(int code, std::string_view program, std::string_view what, std::string_view why) {
   print_error(program, what, why);
   std::exit(code);

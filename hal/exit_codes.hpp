@@ -4,6 +4,7 @@
 // the table below, which every --help prints (exit_codes_help) and the README repeats. It lives
 // here, at the lowest layer that knows processes, so that firmware/ and host_tools/ share it.
 #include <cstdio>
+#include <string>
 #include <string_view>
 
 namespace gyrochar::exit_code {
@@ -28,6 +29,11 @@ namespace gyrochar {
 /// with one write, so that lines of processes sharing stderr do not interleave. O(length);
 /// allocates nothing for lines up to 1 KiB (longer ones are cut there); never fails.
 void print_error(std::string_view program, std::string_view what, std::string_view why = {});
+
+/// `text` for a message on a terminal or in a journal: bytes outside printable ASCII (control bytes
+/// such as ESC and NUL, and bytes >= 0x7f) as \xNN, as the analyzer shows a data file's bytes.
+/// O(length); allocates.
+std::string printable(std::string_view text);
 
 /// print_error, then std::exit(code) (stdio buffers are flushed, destructors do not run).
 [[noreturn]] void exit_with(int code, std::string_view program, std::string_view what, std::string_view why = {});

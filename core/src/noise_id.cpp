@@ -1,6 +1,9 @@
 #include "gyrochar/noise_id.hpp"
 
 #include <cmath>
+#include <cstring>
+#include <initializer_list>
+#include <cstring>
 
 #if defined(__aarch64__) && defined(__ARM_NEON)
 #include <arm_neon.h>
@@ -248,6 +251,14 @@ void IntegerNoiseIdAccumulator::reset_segment() {
 //   sum (v - q)^2 = S2 - 2 q S1 + n q^2, and likewise the first and last values;
 //   sum over pairs of (v_i - q)(v_{i+1} - q) = (2 sum (v - q)^2 - sum of the end values' squares
 //   - S2 of order d + 1) / 2; left (right) values: all but each segment's last (first).
+bool IntegerNoiseIdAccumulator::plausible(std::uint64_t max_values) const {
+  if (have_ > 5 || n_[0] > max_values || have_ > n_[0]) return false;
+  for (std::size_t j = 0; j + 1 < n_.size(); ++j) {
+    if (n_[j + 1] > n_[j]) return false;
+  }
+  return true;
+}
+
 Lag1Sums IntegerNoiseIdAccumulator::order(int d) const {
   const auto k = static_cast<std::size_t>(d);
   Lag1Sums out;
@@ -297,6 +308,19 @@ double rn_expected(std::uint64_t m, int alpha) {
   const double avar = (1.038 + 3.0 * std::log(2.0 * pi * 0.5 * n)) / (4.0 * pi * pi);
   const double mvar = 3.0 * std::log(256.0 / 27.0) / (8.0 * pi * pi);
   return mvar / avar;
+}
+
+bool NoiseIdAccumulator::plausible(std::uint64_t max_values) const {
+  std::uint8_t linked[4];
+  std::memcpy(linked, linked_, sizeof linked);  // as bytes: a restored flag may be any byte
+  if (have_ < 0 || have_ > 3 || n_[0] > max_values) return false;
+  for (int d = 0; d < 4; ++d) {
+    if (linked[d] > 1 || pairs_[d] > n_[d] || (d > 0 && n_[d] > n_[d - 1])) return false;
+    for (const Lanes* lane : {&shift_, &sum_, &sum_sq_, &sum_lag_, &firsts_, &lasts_, &last_, &raw_}) {
+      if (!std::isfinite((*lane)[d])) return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace gyrochar

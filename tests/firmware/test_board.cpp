@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <new>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "board.hpp"
+#include "gyrochar/crc32.hpp"
 #include "hal/fake/fake_can_bus.hpp"
 #include "hal/fake/fake_clock.hpp"
 #include "hal/fake/fake_count_source.hpp"
@@ -376,6 +378,110 @@ TEST_F(BoardCheckpoint, AnotherConfigurationIsNotResumed) {
   EXPECT_NE(rig2.board->resume().find("not a gyrochard checkpoint"), std::string::npos);
 }
 
+// The CRC over bytes [begin, end) of a checkpoint recomputed and stored at end: the state is what
+// the test made it, the CRC holds (as anything writing the file could make it).
+void reseal(std::string& b, std::size_t begin, std::size_t end) {
+  const std::uint32_t crc = crc32(std::as_bytes(std::span(b.data() + begin, end - begin)));
+  std::memcpy(b.data() + end, &crc, sizeof crc);
+}
+
+// issue 19's reproducers: random bytes over 256 bytes of the run state, a body of 0xFF, and the
+// sample count alone set to 0xFF..., each with the CRC recomputed, crashed, hung or resumed
+// nonsense. Each is now refused naming a field, kept aside, and the run starts fresh.
+TEST_F(BoardCheckpoint, AValidCrcOverAStateThatWasNeverValidIsRefusedNamingTheField) {
+  const std::string good = bytes();
+  const std::size_t body = 40 + 8 * c.octaves;  // the header, the m list (characterizer.hpp's save())
+  std::mt19937_64 rng(19);
+  std::vector<std::string> variants;
+  for (int k = 0; k < 50; ++k) {
+    std::string b = good;
+    for (std::size_t i = body; i < body + 256; ++i) b[i] = static_cast<char>(rng());
+    variants.push_back(b);
+  }
+  std::string ff = good;
+  std::fill(ff.begin() + static_cast<std::ptrdiff_t>(body), ff.end() - 4, '\xff');
+  variants.push_back(ff);
+  std::string count = good;
+  std::fill_n(count.begin() + static_cast<std::ptrdiff_t>(body + 24), 8, '\xff');  // RunState::increments
+  variants.push_back(count);
+  for (std::string& b : variants) {
+    reseal(b, 0, b.size() - 4);
+    rewrite(b);
+    Rig rig(c);
+    const std::string said = rig.board->resume();
+    EXPECT_NE(said.find("not used: invalid state: "), std::string::npos) << said;
+    EXPECT_NE(said.find("starting fresh"), std::string::npos) << said;
+    EXPECT_EQ(rig.board->characterizer().increments(), 0u) << said;
+    EXPECT_TRUE(exists(c.checkpoint_path + ".bad"));
+    // The fresh run works: a second's counts accumulate as in a fresh board.
+    rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), 1000);
+    rig.run_for(1000 * ms);
+    EXPECT_EQ(rig.board->characterizer().increments(), 1000u);
+  }
+  EXPECT_NE(variants.back(), good);
+}
+
+TEST_F(BoardCheckpoint, AnotherGyrosCheckpointIsRefusedSayingWhose) {
+  Config other = c;
+  other.node = 8;
+  Rig rig(other);
+  const std::string said = rig.board->resume();
+  EXPECT_NE(said.find("written for another gyro (node address 0x07, no CAN counter; this run: node address 0x08, no "
+                      "CAN counter)"),
+            std::string::npos)
+      << said;
+  EXPECT_EQ(rig.board->characterizer().increments(), 0u);
+  EXPECT_TRUE(exists(c.checkpoint_path + ".bad"));
+}
+
+// A checkpoint path that can never be written (under /proc): every period's failure is counted
+// (gyrochard exits 4 at the end when any failed, firmware/main.cpp), the run goes on.
+TEST(Board, CheckpointsThatCannotBeWrittenAreCounted) {
+  Config c = test_config();
+  c.checkpoint_path = "/proc/gyrochar_cannot_be_written.ckpt";
+  c.checkpoint_period_s = 0.1;
+  const auto counts = test_counts(1000);
+  Rig rig(c);
+  rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+  rig.run_for(1000 * ms);
+  EXPECT_GE(rig.board->checkpoint_failures(), 9u);  // oracle: one attempt per 0.1 s of 1 s (the first at 0.1 s)
+  EXPECT_NE(rig.board->checkpoint(), 0);
+  EXPECT_EQ(rig.board->characterizer().increments(), counts.size());
+  Config fine = c;
+  fine.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_fine.ckpt";
+  Rig ok(fine);
+  ok.run_for(300 * ms);
+  EXPECT_EQ(ok.board->checkpoint(), 0);
+  EXPECT_EQ(ok.board->checkpoint_failures(), 0u);
+  std::remove(fine.checkpoint_path.c_str());
+}
+
+// With counts from CAN the gyro is its electronics too: another --counter-node is another gyro.
+TEST(Board, AnotherCounterNodesCheckpointIsRefused) {
+  Config c = test_config();
+  c.source = SourceKind::can_counter;  // the rig's scripted source still feeds the board
+  c.counter_node = 0x80;
+  c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_counter_node.ckpt";
+  std::remove(c.checkpoint_path.c_str());
+  const auto counts = test_counts(500);
+  {
+    Rig rig(c);
+    rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
+    rig.run_for(600 * ms);
+    ASSERT_EQ(rig.board->checkpoint(), 0);
+  }
+  Config other = c;
+  other.counter_node = 0x81;
+  Rig rig(other);
+  const std::string said = rig.board->resume();
+  EXPECT_NE(said.find("another gyro (node address 0x07, counter node 0x80; this run: node address 0x07, counter node "
+                      "0x81)"),
+            std::string::npos)
+      << said;
+  EXPECT_EQ(rig.board->characterizer().increments(), 0u);
+  std::remove((c.checkpoint_path + ".bad").c_str());
+}
+
 // --- the dynamic Allan deviation --------------------------------------------------------------
 
 // The window's oracle: a characterizer of the window's taus fed one window's counts directly.
@@ -472,6 +578,53 @@ TEST(Board, AWindowSurvivesACheckpointAndAWindowlessCheckpointIsAnotherConfigura
     EXPECT_NE(said.find("window part: truncated"), std::string::npos) << said;
     EXPECT_EQ(rig.board->characterizer().increments(), 0u);
     EXPECT_EQ(rig.board->window().samples_in_window(), 0u);
+    std::remove((c.checkpoint_path + ".bad").c_str());
+  }
+  // The window part with its own CRC recomputed over fields that disagree: windows completed,
+  // the latest curve's flags and values, and the samples against the cumulative count.
+  {
+    Rig writer(c);
+    writer.source.script_counts(writer.clock.now_ns(), ms, counts.data(), counts.size());
+    writer.run_for(1400 * ms);
+    ASSERT_EQ(writer.board->checkpoint(), 0);
+    std::ifstream in(c.checkpoint_path, std::ios::binary);
+    const std::string good{std::istreambuf_iterator<char>(in), {}};
+    const WindowCurve w0{};
+    const auto at = [&](const auto& member) {
+      return static_cast<std::size_t>(reinterpret_cast<const char*>(&member) - reinterpret_cast<const char*>(&w0));
+    };
+    const std::size_t end = good.size() - 4, curve = end - sizeof(WindowCurve), windows = curve - 8;
+    struct Case {
+      std::size_t offset;
+      std::string value;
+      const char* says;
+    };
+    const double nan = std::nan("");
+    const Case cases[] = {
+        {windows, std::string("\x03\0\0\0\0\0\0\0", 8), "window: latest.window"},  // 2 completed (1300 / 500)
+        {curve + at(w0.complete), std::string("\x02", 1), "window: latest.complete"},
+        {curve + at(w0.valid[29]), std::string("\x01", 1), "window: latest.valid"},  // beyond the window's taus
+        {curve + at(w0.avar[0]), std::string(reinterpret_cast<const char*>(&nan), 8), "window: latest.avar/mvar"},
+        // Beyond the window's taus a curve stays zero (fuzz_checkpoint found a NaN there carried on).
+        {curve + at(w0.mvar[29]), std::string(reinterpret_cast<const char*>(&nan), 8), "window: latest.avar/mvar"},
+        // One window fewer and its curve renumbered: consistent in itself, 500 samples short.
+        {windows, std::string("\x01\0\0\0\0\0\0\0", 8) + std::string(1, '\x01') + std::string(3, '\0') +
+                      std::string(4, '\0'),
+         "window: samples"},
+    };
+    for (const Case& k : cases) {
+      std::string b = good;
+      b.replace(k.offset, k.value.size(), k.value);
+      ASSERT_NE(b, good) << k.says;
+      reseal(b, windows, end);
+      std::ofstream(c.checkpoint_path, std::ios::binary) << b;
+      Rig rig(c);
+      const std::string said = rig.board->resume();
+      EXPECT_NE(said.find(std::string("window part: invalid state: ") + k.says), std::string::npos) << said;
+      EXPECT_EQ(rig.board->characterizer().increments(), 0u) << said;
+      EXPECT_EQ(rig.board->window().samples_in_window(), 0u) << said;
+      EXPECT_FALSE(rig.board->window().latest().complete) << said;
+    }
     std::remove((c.checkpoint_path + ".bad").c_str());
   }
   // A checkpoint written without a window does not resume a board with one.

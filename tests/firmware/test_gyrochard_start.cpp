@@ -1,7 +1,8 @@
 // gyrochard's start-up as an operator meets it: invalid configuration (command line or file, named
 // by file and line) names the key and exits bad_input with nothing started, before any hardware is
-// opened; a missing CAN interface or GPIO chip exits no_hardware and names it. Oracle: the exit
-// codes of hal/exit_codes.hpp.
+// opened; a missing CAN interface or GPIO chip exits no_hardware and names it; reads of the
+// configuration are bounded; control bytes from it are escaped. Oracle: the exit codes of
+// hal/exit_codes.hpp.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -98,6 +99,63 @@ TEST(GyrochardStart, MissingHardwareIsNamedByItsName) {
   expect("--source quadrature --gpio-chip nosuchchip9", exit_code::no_hardware, "nosuchchip9: ");
   expect("--source strobe --gpio-chip nosuchchip9 --counter-path /nonexistent", exit_code::no_hardware, "nosuchchip9: ");
   EXPECT_EQ(run("--help").code, exit_code::ok);
+}
+
+// issue 19: `--config /dev/zero` grew to 2.1 GB, a 50 MB value took 525 MB. The file is read up
+// to 65536 bytes and a line up to 4096 (firmware/config.hpp), under a 256 MB address-space limit
+// that the old reads would have exceeded (/dev/zero never ends).
+TEST(GyrochardStart, ConfigurationReadsAreBounded) {
+  const int bad = exit_code::bad_input;
+  const std::string limit = "ulimit -v 262144; ";
+  Outcome r = run("--config /dev/zero");
+  EXPECT_EQ(r.code, bad) << r.err;
+  EXPECT_EQ(r.err, "gyrochard: config: /dev/zero: larger than 65536 bytes (the limit for a configuration file)\n");
+  const int status = std::system(("bash -c '" + limit + tool + " --config /dev/zero' 2>/dev/null").c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == bad) << status;
+  std::string f = conf_file("long_value", "source = can-counter\ncan-interface = " + std::string(5000, 'x') + "\n");
+  expect("--config " + f, bad, f + ":2: config: line longer than 4096 bytes (the limit)");
+  f = conf_file("big", "# " + std::string(70000, '#') + "\n");  // a comment too: the file's size counts
+  expect("--config " + f, bad, "config: " + f + ": larger than 65536 bytes");
+  // At the limits exactly, a 4096-byte line and a 65536-byte file are read to their last line.
+  const std::size_t blank = 65536 - 4097 - 12;
+  f = conf_file("at_limits", "#" + std::string(4095, 'x') + "\n" + std::string(blank, '\n') + "octaves = 0\n");
+  expect("--config " + f, bad, f + ":" + std::to_string(blank + 2) + ": octaves: must be 1..40");
+}
+
+TEST(GyrochardStart, TheHelpStatesTheLimitsAndExitFour) {
+  const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_help.txt";
+  ASSERT_EQ(std::system((tool + " --help >" + out).c_str()), 0);
+  std::ifstream in(out);
+  const std::string help{std::istreambuf_iterator<char>(in), {}};
+  EXPECT_NE(help.find("at most 65536 bytes, a line at\nmost 4096 bytes"), std::string::npos) << help;
+  EXPECT_NE(help.find("4 when a\ncheckpoint could not be written"), std::string::npos) << help;
+}
+
+// An interface name that can never be valid (IFNAMSIZ - 1 = 15 characters) is bad input, not
+// missing hardware.
+TEST(GyrochardStart, AnImpossibleInterfaceNameIsBadInput) {
+  expect("--source can-counter --can-interface abcdefghijklmnop", exit_code::bad_input,
+         "can-interface: must be an interface name of 1..15 characters");
+  expect("--source can-counter --can-interface nosuchcan123456", exit_code::no_hardware, "nosuchcan123456: ");
+}
+
+// Control bytes from the file (ESC, NUL) reach stderr as \xNN, as the analyzer shows a data file's.
+TEST(GyrochardStart, ControlBytesFromTheFileAreEscaped) {
+  const std::string f = conf_file("control", std::string("tau0\x1b[2J = 1\n", 14));
+  Outcome r = run("--config " + f);
+  EXPECT_EQ(r.code, exit_code::bad_input);
+  EXPECT_NE(r.err.find("tau0\\x1b[2J: unknown key"), std::string::npos) << r.err;
+  const std::string g = conf_file("nul", std::string("source = can-counter\ntau0 = 1\0x\n", 32));
+  r = run("--config " + g);
+  EXPECT_EQ(r.code, exit_code::bad_input);
+  EXPECT_NE(r.err.find("'1\\x00x' is not valid"), std::string::npos) << r.err;
+  const std::string h = conf_file("esc_interface", "source = can-counter\ncan-interface = \"x\x1b[31m\"\n");
+  r = run("--config " + h);
+  EXPECT_EQ(r.code, exit_code::no_hardware);
+  EXPECT_NE(r.err.find("x\\x1b[31m"), std::string::npos) << r.err;
+  for (const Outcome& o : {run("--config " + f), run("--config " + g), run("--config " + h)}) {
+    for (const char ch : o.err) EXPECT_TRUE(ch == '\n' || (ch >= 0x20 && ch < 0x7f)) << o.err;
+  }
 }
 
 }  // namespace

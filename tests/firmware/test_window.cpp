@@ -103,6 +103,11 @@ TEST(Window, ConfigurationsBeyondItsCapacityAreRefused) {
   EXPECT_FALSE(w->configure(8, 0, 9, 1000)) << "m = 256 needs 1024 samples";
   EXPECT_FALSE(w->configure(128, 0, 4, 1000)) << "stride factor beyond the pyramid's";
   EXPECT_TRUE(w->configure(8, 0, 8, 1000));
+  // A window whose configure() failed restores nothing (it has no length to check samples against).
+  std::vector<std::byte> bytes(w->checkpoint_size());
+  ASSERT_EQ(w->save(bytes), bytes.size());
+  EXPECT_FALSE(w->configure(8, 0, 0, 1000));
+  EXPECT_EQ(w->restore(bytes), RestoreStatus::config_mismatch);
 }
 
 TEST(Window, ACheckpointCarriesTheWindowOnAfterAGap) {

@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds=${1:-10}
 status=0
-for target in candump protocol datafile config; do
+for target in candump protocol datafile config checkpoint; do
   scratch=build/fuzz/corpus/$target
   mkdir -p "$scratch"
   echo "fuzz: $target for ${seconds}s" >&2

@@ -55,6 +55,10 @@ class NoiseIdAccumulator {
     }
   }
   std::uint64_t points() const { return n_[0]; }
+  /// Whether the state could have come from at most `max_values` add()s: counts ordered as the
+  /// orders nest, every sum finite, the segment's bookkeeping in range (a restored checkpoint,
+  /// Characterizer::restore()). Reads the flags as bytes: any byte pattern is safe. O(1).
+  bool plausible(std::uint64_t max_values) const;
   /// The sums of difference order d (0..3).
   Lag1Sums order(int d) const {
     // Every value but the last of each segment is a left one; every value but the first, a right one.
@@ -121,6 +125,10 @@ class IntegerNoiseIdAccumulator {
   /// A gap: the next value starts a new segment; no difference or pair spans it.
   void reset_segment();
   std::uint64_t points() const { return n_[0]; }
+  /// Whether the state could have come from at most `max_values` add()s: n_ of order j + 1 at
+  /// most that of order j, the segment's point count in range (a restored checkpoint,
+  /// Characterizer::restore()). The sums are integers modulo 2^128: any value is safe. O(1).
+  bool plausible(std::uint64_t max_values) const;
   /// The sums of difference order d (0..3), centred on the integer nearest their mean.
   Lag1Sums order(int d) const;
 
