@@ -996,19 +996,34 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
   }
   Candidate chosen = best;
   // On the exact covariance the selection is checked once more: where the runner-up with fewer
-  // Markov terms now has the lower criterion, it is the model (fitted on its own covariance).
-  while (chosen.model.markov > 0 && refit_exactly(pr, setup, free, fixed, chosen, runner_up, nl_sd) && runner_up.valid &&
-         runner_up.model.markov < chosen.model.markov && runner_up.criterion < chosen.criterion) {
+  // Markov terms has the lower criterion there, it is the model (fitted on its own covariance),
+  // unless it is rejected where the other is not: an accepted model is never traded for a
+  // rejected one.
+  if (chosen.model.markov > 0 && refit_exactly(pr, setup, free, fixed, chosen, runner_up, nl_sd) && runner_up.valid &&
+      runner_up.model.markov < chosen.model.markov && runner_up.criterion < chosen.criterion) {
     const Candidate more = chosen;
+    std::array<double, max_markov + 1> fewer_sd = nl_sd;
     pr.exact_markov = false;
     pr.model = runner_up.model;
-    chosen = fit_model(pr, free, fixed, false, 12);
-    for (std::size_t k = chosen.model.markov; k < max_markov; ++k) nl_sd[k] = 0;
-    runner_up = more;
-    runner_up.sol.chi2 = profile_chi2(pr, free, fixed);  // on the simpler model's covariance
-    runner_up.criterion = criterion_of(runner_up.sol.chi2, runner_up.parameters, pr.n);
-    pr.model = chosen.model;
-    set_rows(pr);
+    Candidate fewer = fit_model(pr, free, fixed, false, 12);
+    for (std::size_t k = fewer.model.markov; k < max_markov; ++k) fewer_sd[k] = 0;
+    Candidate none;
+    if (fewer.valid && fewer.model.markov > 0) refit_exactly(pr, setup, free, fixed, fewer, none, fewer_sd);
+    if (fewer.valid && (fewer.status == FitStatus::ok || more.status != FitStatus::ok)) {
+      chosen = fewer;
+      nl_sd = fewer_sd;
+      runner_up = more;
+      pr.model = more.model;
+      runner_up.sol.chi2 = profile_chi2(pr, free, fixed);  // on the chosen model's covariance
+      runner_up.criterion = criterion_of(runner_up.sol.chi2, runner_up.parameters, pr.n);
+      pr.model = chosen.model;
+      set_rows(pr);
+    } else {
+      pr.model = more.model;
+      markov_sums_of_points(pr, setup);
+      set_rows(pr);
+      weigh(pr, more.sol.theta);
+    }
   }
   sol = chosen.sol;
   Candidate widened = chosen;
