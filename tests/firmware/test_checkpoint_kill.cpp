@@ -182,8 +182,11 @@ enum Start { resumed = 1, fresh = 0, refused = 2 };
 // One run, in a child process: resume, log where this segment starts and how, run until the data
 // ends. With power loss armed, the disk's durable image follows every fsync.
 // `ready` (a pipe) gets a byte once the start is logged: the kill's random instant counts from there,
-// so that a loaded machine does not shift the kills before the runs' loops.
-[[noreturn]] void run_child(const std::string& dir, int ready, bool power_loss = false, bool drop_file_fsync = false) {
+// so that a loaded machine does not shift the kills before the runs' loops. A run that is not the
+// `last` waits for its kill once its data are done: on a fast machine a run could otherwise finish
+// the record before its kill and end the test with fewer kills than it asks for.
+[[noreturn]] void run_child(const std::string& dir, int ready, bool last, bool power_loss = false,
+                           bool drop_file_fsync = false) {
   if (power_loss) powerloss::arm(dir, drop_file_fsync);
   const Config c = kill_config(dir);
   hal::FakeCanBus bus;
@@ -218,7 +221,9 @@ enum Start { resumed = 1, fresh = 0, refused = 2 };
     timer.update();
     board.run_once(0);
   }
-  _exit(board.checkpoint() == 0 && board.characterizer().increments() == total_samples ? 0 : 4);
+  const bool complete = board.checkpoint() == 0 && board.characterizer().increments() == total_samples;
+  while (!last) pause();
+  _exit(complete ? 0 : 4);
 }
 
 struct Tally {
@@ -244,7 +249,7 @@ Tally kill_and_check(const std::string& name, int kills_wanted, bool power_loss,
     EXPECT_GE(child, 0);
     if (child == 0) {
       close(ready[0]);
-      run_child(dir, ready[1], power_loss, drop_file_fsync);
+      run_child(dir, ready[1], t.kills >= kills_wanted, power_loss, drop_file_fsync);
     }
     close(ready[1]);
     char byte = 0;
