@@ -16,6 +16,7 @@
 #include <memory>
 
 #include "hal/exit_codes.hpp"
+#include "hal/linux/can_interface.hpp"
 
 namespace gyrochar::firmware {
 
@@ -227,8 +228,8 @@ std::optional<ConfigError> validate(const Config& c) {
     return ConfigError{"window", "must be 0 (none) or at least 4 report periods and 4 tau0, below 2^40 tau0"};
   if (!c.checkpoint_path.empty() && !positive(c.checkpoint_period_s))
     return ConfigError{"checkpoint-period", "must be positive"};
-  if (c.can_interface.empty() || c.can_interface.size() > 15)
-    return ConfigError{"can-interface", "must be an interface name of 1..15 characters"};
+  if (const std::string why = interface_name_problem(c.can_interface); !why.empty())
+    return ConfigError{"can-interface", why};
   if (c.source == SourceKind::quadrature && c.line_a == c.line_b)
     return ConfigError{"line-b", "must differ from line-a"};
   if (c.source == SourceKind::strobe && c.counter_path.empty())

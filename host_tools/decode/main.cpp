@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "can_interface.hpp"
+#include "hal/linux/can_interface.hpp"
 #include "hal/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
 #include "output_paths.hpp"

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "can_interface.hpp"
+#include "hal/linux/can_interface.hpp"
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
 #include "gyrochar/protocol.hpp"

@@ -1,4 +1,4 @@
-#include "can_interface.hpp"
+#include "hal/linux/can_interface.hpp"
 
 namespace gyrochar {
 
