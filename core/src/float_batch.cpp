@@ -132,8 +132,9 @@ TauResult<double> float_batch_sums(const FloatRecord& record, std::uint64_t m, s
       s.n[k] += size - 3 * lag;
     }
   } else {
-    const std::size_t first = (2 * lag + static_cast<std::size_t>(stride) - 1) / stride * stride;
-    for (std::size_t e = first; e < size; e += stride) point_terms(record, e, lag, s);
+    const auto step = static_cast<std::size_t>(stride);
+    const std::size_t first = (2 * lag + step - 1) / step * step;
+    for (std::size_t e = first; e < size; e += step) point_terms(record, e, lag, s);
   }
   for (int k = 0; k < 3; ++k) {
     result.sum[k] = s.sum[k];
