@@ -79,7 +79,7 @@ void steady_terms(const double* x, const double* ph, const double* pl, std::size
     s[1] += t * t;
     s[2] += h * h;
   }
-  for (int k = 0; k < 3; ++k) out[k] = s[k];
+  for (std::size_t k = 0; k < 3; ++k) out[k] = s[k];
 }
 
 // The decimated series x_0, x_m, x_2m, ...: the characterizer's decimate(), point by point.
@@ -127,7 +127,7 @@ TauResult<double> float_batch_sums(const FloatRecord& record, std::uint64_t m, s
     for (std::size_t e = 2 * lag; e < 3 * lag; ++e) point_terms(record, e, lag, s);
     double steady[3];
     steady_terms(record.x.data(), record.p_hi.data(), record.p_lo.data(), 3 * lag, size, lag, steady);
-    for (int k = 0; k < 3; ++k) {
+    for (std::size_t k = 0; k < 3; ++k) {
       s.sum[k] += steady[k];
       s.n[k] += size - 3 * lag;
     }
@@ -136,7 +136,7 @@ TauResult<double> float_batch_sums(const FloatRecord& record, std::uint64_t m, s
     const std::size_t first = (2 * lag + step - 1) / step * step;
     for (std::size_t e = first; e < size; e += step) point_terms(record, e, lag, s);
   }
-  for (int k = 0; k < 3; ++k) {
+  for (std::size_t k = 0; k < 3; ++k) {
     result.sum[k] = s.sum[k];
     result.n[k] = s.n[k];
   }
