@@ -406,6 +406,43 @@ std::array<double, max_noises> tail_powers(const PairSetup& s, const TermGrid& a
   return p;
 }
 
+// The power-law noises' c at any lag, for the sums beside a Markov rate or a sinusoid that reach
+// beyond the kernel's span: there every R argument has one sign, the kernel annihilates R's
+// polynomial part and c is zero but for flicker noises: direct to three kernel widths, then the
+// power law pair_sums() integrates (its value at three widths times (L / |lag - centre|)^p).
+struct NoiseAtAnyLag {
+  std::int64_t span_lo = 0, span_hi = 0, flicker_lo = 0, flicker_hi = 0;
+  double center = 0;
+  std::array<double, max_noises> p{}, tail_lo{}, tail_hi{};
+
+  NoiseAtAnyLag(const PairSetup& s, const TermGrid& a, const TermGrid& b)
+      : span_lo(-s.k.u_max()), span_hi(-s.k.u_min()), center(-0.5 * static_cast<double>(s.k.u_min() + s.k.u_max())),
+        p(tail_powers(s, a, b)) {
+    const std::int64_t width = span_hi - span_lo + 1;
+    flicker_lo = span_lo - 3 * width;
+    flicker_hi = span_hi + 3 * width;
+    if (!s.many.flicker) return;
+    covariances(s.k, s.many, flicker_lo, tail_lo);
+    covariances(s.k, s.many, flicker_hi, tail_hi);
+  }
+  bool inside(std::int64_t lag) const { return lag >= span_lo && lag <= span_hi; }
+  void at(const PairSetup& s, std::int64_t lag, std::array<double, max_noises>& c) const {
+    c.fill(0.0);
+    const bool near = lag >= flicker_lo && lag <= flicker_hi;
+    if (inside(lag) || (s.many.flicker && near)) covariances(s.k, s.many, lag, c);
+    if (inside(lag)) return;
+    for (std::size_t t = 0; t < s.many.count; ++t) {
+      if (s.many.twice_d[t] % 2 == 0) {
+        c[t] = 0;  // beyond the span: zero but for rounding
+      } else if (!near) {
+        const bool left = lag < flicker_lo;
+        const double L = std::fabs(static_cast<double>(left ? flicker_lo : flicker_hi) - center);
+        c[t] = (left ? tail_lo[t] : tail_hi[t]) * std::pow(L / std::fabs(static_cast<double>(lag) - center), p[t]);
+      }
+    }
+  }
+};
+
 }  // namespace
 
 PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
@@ -494,12 +531,11 @@ MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rat
   const Kernel& k = setup.k;
   const ManyR& many = setup.many;
   const std::int64_t step = setup.step;
-  // Inside [span_lo, span_hi] the R arguments have both signs. Beyond, every R argument has one
-  // sign, the kernel annihilates R's polynomial part, and a Markov rate's c is the exponential
-  // alone: c(edge) e^(-a |lag - edge|), summed out to e^-27 (2e-12) of its edge value. The
-  // power-law noises' c is zero there, but for flicker noises: direct to three kernel widths, then
-  // the power law pair_sums() integrates (its edge value times (L / |lag - centre|)^p).
-  const std::int64_t span_lo = -k.u_max(), span_hi = -k.u_min();
+  // Inside [span_lo, span_hi] the R arguments have both signs. Beyond, a Markov rate's c is the
+  // exponential alone: c(edge) e^(-a |lag - edge|), summed out to e^-27 (2e-12) of its edge value;
+  // the power-law noises' as NoiseAtAnyLag says.
+  const NoiseAtAnyLag noise(setup, a, b);
+  const std::int64_t span_lo = noise.span_lo, span_hi = noise.span_hi;
   const double reach_lags = 27 / slowest;
   const std::int64_t reach = reach_lags < 4e15 ? static_cast<std::int64_t>(reach_lags) + 1 : std::int64_t{4000000000000000};
   std::int64_t lo = setup.extent_lo, hi = setup.extent_hi;
@@ -513,32 +549,14 @@ MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rat
     edge_lo[j] = markov_covariance(k, rates[j], span_lo);
     edge_hi[j] = markov_covariance(k, rates[j], span_hi);
   }
-  const std::int64_t width = span_hi - span_lo + 1;
-  const std::int64_t flicker_lo = span_lo - 3 * width, flicker_hi = span_hi + 3 * width;
-  const double center = -0.5 * static_cast<double>(k.u_min() + k.u_max());
-  const std::array<double, max_noises> p = tail_powers(setup, a, b);
-  std::array<double, max_noises> tail_lo{}, tail_hi{};
-  if (many.flicker) {
-    covariances(k, many, flicker_lo, tail_lo);
-    covariances(k, many, flicker_hi, tail_hi);
-  }
   visit_nodes(lo, hi, step, smooth_step(a, b, step), span_lo, span_hi, breaks.data(), n_breaks,
               [&](std::int64_t lag, double weight) {
                 const double w = weight * static_cast<double>(setup.pairs(lag));
                 if (w == 0) return;
                 std::array<double, max_noises> c{};
                 std::array<double, max_markov_rates> cm{};
-                const bool inside = lag >= span_lo && lag <= span_hi;
-                if (inside || (many.flicker && lag >= flicker_lo && lag <= flicker_hi)) covariances(k, many, lag, c);
-                for (std::size_t t = 0; t < many.count && !inside; ++t) {
-                  if (many.twice_d[t] % 2 == 0) {
-                    c[t] = 0;  // beyond the span: zero but for rounding
-                  } else if (lag < flicker_lo || lag > flicker_hi) {
-                    const bool left = lag < flicker_lo;
-                    const double L = std::fabs(static_cast<double>(left ? flicker_lo : flicker_hi) - center);
-                    c[t] = (left ? tail_lo[t] : tail_hi[t]) * std::pow(L / std::fabs(static_cast<double>(lag) - center), p[t]);
-                  }
-                }
+                const bool inside = noise.inside(lag);
+                noise.at(setup, lag, c);
                 for (std::size_t j = 0; j < markov; ++j)
                   cm[j] = inside          ? markov_covariance(k, rates[j], lag)
                           : lag < span_lo ? edge_lo[j] * std::exp(-rates[j] * static_cast<double>(span_lo - lag))
@@ -551,6 +569,97 @@ MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rat
               });
   for (std::size_t j = 0; j < markov; ++j)
     for (std::size_t l = 0; l < j; ++l) out.mm[l][j] = out.mm[j][l];
+  return out;
+}
+
+namespace {
+
+// The response sum_k w_k e^(i theta o_k) of a term's taps: its real and imaginary parts.
+void response(const Taps& t, double theta, double& re, double& im) {
+  re = im = 0;
+  for (int k = 0; k < t.count; ++k) {
+    const double phase = theta * static_cast<double>(t.offset[static_cast<std::size_t>(k)]);
+    re += t.weight[static_cast<std::size_t>(k)] * std::cos(phase);
+    im += t.weight[static_cast<std::size_t>(k)] * std::sin(phase);
+  }
+}
+
+// A sinusoid's c(lag) = Re(e^(i theta lag) W) g / (2 theta^2): W = F_a conj(F_b) as (re, im), g the
+// prefix sums' gain at `level`.
+struct SinusoidKernel {
+  double theta = 0, re = 0, im = 0;
+  double at(std::int64_t lag) const {
+    const double phase = theta * static_cast<double>(lag);
+    return std::cos(phase) * re - std::sin(phase) * im;
+  }
+};
+
+SinusoidKernel sinusoid_kernel(double theta, Stat a, std::uint64_t m_a, Stat b, std::uint64_t m_b) {
+  const int level = a == Stat::mvar || b == Stat::mvar ? 1 : 0;
+  double ar, ai, br, bi;
+  response(taps(a, m_a, level), theta, ar, ai);
+  response(taps(b, m_b, level), theta, br, bi);
+  const double half = std::sin(theta / 2);
+  const double scale = 1 / (2 * theta * theta * (level == 1 ? 4 * half * half : 1.0));
+  return {theta, (ar * br + ai * bi) * scale, (ai * br - ar * bi) * scale};
+}
+
+}  // namespace
+
+double sinusoid_term_covariance(double theta, Stat a_stat, std::uint64_t m_a, Stat b_stat, std::uint64_t m_b,
+                                std::int64_t lag) {
+  if (!(theta > 0 && theta <= pi)) return 0.0;
+  return sinusoid_kernel(theta, a_stat, m_a, b_stat, m_b).at(lag);
+}
+
+SinusoidPairSums sinusoid_pair_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a,
+                                    const TermGrid& b) {
+  SinusoidPairSums out;
+  PairSetup setup;
+  const std::size_t count = thetas.size() < max_sinusoid_rates ? thetas.size() : max_sinusoid_rates;
+  if (count == 0 || !pair_setup(set, a, b, setup)) return out;
+  const double m_max = static_cast<double>(a.m > b.m ? a.m : b.m);
+  std::array<SinusoidKernel, max_sinusoid_rates> sk{};
+  double fastest = 0;
+  for (std::size_t j = 0; j < count; ++j) {
+    const double theta = thetas[j];
+    if (!(theta > 0 && theta <= pi) || theta * m_max / 2 > 64) continue;
+    sk[j] = sinusoid_kernel(theta, a.stat, a.m, b.stat, b.m);
+    fastest = std::fmax(fastest, theta);
+  }
+  if (fastest == 0) return out;
+  const ManyR& many = setup.many;
+  const std::int64_t step = setup.step;
+  // The noises' c as NoiseAtAnyLag gives it, summed out to four periods of the slowest sinusoid
+  // beyond a flicker noise's three kernel widths, where the oscillation has cancelled the rest.
+  const NoiseAtAnyLag noise(setup, a, b);
+  const std::int64_t span_lo = noise.span_lo, span_hi = noise.span_hi;
+  const std::int64_t width = span_hi - span_lo + 1;
+  double slowest = pi;
+  for (std::size_t j = 0; j < count; ++j)
+    if (sk[j].theta > 0) slowest = std::fmin(slowest, sk[j].theta);
+  const std::int64_t reach = many.flicker ? 3 * width + static_cast<std::int64_t>(8 * pi / slowest) + 1 : 0;
+  std::int64_t lo = setup.extent_lo, hi = setup.extent_hi;
+  if (lo < span_lo - reach) lo = ceil_div(span_lo - reach, step) * step;
+  if (hi > span_hi + reach) hi = floor_div(span_hi + reach, step) * step;
+  if (lo > hi) return out;
+  std::array<std::int64_t, 72> breaks{};
+  const int n_breaks = pair_breaks(setup, lo, hi, breaks);
+  // A tenth of the fastest sinusoid's period at most, and no more than the power-law sums take.
+  std::int64_t max_step = static_cast<std::int64_t>(2 * pi / (10 * fastest)) / step * step;
+  const std::int64_t power_step = smooth_step(a, b, step);
+  max_step = max_step < step ? step : max_step > power_step ? power_step : max_step;
+  visit_nodes(lo, hi, step, max_step, lo, hi, breaks.data(), n_breaks, [&](std::int64_t lag, double weight) {
+    const double w = weight * static_cast<double>(setup.pairs(lag));
+    if (w == 0) return;
+    std::array<double, max_noises> c{};
+    noise.at(setup, lag, c);
+    for (std::size_t j = 0; j < count; ++j) {
+      if (sk[j].theta == 0) continue;
+      const double cj = sk[j].at(lag);
+      for (std::size_t t = 0; t < many.count; ++t) out.cs[j][t] += w * cj * c[t];
+    }
+  });
   return out;
 }
 

@@ -180,7 +180,6 @@ void check_adev_nulls(PeakSearch& search, const std::vector<std::pair<double, do
 }
 
 void RateRecord::add(std::span<const double> values) {
-  rate_.reserve(rate_.size() + values.size());
   for (const double v : values) {
     if (!phase_) {
       rate_.push_back(counts_ ? v / tau0_s_ : v);

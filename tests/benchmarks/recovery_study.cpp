@@ -36,6 +36,8 @@ std::string describe(const gyrochar::SimOptions& o) {
   if (o.rrw_deg_per_h_sqrt_h > 0) s += fmt::format(", K {:g} deg/h/sqrt(h)", o.rrw_deg_per_h_sqrt_h);
   if (o.ramp_deg_per_h2 > 0) s += fmt::format(", R {:g} deg/h/h", o.ramp_deg_per_h2);
   for (const gyrochar::SimMarkov& m : o.markov) s += fmt::format(", Markov {:g} deg/h at Tc {:g} s", m.sigma_deg_per_h, m.tc_s);
+  for (const gyrochar::SimSinusoid& w : o.sinusoids)
+    s += fmt::format(", sinusoid {:g} deg/h at {:g} Hz", w.amplitude_deg_per_h, w.frequency_hz);
   return s;
 }
 
@@ -132,6 +134,10 @@ Examples:
     if (markov.present == 0)
       fmt::format_to(to, "A Markov term in the model (resolved or not) where none was simulated: {} % of the runs.\n",
                      share(markov.fitted, markov.runs));
+    const TermTally& sinusoid = c.terms[7];
+    if (sinusoid.present == 0)
+      fmt::format_to(to, "A sinusoid in the model (resolved or not) where none was simulated: {} % of the runs.\n",
+                     share(sinusoid.fitted, sinusoid.runs));
     fmt::format_to(to, "\n");
     if (!c.long_tau) continue;
     fmt::format_to(to, "The same runs fitted with the Allan curve's long taus from the total family (docs/total.md): "

@@ -6,6 +6,8 @@
 // must give back (their parameters, and the model selection that names the right terms).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <vector>
@@ -163,6 +165,91 @@ TEST(MarkovTerms, SinusoidVariancesAreThePhaseMeanOfTheSampledEstimator) {
       }
       EXPECT_NEAR(fitted_variance(f, s, m, tau0), mean, 1e-9 * mean) << "m " << m;
     }
+}
+
+// A sinusoid's term covariance against the mean over its phase of the terms' product, each term
+// formed from the phase x_k = -cos(theta k + p) / theta (a rate sin(theta k + p) integrated
+// exactly, one sample a unit of time). Eight phases make the mean exact: the products are
+// sinusoids of twice the phase, which eight equally spaced phases average to zero.
+TEST(MarkovTerms, SinusoidCovarianceIsThePhaseMeanOfTheTermsProduct) {
+  auto term = [](Stat s, long m, long e, double theta, double p) {
+    auto x = [&](long k) { return -std::cos(theta * static_cast<double>(k) + p) / theta; };
+    double t = 0;
+    for (long j = 0; j < (s == Stat::avar ? 1 : m); ++j) t += x(e - j) - 2 * x(e - j - m) + x(e - j - 2 * m);
+    return t;
+  };
+  for (double theta : {3e-3, 0.2, 1.3, 3.0})
+    for (Stat sa : {Stat::avar, Stat::mvar})
+      for (Stat sb : {Stat::avar, Stat::mvar})
+        for (long ma : {1L, 4L})
+          for (long mb : {3L, 8L})
+            for (long lag : {-9L, 0L, 2L, 31L}) {
+              double mean = 0, scale = 0;
+              for (int k = 0; k < 8; ++k) {
+                const double p = 2 * 3.141592653589793 * k / 8;
+                mean += term(sa, ma, 100, theta, p) * term(sb, mb, 100 - lag, theta, p) / 8;
+                scale += std::fabs(term(sa, ma, 100, theta, p) * term(sb, mb, 100, theta, p)) / 8;
+              }
+              EXPECT_NEAR(sinusoid_term_covariance(theta, sa, static_cast<std::uint64_t>(ma), sb,
+                                                   static_cast<std::uint64_t>(mb), lag),
+                          mean, 1e-9 * scale + 1e-300)
+                  << "theta " << theta << " m " << ma << "/" << mb << " lag " << lag;
+            }
+  EXPECT_EQ(sinusoid_term_covariance(0, Stat::avar, 1, Stat::avar, 1, 0), 0);
+  EXPECT_EQ(sinusoid_term_covariance(3.2, Stat::avar, 1, Stat::avar, 1, 0), 0);  // above the Nyquist frequency
+}
+
+// sinusoid_pair_sums() against the double sums over every pair of terms, each c from
+// sinusoid_term_covariance() and term_covariance() (checked above and in test_noise_model): the
+// quadrature over an oscillating c, the flicker noise's reach, and the cut beyond theta m / 2 = 64.
+TEST(MarkovTerms, SinusoidPairSumsMatchTheDoubleSumOverEveryPairOfTerms) {
+  NoiseSet set;
+  set.alpha = {2, 0, -1, -2, 0};
+  set.count = 4;
+  struct Case {
+    Stat sa;
+    std::uint64_t ma, stride_a;
+    Stat sb;
+    std::uint64_t mb, stride_b;
+    double theta0, theta1;
+  };
+  const Case cases[] = {{Stat::avar, 8, 1, Stat::avar, 8, 1, 0.05, 0.7},
+                        {Stat::avar, 4, 1, Stat::avar, 32, 2, 0.3, 0.01},
+                        {Stat::mvar, 16, 1, Stat::mvar, 16, 1, 0.02, 0.2},
+                        {Stat::mvar, 8, 1, Stat::avar, 64, 4, 0.002, 0.05},
+                        {Stat::avar, 600, 1, Stat::avar, 600, 1, 0.1, 0.001},
+                        {Stat::mvar, 300, 1, Stat::mvar, 300, 1, 0.03, 2.0}};  // 2.0: beyond the cut
+  constexpr std::uint64_t n_phase = 3000;
+  for (const Case& c : cases) {
+    const TermGrid ga = unbroken_grid(c.sa, c.ma, c.stride_a, n_phase), gb = unbroken_grid(c.sb, c.mb, c.stride_b, n_phase);
+    const double thetas[] = {c.theta0, c.theta1};
+    const SinusoidPairSums got = sinusoid_pair_sums(set, thetas, ga, gb);
+    std::map<std::int64_t, double> pairs;
+    for (std::uint64_t i = 0; i < ga.n; ++i)
+      for (std::uint64_t j = 0; j < gb.n; ++j)
+        pairs[static_cast<std::int64_t>(ga.first + i * ga.stride) - static_cast<std::int64_t>(gb.first + j * gb.stride)] += 1;
+    SinusoidPairSums want;
+    std::array<double, 2> own{};  // sum c_s^2: the scale of each sinusoid's sums
+    for (const auto& [lag, count] : pairs)
+      for (std::size_t r = 0; r < 2; ++r) {
+        const double cs = sinusoid_term_covariance(thetas[r], c.sa, c.ma, c.sb, c.mb, lag);
+        own[r] += count * cs * cs;
+        for (std::size_t t = 0; t < 4; ++t)
+          want.cs[r][t] += count * cs * term_covariance(set.alpha[t], c.sa, c.ma, c.sb, c.mb, lag);
+      }
+    const PairSums noise = pair_sums(set, ga, gb);
+    for (std::size_t r = 0; r < 2; ++r)
+      for (std::size_t t = 0; t < 4; ++t) {
+        const double scale = std::sqrt(own[r] * std::fabs(noise.cc[t][t]));
+        if (thetas[r] * static_cast<double>(std::max(c.ma, c.mb)) / 2 > 64) {
+          EXPECT_EQ(got.cs[r][t], 0) << "beyond the cut";
+          // What the cut leaves out is small beside the sinusoid's own scale (A^2 / 4096 there).
+          EXPECT_LE(std::fabs(want.cs[r][t]), 1e-3 * scale) << "m " << c.ma << " cs " << r << t;
+          continue;
+        }
+        EXPECT_NEAR(got.cs[r][t], want.cs[r][t], 1e-3 * scale + 1e-300) << "m " << c.ma << "/" << c.mb << " cs " << r << t;
+      }
+  }
 }
 
 std::vector<FitPoint> exact_points(const Ieee952Fit& model) {

@@ -1,5 +1,7 @@
 #include "support/recovery.hpp"
 
+#include "psd.hpp"
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -93,6 +95,21 @@ std::vector<Scenario> standard_scenarios() {
              o.arw_deg_per_sqrt_h = 0.02;
              o.markov = {{0.5, 20}, {0.4, 1500}};
            }),
+      // A sinusoidal rate (a thermal cycle of 100 s; its Allan bump near 37 s, twice the white
+      // rate noise's level there), alone and beside a Markov term whose bump lies an octave above.
+      make("ARW + sinusoid", 8, 0.1,
+           [](SimOptions& o) {
+             o.white_angle_arcsec = 1;
+             o.arw_deg_per_sqrt_h = 0.02;
+             o.sinusoids = {{0.5, 0.01}};
+           }),
+      make("ARW + sinusoid + Markov", 8, 0.1,
+           [](SimOptions& o) {
+             o.white_angle_arcsec = 1;
+             o.arw_deg_per_sqrt_h = 0.02;
+             o.sinusoids = {{0.5, 0.01}};
+             o.markov = {{0.5, 300}};
+           }),
       // Long runs, the seed paper's length and a day: N/B cross at 80 s, B/K at 760 s, K/R at 17 h.
       long_run("long-run RLG, 24 h", 24, 0.01), long_run("long-run RLG, 120 h", 120, 0.01),
       long_run("long-run RLG without ramp, 24 h", 24, 0),
@@ -109,7 +126,22 @@ Recovery recover(const SimOptions& sim, bool long_tau) {
   o.stats = {DevStat::oadev, DevStat::mdev};
   o.keep_record = long_tau;  // the total family's record, for the long-tau fits
   Analyzer analyzer(o);
-  for (std::uint64_t k = 0; k < n; ++k) analyzer.add(static_cast<double>(gyro.next_count()));
+  RateRecord rates(false, true, sim.tau0_s);
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const double count = static_cast<double>(gyro.next_count());
+    analyzer.add(count);
+    rates.add(std::span(&count, 1));
+  }
+  // The sinusoids the analyzer would offer the fit (its default search).
+  std::array<double, max_sinusoids> offered_hz{};
+  const std::size_t segment = default_psd_segment(rates.rate().size());
+  if (segment != 0) {
+    Spectrum spectrum;
+    spectrum.psd = welch_psd(rates.rate(), sim.tau0_s, segment, 0.683);
+    spectrum.searched = true;
+    spectrum.search = find_sinusoids(spectrum.psd);
+    offered_hz = spectrum.fit_hz();
+  }
   ReportUnits units;
   units.gyro = true;
   units.phase_unit_si = sim.pulse_arcsec * units::arcsec;
@@ -121,7 +153,9 @@ Recovery recover(const SimOptions& sim, bool long_tau) {
   auto fit = [&](LongTau input) {
     const std::vector<FitPoint> points = fit_points(analysis, units, sim.tau0_s, input, analyzer.record());
     std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
-    return fit_ieee952(points, {sim.tau0_s, analysis.n_phase, qw}, curve, workspace);
+    FitSetup setup{sim.tau0_s, analysis.n_phase, qw};
+    setup.sinusoid_hz = offered_hz;
+    return fit_ieee952(points, setup, curve, workspace);
   };
   Recovery out{{fit(LongTau::oadev)}, ieee952_truth(sim)};
   if (!long_tau) return out;
@@ -200,6 +234,25 @@ void tally_markov(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit&
   }
 }
 
+void tally_sinusoids(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit& f, const Ieee952Truth& truth_si) {
+  if (truth_si.sinusoids.empty()) {  // any resolved sinusoid is false; "fitted": one in the model
+    bool resolved = false;
+    for (std::size_t j = 0; j < f.n_sinusoids; ++j) resolved |= f.sinusoids[j].amplitude.resolved;
+    tally_value(terms[7], 0, f.ok(), f.n_sinusoids > 0, resolved, 0, 0);
+    return;
+  }
+  for (const SinusoidRate& r : truth_si.sinusoids) {
+    std::size_t nearest = f.n_sinusoids;
+    for (std::size_t j = 0; j < f.n_sinusoids; ++j)
+      if (nearest == f.n_sinusoids || std::fabs(f.sinusoids[j].frequency_hz - r.frequency_hz) <
+                                          std::fabs(f.sinusoids[nearest].frequency_hz - r.frequency_hz))
+        nearest = j;
+    const bool found = nearest < f.n_sinusoids;
+    const Ieee952Parameter a = found ? f.sinusoids[nearest].amplitude : Ieee952Parameter{};
+    tally_value(terms[7], r.amplitude_rad_s, f.ok(), found, found && a.resolved, a.value, a.uncertainty);
+  }
+}
+
 void tally_terms(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit& f, const Ieee952Truth& truth_si) {
   const std::array<double, 5> truth{truth_si.q_rad, truth_si.n_rad_sqrt_s, truth_si.b_rad_s, truth_si.k_rad_s_sqrt_s,
                                     truth_si.r_rad_s2};
@@ -209,6 +262,7 @@ void tally_terms(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit& 
     terms[k].held += f.ok() && !p.fitted && k == 0 && !f.quantization_white;
   }
   tally_markov(terms, f, truth_si);
+  tally_sinusoids(terms, f, truth_si);
 }
 
 }  // namespace

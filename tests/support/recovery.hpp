@@ -39,7 +39,8 @@ inline constexpr std::array<const char*, 3> long_tau_names{"OADEV", "TOTDEV", "T
 /// periodic (no dither), angle random walk, bias instability, rate random walk and rate ramp in
 /// the combinations of the issue's reports and a complete RLG; then one long-run gyro (every term
 /// but Q dominating somewhere, the ramp only after 17 h) over 24 h and 120 h, and the same gyro
-/// without the ramp over 24 h, with long_tau set; and gyros with one and two Markov terms.
+/// without the ramp over 24 h, with long_tau set; and gyros with one and two Markov terms, a
+/// sinusoid, and a sinusoid beside a Markov term.
 std::vector<Scenario> standard_scenarios();
 
 /// One run: the fits (by LongTau; only OADEV's unless long_tau) and the truth (SI units).
@@ -49,15 +50,20 @@ struct Recovery {
   const Ieee952Fit& fit() const { return fits[0]; }
 };
 
-/// Simulates `sim`, analyzes the counts (stride factor full, octave taus) and fits both curves;
+/// Simulates `sim`, analyzes the counts (stride factor full, octave taus), looks for sinusoids in
+/// the rate's PSD as gyrochar-analyze does (Welch, default segment, 1 % false alarms) and fits both
+/// curves with the ones found offered;
 /// with long_tau also with TOTDEV and TheoH on the Allan curve (holding the run's phase, 8 bytes a
 /// sample). O(samples). Throws what the analyzer throws.
 Recovery recover(const SimOptions& sim, bool long_tau = false);
 
 /// The terms tallied: Q N B K R, then a Markov term's sigma and its Tc (each simulated Markov term
-/// against the fitted one nearest in ln Tc; with none simulated, a resolved one is "false").
-inline constexpr std::size_t tallied_terms = 7;
-inline constexpr std::array<const char*, tallied_terms> tallied_names{"Q", "N", "B", "K", "R", "Markov sigma", "Markov Tc"};
+/// against the fitted one nearest in ln Tc; with none simulated, a resolved one is "false"), then a
+/// sinusoid's amplitude (each simulated one against the fitted one nearest in frequency; likewise).
+inline constexpr std::size_t tallied_terms = 8;
+inline constexpr std::array<const char*, tallied_terms> tallied_names{"Q",        "N",           "B",
+                                                                      "K",        "R",           "Markov sigma",
+                                                                      "Markov Tc", "Sinusoid A"};
 
 /// The tally of one term over the runs of a scenario.
 struct TermTally {

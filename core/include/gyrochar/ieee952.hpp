@@ -56,15 +56,17 @@
 // Their expected variances are exact for the sampled estimators. During the model search their
 // part in the covariance of the points is approximate: a Markov term's variance at each point is
 // taken as white rate noise and rate random walk in the proportion its local slope says (-1:
-// white, +1: random walk), the filter as white rate noise of the filtered level, a sinusoid
-// (deterministic) as none. The chosen model's Markov terms are then fitted again on the exact
+// white, +1: random walk), the filter as white rate noise of the filtered level. A sinusoid is
+// deterministic but for its phase: its part is its cross term with the noises, exact for a phase
+// uniform over the turn (sinusoid_pair_sums(); its cross term with a Markov term is left out). The chosen model's Markov terms are then fitted again on the exact
 // covariance (markov_pair_sums()), where the choice is checked once more; the recovery study
 // measures the result (docs/metrology.md).
-// Model selection (FitSetup::select_model): from the five terms, the filter, then one Markov term
-// and a second are added while each lowers the Bayesian information criterion chi2 + p ln(points)
-// (p: the terms fitted plus twice each correlation time or frequency); a correlation time is found on a grid of four
-// per octave (Tc from twice the shortest usable tau to half the longest), then refined by golden
-// section, both on the covariance of the model before it; given sinusoids are tried last. A candidate is compared with the model before it on its
+// Model selection (FitSetup::select_model): from the five terms, the filter, then the given
+// sinusoids (spectral lines found in the record), then one Markov term and a second are added while
+// each lowers the Bayesian information criterion chi2 + p ln(points) (p: the terms fitted plus
+// twice each correlation time or frequency); a correlation time is found on a grid of four per
+// octave (Tc from twice the shortest usable tau to half the longest), then refined by golden
+// section, both on the covariance of the model before it. A candidate is compared with the model before it on its
 // own covariance (under the other's, a model that overshoots the long taus predicts their variance
 // too large and is hardly charged for it) and wins when its criterion is lower and the term it adds
 // lies two standard uncertainties above zero with its time inside the search range (a Markov term:
@@ -185,11 +187,12 @@ struct Ieee952Fit {
   double chi2_per_dof() const { return dof ? chi2 / static_cast<double>(dof) : 0.0; }
 };
 
-/// Doubles of workspace fit_ieee952() needs for `points` points: about 15 points^2.
+/// Doubles of workspace fit_ieee952() needs for `points` points: about 19 points^2.
 constexpr std::size_t ieee952_workspace_doubles(std::size_t points) {
-  // per pair: 14 power-law sums and the Markov terms' (4 noises, each other, alone); Sigma; rows
-  return points * (points + 1) / 2 * (14 + max_markov * 4 + max_markov * max_markov + max_markov) + points * points +
-         points * 12;
+  // per pair: 14 power-law sums, the Markov terms' (4 noises, each other, alone) and the sinusoids'
+  // (4 noises); Sigma; rows
+  return points * (points + 1) / 2 * (14 + max_markov * 4 + max_markov * max_markov + max_markov + max_sinusoids * 4) +
+         points * points + points * 12;
 }
 
 /// Fits the model to the points of `curve` (points of the other statistic are ignored; any

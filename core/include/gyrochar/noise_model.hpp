@@ -114,6 +114,33 @@ struct MarkovPairSums {
 };
 MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rates, const TermGrid& a, const TermGrid& b);
 
+/// A sinusoidal rate sin(theta k + phi) (theta = 2 pi f tau0 in (0, pi], the phase phi uniform
+/// over the turn), in the units of markov_term_covariance() (multiply by A^2 tau0^2): its phase
+/// -cos(theta k + phi) / theta has the autocovariance cos(theta k) / (2 theta^2) over phi, its prefix
+/// sums that over 4 sin^2(theta / 2). Cov[term (a_stat, m_a) newest e, term (b_stat, m_b) newest
+/// e - lag] over phi: Re(e^(i theta lag) F_a conj(F_b)) times that, F the terms' filters' responses
+/// at theta. O(1). 0 for theta outside (0, pi].
+double sinusoid_term_covariance(double theta, Stat a_stat, std::uint64_t m_a, Stat b_stat, std::uint64_t m_b,
+                                std::int64_t lag);
+
+/// The cross sums of sinusoids with the noises of `set`: cs[j][t] = sum c_j c_t over all pairs of
+/// terms of grids a and b, c_j the term covariance of sinusoid j (sinusoid_term_covariance() with
+/// theta = thetas[j]), c_t that of noise t. A sinusoid with a random phase adds 4 A^2 tau0^2 h_t
+/// cs[j][t] to the covariance of two estimates' sums of squares (h_t noise t's innovation
+/// variance); its own part is of order 1/n^2 (deterministic given phi) and is not summed. Summed
+/// where c_t is not zero (the kernel's span; flicker noises directly to three kernel widths, then
+/// their power-law tail as markov_pair_sums() takes it, four periods of the slowest sinusoid
+/// further, where the oscillating c_j has cancelled the rest) on nodes no further apart than a
+/// tenth of a period.
+/// Zero where theta m / 2 > 64 for either grid: the sinusoid's variance there is below A^2 / 4096.
+/// O(nodes x (taps + noises)).
+inline constexpr std::size_t max_sinusoid_rates = 2;
+struct SinusoidPairSums {
+  std::array<std::array<double, max_noises>, max_sinusoid_rates> cs{};
+};
+SinusoidPairSums sinusoid_pair_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a,
+                                    const TermGrid& b);
+
 /// How far the correlation of the estimates over grids a and b under noise alpha, as pair_sums()
 /// computes it in double precision, can be off through rounding (a bound, typically far above the
 /// actual error). The closed forms of c are sums of R at arguments as wide as the kernel, nearly
