@@ -123,7 +123,7 @@ std::optional<CanFrame> SocketCan::receive() {
   sockaddr_can from{};
   msghdr msg{};
   ssize_t n = 0;
-  for (int skipped = 0;; ++skipped) {  // frames of other CAN interfaces are not ours: skip them
+  for (int skipped = 0;; ++skipped) {  // frames of other CAN interfaces and remote frames are not ours: skip them
     msg = msghdr{};
     msg.msg_name = &from;
     msg.msg_namelen = sizeof from;
@@ -135,6 +135,12 @@ std::optional<CanFrame> SocketCan::receive() {
     if (n < static_cast<ssize_t>(CAN_MTU)) {
       if (n < 0 && (errno == ENETDOWN || errno == ENODEV)) state_ = BusState::down;
       return std::nullopt;
+    }
+    // A remote (RTR) frame is a request for data and carries none: it is nobody's data frame.
+    const bool remote = (raw.can_id & CAN_RTR_FLAG) != 0 && (raw.can_id & CAN_ERR_FLAG) == 0;
+    if (remote) {
+      if (skipped == 255) return std::nullopt;
+      continue;
     }
     if (from.can_ifindex == ifindex_) break;
     // Ours may have come back under a new index (a receive-only user never sends to find out).
