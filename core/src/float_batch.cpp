@@ -129,7 +129,7 @@ void decimate(const FloatRecord& r, std::size_t m, TauResult<double>& result, No
 // rather than once a tau. Each tau adds its terms to its sums in float_batch_sums()' order: the
 // AVAR terms alone (2m <= e < 3m) one by one in e's order, then four lanes that keep their points
 // (e = 3m + 4i + lane) from chunk to chunk, combined, and the tail one by one.
-constexpr std::size_t chunk_points = 512;
+constexpr std::size_t chunk_points = 256;
 
 // One fully overlapped tau (stride 1, 2m < size) while the chunks pass.
 struct Run {
