@@ -70,7 +70,7 @@ inline constexpr std::size_t float_batch_group = 64;
 /// float_batch_sums() gives for that tau (the same terms added in the same order). The fully
 /// overlapped taus (stride 1) go through the record float_batch_group at a time, a chunk of points
 /// at a time, so that the chunk's points at the ages of all of them come from the cache (consecutive
-/// m share most of them); the others one by one. O(N) per tau; about 50 KB of stack, no allocation.
+/// m share most of them); the others one by one. O(N) per tau; about 25 KB of stack, no allocation.
 /// The four spans have the same size.
 void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
                       std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise);
