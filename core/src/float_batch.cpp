@@ -87,8 +87,8 @@ using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
 #else
 #define GYROCHAR_FLOAT_CLONES
 #endif
-GYROCHAR_FLOAT_CLONES void steady_terms(const double* x, const double* ph, const double* pl, std::size_t from, std::size_t size,
-                  std::size_t m, double out[3]) {
+GYROCHAR_FLOAT_CLONES void steady_terms(const double* x, const double* ph, const double* pl, std::size_t from,
+                                        std::size_t size, std::size_t m, double out[3]) {
   Lanes sa{0, 0, 0, 0}, st{0, 0, 0, 0}, sh{0, 0, 0, 0};
   std::size_t e = from;
   for (; e + 4 <= size; e += 4) steady_step(x, ph, pl, e, m, sa, st, sh);
@@ -122,7 +122,6 @@ void decimate(const FloatRecord& r, std::size_t m, TauResult<double>& result, No
   }
 }
 
-
 // Several taus at once (float_batch_taus()). A group's taus go through the record together, a
 // chunk of points at a time: the points of the chunk at the four ages of the group's taus stay in
 // the cache while each tau takes its terms there, so the record streams from memory once a group
@@ -142,8 +141,8 @@ struct Run {
 
 // The AVAR terms alone of the runs in [c0, c1), eight runs a step: their terms formed into a[][],
 // one row per point with a column per run (0 where a run has no term: adding 0 * 0 leaves a sum of
-// squares as it is), then each row added to the eight sums, in two vector lanes: each sum takes
-// its squares in e's order, as point_terms() does, and the eight run side by side.
+// squares as it is), then each row added to the eight sums, two vectors of four lanes: each sum
+// takes its squares in e's order, as point_terms() does, and the eight run side by side.
 constexpr std::size_t alone_lanes = 8;
 GYROCHAR_FLOAT_CLONES void alone_chunk(const double* x, Run* runs, std::size_t count, std::size_t c0, std::size_t c1) {
   alignas(32) double a[chunk_points][alone_lanes];
@@ -183,7 +182,8 @@ GYROCHAR_FLOAT_CLONES void alone_chunk(const double* x, Run* runs, std::size_t c
   }
 }
 
-// The four-point steps of the runs that start in [c0, c1) (each run's steps from 3m on).
+// The four-point steps of the runs that start in [c0, c1) (each run's steps start at 3m + 4i, so
+// a step may reach three points past c1).
 GYROCHAR_FLOAT_CLONES void steady_chunk(const double* x, const double* ph, const double* pl, Run* runs,
                                         std::size_t count, std::size_t c0, std::size_t c1) {
   for (std::size_t j = 0; j < count; ++j) {
