@@ -18,7 +18,7 @@ for p in valgrind time libbenchmark-dev python3-numpy python3-scipy libdeflate-t
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || {
     echo "benchmarks.sh: installing $p" >&2; apt-get install -y -qq "$p" >/dev/null; }
 done
-cmake -S . -B build/perf -G Ninja -DCMAKE_BUILD_TYPE=Release -DGYROCHAR_BENCHMARKS=ON >/dev/null
+cmake --preset perf >/dev/null  # build/perf: Release, GYROCHAR_BENCHMARKS=ON
 if [ "${1:-}" = --analyzer ]; then
   cmake --build build/perf --target gyrochar-analyze gyrochar-sim bench_datafile >/dev/null
 elif [ "${1:-}" = --fit ]; then
