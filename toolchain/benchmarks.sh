@@ -18,7 +18,7 @@ for p in valgrind time libbenchmark-dev python3-numpy python3-scipy libdeflate-t
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || {
     echo "benchmarks.sh: installing $p" >&2; apt-get install -y -qq "$p" >/dev/null; }
 done
-cmake -S . -B build/perf -G Ninja -DCMAKE_BUILD_TYPE=Release -DGYROCHAR_BENCHMARKS=ON >/dev/null
+cmake --preset perf >/dev/null  # build/perf: Release, GYROCHAR_BENCHMARKS=ON
 if [ "${1:-}" = --analyzer ]; then
   cmake --build build/perf --target gyrochar-analyze gyrochar-sim bench_datafile >/dev/null
 elif [ "${1:-}" = --fit ]; then
@@ -261,7 +261,7 @@ block=$(rate Block/8/10000000 | tr -d M/s)
 state_bytes=$(echo "$state" | sed 's/.*) = \([0-9]*\) bytes.*/\1/')
 echo "## Against the targets"
 echo
-echo "Core (issue 11), one run on this machine:"
+echo "Core, one run on this machine:"
 echo
 echo "- Block API >= 150 M samples/s at S = 8, 40 octaves, one core: $(met "$block" 150 min) (${block} M/s)."
 echo "- Per-sample path <= 200 instructions (moonshot 80): $(met "$x86" 200 max) on x86-64 ($x86),"
@@ -279,7 +279,7 @@ row() { awk -v n="$1" -v o="$2" '$1 == n && $2 == o' "$data/rows.txt"; }
 ratio() { row "$1" "$2" | awk '$3 != "-" && $5 != "-" { printf "%.1fx by wall time (%s s against %s s), %.1fx by CPU time (%s s against %s s)", $5 / $3, $3, $5, $6 / $4, $4, $6 }'; }
 met_at() { row "$1" "$2" | awk -v t="$3" '$3 != "-" && $5 != "-" { print (($5 / $3 >= t && $6 / $4 >= t) ? "met" : ($5 / $3 >= t ? "met by wall time, **missed** by CPU time" : "**missed**")) }'; }
 mbs=$(awk '/^ReadCounts /{ for (i = 1; i <= NF; ++i) if ($i ~ /^bytes_per_second=/) { sub(/bytes_per_second=/, "", $i); print $i } }' "$data/reader.txt")
-echo "## Against the targets (issue 11, the analyzer)"
+echo "## Against the analyzer's targets"
 echo
 echo "From the rows above (this run, this machine; the default sums the taus on every core):"
 echo
@@ -350,7 +350,7 @@ fi
 echo '```'
 echo
 core_targets
-echo "Tools (issue 5):"
+echo "Tools:"
 echo
 rss() { awk -v n="$1" '$1 == n && $2 == "--stride-factor_8" { print $7 }' "$data/rows.txt"; }
 echo "- gyrochar-analyze peak RSS independent of file length at a fixed stride factor: $([ "$(rss 10000000)" = "$(rss 100000000)" ] && echo met || echo '**missed**')"

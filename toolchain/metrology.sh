@@ -43,7 +43,7 @@ for p in g++ cmake ninja-build pkg-config libbenchmark-dev libfftw3-dev libcli11
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || {
     echo "metrology.sh: installing $p" >&2; apt-get install -y -qq "$p" >/dev/null; }
 done
-cmake -S . -B build/perf -G Ninja -DCMAKE_BUILD_TYPE=Release -DGYROCHAR_BENCHMARKS=ON >/dev/null
+cmake --preset perf >/dev/null  # build/perf: Release, GYROCHAR_BENCHMARKS=ON
 cmake --build build/perf --target coverage_study recovery_study >/dev/null
 mkdir -p "$(dirname "$csv")"
 

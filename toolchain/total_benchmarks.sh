@@ -16,7 +16,7 @@ for p in python3-numpy python3-scipy time; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || {
     echo "total_benchmarks.sh: installing $p" >&2; apt-get install -y -qq "$p" >/dev/null; }
 done
-cmake -S . -B build/perf -G Ninja -DCMAKE_BUILD_TYPE=Release -DGYROCHAR_BENCHMARKS=ON >/dev/null
+cmake --preset perf >/dev/null  # build/perf: Release, GYROCHAR_BENCHMARKS=ON
 cmake --build build/perf --target bench_total >/dev/null
 data=build/perf/data
 mkdir -p "$data"

@@ -1,5 +1,5 @@
 // The characterizer against the estimator definitions evaluated by brute force.
-// Oracle: the definitions in the header (and in ../shared/refdata/README.md) computed directly
+// Oracle: the definitions in the header (and in tests/data/README.md) computed directly
 // over the whole series with exact 128-bit integers; the sums must equal them bit for bit. The
 // noise identification sums against the lag-1 autocorrelation computed directly.
 #include <gtest/gtest.h>

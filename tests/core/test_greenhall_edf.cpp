@@ -1,4 +1,4 @@
-// Greenhall & Riley EDF. Oracles: ../shared/refdata/edf/edf_greenhall_table.csv (allantools'
+// Greenhall & Riley EDF. Oracles: tests/data/edf/edf_greenhall_table.csv (allantools'
 // implementation of the same paper, S = 1 and S = m) and, for the strided estimator (1 < S < m),
 // the paper's BasicSum evaluated directly.
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@ namespace gyrochar {
 namespace {
 
 TEST(GreenhallEdf, MatchesReferenceTable) {
-  std::ifstream in(GYROCHAR_REFDATA "/edf/edf_greenhall_table.csv");
+  std::ifstream in(GYROCHAR_TEST_DATA "/edf/edf_greenhall_table.csv");
   ASSERT_TRUE(in) << "reference table missing";
   std::string line;
   int rows = 0, not_implemented = 0;

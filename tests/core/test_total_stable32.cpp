@@ -1,5 +1,5 @@
 // The total and Theo family (core/include/gyrochar/total.hpp, exact estimators) against Stable32 on
-// the reference sets in ../shared/refdata (README there): n exact, deviation within 1e-4 relative
+// the reference sets in tests/data (README there): n exact, deviation within 1e-4 relative
 // (Stable32 prints 5 digits; 5e-5 for the OCXO all-tau file, 2e-3 for the OCXO octave file, whose
 // normalisation lost precision). Rows Stable32's files carry as comments ('#' before the AF) are
 // compared too: they are the longest taus, left out by the tool the files come from.
@@ -23,7 +23,7 @@
 namespace gyrochar {
 namespace {
 
-const std::string ref = GYROCHAR_REFDATA;
+const std::string ref = GYROCHAR_TEST_DATA;
 
 struct Row {
   std::uint64_t m = 0;

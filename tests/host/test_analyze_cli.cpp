@@ -2,8 +2,9 @@
 // 'gyrochar-analyze: what: why' on stderr, nothing on stdout and exit code 2; good input gives the
 // documented formats and units. Oracles: the exit codes of hal/exit_codes.hpp; unit identities; the
 // closed-form angle random walk of white rate noise (values themselves: test_analyze_reference);
-// for the IEEE-952 read-off, the ADIS16405 data sheet (../shared/refdata/real-imu/README.md), the
-// measured curve itself and the agreement rule of analysis_report.hpp recomputed from the JSON.
+// for the IEEE-952 read-off, the ADIS16405 data sheet (README beside the records, which are not part
+// of the project: support/real_imu.hpp), the measured curve itself and the agreement rule of
+// analysis_report.hpp recomputed from the JSON.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -26,6 +27,7 @@
 
 #include "hal/exit_codes.hpp"
 #include "oracle/brute_force.hpp"
+#include "support/real_imu.hpp"
 
 #include "gyrochar/total.hpp"
 
@@ -284,7 +286,8 @@ TEST(AnalyzeCli, KalibrWithoutKWritesWhatTheFitHasAndPrintsTheAnalysis) {
 // names read at 1 s on the -1/2 line: adev sqrt(tau), deg/h x sqrt(s) / 60 = deg/sqrt(h)); the
 // closed form B = floor / sqrt(2 ln 2 / pi). Its last octave rises at slope 0.13, never +1/2: no K.
 TEST(AnalyzeCli, ReadoffOfARealGyroIsWhatADataSheetPrints) {
-  const std::string record = GYROCHAR_REFDATA "/real-imu/adis16405_run1_gyro_x.txt.gz";
+  const std::string record = test::real_imu_record("adis16405_run1_gyro_x.txt.gz");
+  if (const std::string why = test::real_imu_absent(record); !why.empty()) GTEST_SKIP() << why;
   const Outcome r = run("--type freq --unit deg/s --tau0 0.01 --format json " + record);
   ASSERT_EQ(r.code, exit_code::ok) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -371,16 +374,16 @@ TEST(AnalyzeCli, ReadoffSaysWhereItDisagreesWithTheFit) {
   EXPECT_NE(table.out.find("the read-off B is an upper bound when other terms add at the floor"), std::string::npos);
 }
 
-// --format stable32 against the layout of Stable32's own file for PHASE.DAT (../shared/refdata):
+// --format stable32 against the layout of Stable32's own file for PHASE.DAT (tests/data):
 // the same header lines but the file's name, the same column line, every row in the same columns
 // with AF, Tau and # equal, Sigma within Stable32's 5 printed digits. (Min/Max Sigma: gyrochar's
 // intervals use the exact EDF, Stable32's Greenhall's approximation: within 5 % here.)
 TEST(AnalyzeCli, Stable32TablesHaveStable32sLayout) {
   for (const std::string stat : {"oadev", "mdev"}) {
-    const Outcome r = run("--type phase --tau0 1 --alpha 0 --format stable32 --stats " + stat + " " GYROCHAR_REFDATA
+    const Outcome r = run("--type phase --tau0 1 --alpha 0 --format stable32 --stats " + stat + " " GYROCHAR_TEST_DATA
                           "/phasedat/PHASE.DAT");
     ASSERT_EQ(r.code, exit_code::ok) << r.err;
-    std::ifstream ref(GYROCHAR_REFDATA "/phasedat/phase_dat_" + stat + "_octave.txt");
+    std::ifstream ref(GYROCHAR_TEST_DATA "/phasedat/phase_dat_" + stat + "_octave.txt");
     std::vector<std::string> want, got;
     for (std::string line; std::getline(ref, line);) {
       if (!line.empty() && line.back() == '\r') line.pop_back();

@@ -158,7 +158,7 @@ TEST(AnalyzeEngine, PhaseOffsetAndTrendChangeNothing) {
   // added line is large (up to 10^6 s, 10^9 times the noise), so this exercises the reference line
   // the engine subtracts; 1e-9 covers the rounding of the shifted input values themselves.
   const std::vector<std::string> stats{"adev", "oadev", "mdev", "tdev", "hdev", "ohdev"};
-  DataFile file(std::string(GYROCHAR_REFDATA) + "/phasedat/PHASE.DAT");
+  DataFile file(std::string(GYROCHAR_TEST_DATA) + "/phasedat/PHASE.DAT");
   std::vector<double> x;
   for (double v = 0; file.next(v);) x.push_back(v);
   AnalysisOptions o;

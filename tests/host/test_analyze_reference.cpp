@@ -1,5 +1,5 @@
 // The offline analysis engine against Stable32 and NIST SP 1065 on the reference sets in
-// ../shared/refdata (README there): n exact; deviation within 1e-4 relative (Stable32 prints 5
+// tests/data (README there): n exact; deviation within 1e-4 relative (Stable32 prints 5
 // digits), 5e-5 for the OCXO all-tau files, 2e-3 for the OCXO octave files (Stable32 lost
 // precision normalising them); CI bounds within 1e-3 relative (2e-3 OCXO octave) when computed
 // with Stable32's alpha and Stable32's EDF (EdfModel::greenhall). gyrochar's own intervals use the
@@ -26,7 +26,7 @@
 namespace gyrochar {
 namespace {
 
-const std::string ref = GYROCHAR_REFDATA;
+const std::string ref = GYROCHAR_TEST_DATA;
 const std::vector<std::string> stat_names{"adev", "oadev", "mdev", "tdev", "hdev", "ohdev"};
 
 // One data row of a Stable32 result file: AF Tau # Alpha MinSigma Sigma MaxSigma.
