@@ -28,6 +28,32 @@ double model_adev(const std::array<double, 5>& qnbkr, double tau_s, double rate)
   return std::sqrt(ieee952_avar(qnbkr, tau_s)) * rate;
 }
 
+// The fit of the node as core's Ieee952Fit (wire units): the five terms `qnbkr` and the model
+// beyond them, for fitted_variance().
+Ieee952Fit wire_fit(const std::array<double, 5>& qnbkr, const FitModelRow& m, double rate) {
+  Ieee952Fit f;
+  for (std::size_t k = 0; k < 5; ++k) f.p[k].value = qnbkr[k];
+  const auto page = [&](FitParameter p, std::uint8_t j) { return m.parameters[fit_parameter_position(p, j)].value; };
+  f.n_markov = std::min<std::size_t>(m.markov, max_markov);
+  for (std::uint8_t j = 0; j < f.n_markov; ++j) {
+    f.markov[j].sigma.value = page(FitParameter::markov_sigma, j) / rate;
+    f.markov[j].tc_s = page(FitParameter::markov_tc, j);
+  }
+  f.n_sinusoids = std::min<std::size_t>(m.sinusoids, max_sinusoids);
+  for (std::uint8_t j = 0; j < f.n_sinusoids; ++j) {
+    f.sinusoids[j].amplitude.value = page(FitParameter::sinusoid_amplitude, j) / rate;
+    f.sinusoids[j].frequency_hz = page(FitParameter::sinusoid_frequency, j);
+  }
+  if (m.bandwidth) f.bandwidth_tc_s = page(FitParameter::filter_tf, 0);
+  return f;
+}
+
+// ADEV of a fit's exact sampled AVAR at the averaging factor nearest tau, in display units.
+double fit_adev(const Ieee952Fit& f, double tau_s, double tau0_s, double rate) {
+  const double m = std::max(1.0, std::round(tau_s / tau0_s));
+  return std::sqrt(std::max(0.0, fitted_variance(f, Stat::avar, static_cast<std::uint64_t>(m), tau0_s))) * rate;
+}
+
 // The heat map of the node's window curves: a column per window, a row per window tau (while tau0,
 // the window length or a window tau's m is unknown: no columns yet).
 HeatMap window_heat_map(const NodeView& node, const Units& u) {
@@ -82,7 +108,7 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
     if (const std::optional<double> to_wire = wire_per_si(node)) {
       std::array<double, 5> wire{};
       for (std::size_t k = 0; k < 5; ++k) wire[k] = (*truth)[k] * *to_wire;
-      PlotLine line{std::nullopt, "simulated gyro (truth)", grid, {}};
+      PlotLine line{std::nullopt, false, "simulated gyro (truth)", grid, {}};
       for (const double tau : grid) line.dev.push_back(model_adev(wire, tau, u.rate));
       p.truth = std::move(line);
     }
@@ -130,7 +156,7 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
     if (!t.resolved) continue;
     std::array<double, 5> one{};
     one[k] = t.value;
-    PlotLine line{static_cast<Ieee952Term>(k),
+    PlotLine line{static_cast<Ieee952Term>(k), false,
                   fmt::format("{} {:.3g} {} (±{:.2g}%)", units::ieee952[k].letter, t.value * u.ieee[k], u.ieee_name[k],
                               100.0 * t.rel_uncertainty),
                   grid,
@@ -140,14 +166,47 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
     if (k != b_index && inside(read_tau_s[k]))
       p.read_offs.push_back({read_tau_s[k], model_adev(one, read_tau_s[k], u.rate), read_label[k]});
   }
-  if (fitted == 0) return p;
+  // Version 4: the model beyond the five terms, from the same fit (never another's).
+  const std::optional<FitModelRow> beyond = fit_model_row(node, u);
+  if (beyond && beyond->state != Viewed::shown) {
+    p.notes.push_back(fmt::format("fit's model pages {}:", name(beyond->state)));
+    p.notes.push_back("model not drawn");
+    return p;
+  }
+  const bool extra = beyond && (beyond->markov > 0 || beyond->sinusoids > 0 || beyond->bandwidth) && node.sampling;
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  if (extra) {
+    for (std::uint8_t j = 0; j < beyond->markov; ++j) {
+      const FitModelRow::Parameter& sigma = beyond->parameters[fit_parameter_position(FitParameter::markov_sigma, j)];
+      if (!sigma.resolved) continue;
+      FitModelRow one = *beyond;
+      one.markov = 1, one.sinusoids = 0, one.bandwidth = false;
+      one.parameters[fit_parameter_position(FitParameter::markov_sigma, 0)] = sigma;
+      one.parameters[fit_parameter_position(FitParameter::markov_tc, 0)] =
+          beyond->parameters[fit_parameter_position(FitParameter::markov_tc, j)];
+      const Ieee952Fit f = wire_fit({}, one, u.rate);
+      PlotLine line{std::nullopt, true,
+                    fmt::format("Markov sigma {:.3g} {} (±{:.2g}%), Tc {:.3g} s", sigma.value, u.rate_name,
+                                100.0 * sigma.rel_uncertainty, f.markov[0].tc_s),
+                    grid,
+                    {}};
+      for (const double tau : grid) line.dev.push_back(fit_adev(f, tau, tau0_s, u.rate));
+      p.terms.push_back(std::move(line));
+    }
+  }
+  if (fitted == 0 && !extra) return p;
   if (fit && !fit->quantization_white && !node.ieee952[0].in_model() && node.scale)
     model[0] = static_cast<double>(node.scale->angle_per_pulse) / std::sqrt(12.0);  // Q held there
-  PlotLine sum{std::nullopt,
+  PlotLine sum{std::nullopt, false,
                fit ? fmt::format("IEEE-952 model, chi2/dof {:.2g}", fit->chi2_per_dof) : "IEEE-952 model (sum)",
                grid,
                {}};
-  for (const double tau : grid) sum.dev.push_back(model_adev(model, tau, u.rate));
+  if (extra) {
+    const Ieee952Fit f = wire_fit(model, *beyond, u.rate);
+    for (const double tau : grid) sum.dev.push_back(fit_adev(f, tau, tau0_s, u.rate));
+  } else {
+    for (const double tau : grid) sum.dev.push_back(model_adev(model, tau, u.rate));
+  }
   if (node.ieee952[b_index].resolved && model[b_index] > 0) {  // B: the floor, at the sum's minimum within the points
     std::optional<std::size_t> floor;
     for (std::size_t k = 0; k < grid.size(); ++k) {
