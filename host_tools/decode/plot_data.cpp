@@ -48,10 +48,17 @@ Ieee952Fit wire_fit(const std::array<double, 5>& qnbkr, const FitModelRow& m, do
   return f;
 }
 
-// ADEV of a fit's exact sampled AVAR at the averaging factor nearest tau, in display units.
+// ADEV of a fit's exact sampled AVAR at tau (>= tau0), in display units: between the integer
+// averaging factors around tau / tau0, interpolated in log-log (no steps at the shortest taus).
 double fit_adev(const Ieee952Fit& f, double tau_s, double tau0_s, double rate) {
-  const double m = std::max(1.0, std::round(tau_s / tau0_s));
-  return std::sqrt(std::max(0.0, fitted_variance(f, Stat::avar, static_cast<std::uint64_t>(m), tau0_s))) * rate;
+  const double x = std::max(1.0, tau_s / tau0_s), lo = std::floor(x);
+  const auto avar = [&](double m) {
+    return std::max(0.0, fitted_variance(f, Stat::avar, static_cast<std::uint64_t>(m), tau0_s));
+  };
+  const double v_lo = avar(lo), v_hi = avar(lo + 1);
+  const double w = std::log(x / lo) / std::log((lo + 1) / lo);
+  const double v = v_lo > 0 && v_hi > 0 ? std::exp((1 - w) * std::log(v_lo) + w * std::log(v_hi)) : v_lo;
+  return std::sqrt(v) * rate;
 }
 
 // The heat map of the node's window curves: a column per window, a row per window tau (while tau0,
@@ -175,6 +182,8 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
   }
   const bool extra = beyond && (beyond->markov > 0 || beyond->sinusoids > 0 || beyond->bandwidth) && node.sampling;
   const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  // The exact sampled model exists from tau0 on: its lines start there.
+  const std::vector<double> sampled_grid = extra ? log_grid(std::max(p.tau_min_s, tau0_s), p.tau_max_s) : grid;
   if (extra) {
     for (std::uint8_t j = 0; j < beyond->markov; ++j) {
       const FitModelRow::Parameter& sigma = beyond->parameters[fit_parameter_position(FitParameter::markov_sigma, j)];
@@ -186,11 +195,11 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
           beyond->parameters[fit_parameter_position(FitParameter::markov_tc, j)];
       const Ieee952Fit f = wire_fit({}, one, u.rate);
       PlotLine line{std::nullopt, true,
-                    fmt::format("Markov sigma {:.3g} {} (±{:.2g}%), Tc {:.3g} s", sigma.value, u.rate_name,
+                    fmt::format("Markov {:.3g} {} (±{:.2g}%), Tc {:.3g} s", sigma.value, u.rate_name,
                                 100.0 * sigma.rel_uncertainty, f.markov[0].tc_s),
-                    grid,
+                    sampled_grid,
                     {}};
-      for (const double tau : grid) line.dev.push_back(fit_adev(f, tau, tau0_s, u.rate));
+      for (const double tau : sampled_grid) line.dev.push_back(fit_adev(f, tau, tau0_s, u.rate));
       p.terms.push_back(std::move(line));
     }
   }
@@ -203,18 +212,19 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
                {}};
   if (extra) {
     const Ieee952Fit f = wire_fit(model, *beyond, u.rate);
-    for (const double tau : grid) sum.dev.push_back(fit_adev(f, tau, tau0_s, u.rate));
+    sum.tau_s = sampled_grid;
+    for (const double tau : sampled_grid) sum.dev.push_back(fit_adev(f, tau, tau0_s, u.rate));
   } else {
     for (const double tau : grid) sum.dev.push_back(model_adev(model, tau, u.rate));
   }
   if (node.ieee952[b_index].resolved && model[b_index] > 0) {  // B: the floor, at the sum's minimum within the points
     std::optional<std::size_t> floor;
-    for (std::size_t k = 0; k < grid.size(); ++k) {
-      if (grid[k] >= lo && grid[k] <= hi && (!floor || sum.dev[k] < sum.dev[*floor])) floor = k;
+    for (std::size_t k = 0; k < sum.tau_s.size(); ++k) {
+      if (sum.tau_s[k] >= lo && sum.tau_s[k] <= hi && (!floor || sum.dev[k] < sum.dev[*floor])) floor = k;
     }
     std::array<double, 5> b{};
     b[b_index] = model[b_index];
-    if (floor) p.read_offs.push_back({grid[*floor], model_adev(b, grid[*floor], u.rate), read_label[b_index]});
+    if (floor) p.read_offs.push_back({sum.tau_s[*floor], model_adev(b, sum.tau_s[*floor], u.rate), read_label[b_index]});
   }
   p.terms.push_back(std::move(sum));
   return p;

@@ -322,7 +322,7 @@ TEST(DecodeOutput, PlotOfAVersionFourModelDrawsItsMarkovTermAndNeverAnotherCycle
   const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals);  // deg/h: numerically arcsec/s
   ASSERT_EQ(p.terms.size(), 3u);  // N, the Markov term, the sum
   EXPECT_TRUE(p.terms[1].markov);
-  EXPECT_EQ(p.terms[1].label, "Markov sigma 0.05 deg/h (±10%), Tc 5 s");
+  EXPECT_EQ(p.terms[1].label, "Markov 0.05 deg/h (±10%), Tc 5 s");  // sigma, its uncertainty, Tc
   const double n = 0.1f, sigma = 0.05f, tc = 5.0;
   const auto markov_avar = [&](double t) {
     return 2 * sigma * sigma * tc / t * (1 - tc / (2 * t) * (3 - 4 * std::exp(-t / tc) + std::exp(-2 * t / tc)));
