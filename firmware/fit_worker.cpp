@@ -33,10 +33,7 @@ void FitWorker::request(std::span<const FitPoint> points, const FitSetup& setup,
     if (busy_) return;
     n_points_ = std::min(points.size(), points_.size());
     std::copy_n(points.begin(), n_points_, points_.begin());
-    setup_ = setup;
-    // The five terms only on the board for now: the CAN protocol does not yet carry Markov terms,
-    // the filter or sinusoids, and the selection's time on the board is not yet measured.
-    setup_.select_model = false;
+    setup_ = setup;  // with model selection (protocol version 4 carries the model's terms)
     job_samples_ = samples;
     busy_ = true;
   }

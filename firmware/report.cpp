@@ -29,23 +29,89 @@ protocol::Ieee952Status status_on_wire(FitStatus s) {
   return protocol::Ieee952Status::singular;
 }
 
-/// The summary page of `fit`. The taus below which points were left out are 2 m tau0 of the
-/// longest one left out: on the wire as log2 of 2m, rounded up (exact for the octave taus), 1..31.
+/// A tau below which points were left out, 2 m tau0 of the longest one left out: on the wire as
+/// log2 of 2m, rounded up (exact for the octave taus), 1..31; 0 for none.
+std::uint8_t excluded_code(double below_tau_s, double tau0_s) {
+  const double below_m = below_tau_s / tau0_s;
+  if (!(below_m > 1)) return 0;
+  const double code = std::ceil(std::log2(below_m) - 1e-6);  // 2m tau0 / tau0 may miss 2m by an ulp
+  return static_cast<std::uint8_t>(std::clamp(code, 1.0, 31.0));
+}
+
+/// A double as a finite float of the wire, within [-max, max] of float.
+float wire_float(double v) {
+  const double largest = static_cast<double>(std::numeric_limits<float>::max());
+  return static_cast<float>(std::isfinite(v) ? std::clamp(v, -largest, largest) : largest);
+}
+
+/// The summary page of `fit`.
 protocol::Ieee952SummaryMsg ieee952_summary(const Ieee952Fit& fit, std::uint8_t seq, double tau0_s) {
   protocol::Ieee952SummaryMsg m;
   m.seq = seq;
   m.status = status_on_wire(fit.status);
-  const double chi2_per_dof = fit.chi2_per_dof();
-  const double largest = static_cast<double>(std::numeric_limits<float>::max());
-  m.chi2_per_dof = static_cast<float>(std::isfinite(chi2_per_dof) ? std::clamp(chi2_per_dof, 0.0, largest) : largest);
+  m.chi2_per_dof = wire_float(std::max(fit.chi2_per_dof(), 0.0));
   m.points = static_cast<std::uint32_t>(fit.points);
   m.quantization_white = fit.quantization_white;
-  for (std::size_t k = 0; k < 2 && !fit.quantization_white; ++k) {
-    const double below_m = fit.excluded_below_tau_s[k] / tau0_s;
-    if (!(below_m > 1)) continue;
-    const double code = std::ceil(std::log2(below_m) - 1e-6);  // 2m tau0 / tau0 may miss 2m by an ulp
-    m.excluded_below_log2_m[k] = static_cast<std::uint8_t>(std::clamp(code, 1.0, 31.0));
+  for (std::size_t k = 0; k < 2 && !fit.quantization_white; ++k)
+    m.excluded_below_log2_m[k] = excluded_code(fit.excluded_below_tau_s[k], tau0_s);
+  return m;
+}
+
+/// The model page of `fit` (version 4): the terms the arrays of the fit hold, and its runner-up.
+protocol::Ieee952ModelMsg ieee952_model(const Ieee952Fit& fit, std::uint8_t seq, double tau0_s) {
+  protocol::Ieee952ModelMsg m;
+  m.seq = seq;
+  m.markov = static_cast<std::uint8_t>(fit.n_markov);
+  m.sinusoids = static_cast<std::uint8_t>(fit.n_sinusoids);
+  m.bandwidth = fit.bandwidth_tc_s > 0;
+  m.bandwidth_excluded_below_log2_m = excluded_code(fit.bandwidth_excluded_below_tau_s, tau0_s);
+  if (fit.chosen.valid && fit.runner_up.valid) {
+    m.runner_up = true;
+    m.runner_up_markov = fit.runner_up.markov;
+    m.runner_up_sinusoids = fit.runner_up.sinusoids;
+    m.runner_up_bandwidth = fit.runner_up.bandwidth;
+    m.criterion_margin = wire_float(fit.runner_up.criterion - fit.chosen.criterion);
   }
+  return m;
+}
+
+/// Parameter page k (protocol::fit_parameter_slot order) of `fit`: a value with its relative
+/// uncertainty, zeros for a term the model does not hold. Resolved needs an accepted fit.
+protocol::Ieee952ParameterMsg ieee952_parameter(const Ieee952Fit& fit, std::uint8_t seq, std::size_t k) {
+  using protocol::FitParameter;
+  const protocol::FitParameterSlot slot = protocol::fit_parameter_slot(k);
+  protocol::Ieee952ParameterMsg m{seq, slot.parameter, slot.index};
+  double value = 0, uncertainty = 0;
+  bool resolved = false;
+  switch (slot.parameter) {
+    case FitParameter::markov_sigma:
+    case FitParameter::markov_tc:
+      if (slot.index >= fit.n_markov) break;
+      if (slot.parameter == FitParameter::markov_sigma) {
+        const Ieee952Parameter& sigma = fit.markov[slot.index].sigma;
+        value = sigma.value, uncertainty = sigma.uncertainty, resolved = sigma.resolved;
+      } else {
+        value = fit.markov[slot.index].tc_s, uncertainty = fit.markov[slot.index].tc_uncertainty_s;
+      }
+      break;
+    case FitParameter::filter_tf:
+      value = fit.bandwidth_tc_s, uncertainty = fit.bandwidth_tc_uncertainty_s;
+      break;
+    case FitParameter::sinusoid_amplitude:
+    case FitParameter::sinusoid_frequency:
+      if (slot.index >= fit.n_sinusoids) break;
+      if (slot.parameter == FitParameter::sinusoid_amplitude) {
+        const Ieee952Parameter& a = fit.sinusoids[slot.index].amplitude;
+        value = a.value, uncertainty = a.uncertainty, resolved = a.resolved;
+      } else {
+        value = fit.sinusoids[slot.index].frequency_hz;  // given to the fit, not fitted
+      }
+      break;
+  }
+  if (!(value > 0) || !std::isfinite(value)) return m;
+  m.value = wire_float(value);
+  m.rel_uncertainty = std::isfinite(uncertainty) && uncertainty > 0 ? uncertainty / value : 0.0;
+  m.resolved = resolved && fit.ok() && protocol::has_resolved(slot.parameter);
   return m;
 }
 
@@ -120,18 +186,19 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
   out.scale = {seq, static_cast<float>(s.pulse_weight_arcsec), AngleUnit::arcsec, s.source};
   out.config = {seq, s.config_hash, s.report_period_ms};
   build_window(s, seq, window, out);
-  // The recommended fit of both curves, in arcsec and seconds; quantization's white level is the
-  // pulse weight over sqrt(12). Only for the reports that carry the Ieee952 frames (one in
-  // protocol::slow_cycle_reports); they ask for a new fit when refit_due() and send the latest.
-  bool carries_fit = false;
-  for (std::size_t k = 0; k < report_frame_count(seq, taus, version, out.window_taus) && !carries_fit; ++k)
-    carries_fit = report_slot(seq, taus, k, version, out.window_taus).slot == Slot::ieee952;
-  if (!carries_fit) return;
-  if (refit_due(samples, work.fitter().requested_samples(), s.tau0_s))
-    work.fitter().request(std::span(points.data(), n_points),
-                          {s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)}, samples);
-  const FitWorker::Result latest = work.fitter().latest();
-  const Ieee952Fit& fit = latest.fit;
+  // The recommended fit of both curves with model selection, in arcsec and seconds; quantization's
+  // white level is the pulse weight over sqrt(12). The first report of each slow cycle asks for a
+  // new fit when refit_due() and takes the latest finished one: every Ieee952 frame of the cycle
+  // (the terms, the summary, the model and its parameters, spread over its reports) describes it.
+  if (seq % slow_cycle_reports == 0) {
+    if (refit_due(samples, work.fitter().requested_samples(), s.tau0_s))
+      work.fitter().request(std::span(points.data(), n_points),
+                            {s.tau0_s, c.phase_points(), s.pulse_weight_arcsec / std::sqrt(12.0)}, samples);
+    const FitWorker::Result latest = work.fitter().latest();
+    out.fit = latest.fit;
+    out.fit_samples = latest.samples;
+  }
+  const Ieee952Fit& fit = out.fit;
   // A term in the model goes out with its value and uncertainty, resolved or not (an upper-bound
   // reading); Resolved also needs an accepted fit. A term left out or held fixed goes out as zeros.
   for (std::size_t k = 0; k < 5; ++k) {
@@ -142,8 +209,8 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
                       fitted ? p.uncertainty / p.value : 0.0, fitted};
   }
   out.ieee952_summary = ieee952_summary(fit, seq, s.tau0_s);
-  out.fit = fit;
-  out.fit_samples = latest.samples;
+  out.ieee952_model = ieee952_model(fit, seq, s.tau0_s);
+  for (std::size_t k = 0; k < fit_parameter_pages; ++k) out.ieee952_parameters[k] = ieee952_parameter(fit, seq, k);
 }
 
 protocol::Message report_message(const ReportContent& c, std::size_t k) {
@@ -164,6 +231,8 @@ protocol::Message report_message(const ReportContent& c, std::size_t k) {
     case Slot::window: return c.window;
     case Slot::window_length: return c.window_length;
     case Slot::window_dev: return c.window_dev[s.index];
+    case Slot::fit_model: return c.ieee952_model;
+    case Slot::fit_parameter: return c.ieee952_parameters[s.index];
   }
   return c.status;
 }

@@ -57,13 +57,18 @@ struct ReportContent {
   protocol::MetaConfigMsg config;
   std::array<protocol::Ieee952Msg, 5> ieee952{};
   protocol::Ieee952SummaryMsg ieee952_summary;
+  // The selected model beyond the five terms (version 4), from the same fit.
+  protocol::Ieee952ModelMsg ieee952_model;
+  std::array<protocol::Ieee952ParameterMsg, protocol::fit_parameter_pages> ieee952_parameters{};
   // The window curve (version 3): the window completed last when the slow cycle began.
   std::size_t window_taus = 0;  // 0: the node has no window, and the reports no window frames
   protocol::WindowMsg window;
   protocol::WindowLengthMsg window_length;
   std::array<protocol::WindowDevMsg, max_window_taus> window_dev{};
-  Ieee952Fit fit;  // the fit the IEEE-952 frames were made from (for logs and tests)
-  std::uint64_t fit_samples = 0;  // the samples it was made from (0: none yet)
+  // The fit the IEEE-952 frames of the current slow cycle are made from (taken at its first report;
+  // kept across reports: build_report() reads it), and the samples it was made from (0: none yet).
+  Ieee952Fit fit;
+  std::uint64_t fit_samples = 0;
 };
 
 /// What build_report() works in, allocated once for `octaves` taus: the cache of the covariance
@@ -82,6 +87,8 @@ class ReportWorkspace {
   FitWorker fitter_;
 };
 static_assert(2 * max_octaves <= FitWorker::max_points);
+static_assert(max_markov <= protocol::wire_markov_terms && max_sinusoids <= protocol::wire_sinusoids,
+              "the protocol must carry every Markov term and sinusoid a fit can hold");
 
 /// When a report that carries the IEEE-952 frames asks for a new fit: once the run has grown by a
 /// quarter since the points of the last fit, or by `refit_after_s` of samples. In between the
@@ -90,8 +97,8 @@ inline constexpr double refit_after_s = 900.0;
 bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau0_s);
 
 /// Fills `out` for report `seq` from the characterizer's current state: the deviations, EDFs and
-/// noise types of every report, the IEEE-952 fit for the reports that carry its frames (the
-/// others keep the last one) and, when the settings have window taus, the curve of `window` (the
+/// noise types of every report, the IEEE-952 frames of the fit taken at the first report of the
+/// slow cycle (`out` keeps it for the cycle's other reports: pass the same `out` every report) and, when the settings have window taus, the curve of `window` (the
 /// board's latest completed window), taken at the first report of each slow cycle and repeated
 /// through it. No allocation: everything is worked out in `work` (built for the same number of
 /// octaves).

@@ -131,6 +131,22 @@ ProtocolError check(const WindowDevMsg& m) {
   return ok_if(m.tau_index < max_taus && m.window < 16 && nonnegative(m.adev_angle_per_s) &&
                nonnegative(m.mdev_angle_per_s));
 }
+ProtocolError check(const Ieee952ParameterMsg& m) {
+  const std::size_t terms = m.parameter == FitParameter::filter_tf ? 1
+                            : m.parameter <= FitParameter::markov_tc ? wire_markov_terms
+                                                                     : wire_sinusoids;
+  return ok_if(m.parameter <= FitParameter::sinusoid_frequency && m.index < terms &&
+               (!m.resolved || has_resolved(m.parameter)) && nonnegative(m.value) &&
+               !std::isnan(m.rel_uncertainty) && m.rel_uncertainty >= 0.0);
+}
+ProtocolError check(const Ieee952ModelMsg& m) {
+  const bool runner_up_blank = m.runner_up_markov == 0 && m.runner_up_sinusoids == 0 && !m.runner_up_bandwidth &&
+                               m.criterion_margin == 0.0f;
+  return ok_if(m.markov <= wire_markov_terms && m.sinusoids <= wire_sinusoids &&
+               m.bandwidth_excluded_below_log2_m < (1u << excluded_code_bits) &&
+               m.runner_up_markov <= wire_markov_terms && m.runner_up_sinusoids <= wire_sinusoids &&
+               std::isfinite(m.criterion_margin) && (m.runner_up || runner_up_blank));
+}
 ProtocolError check(const CounterInputMsg&) { return ProtocolError::none; }
 
 // --- encoding --------------------------------------------------------------------------------
@@ -250,8 +266,37 @@ ProtocolError decode_metadata(const CanFrame& f, Message& out) {
   }
 }
 
+ProtocolError decode_ieee952_model(const CanFrame& f, Message& out) {
+  if (f.data[3] & 0xF8u) return ProtocolError::reserved_bits;
+  Ieee952ModelMsg m;
+  m.seq = f.data[1];
+  m.markov = u8(f.data[0] >> 3 & 3u);
+  m.sinusoids = u8(f.data[0] >> 5 & 3u);
+  m.bandwidth = (f.data[0] & 0x80u) != 0;
+  m.bandwidth_excluded_below_log2_m = u8(f.data[2] & 0x1Fu);
+  m.runner_up = (f.data[2] & 0x20u) != 0;
+  m.runner_up_markov = u8(f.data[2] >> 6);
+  m.runner_up_sinusoids = u8(f.data[3] & 3u);
+  m.runner_up_bandwidth = (f.data[3] & 4u) != 0;
+  m.criterion_margin = get_float(f, 4);
+  return accept(m, out);
+}
+
+ProtocolError decode_ieee952_parameter(const CanFrame& f, Message& out) {
+  Ieee952ParameterMsg m;
+  m.seq = f.data[1];
+  m.parameter = static_cast<FitParameter>(f.data[0] >> 3 & 7u);
+  m.index = u8(f.data[0] >> 6 & 1u);
+  m.resolved = (f.data[0] & 0x80u) != 0;
+  m.value = get_float(f, 2);
+  m.rel_uncertainty = static_cast<double>(get(f, 6, 2)) * rel_uncertainty_step;
+  return accept(m, out);
+}
+
 ProtocolError decode_ieee952(const CanFrame& f, Message& out) {
   const unsigned page = f.data[0] & 7u;
+  if (page == ieee952_model_page) return decode_ieee952_model(f, out);
+  if (page == ieee952_parameter_page) return decode_ieee952_parameter(f, out);
   if (page == ieee952_summary_page) {
     Ieee952SummaryMsg m;
     m.seq = f.data[1];
@@ -392,6 +437,34 @@ const char* name(Ieee952Status s) {
   return "invalid";
 }
 
+const char* name(FitParameter p) {
+  switch (p) {
+    case FitParameter::markov_sigma: return "markov_sigma";
+    case FitParameter::markov_tc: return "markov_tc";
+    case FitParameter::filter_tf: return "filter_tf";
+    case FitParameter::sinusoid_amplitude: return "sinusoid_amplitude";
+    case FitParameter::sinusoid_frequency: return "sinusoid_frequency";
+  }
+  return "invalid";
+}
+
+FitParameterSlot fit_parameter_slot(std::size_t k) {
+  if (k < 2 * wire_markov_terms)
+    return {k % 2 == 0 ? FitParameter::markov_sigma : FitParameter::markov_tc, u8(static_cast<unsigned>(k / 2))};
+  if (k == 2 * wire_markov_terms) return {FitParameter::filter_tf, 0};
+  k -= 2 * wire_markov_terms + 1;
+  return {k % 2 == 0 ? FitParameter::sinusoid_amplitude : FitParameter::sinusoid_frequency,
+          u8(static_cast<unsigned>(k / 2))};
+}
+
+std::size_t fit_parameter_position(FitParameter parameter, std::uint8_t index) {
+  for (std::size_t k = 0; k < fit_parameter_pages; ++k) {
+    const FitParameterSlot s = fit_parameter_slot(k);
+    if (s.parameter == parameter && s.index == index) return k;
+  }
+  return fit_parameter_pages;
+}
+
 const char* name(Ieee952Term t) {
   switch (t) {
     case Ieee952Term::quantization: return "Q_quantization";
@@ -521,6 +594,28 @@ ProtocolError encode(const WindowDevMsg& msg, std::uint8_t node, CanFrame& frame
   });
 }
 
+ProtocolError encode(const Ieee952ParameterMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, ieee952_id, report_len, frame, [&](CanFrame& f) {
+    f.data[0] = u8(ieee952_parameter_page | code(msg.parameter) << 3 | unsigned{msg.index} << 6 |
+                   (msg.resolved ? 0x80u : 0u));
+    f.data[1] = msg.seq;
+    put_float(f, 2, msg.value);
+    put(f, 6, 2, rel_uncertainty_code(msg.rel_uncertainty));
+  });
+}
+
+ProtocolError encode(const Ieee952ModelMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, ieee952_id, report_len, frame, [&](CanFrame& f) {
+    f.data[0] = u8(ieee952_model_page | unsigned{msg.markov} << 3 | unsigned{msg.sinusoids} << 5 |
+                   (msg.bandwidth ? 0x80u : 0u));
+    f.data[1] = msg.seq;
+    f.data[2] = u8(unsigned{msg.bandwidth_excluded_below_log2_m} | (msg.runner_up ? 0x20u : 0u) |
+                   unsigned{msg.runner_up_markov} << 6);
+    f.data[3] = u8(unsigned{msg.runner_up_sinusoids} | (msg.runner_up_bandwidth ? 4u : 0u));
+    put_float(f, 4, msg.criterion_margin);
+  });
+}
+
 ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame) {
   return encode_with(msg, node, counter_input_id, counter_input_len, frame, [&](CanFrame& f) {
     put(f, 0, 4, msg.count);
@@ -601,6 +696,15 @@ constexpr std::size_t window_part_length(std::size_t window_taus, std::uint8_t p
   return (window_list_length(window_taus, protocol_version) + slow_cycle_reports - 1) / slow_cycle_reports;
 }
 
+/// The model list (version 4): the Ieee952 model page, then every parameter page. Cut into parts
+/// like the slow list.
+constexpr std::size_t model_list_length(std::uint8_t protocol_version) {
+  return protocol_version >= 4 ? 1 + fit_parameter_pages : 0;
+}
+constexpr std::size_t model_part_length(std::uint8_t protocol_version) {
+  return (model_list_length(protocol_version) + slow_cycle_reports - 1) / slow_cycle_reports;
+}
+
 /// Entry j of the slow list: metadata pages, tau info for every tau, terms for every tau, IEEE-952
 /// terms, then the fit summary (version 2; the caller keeps j below the version's list length).
 ReportSlot slow_slot(std::size_t j, std::size_t tau_count) {
@@ -622,16 +726,28 @@ ReportSlot window_slot(std::size_t j) {
   return {Slot::window_dev, u8(static_cast<unsigned>(j - 2))};
 }
 
+/// Entry j of the model list.
+ReportSlot model_slot(std::size_t j) {
+  if (j == 0) return {Slot::fit_model, 0};
+  return {Slot::fit_parameter, u8(static_cast<unsigned>(j - 1))};
+}
+
 /// Frames of report seq before its window part: the fast frames and its part of the slow list.
 std::size_t frames_before_window(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version) {
   return fast_frames(tau_count) + part_of(seq, slow_list_length(tau_count, protocol_version), slow_part_length(tau_count));
+}
+/// Frames of report seq before its model part: those and its part of the window list.
+std::size_t frames_before_model(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version,
+                                std::size_t window_taus) {
+  return frames_before_window(seq, tau_count, protocol_version) +
+         part_of(seq, window_list_length(window_taus, protocol_version), window_part_length(window_taus, protocol_version));
 }
 }  // namespace
 
 std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version,
                                std::size_t window_taus) {
-  return frames_before_window(seq, tau_count, protocol_version) +
-         part_of(seq, window_list_length(window_taus, protocol_version), window_part_length(window_taus, protocol_version));
+  return frames_before_model(seq, tau_count, protocol_version, window_taus) +
+         part_of(seq, model_list_length(protocol_version), model_part_length(protocol_version));
 }
 
 ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position, std::uint8_t protocol_version,
@@ -645,8 +761,11 @@ ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t posi
   const std::size_t before_window = frames_before_window(seq, tau_count, protocol_version);
   if (position < before_window)
     return slow_slot(slow_part_begin(seq, tau_count) + position - fast_frames(tau_count), tau_count);
-  return window_slot(seq % slow_cycle_reports * window_part_length(window_taus, protocol_version) + position -
-                     before_window);
+  const std::size_t before_model = frames_before_model(seq, tau_count, protocol_version, window_taus);
+  if (position < before_model)
+    return window_slot(seq % slow_cycle_reports * window_part_length(window_taus, protocol_version) + position -
+                       before_window);
+  return model_slot(seq % slow_cycle_reports * model_part_length(protocol_version) + position - before_model);
 }
 
 double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps, std::size_t window_taus) {

@@ -140,8 +140,17 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
           mark_slot(v, a, Slot::ieee952, static_cast<std::uint8_t>(msg.term));
         } else if constexpr (std::is_same_v<M, Ieee952SummaryMsg>) {
           v.ieee952_summary = msg;
+          v.ieee952_summary_cycle = v.cycle();
           relayout_if_schedule_changed(v, a);
           mark_slot(v, a, Slot::ieee952, ieee952_summary_page);
+        } else if constexpr (std::is_same_v<M, Ieee952ModelMsg>) {
+          fit_model_of_cycle(v).model = msg;
+          relayout_if_schedule_changed(v, a);
+          mark_slot(v, a, Slot::fit_model, 0);
+        } else if constexpr (std::is_same_v<M, Ieee952ParameterMsg>) {
+          const std::size_t k = fit_parameter_position(msg.parameter, msg.index);
+          fit_model_of_cycle(v).parameters[k] = msg;
+          mark_slot(v, a, Slot::fit_parameter, static_cast<std::uint8_t>(k));
         } else if constexpr (std::is_same_v<M, WindowMsg>) {
           if (v.window_taus != 0 && msg.tau_count != v.window_taus) {  // reconfigured, like TauCount
             restart(v, a);
@@ -168,6 +177,17 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
         }
       },
       message);
+}
+
+FitModelView& Decoder::fit_model_of_cycle(NodeView& v) {
+  // A page of a new cycle starts that cycle's model; the one before stays for a summary that
+  // belongs to it.
+  if (v.fit_model.cycle != v.cycle()) {
+    v.previous_fit_model = v.fit_model;
+    v.fit_model = FitModelView{};
+    v.fit_model.cycle = v.cycle();
+  }
+  return v.fit_model;
 }
 
 void Decoder::accept_window_dev(NodeView& v, Assembly& a, const WindowDevMsg& msg) {
@@ -204,6 +224,7 @@ void Decoder::open_report(NodeView& v, Assembly& a, std::uint8_t seq) {
       v.health.reports_lost += lost;
     }
   }
+  v.reports_made = v.report == 0 ? seq : v.reports_made + static_cast<std::uint8_t>(seq - a.seq);
   ++v.report;
   v.report_open = true;
   a.open = true;

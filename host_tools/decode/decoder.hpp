@@ -48,6 +48,36 @@ struct Ieee952View {
   bool in_model() const { return received && (fitted || resolved); }
 };
 
+/// The selected model of the node's fit beyond the five terms (protocol version 4): the model page
+/// and the parameter pages received in one slow cycle. The node takes its fit at the first report
+/// of a cycle, so every Ieee952 frame of one cycle describes the same fit.
+struct FitModelView {
+  std::uint64_t cycle = 0;  // NodeView::cycle() of the slow cycle the pages came in; 0: none
+  std::optional<protocol::Ieee952ModelMsg> model;
+  std::array<std::optional<protocol::Ieee952ParameterMsg>, protocol::fit_parameter_pages> parameters{};
+  /// Parameter page k belongs to the model: a term the model page says it holds (false until the
+  /// model page has arrived).
+  bool in_model(std::size_t k) const {
+    if (!model) return false;
+    const protocol::FitParameterSlot s = protocol::fit_parameter_slot(k);
+    switch (s.parameter) {
+      case protocol::FitParameter::markov_sigma:
+      case protocol::FitParameter::markov_tc: return s.index < model->markov;
+      case protocol::FitParameter::filter_tf: return model->bandwidth;
+      case protocol::FitParameter::sinusoid_amplitude:
+      case protocol::FitParameter::sinusoid_frequency: return s.index < model->sinusoids;
+    }
+    return false;
+  }
+  /// The model page and every parameter page of a term it holds arrived.
+  bool complete() const {
+    if (!model) return false;
+    for (std::size_t k = 0; k < parameters.size(); ++k)
+      if (in_model(k) && !parameters[k]) return false;
+    return true;
+  }
+};
+
 /// One window of the node's dynamic Allan deviation (protocol version 3): the window k covers the
 /// node's samples k L .. (k+1) L - 1 (L = NodeView::window_length).
 struct WindowView {
@@ -82,6 +112,12 @@ struct NodeView {
   /// whether it is still being received. TauView::Dev::report says which report a value is from.
   std::uint64_t report = 0;
   bool report_open = false;
+  /// Reports the node made in this session up to its latest, lost ones included, counted from its
+  /// first Seq: a multiple of slow_cycle_reports at the first report of each slow cycle.
+  std::uint64_t reports_made = 0;
+  /// The slow cycle of the latest report (1 for the cycle of the session's first report; 0 before
+  /// any report).
+  std::uint64_t cycle() const { return report == 0 ? 0 : reports_made / protocol::slow_cycle_reports + 1; }
   // Latest status (fast cycle)
   bool have_status = false;
   protocol::StatusMsg status;
@@ -96,6 +132,10 @@ struct NodeView {
   /// The fit's summary (protocol version 2, slow cycle); empty until received, and always for a
   /// version-1 node, which has none.
   std::optional<protocol::Ieee952SummaryMsg> ieee952_summary;
+  std::uint64_t ieee952_summary_cycle = 0;  // cycle() of the report that carried the summary
+  /// The fit's model pages (protocol version 4) of the latest slow cycle that sent one, and of the
+  /// cycle before (the summary of a cycle may come after the next cycle's first model pages).
+  FitModelView fit_model, previous_fit_model;
   // The dynamic Allan deviation (protocol version 3, slow cycle): 0 until the window pages arrive.
   std::uint8_t window_taus = 0;     // WindowTauCount; window tau i is tau i
   std::uint64_t window_length = 0;  // samples per window
@@ -114,12 +154,13 @@ struct NodeView {
   /// longer decoded (counted in health.not_decoded) until it announces a known version again.
   std::uint8_t unknown_version = 0;
 
-  /// The protocol version whose schedule the node follows: the clock page's; before it arrives 3
-  /// once a window page came (only version 3 sends one), 2 once a summary page came (from version
-  /// 2), else 1. A version-1 report then misses nothing, and a newer report opened before the
+  /// The protocol version whose schedule the node follows: the clock page's; before it arrives 4
+  /// once a model page came (only version 4 sends one), 3 once a window page came (from version
+  /// 3), 2 once a summary page came (from version 2), else 1. A version-1 report then misses nothing, and a newer report opened before the
   /// clock page only leaves its newer frames uncounted.
   std::uint8_t schedule_version() const {
     return clock            ? clock->protocol_version
+           : fit_model.model ? std::uint8_t{4}
            : window_taus    ? std::uint8_t{3}
            : ieee952_summary ? std::uint8_t{2}
                              : std::uint8_t{1};
@@ -200,6 +241,8 @@ class Decoder {
 
   void accept(NodeView& v, Assembly& a, const protocol::Message& message);
   void accept_window_dev(NodeView& v, Assembly& a, const protocol::WindowDevMsg& msg);
+  /// The node's model pages of the current slow cycle (a new, empty one at its first page).
+  static FitModelView& fit_model_of_cycle(NodeView& v);
   void open_report(NodeView& v, Assembly& a, std::uint8_t seq);
   void close_report(NodeView& v, Assembly& a);
   void restart(NodeView& v, Assembly& a);

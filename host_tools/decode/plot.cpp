@@ -46,8 +46,9 @@ void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
     legend.line(line.label, colour, style);
   };
   for (const PlotLine& line : p.terms) {
-    const bool sum = !line.term;
-    draw_line(line, sum ? sum_colour : term_colour(static_cast<std::size_t>(*line.term)), sum ? 1 : 2, sum ? 2.0 : 1.5);
+    const bool sum = !line.term && !line.markov;
+    const PlotColour colour = sum ? sum_colour : line.markov ? markov_colour : term_colour(static_cast<std::size_t>(*line.term));
+    draw_line(line, colour, sum ? 1 : 2, sum ? 2.0 : 1.5);
   }
   if (p.truth) draw_line(*p.truth, truth_colour, 3, 2.0);  // long dashes: told apart from the terms'
   draw_points(pls, p.adev, adev_colour, adev_glyph);

@@ -28,6 +28,39 @@ double model_adev(const std::array<double, 5>& qnbkr, double tau_s, double rate)
   return std::sqrt(ieee952_avar(qnbkr, tau_s)) * rate;
 }
 
+// The fit of the node as core's Ieee952Fit (wire units): the five terms `qnbkr` and the model
+// beyond them, for fitted_variance().
+Ieee952Fit wire_fit(const std::array<double, 5>& qnbkr, const FitModelRow& m, double rate) {
+  Ieee952Fit f;
+  for (std::size_t k = 0; k < 5; ++k) f.p[k].value = qnbkr[k];
+  const auto page = [&](FitParameter p, std::uint8_t j) { return m.parameters[fit_parameter_position(p, j)].value; };
+  f.n_markov = std::min<std::size_t>(m.markov, max_markov);
+  for (std::uint8_t j = 0; j < f.n_markov; ++j) {
+    f.markov[j].sigma.value = page(FitParameter::markov_sigma, j) / rate;
+    f.markov[j].tc_s = page(FitParameter::markov_tc, j);
+  }
+  f.n_sinusoids = std::min<std::size_t>(m.sinusoids, max_sinusoids);
+  for (std::uint8_t j = 0; j < f.n_sinusoids; ++j) {
+    f.sinusoids[j].amplitude.value = page(FitParameter::sinusoid_amplitude, j) / rate;
+    f.sinusoids[j].frequency_hz = page(FitParameter::sinusoid_frequency, j);
+  }
+  if (m.bandwidth) f.bandwidth_tc_s = page(FitParameter::filter_tf, 0);
+  return f;
+}
+
+// ADEV of a fit's exact sampled AVAR at tau (>= tau0), in display units: between the integer
+// averaging factors around tau / tau0, interpolated in log-log (no steps at the shortest taus).
+double fit_adev(const Ieee952Fit& f, double tau_s, double tau0_s, double rate) {
+  const double x = std::max(1.0, tau_s / tau0_s), lo = std::floor(x);
+  const auto avar = [&](double m) {
+    return std::max(0.0, fitted_variance(f, Stat::avar, static_cast<std::uint64_t>(m), tau0_s));
+  };
+  const double v_lo = avar(lo), v_hi = avar(lo + 1);
+  const double w = std::log(x / lo) / std::log((lo + 1) / lo);
+  const double v = v_lo > 0 && v_hi > 0 ? std::exp((1 - w) * std::log(v_lo) + w * std::log(v_hi)) : v_lo;
+  return std::sqrt(v) * rate;
+}
+
 // The heat map of the node's window curves: a column per window, a row per window tau (while tau0,
 // the window length or a window tau's m is unknown: no columns yet).
 HeatMap window_heat_map(const NodeView& node, const Units& u) {
@@ -82,7 +115,7 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
     if (const std::optional<double> to_wire = wire_per_si(node)) {
       std::array<double, 5> wire{};
       for (std::size_t k = 0; k < 5; ++k) wire[k] = (*truth)[k] * *to_wire;
-      PlotLine line{std::nullopt, "simulated gyro (truth)", grid, {}};
+      PlotLine line{std::nullopt, false, "simulated gyro (truth)", grid, {}};
       for (const double tau : grid) line.dev.push_back(model_adev(wire, tau, u.rate));
       p.truth = std::move(line);
     }
@@ -130,7 +163,7 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
     if (!t.resolved) continue;
     std::array<double, 5> one{};
     one[k] = t.value;
-    PlotLine line{static_cast<Ieee952Term>(k),
+    PlotLine line{static_cast<Ieee952Term>(k), false,
                   fmt::format("{} {:.3g} {} (±{:.2g}%)", units::ieee952[k].letter, t.value * u.ieee[k], u.ieee_name[k],
                               100.0 * t.rel_uncertainty),
                   grid,
@@ -140,22 +173,58 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
     if (k != b_index && inside(read_tau_s[k]))
       p.read_offs.push_back({read_tau_s[k], model_adev(one, read_tau_s[k], u.rate), read_label[k]});
   }
-  if (fitted == 0) return p;
+  // Version 4: the model beyond the five terms, from the same fit (never another's).
+  const std::optional<FitModelRow> beyond = fit_model_row(node, u);
+  if (beyond && beyond->state != Viewed::shown) {
+    p.notes.push_back(fmt::format("fit's model pages {}:", name(beyond->state)));
+    p.notes.push_back("model not drawn");
+    return p;
+  }
+  const bool extra = beyond && (beyond->markov > 0 || beyond->sinusoids > 0 || beyond->bandwidth) && node.sampling;
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  // The exact sampled model exists from tau0 on: its lines start there.
+  const std::vector<double> sampled_grid = extra ? log_grid(std::max(p.tau_min_s, tau0_s), p.tau_max_s) : grid;
+  if (extra) {
+    for (std::uint8_t j = 0; j < beyond->markov; ++j) {
+      const FitModelRow::Parameter& sigma = beyond->parameters[fit_parameter_position(FitParameter::markov_sigma, j)];
+      if (!sigma.resolved) continue;
+      FitModelRow one = *beyond;
+      one.markov = 1, one.sinusoids = 0, one.bandwidth = false;
+      one.parameters[fit_parameter_position(FitParameter::markov_sigma, 0)] = sigma;
+      one.parameters[fit_parameter_position(FitParameter::markov_tc, 0)] =
+          beyond->parameters[fit_parameter_position(FitParameter::markov_tc, j)];
+      const Ieee952Fit f = wire_fit({}, one, u.rate);
+      PlotLine line{std::nullopt, true,
+                    fmt::format("Markov {:.3g} {} (±{:.2g}%), Tc {:.3g} s", sigma.value, u.rate_name,
+                                100.0 * sigma.rel_uncertainty, f.markov[0].tc_s),
+                    sampled_grid,
+                    {}};
+      for (const double tau : sampled_grid) line.dev.push_back(fit_adev(f, tau, tau0_s, u.rate));
+      p.terms.push_back(std::move(line));
+    }
+  }
+  if (fitted == 0 && !extra) return p;
   if (fit && !fit->quantization_white && !node.ieee952[0].in_model() && node.scale)
     model[0] = static_cast<double>(node.scale->angle_per_pulse) / std::sqrt(12.0);  // Q held there
-  PlotLine sum{std::nullopt,
+  PlotLine sum{std::nullopt, false,
                fit ? fmt::format("IEEE-952 model, chi2/dof {:.2g}", fit->chi2_per_dof) : "IEEE-952 model (sum)",
                grid,
                {}};
-  for (const double tau : grid) sum.dev.push_back(model_adev(model, tau, u.rate));
+  if (extra) {
+    const Ieee952Fit f = wire_fit(model, *beyond, u.rate);
+    sum.tau_s = sampled_grid;
+    for (const double tau : sampled_grid) sum.dev.push_back(fit_adev(f, tau, tau0_s, u.rate));
+  } else {
+    for (const double tau : grid) sum.dev.push_back(model_adev(model, tau, u.rate));
+  }
   if (node.ieee952[b_index].resolved && model[b_index] > 0) {  // B: the floor, at the sum's minimum within the points
     std::optional<std::size_t> floor;
-    for (std::size_t k = 0; k < grid.size(); ++k) {
-      if (grid[k] >= lo && grid[k] <= hi && (!floor || sum.dev[k] < sum.dev[*floor])) floor = k;
+    for (std::size_t k = 0; k < sum.tau_s.size(); ++k) {
+      if (sum.tau_s[k] >= lo && sum.tau_s[k] <= hi && (!floor || sum.dev[k] < sum.dev[*floor])) floor = k;
     }
     std::array<double, 5> b{};
     b[b_index] = model[b_index];
-    if (floor) p.read_offs.push_back({grid[*floor], model_adev(b, grid[*floor], u.rate), read_label[b_index]});
+    if (floor) p.read_offs.push_back({sum.tau_s[*floor], model_adev(b, sum.tau_s[*floor], u.rate), read_label[b_index]});
   }
   p.terms.push_back(std::move(sum));
   return p;

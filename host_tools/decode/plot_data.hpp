@@ -14,7 +14,8 @@ namespace gyrochar::decoding {
 
 using PlotPoint = DevPoint;  // tau, deviation, interval (invalid: no error bar)
 struct PlotLine {
-  std::optional<protocol::Ieee952Term> term;  // the term drawn; empty: the model's sum
+  std::optional<protocol::Ieee952Term> term;  // the term drawn; empty: the model's sum or a Markov term
+  bool markov = false;                        // a Markov term of the model (protocol version 4)
   std::string label;                          // e.g. "N 0.00212 deg/sqrt(h) (±13%)" (UTF-8)
   std::vector<double> tau_s, dev;             // log-spaced over the plot's tau range
 };
@@ -26,7 +27,8 @@ struct NodePlot {
   std::string title;                  // "node 0x10, session 0"
   std::string rate_name;              // unit of every deviation
   std::vector<PlotPoint> adev, mdev;  // valid values with a known tau
-  std::vector<PlotLine> terms;        // resolved IEEE-952 terms, then the fitted model ("sum")
+  std::vector<PlotLine> terms;        // resolved IEEE-952 terms, resolved Markov terms (version 4),
+                                      // then the fitted model ("sum")
   std::optional<PlotLine> truth;      // the true model (simulation), drawn dashed beside the fit
   std::vector<std::string> notes;     // legend lines without a symbol: the fit rejected, short taus
                                       // left out (quantization not white), no fit
@@ -44,7 +46,10 @@ struct NodePlot {
 /// the points' taus. The sum is the fitted model: every fitted term, resolved or not, and Q at
 /// pulse weight / sqrt(12) where the node held it there (quantization not white). A fit the node
 /// rejected, or could not make, draws no model line and says so in `notes`. With `truth` (SI), its
-/// model is drawn too (`truth`, the same closed form). Lines span the tau axis; read-off points
+/// model is drawn too (`truth`, the same closed form). From protocol version 4 the sum is the exact
+/// sampled AVAR of the whole model (core's fitted_variance(): Markov terms, the sensor's filter,
+/// sinusoids) when it has such terms, each resolved Markov term gets its own line, and while the
+/// fit's model pages are pending or lost no model is drawn (a note says so). Lines span the tau axis; read-off points
 /// outside it are left out. A node with window taus also gets the heat map of its windows' ADEV
 /// (`dynamic`: one column per window, placed at its samples times tau0). O(taus + line points +
 /// windows x window taus); allocates.

@@ -21,6 +21,42 @@ Json json_or_null(const std::optional<T>& value) {
   return value ? Json(*value) : Json(nullptr);
 }
 
+/// Column name stem of parameter page k: markov1_sigma, markov1_tc_s, filter_tf_s,
+/// sinusoid1_amplitude, sinusoid1_frequency_hz, ...
+std::string parameter_column(std::size_t k) {
+  const FitParameterSlot p = fit_parameter_slot(k);
+  const unsigned n = p.index + 1u;
+  switch (p.parameter) {
+    case FitParameter::markov_sigma: return fmt::format("markov{}_sigma", n);
+    case FitParameter::markov_tc: return fmt::format("markov{}_tc_s", n);
+    case FitParameter::filter_tf: return "filter_tf_s";
+    case FitParameter::sinusoid_amplitude: return fmt::format("sinusoid{}_amplitude", n);
+    case FitParameter::sinusoid_frequency: return fmt::format("sinusoid{}_frequency_hz", n);
+  }
+  return "invalid";
+}
+/// A frequency is given to the fit, not fitted: no uncertainty column.
+bool has_uncertainty(std::size_t k) { return fit_parameter_slot(k).parameter != FitParameter::sinusoid_frequency; }
+
+/// The model's columns after window_gaps (version 4): fit_model (shown, pending, missing),
+/// the counts, then each parameter page's value, relative uncertainty and resolved flag.
+std::string model_header() {
+  std::string h = ",fit_model,fit_markov_terms,fit_sinusoids,fit_filter";
+  for (std::size_t k = 0; k < fit_parameter_pages; ++k) {
+    const std::string c = parameter_column(k);
+    h += "," + c;
+    if (has_uncertainty(k)) h += "," + c + "_rel_uncertainty";
+    if (has_resolved(fit_parameter_slot(k).parameter)) h += "," + c + "_resolved";
+  }
+  return h;
+}
+std::size_t model_columns() {
+  std::size_t n = 4;
+  for (std::size_t k = 0; k < fit_parameter_pages; ++k)
+    n += 1 + (has_uncertainty(k) ? 1 : 0) + (has_resolved(fit_parameter_slot(k).parameter) ? 1 : 0);
+  return n;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -34,8 +70,9 @@ CsvWriter::CsvWriter(std::FILE* out, double confidence) : out_(out), confidence_
       "rate_unit,ci_level,session,"
       "fit_status,fit_chi2_per_dof,fit_points,fit_quantization_white,"
       "fit_avar_excluded_below_tau_s,fit_mvar_excluded_below_tau_s,"
-      "type,window,window_start_s,window_end_s,window_gaps\n",
+      "type,window,window_start_s,window_end_s,window_gaps",
       out_);
+  std::fputs((model_header() + "\n").c_str(), out_);
 }
 
 template <class T>
@@ -63,7 +100,9 @@ void CsvWriter::row(const WindowRow& r, const Units& units) {
   fmt::format_to(out, FMT_COMPILE("{},,{},,,,,,,window,{},"), units.rate_name, r.session, r.window);
   field(r.end_s > 0, r.start_s);
   field(r.end_s > 0, r.end_s);
-  fmt::format_to(out, FMT_COMPILE("{}\n"), r.gaps);
+  fmt::format_to(out, FMT_COMPILE("{}"), r.gaps);
+  line_.append(std::string(model_columns(), ','));  // a window row has no fit
+  line_.push_back('\n');
   std::fwrite(line_.data(), 1, line_.size(), out_);
 }
 
@@ -87,8 +126,24 @@ void CsvWriter::row(const TauRow& r, const Units& units) {
   field(fit, fit && r.fit->quantization_white ? "true" : "false");
   field(r.fit_excluded_below_tau_s[0].has_value(), r.fit_excluded_below_tau_s[0].value_or(0.0));
   field(r.fit_excluded_below_tau_s[1].has_value(), r.fit_excluded_below_tau_s[1].value_or(0.0));
-  fmt::format_to(out, FMT_COMPILE("tau,,,,\n"));
+  fmt::format_to(out, FMT_COMPILE("tau,,,,,"));
+  model_fields(r.fit_model);
+  line_.data()[line_.size() - 1] = '\n';  // the last field's comma ends the line
   std::fwrite(line_.data(), 1, line_.size(), out_);
+}
+
+void CsvWriter::model_fields(const std::optional<FitModelRow>& model) {
+  const bool shown = model && model->state == Viewed::shown;
+  field(model.has_value(), model ? name(model->state) : "");
+  field(shown, shown ? model->markov : 0u);
+  field(shown, shown ? model->sinusoids : 0u);
+  field(shown, shown && model->bandwidth ? "true" : "false");
+  for (std::size_t k = 0; k < fit_parameter_pages; ++k) {
+    const FitModelRow::Parameter p = shown ? model->parameters[k] : FitModelRow::Parameter{};
+    field(p.known, p.value);
+    if (has_uncertainty(k)) field(p.known, p.rel_uncertainty);
+    if (has_resolved(fit_parameter_slot(k).parameter)) field(p.known, p.resolved ? "true" : "false");
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -100,6 +155,54 @@ void JsonlWriter::line(const std::string& text) {
 }
 
 namespace {
+
+Json candidate_json(unsigned markov, unsigned sinusoids, bool bandwidth) {
+  return Json{{"markov", markov}, {"sinusoids", sinusoids}, {"bandwidth", bandwidth}};
+}
+
+/// A parameter as the analyzer's JSON has it: value, uncertainty (absolute), unit (and resolved).
+Json parameter_json(const FitModelRow::Parameter& p, const std::string& unit, bool with_resolved) {
+  Json j{{"value", p.value}, {"uncertainty", p.rel_uncertainty > 0 ? Json(p.rel_uncertainty * p.value) : Json(nullptr)},
+         {"unit", unit}};
+  if (with_resolved) j["resolved"] = p.resolved;
+  return j;
+}
+
+/// The model beyond the five terms (version 4) in the fit object: "model_status", and when shown
+/// "markov", "sinusoids", "bandwidth", "bandwidth_excluded_below_tau_s", "model", "runner_up" in
+/// the analyzer's shape (the uncertainty absolute); null when not shown.
+void add_model_json(Json& fit, const std::optional<FitModelRow>& model, const Units& units) {
+  if (!model) return;
+  fit["model_status"] = name(model->state);
+  if (model->state != Viewed::shown) {
+    for (const char* key : {"markov", "sinusoids", "bandwidth", "bandwidth_excluded_below_tau_s", "model", "runner_up"})
+      fit[key] = nullptr;
+    return;
+  }
+  const auto page = [&](FitParameter p, std::uint8_t index) {
+    return model->parameters[fit_parameter_position(p, index)];
+  };
+  Json markov = Json::array(), sinusoids = Json::array();
+  for (std::uint8_t j = 0; j < model->markov; ++j)
+    markov.push_back({{"sigma", parameter_json(page(FitParameter::markov_sigma, j), units.rate_name, true)},
+                      {"tc", parameter_json(page(FitParameter::markov_tc, j), "s", false)}});
+  for (std::uint8_t j = 0; j < model->sinusoids; ++j)
+    sinusoids.push_back({{"amplitude", parameter_json(page(FitParameter::sinusoid_amplitude, j), units.rate_name, true)},
+                         {"frequency", parameter_json(page(FitParameter::sinusoid_frequency, j), "Hz", false)}});
+  fit["markov"] = std::move(markov);
+  fit["sinusoids"] = std::move(sinusoids);
+  fit["bandwidth"] = model->bandwidth ? Json{{"tf", parameter_json(page(FitParameter::filter_tf, 0), "s", false)}}
+                                      : Json(nullptr);
+  fit["bandwidth_excluded_below_tau_s"] = json_or_null(model->bandwidth_excluded_below_tau_s);
+  fit["model"] = candidate_json(model->markov, model->sinusoids, model->bandwidth);
+  if (const auto& r = model->runner_up) {
+    Json j = candidate_json(r->runner_up_markov, r->runner_up_sinusoids, r->runner_up_bandwidth);
+    j["criterion_margin"] = r->criterion_margin;
+    fit["runner_up"] = std::move(j);
+  } else {
+    fit["runner_up"] = nullptr;
+  }
+}
 
 Json health_json(const LinkHealth& h) {
   Json rejected = Json::object();
@@ -211,6 +314,7 @@ void JsonlWriter::report(double time_s, const NodeView& node, std::uint8_t seq, 
                {"quantization_white", f->quantization_white},
                {"avar_excluded_below_tau_s", json_or_null(fit_excluded_below_tau_s(node, 0))},
                {"mvar_excluded_below_tau_s", json_or_null(fit_excluded_below_tau_s(node, 1))}};
+    add_model_json(fit, fit_model_row(node, units), units);
   }
   const Json j{{"type", "report"},
                {"time_s", time_s},

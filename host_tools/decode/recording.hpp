@@ -26,6 +26,7 @@ class CsvWriter {
  private:
   template <class T>
   void field(bool known, T value);  // the value (or nothing) and a comma
+  void model_fields(const std::optional<FitModelRow>& model);  // the fit_model columns, each with its comma
   void begin(double time_s, std::uint8_t node, std::uint8_t seq, std::uint8_t tau_index, std::uint64_t m, double tau_s);
   std::FILE* out_;
   double confidence_;
@@ -34,7 +35,7 @@ class CsvWriter {
 
 /// JSON lines, one object per line, told apart by "type": "tau" (the CSV row but its fit_ columns),
 /// "window" (a window row), "report" (one per closed report: status, node faults, link health,
-/// metadata, IEEE-952 terms and the fit's summary), "event" (restart, offline, online, duplicate)
+/// metadata, IEEE-952 terms and the fit's summary with, from protocol version 4, its model), "event" (restart, offline, online, duplicate)
 /// and "summary" (once, at the end: input counters and every node's link health).
 class JsonlWriter {
  public:

@@ -45,6 +45,39 @@ const char* name(Viewed v) {
   return "invalid";
 }
 
+std::optional<FitModelRow> fit_model_row(const NodeView& node, const Units& units) {
+  if (!node.ieee952_summary || node.schedule_version() < 4) return std::nullopt;
+  const std::uint64_t cycle = node.ieee952_summary_cycle;
+  const FitModelView* pages = node.fit_model.cycle == cycle           ? &node.fit_model
+                              : node.previous_fit_model.cycle == cycle ? &node.previous_fit_model
+                                                                       : nullptr;
+  FitModelRow row;
+  if (pages == nullptr || !pages->complete()) {
+    // The summary's cycle is still being received unless its last report has closed.
+    const bool last_closed = node.reports_made % slow_cycle_reports == slow_cycle_reports - 1 && !node.report_open;
+    row.state = node.cycle() == cycle && !last_closed ? Viewed::pending : Viewed::missing;
+    return row;
+  }
+  const Ieee952ModelMsg& m = *pages->model;
+  row.state = Viewed::shown;
+  row.markov = m.markov;
+  row.sinusoids = m.sinusoids;
+  row.bandwidth = m.bandwidth;
+  if (m.bandwidth_excluded_below_log2_m == 0)
+    row.bandwidth_excluded_below_tau_s = 0.0;
+  else if (node.sampling)
+    row.bandwidth_excluded_below_tau_s =
+        static_cast<double>(node.sampling->tau0_s) * std::ldexp(1.0, m.bandwidth_excluded_below_log2_m);
+  if (m.runner_up) row.runner_up = m;
+  for (std::size_t k = 0; k < fit_parameter_pages; ++k) {
+    if (!pages->in_model(k)) continue;
+    const Ieee952ParameterMsg& p = *pages->parameters[k];
+    const bool rate = p.parameter == FitParameter::markov_sigma || p.parameter == FitParameter::sinusoid_amplitude;
+    row.parameters[k] = {true, static_cast<double>(p.value) * (rate ? units.rate : 1.0), p.rel_uncertainty, p.resolved};
+  }
+  return row;
+}
+
 namespace {
 
 DevCell dev_cell(const TauView::Dev& d, bool received, double rate, ConfidenceIntervals& intervals) {
@@ -66,6 +99,7 @@ DevCell dev_cell(const TauView::Dev& d, bool received, double rate, ConfidenceIn
 
 void tau_rows(const NodeView& node, const Decoder::Report& report, const Units& units, ConfidenceIntervals& intervals,
               std::vector<TauRow>& out) {
+  const std::optional<FitModelRow> model = fit_model_row(node, units);
   for (std::uint8_t i = 0; i < node.status.tau_count && i < max_taus; ++i) {
     const TauView& t = node.taus[i];
     TauRow r;
@@ -81,6 +115,7 @@ void tau_rows(const NodeView& node, const Decoder::Report& report, const Units& 
     r.mdev = dev_cell(t.mdev, report.received(Slot::mdev, i), units.rate, intervals);
     r.fit = node.ieee952_summary;
     r.fit_excluded_below_tau_s = {fit_excluded_below_tau_s(node, 0), fit_excluded_below_tau_s(node, 1)};
+    r.fit_model = model;
     out.push_back(r);
   }
 }

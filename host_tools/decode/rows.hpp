@@ -57,6 +57,29 @@ struct ViewedRow {
 ViewedRow viewed_row(const NodeView& node, std::size_t i);
 const char* name(Viewed v);
 
+/// The node's selected model beyond the five terms (protocol version 4) as the views and
+/// recordings show it: the model pages of the slow cycle that carried the fit summary shown, so
+/// that its terms and the five are one fit's. `shown` once the model page and every page of a term
+/// it holds arrived; `pending` while that cycle is still being received; `missing` when it ended
+/// without them (a page was lost): then no value is shown. Sigma and amplitudes in the display rate
+/// unit (Units::rate), times in s, frequencies in Hz.
+struct FitModelRow {
+  Viewed state = Viewed::pending;
+  std::uint8_t markov = 0, sinusoids = 0;  // terms in the model (shown only)
+  bool bandwidth = false;
+  std::optional<double> bandwidth_excluded_below_tau_s;  // 0: none; nullopt while tau0 is unknown
+  struct Parameter {
+    bool known = false;  // shown, and a term of the model
+    double value = 0, rel_uncertainty = 0;
+    bool resolved = false;
+  };
+  std::array<Parameter, protocol::fit_parameter_pages> parameters{};  // protocol::fit_parameter_slot order
+  std::optional<protocol::Ieee952ModelMsg> runner_up;  // the model page, when it names a runner-up
+};
+/// Empty for a node that follows a schedule before version 4 or whose summary has not arrived.
+/// O(1).
+std::optional<FitModelRow> fit_model_row(const NodeView& node, const Units& units);
+
 struct TauRow {
   double time_s = 0.0;  // time of the report's first frame (log timestamp or clock)
   std::uint8_t node = 0;
@@ -71,6 +94,7 @@ struct TauRow {
   // taus below which it left points out (fit_excluded_below_tau_s()).
   std::optional<protocol::Ieee952SummaryMsg> fit;
   std::array<std::optional<double>, 2> fit_excluded_below_tau_s{};
+  std::optional<FitModelRow> fit_model;  // the fit's model beyond the five terms (version 4)
 };
 
 /// The rows of the report of `node` that has just closed (one per tau of its TauCount), from the

@@ -104,6 +104,48 @@ void ieee952_view(std::string& s, const NodeView& v, const Units& u, const TrueT
   }
 }
 
+/// A parameter of the model beyond the five terms: its value with the relative uncertainty.
+std::string parameter_text(const FitModelRow::Parameter& p, const char* unit, bool with_resolved) {
+  std::string s = fmt::format("{:.4g} {}", p.value, unit);
+  if (p.rel_uncertainty > 0 || (with_resolved && !p.resolved))
+    s += fmt::format(" ({}+-{:.1f}%)", with_resolved && !p.resolved ? "not resolved, " : "", 100.0 * p.rel_uncertainty);
+  return s;
+}
+
+/// The model's line (protocol version 4): the Markov terms, the sensor's filter and the sinusoids
+/// of the fit the summary above describes, or why they are not shown.
+void model_view(std::string& s, const NodeView& v, const Units& u) {
+  const std::optional<FitModelRow> m = fit_model_row(v, u);
+  if (!m || !v.ieee952_summary) return;
+  const Ieee952Status status = v.ieee952_summary->status;
+  if (status != Ieee952Status::ok && status != Ieee952Status::rejected) return;
+  auto out = std::back_inserter(s);
+  s += "  model:";
+  if (m->state != Viewed::shown) {
+    fmt::format_to(out, " {} (this fit's model pages {})\n", name(m->state),
+                   m->state == Viewed::pending ? "are still arriving" : "were lost");
+    return;
+  }
+  const auto page = [&](FitParameter p, std::uint8_t j) { return m->parameters[fit_parameter_position(p, j)]; };
+  const std::string rate = u.rate_name;
+  if (m->markov == 0 && m->sinusoids == 0 && !m->bandwidth) s += " the five terms";
+  for (std::uint8_t j = 0; j < m->markov; ++j)
+    fmt::format_to(out, "  Markov {}: sigma {}, Tc {}", j + 1, parameter_text(page(FitParameter::markov_sigma, j), rate.c_str(), true),
+                   parameter_text(page(FitParameter::markov_tc, j), "s", false));
+  if (m->bandwidth)
+    fmt::format_to(out, "  sensor filter: Tf {}", parameter_text(page(FitParameter::filter_tf, 0), "s", false));
+  for (std::uint8_t j = 0; j < m->sinusoids; ++j)
+    fmt::format_to(out, "  sinusoid {}: amplitude {} at {:.4g} Hz", j + 1,
+                   parameter_text(page(FitParameter::sinusoid_amplitude, j), rate.c_str(), true),
+                   page(FitParameter::sinusoid_frequency, j).value);
+  if (m->bandwidth_excluded_below_tau_s && *m->bandwidth_excluded_below_tau_s > 0)
+    fmt::format_to(out, "; taus below {:.4g} s left out (sensor filter)", *m->bandwidth_excluded_below_tau_s);
+  if (const auto& r = m->runner_up)
+    fmt::format_to(out, "; runner-up: {} Markov, {} sinusoids{}, criterion {:+.3g}", r->runner_up_markov,
+                   r->runner_up_sinusoids, r->runner_up_bandwidth ? ", filter" : "", r->criterion_margin);
+  s += '\n';
+}
+
 /// The dynamic Allan deviation's line: the window, and the latest window's ADEV at each window tau.
 void window_view(std::string& s, const NodeView& v, const Units& u) {
   if (v.window_taus == 0) return;
@@ -171,6 +213,7 @@ void node_view(std::string& s, const NodeView& v, const DisplayRate& rate, Confi
                    dev_text(t.mdev, viewed.mdev, u.rate, intervals), edf, noise);
   }
   ieee952_view(s, v, u, truth);
+  model_view(s, v, u);
   window_view(s, v, u);
 }
 

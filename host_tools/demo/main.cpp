@@ -126,7 +126,9 @@ int main(int argc, char** argv) {
     c.report_period_s = 1.0;
     c.window_s = window_min * 60;
     // 1 arcsec pulses at the earth rate with 2 arcsec of white angle noise (so the quantization is
-    // white), ARW 0.002, 0.003, ... deg/sqrt(h), bias instability 0.01 deg/h, RRW 0.03 deg/h/sqrt(h).
+    // white), ARW 0.002, 0.003, ... deg/sqrt(h), bias instability 0.01 deg/h, RRW 0.03 deg/h/sqrt(h);
+    // the second gyro also a Gauss-Markov rate of 0.2 deg/h, Tc 300 s (a hump near 570 s), which
+    // its board's model selection finds and the view and plot show (protocol version 4).
     SimOptions o;
     o.duration_s = hours * 3600;
     o.tau0_s = tau0;
@@ -136,6 +138,7 @@ int main(int argc, char** argv) {
     o.bias_deg_per_h = 0.01;
     o.rrw_deg_per_h_sqrt_h = 0.03;
     o.seed = 100 + i;
+    if (i == 1) o.markov = {{0.2, 300.0}};
     if (const auto problem = check_parameters(o)) bad(problem->what, problem->why);
     const Ieee952Truth t = ieee952_truth(o);
     truth[c.node] = {t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2};

@@ -101,6 +101,20 @@ Expected expected(const Ieee952SummaryMsg& m) {
            {"FitStatus", static_cast<int>(m.status)}},
           {{"Term", "fit_summary"}, {"FitStatus", name(m.status)}}};
 }
+Expected expected(const Ieee952ParameterMsg& m) {
+  return {{{"Term", ieee952_parameter_page}, {"Parameter", static_cast<int>(m.parameter)}, {"ParameterIndex", m.index},
+           {"ParameterResolved", m.resolved ? 1 : 0}, {"Seq", m.seq}, {"ParameterValue", physical(m.value)},
+           {"ParameterRelUncertainty", m.rel_uncertainty * 100.0}},
+          {{"Term", "fit_parameter"}, {"Parameter", name(m.parameter)}}};
+}
+Expected expected(const Ieee952ModelMsg& m) {
+  return {{{"Term", ieee952_model_page}, {"MarkovTerms", m.markov}, {"Sinusoids", m.sinusoids},
+           {"Bandwidth", m.bandwidth ? 1 : 0}, {"Seq", m.seq}, {"BandwidthExcludedLog2M", m.bandwidth_excluded_below_log2_m},
+           {"RunnerUp", m.runner_up ? 1 : 0}, {"RunnerUpMarkovTerms", m.runner_up_markov},
+           {"RunnerUpSinusoids", m.runner_up_sinusoids}, {"RunnerUpBandwidth", m.runner_up_bandwidth ? 1 : 0},
+           {"CriterionMargin", physical(m.criterion_margin)}},
+          {{"Term", "fit_model"}}};
+}
 // A window deviation's log2 on the wire's grid (2^-14 steps); raw 0 (no estimate) is the offset, -128.
 double window_log2(double dev) {
   return dev == 0.0 ? -128.0 : std::round(std::log2(dev) * 16384.0) / 16384.0;
@@ -144,6 +158,15 @@ Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
     case Slot::window_length: return WindowLengthMsg{seq, 60000};
     case Slot::window_dev:
       return WindowDevMsg{seq, i, 41 % 16, 0.021 / std::sqrt(tau_s), i == 0 ? 0.016 / std::sqrt(tau_s) : 0.0};
+    case Slot::fit_model: return Ieee952ModelMsg{seq, 2, 1, true, 3, true, 1, 0, false, 7.25f};
+    case Slot::fit_parameter: {  // two Markov terms (the first resolved), the filter, one sinusoid
+      const FitParameterSlot p = fit_parameter_slot(i);
+      const bool held = p.parameter != FitParameter::sinusoid_amplitude && p.parameter != FitParameter::sinusoid_frequency;
+      const bool in_model = held || p.index == 0;
+      return Ieee952ParameterMsg{seq, p.parameter, p.index, in_model && has_resolved(p.parameter) && p.index == 0,
+                                 in_model ? 0.002f * static_cast<float>(i + 1) : 0.0f,
+                                 in_model && p.parameter != FitParameter::sinusoid_frequency ? 0.1 * (i + 1) : 0.0};
+    }
   }
   return StatusMsg{};
 }
@@ -188,6 +211,10 @@ std::vector<Entry> frames() {
       Ieee952SummaryMsg{0, Ieee952Status::too_few_points, 0.0f, 0, true, {0, 0}},
       Ieee952SummaryMsg{1, Ieee952Status::singular, 0.0f, 3, false, {4, 0}},
       Ieee952SummaryMsg{2, Ieee952Status::ok, 1.25f, 48, false, {0, 5}},
+      Ieee952ParameterMsg{255, FitParameter::sinusoid_amplitude, 1, true, FLT_MAX, 6.5535},
+      Ieee952ParameterMsg{0, FitParameter::markov_tc, 0, false, 0.0f, 0.0},
+      Ieee952ModelMsg{255, 2, 2, true, 31, true, 2, 2, true, -FLT_MAX},
+      Ieee952ModelMsg{0, 0, 0, false, 0, false, 0, 0, false, 0.0f},
       CounterInputMsg{0xFFFFFFFFu, 255, true, true},
       CounterInputMsg{0, 0, false, false},
       CounterInputMsg{123456789, 17, false, true},

@@ -46,6 +46,27 @@ void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, 
     const double rel = fitted ? std::min(p.uncertainty / p.value, 6.5535) : 0.0;
     EXPECT_NEAR(t.rel_uncertainty, rel, 0.5e-4 + 1e-12) << k;
   }
+  // Version 4: the model pages of the summary's slow cycle, whole, say the fit's model.
+  const FitModelView& m = v.fit_model.cycle == v.ieee952_summary_cycle ? v.fit_model : v.previous_fit_model;
+  ASSERT_EQ(m.cycle, v.ieee952_summary_cycle);
+  ASSERT_TRUE(m.complete());
+  EXPECT_EQ(m.model->markov, fit.n_markov);
+  EXPECT_EQ(m.model->sinusoids, fit.n_sinusoids);
+  EXPECT_EQ(m.model->bandwidth, fit.bandwidth_tc_s > 0);
+  EXPECT_EQ(m.model->runner_up, fit.chosen.valid && fit.runner_up.valid);
+  for (std::size_t j = 0; j < fit.n_markov; ++j) {
+    const auto& sigma = *m.parameters[protocol::fit_parameter_position(protocol::FitParameter::markov_sigma, static_cast<std::uint8_t>(j))];
+    const auto& tc = *m.parameters[protocol::fit_parameter_position(protocol::FitParameter::markov_tc, static_cast<std::uint8_t>(j))];
+    EXPECT_EQ(sigma.value, static_cast<float>(fit.markov[j].sigma.value)) << j;
+    EXPECT_EQ(sigma.resolved, fit.ok() && fit.markov[j].sigma.resolved) << j;
+    EXPECT_NEAR(sigma.rel_uncertainty, std::min(fit.markov[j].sigma.uncertainty / fit.markov[j].sigma.value, 6.5535),
+                0.5e-4 + 1e-12) << j;
+    EXPECT_EQ(tc.value, static_cast<float>(fit.markov[j].tc_s)) << j;
+  }
+  if (fit.bandwidth_tc_s > 0) {
+    EXPECT_EQ(m.parameters[protocol::fit_parameter_position(protocol::FitParameter::filter_tf, 0)]->value,
+              static_cast<float>(fit.bandwidth_tc_s));
+  }
 }
 
 TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
@@ -171,7 +192,7 @@ TEST(ReportSchedule, RefitWhenTheRunHasGrownByAQuarterOrByFifteenMinutes) {
   EXPECT_TRUE(firmware::refit_due(10, 1000, 0.01));     // fewer samples than the fit: a new run
 }
 
-TEST(ReportSchedule, ReportsBetweenRefitsRepeatTheLastFitWithTheirOwnSeq) {
+TEST(ReportSchedule, EveryReportOfACycleCarriesTheFitTakenAtItsStartWithItsOwnSeq) {
   GyroParameters g;
   g.tau0_s = 0.01;
   g.pulse_weight_rad = units::arcsec;
@@ -184,23 +205,25 @@ TEST(ReportSchedule, ReportsBetweenRefitsRepeatTheLastFitWithTheirOwnSeq) {
   ASSERT_TRUE(firmware::configure(*board, s));
   firmware::ReportContent content;
   firmware::ReportWorkspace workspace(s.octaves);
-  // Three slow cycles: 40 000 samples before the first, 1000 more per report in the second (the run
-  // grows by 10 %: the fit is repeated), 40 000 more per report in the third (a new fit).
+  // Three slow cycles: 40 000 samples before the first report, 1000 more in each of reports 1-6
+  // (at the second cycle's start the run has grown by 10 %: the fit is repeated), 40 000 more in
+  // each from report 7 (at the third cycle's start: a new fit). The fit is taken
+  // at the first report of each cycle; every report sends its frames with its own Seq.
   std::vector<std::uint64_t> fitted_from;
   for (std::uint8_t seq = 0; seq < 12; ++seq) {
-    const int add = seq < 4 ? 10000 : seq < 8 ? 1000 : 40000;
+    const int add = seq == 0 ? 40000 : seq < 7 ? 1000 : 40000;
     for (int k = 0; k < add; ++k) board->add_increment(static_cast<std::int32_t>(sim.next_count()));
     firmware::build_report(*board, s, seq, 1000u * (seq + 1), {}, workspace, content);
-    bool carries = false;
-    for (std::size_t k = 0; k < protocol::report_frame_count(seq, board->tau_count()); ++k)
-      carries |= protocol::report_slot(seq, board->tau_count(), k).slot == protocol::Slot::ieee952;
-    if (!carries) continue;
     EXPECT_EQ(content.ieee952_summary.seq, seq);
     for (const auto& term : content.ieee952) EXPECT_EQ(term.seq, seq);
-    fitted_from.push_back(content.fit_samples);
+    EXPECT_EQ(content.ieee952_model.seq, seq);
+    for (const auto& page : content.ieee952_parameters) EXPECT_EQ(page.seq, seq);
     EXPECT_EQ(content.ieee952_summary.points, content.fit.points);
+    if (seq % 4 == 0) fitted_from.push_back(content.fit_samples);
+    EXPECT_EQ(content.fit_samples, fitted_from.back()) << "the fit changed inside a cycle, report " << int(seq);
   }
-  ASSERT_EQ(fitted_from.size(), 3u);  // one report of each slow cycle carries the fit
+  ASSERT_EQ(fitted_from.size(), 3u);
+  EXPECT_EQ(fitted_from[0], 40000u);
   EXPECT_EQ(fitted_from[1], fitted_from[0]);  // repeated
   EXPECT_GT(fitted_from[2], fitted_from[1]);  // fitted again
 }

@@ -90,6 +90,7 @@ std::uint64_t n_of(std::uint8_t seq, std::size_t i) { return 1000u * (seq + 1u) 
 std::uint64_t m_of(std::size_t i) { return std::uint64_t{1} << i; }
 float ieee_of(std::size_t k) { return 0.001f * static_cast<float>(k + 1); }
 bool ieee_resolved(std::size_t k) { return k != 4; }  // R not resolved
+constexpr float markov_sigma_of = 0.004f, markov_tc_of = 20.0f;  // angle unit/s, s
 float chi2_per_dof_of(const NodeSpec& n) { return n.fit == Ieee952Status::rejected ? 7.5f : 0.75f; }
 
 Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t samples) {
@@ -135,6 +136,16 @@ Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t
     case Slot::window_length:
     case Slot::window_dev:
       break;
+    case Slot::fit_model:  // version 4: the model holds one Markov term
+      return Ieee952ModelMsg{seq, 1, 0, false, 0, true, 0, 0, false, 4.5f};
+    case Slot::fit_parameter: {
+      const FitParameterSlot p = fit_parameter_slot(s.index);
+      if (p.index == 0 && p.parameter == FitParameter::markov_sigma)
+        return Ieee952ParameterMsg{seq, p.parameter, 0, n.fit == Ieee952Status::ok, markov_sigma_of, 0.125};
+      if (p.index == 0 && p.parameter == FitParameter::markov_tc)
+        return Ieee952ParameterMsg{seq, p.parameter, 0, false, markov_tc_of, 0.25};
+      return Ieee952ParameterMsg{seq, p.parameter, p.index, false, 0.0f, 0.0};
+    }
   }
   return {};
 }
@@ -329,6 +340,22 @@ TEST(DecodeCli, CsvAndJsonLinesCarryTheEncodedValuesOfEveryNode) {
     const bool arcsec = csv.get(row, "node") == "16";
     EXPECT_EQ(csv.get(row, "rate_unit"), arcsec ? "arcsec/s" : "rad/s");
     EXPECT_EQ(csv.get(row, "ci_level"), "0.683");
+    // Version 4: the fit's model from the summary's slow cycle (the first summary closes report 3).
+    const bool summary = std::stoi(csv.get(row, "seq")) >= 3;
+    EXPECT_EQ(csv.get(row, "fit_model"), summary ? "shown" : "");
+    EXPECT_EQ(csv.get(row, "fit_markov_terms"), summary ? "1" : "");
+    EXPECT_EQ(csv.get(row, "fit_filter"), summary ? "false" : "");
+    if (summary) {  // native: the float on the wire
+      EXPECT_EQ(std::stod(csv.get(row, "markov1_sigma")), static_cast<double>(markov_sigma_of));
+    } else {
+      EXPECT_EQ(csv.get(row, "markov1_sigma"), "");
+    }
+    EXPECT_EQ(csv.get(row, "markov1_sigma_resolved"), summary ? "true" : "");
+    EXPECT_EQ(csv.get(row, "markov1_tc_s"), summary ? "20" : "");
+    EXPECT_EQ(csv.get(row, "markov1_tc_s_rel_uncertainty"), summary ? "0.25" : "");
+    EXPECT_EQ(csv.get(row, "markov2_sigma"), "");  // not in the model
+    EXPECT_EQ(csv.get(row, "filter_tf_s"), "");
+    EXPECT_EQ(csv.get(row, "sinusoid1_frequency_hz"), "");
   }
 
   std::size_t taus = 0, reports = 0, summaries = 0;
@@ -409,6 +436,56 @@ TEST(DecodeCli, RatesInDegreesPerHourAndPulsesNeverConverted) {
   EXPECT_TRUE(contains(r.out, "rates [pulse/s] (pulses: not converted)")) << r.out;
   EXPECT_TRUE(contains(r.out, "rates [deg/h]")) << r.out;
   EXPECT_TRUE(contains(r.out, "N 0.002 pulse/sqrt(s)")) << r.out;  // as sent: no conversion
+  // Version 4: the Markov term in the JSON fit object, in the rate unit, the analyzer's shape.
+  const Json& fit = last_rad.at("ieee952_fit");
+  EXPECT_EQ(fit.at("model_status"), "shown");
+  ASSERT_EQ(fit.at("markov").size(), 1u);
+  const Json& sigma = fit.at("markov").at(0).at("sigma");
+  const double sigma_deg_h = static_cast<double>(markov_sigma_of) * rad_to_deg * 3600.0;
+  EXPECT_NEAR(sigma.at("value").get<double>(), sigma_deg_h, 1e-14 * sigma_deg_h);
+  EXPECT_NEAR(sigma.at("uncertainty").get<double>(), 0.125 * sigma_deg_h, 1e-14 * sigma_deg_h);
+  EXPECT_EQ(sigma.at("unit"), "deg/h");
+  EXPECT_EQ(sigma.at("resolved"), true);
+  EXPECT_EQ(fit.at("markov").at(0).at("tc").at("value"), 20.0);
+  EXPECT_EQ(fit.at("markov").at(0).at("tc").at("unit"), "s");
+  EXPECT_TRUE(fit.at("sinusoids").empty());
+  EXPECT_TRUE(fit.at("bandwidth").is_null());
+  EXPECT_EQ(fit.at("runner_up").at("criterion_margin"), 4.5);
+  EXPECT_TRUE(contains(r.out, "model:  Markov 1: sigma")) << r.out;
+  EXPECT_TRUE(contains(r.out, "Tc 20 s (+-25.0%)")) << r.out;
+}
+
+TEST(DecodeCli, ALostModelPageShowsMissingNeverAnotherFitsValue) {
+  // Report 4 opens the second slow cycle and loses its Markov Tc page: that cycle's model is not
+  // shown once its summary (report 7) has come, in the CSV, the JSON nor the view; the first
+  // cycle's model stays shown until then, as it goes with the summary shown.
+  const NodeSpec n{0x10, 6, AngleUnit::arcsec, 0.01f};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 9; ++seq) {
+    const LogWriter::Drop drop = [&](const ReportSlot& s) {
+      return seq == 4 && s.slot == Slot::fit_parameter &&
+             s.index == fit_parameter_position(FitParameter::markov_tc, 0);
+    };
+    log.report(n, seq, 10.0 + seq, 100u * (seq + 1), drop);
+  }
+  const std::string csv_path = temp("lost_model.csv"), jsonl_path = temp("lost_model.jsonl");
+  const Outcome r = run(log.write("lost_model.log") + " --view final --rate-unit native --csv " + csv_path + " --jsonl " +
+                        jsonl_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Csv csv = read_csv(csv_path);
+  for (const auto& row : csv.rows) {
+    const int seq = std::stoi(csv.get(row, "seq"));
+    const std::string want = seq < 3 ? "" : seq < 7 ? "shown" : "missing";
+    EXPECT_EQ(csv.get(row, "fit_model"), want) << "seq " << seq;
+    EXPECT_EQ(csv.get(row, "markov1_sigma").empty(), seq < 3 || seq >= 7) << "seq " << seq;
+    EXPECT_EQ(csv.get(row, "fit_markov_terms"), seq >= 3 && seq < 7 ? "1" : "") << "seq " << seq;
+  }
+  Json last;
+  for (const Json& j : read_jsonl(jsonl_path))
+    if (j.at("type") == "report") last = j;
+  EXPECT_EQ(last.at("ieee952_fit").at("model_status"), "missing");
+  EXPECT_TRUE(last.at("ieee952_fit").at("markov").is_null());
+  EXPECT_TRUE(contains(r.out, "model: missing (this fit's model pages were lost)")) << r.out;
 }
 
 /// The part of the terminal view about node `address`.

@@ -298,6 +298,56 @@ TEST(DecodeOutput, PlotOfARejectedFitDrawsNoModelAndSaysSo) {
   EXPECT_EQ(none.notes[0], "no IEEE-952 fit: too few points");
 }
 
+TEST(DecodeOutput, PlotOfAVersionFourModelDrawsItsMarkovTermAndNeverAnotherCyclesModel) {
+  // N 0.1 arcsec/sqrt(s) and a Markov term of sigma 0.05 arcsec/s, Tc 5 s, in the summary's slow
+  // cycle. Oracle for the lines: IEEE 952 Annex C's AVAR of exponentially correlated rate noise,
+  // (q Tc)^2 / tau [1 - Tc / (2 tau) (3 - 4 e^(-tau/Tc) + e^(-2 tau/Tc))] with (q Tc)^2 = 2 sigma^2 Tc,
+  // the continuous limit of the sampled estimator the plot draws: within 2 % from tau = 16 tau0.
+  NodeView v = node_with_curve({0.0f, 0.1f, 0.0f, 0.0f, 0.0f});
+  v.clock = MetaClockMsg{0, 1000, 4};
+  v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::ok, 1.1f, 20, true, {0, 0}};
+  v.report = 4;  // the latest report, closed; the curve's values are from it
+  v.reports_made = 3;
+  for (std::size_t i = 0; i < 10; ++i) v.taus[i].adev.report = v.taus[i].mdev.report = 4;
+  v.ieee952_summary_cycle = 1;
+  v.fit_model.cycle = 1;
+  v.fit_model.model = Ieee952ModelMsg{0, 1, 0, false, 0, false, 0, 0, false, 0.0f};
+  for (std::size_t k = 0; k < fit_parameter_pages; ++k) {
+    const FitParameterSlot p = fit_parameter_slot(k);
+    v.fit_model.parameters[k] = Ieee952ParameterMsg{0, p.parameter, p.index, false, 0.0f, 0.0};
+  }
+  v.fit_model.parameters[0] = Ieee952ParameterMsg{0, FitParameter::markov_sigma, 0, true, 0.05f, 0.1};
+  v.fit_model.parameters[1] = Ieee952ParameterMsg{0, FitParameter::markov_tc, 0, false, 5.0f, 0.2};
+  ConfidenceIntervals intervals(0.683);
+  const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals);  // deg/h: numerically arcsec/s
+  ASSERT_EQ(p.terms.size(), 3u);  // N, the Markov term, the sum
+  EXPECT_TRUE(p.terms[1].markov);
+  EXPECT_EQ(p.terms[1].label, "Markov 0.05 deg/h (±10%), Tc 5 s");  // sigma, its uncertainty, Tc
+  const double n = 0.1f, sigma = 0.05f, tc = 5.0;
+  const auto markov_avar = [&](double t) {
+    return 2 * sigma * sigma * tc / t * (1 - tc / (2 * t) * (3 - 4 * std::exp(-t / tc) + std::exp(-2 * t / tc)));
+  };
+  std::size_t compared = 0;
+  for (std::size_t j = 0; j < p.terms[1].tau_s.size(); ++j) {
+    const double t = p.terms[1].tau_s[j];
+    if (t < 16 * 0.125) continue;
+    expect_rel(p.terms[1].dev[j], std::sqrt(markov_avar(t)), 0.02);
+    expect_rel(p.terms[2].dev[j], std::sqrt(n * n / t + markov_avar(t)), 0.02);
+    ++compared;
+  }
+  EXPECT_GT(compared, 40u);
+  // The summary of the next cycle has come, its model pages not all: no model is drawn.
+  v.ieee952_summary_cycle = 2;
+  v.reports_made = 6;
+  v.report = 7;
+  v.report_open = true;
+  for (std::size_t i = 0; i < 10; ++i) v.taus[i].adev.report = v.taus[i].mdev.report = 7;
+  const NodePlot pending = plot_data(v, rate_unit("deg/h"), intervals);
+  ASSERT_EQ(pending.notes.size(), 2u);
+  EXPECT_EQ(pending.notes[0], "fit's model pages pending:");
+  EXPECT_EQ(pending.terms.size(), 1u);  // N's own line only: no Markov line, no sum
+}
+
 TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
   // Q held (quantization not white, pulse weight 1 arcsec), N resolved, B fitted but not resolved.
   NodeView v = node_with_curve({0.0f, 0.1f, 0.01f, 0.0f, 0.0f});

@@ -15,6 +15,18 @@ using namespace protocol;
 
 const Ieee952SummaryMsg fit_summary{0, Ieee952Status::ok, 0.93f, 24, true, {0, 0}};
 
+// Version 4's model pages: one Markov term (sigma 0.02 resolved, Tc 30 s) and the sensor's filter
+// (Tf 0.005 s); the other parameter pages zeros.
+Ieee952ModelMsg model_page(std::uint8_t seq) { return {seq, 1, 0, true, 0, false, 0, 0, false, 0.0f}; }
+Ieee952ParameterMsg parameter_page(std::uint8_t seq, std::size_t k) {
+  const FitParameterSlot p = fit_parameter_slot(k);
+  Ieee952ParameterMsg m{seq, p.parameter, p.index, false, 0.0f, 0.0};
+  if (p.index == 0 && p.parameter == FitParameter::markov_sigma) m.value = 0.02f, m.rel_uncertainty = 0.1, m.resolved = true;
+  if (p.index == 0 && p.parameter == FitParameter::markov_tc) m.value = 30.0f, m.rel_uncertainty = 0.2;
+  if (p.parameter == FitParameter::filter_tf) m.value = 0.005f, m.rel_uncertainty = 0.3;
+  return m;
+}
+
 // The frames of report `seq` of a node with `taus` taus, values derived from (seq, tau), speaking
 // protocol version `protocol_version` (1: no summary page, no Fitted flag; B is fitted but not
 // resolved in version 2, and goes out as zeros in version 1). With `window_taus` (version 3) the
@@ -57,7 +69,8 @@ std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t t
       case Slot::window_dev:
         m = WindowDevMsg{seq, s.index, static_cast<std::uint8_t>(window % 16), window_dev(s.index),
                          window_dev(s.index) / 2};
-        break;
+        break;      case Slot::fit_model: m = model_page(seq); break;
+      case Slot::fit_parameter: m = parameter_page(seq, s.index); break;
     }
     CanFrame f;
     EXPECT_EQ(encode(m, node, f), ProtocolError::none);
@@ -99,6 +112,63 @@ TEST(Decoder, CompleteReportsCarryEveryValue) {
   want.seq = v.ieee952_summary->seq;
   EXPECT_EQ(*v.ieee952_summary, want);
   EXPECT_EQ(v.schedule_version(), version);
+  // Version 4: the model pages of the summary's slow cycle (reports 4 and 5 open the second cycle:
+  // its pages so far are the current ones, the first cycle's whole beside them).
+  EXPECT_EQ(v.ieee952_summary_cycle, 1u);
+  EXPECT_EQ(v.fit_model.cycle, 2u);
+  EXPECT_EQ(v.previous_fit_model.cycle, 1u);
+  ASSERT_TRUE(v.previous_fit_model.complete());
+  EXPECT_EQ(*v.previous_fit_model.model, model_page(0));
+  for (std::size_t k = 0; k < fit_parameter_pages; ++k) {
+    ASSERT_TRUE(v.previous_fit_model.parameters[k].has_value()) << k;
+    Ieee952ParameterMsg want_k = parameter_page(v.previous_fit_model.parameters[k]->seq, k);
+    want_k.rel_uncertainty = v.previous_fit_model.parameters[k]->rel_uncertainty;  // 0.01 % steps
+    EXPECT_EQ(*v.previous_fit_model.parameters[k], want_k) << k;
+    EXPECT_NEAR(v.previous_fit_model.parameters[k]->rel_uncertainty, parameter_page(0, k).rel_uncertainty, 1e-12);
+    EXPECT_EQ(v.previous_fit_model.in_model(k), k == 0 || k == 1 || k == 4) << k;  // Markov 1 and the filter
+  }
+}
+
+TEST(Decoder, VersionThreeNodeHasNoModelAndMissesNothing) {
+  // A version-3 node sends no model list: the decoder expects none, and a version-4 decoder reads
+  // every other frame as before.
+  Feed feed;
+  for (std::uint8_t s = 0; s < 8; ++s) feed.frames(report(5, s, 8, 1000 + s * 100, 0, 7, 3));
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.reports_complete, 8u);
+  EXPECT_EQ(v.health.frames_missing, 0u);
+  EXPECT_EQ(v.schedule_version(), 3);
+  EXPECT_FALSE(v.fit_model.model.has_value());
+  EXPECT_EQ(v.fit_model.cycle, 0u);
+  ASSERT_TRUE(v.ieee952_summary.has_value());
+}
+
+TEST(Decoder, ModelPagesAreKeptPerSlowCycleAcrossLostReports) {
+  // Reports 0-3 whole, 4-5 lost, 6-7 received: the second cycle's pages (of reports 6 and 7) start
+  // a model of their own, never filled up with the first cycle's, and the cycles are counted from
+  // Seq, lost reports included. Joining a node late (seq 250) counts the cycles the same way.
+  Feed feed;
+  for (std::uint8_t s = 0; s < 4; ++s) feed.frames(report(5, s, 8, 1000 + s * 100));
+  for (std::uint8_t s = 6; s < 8; ++s) feed.frames(report(5, s, 8, 1000 + s * 100));
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.reports_lost, 2u);
+  EXPECT_EQ(v.reports_made, 7u);
+  EXPECT_EQ(v.cycle(), 2u);
+  EXPECT_EQ(v.fit_model.cycle, 2u);
+  EXPECT_FALSE(v.fit_model.model.has_value());  // the model page came in report 4
+  EXPECT_FALSE(v.fit_model.complete());
+  EXPECT_TRUE(v.previous_fit_model.complete());
+  EXPECT_EQ(v.ieee952_summary_cycle, 2u);       // report 7 carried the second cycle's summary
+  Feed late;
+  for (unsigned s = 250; s < 258; ++s) late.frames(report(9, static_cast<std::uint8_t>(s), 8, 1000 + s * 100));
+  late.decoder.flush();
+  const NodeView& w = late.node(9);
+  EXPECT_EQ(w.reports_made, 257u);  // 250 + 7 reports: Seq wrapped
+  EXPECT_EQ(w.cycle(), 65u);
+  EXPECT_TRUE(w.previous_fit_model.complete());  // seq 252-255
+  EXPECT_TRUE(w.fit_model.complete());           // seq 0-3 (256-259): the page of seq 0 came
 }
 
 TEST(Decoder, VersionOneNodeHasNoSummaryAndMissesNothing) {
@@ -122,8 +192,8 @@ TEST(Decoder, VersionTwoNodeJoinedLateMissesNothingAndItsLostSummaryCounts) {
   // Joining in the cycle's last report (3 taus: the summary is in part 3, the clock page in part
   // 0): the summary arrives before the clock page and tells the decoder the node's version.
   Feed feed;
-  for (std::uint8_t s = 3; s < 8; ++s) feed.frames(report(6, s, 3, 1000 + s * 100));
-  auto lost = report(6, 11, 3, 2100);
+  for (std::uint8_t s = 3; s < 8; ++s) feed.frames(report(6, s, 3, 1000 + s * 100, 0, 7, 2));
+  auto lost = report(6, 11, 3, 2100, 0, 7, 2);
   lost.pop_back();  // the summary, last of its report
   feed.frames(lost);
   feed.decoder.flush();
@@ -136,10 +206,10 @@ TEST(Decoder, VersionTwoNodeJoinedLateMissesNothingAndItsLostSummaryCounts) {
 }
 
 TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
-  // docs/protocol.md 2.2. A node announcing version 4 (its clock page, in report 0 of the 4-report
+  // docs/protocol.md 2.2. A node announcing version 5 (its clock page, in report 0 of the 4-report
   // slow cycle, comes after the 2 + 2 x 8 fast frames and the sampling page) is decoded no further: the frames after
   // its clock page and of its next reports are counted as not decoded and change no value. When it
-  // announces version 3 (this decoder's) again, a new session starts.
+  // announces version 4 (this decoder's) again, a new session starts.
   Feed feed;
   std::vector<DecoderEvent> events;
   feed.decoder = Decoder([&](DecoderEvent e, const NodeView&, std::uint8_t) { events.push_back(e); });
@@ -148,7 +218,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
   const std::uint64_t frames_before = feed.node(5).health.frames;
   std::size_t sent = 0;
   for (std::uint8_t s = 4; s < 8; ++s) {
-    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, 4);
+    auto frames = report(5, s, 8, 1000 + s * 100, 0, 7, version + 1);
     // Tau 0's ADEV (position 2) differs in every report, so that a decoded frame would show.
     EXPECT_EQ(encode(TauDevMsg{s, 0, DevKind::adev, 10.0f + s, 100.0, NoiseType::white_fm, true}, 5, frames[2]),
               ProtocolError::none);
@@ -157,7 +227,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
     feed.frames(frames);
   }
   const NodeView& v = feed.node(5);
-  EXPECT_EQ(v.unknown_version, 4);
+  EXPECT_EQ(v.unknown_version, version + 1);
   EXPECT_EQ(std::count(events.begin(), events.end(), DecoderEvent::unknown_version), 1);
   const std::size_t before_clock = 19;  // report 4's frames before its clock page
   EXPECT_EQ(v.health.frames, frames_before + before_clock);
@@ -171,7 +241,7 @@ TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
   const NodeView& w = feed.node(5);
   EXPECT_EQ(w.unknown_version, 0);
   EXPECT_EQ(w.health.restarts, 1u);
-  EXPECT_EQ(w.schedule_version(), 3);
+  EXPECT_EQ(w.schedule_version(), version);
   EXPECT_EQ(w.taus[0].adev.dev, 1.0f);
 }
 

@@ -1,8 +1,9 @@
 #pragma once
-// The gyrochar CAN protocol, version 3: one value type per frame kind, encode() and decode()
+// The gyrochar CAN protocol, version 4: one value type per frame kind, encode() and decode()
 // between those values and CanFrame, and the report schedule. The codec decodes the frames of
-// versions 1 and 2 too (each version only adds: version 2 the IEEE-952 fit summary page and the
-// Fitted flag of the term frames, version 3 the Window message of the dynamic Allan deviation),
+// versions 1 to 3 too (each version only adds: version 2 the IEEE-952 fit summary page and the
+// Fitted flag of the term frames, version 3 the Window message of the dynamic Allan deviation,
+// version 4 the Ieee952 model and parameter pages of the fit's selected model),
 // and the schedule of every version is available. docs/protocol.md is the specification,
 // docs/gyrochar.dbc describes the same frames for CAN tools (tests/dbc checks it against this codec).
 // The board firmware and the host decoder both use this codec; there is no other.
@@ -21,7 +22,7 @@
 
 namespace gyrochar::protocol {
 
-inline constexpr std::uint8_t version = 3;             // what this codec's nodes send
+inline constexpr std::uint8_t version = 4;             // what this codec's nodes send
 inline constexpr std::uint8_t oldest_version = 1;      // the oldest version decoders accept
 inline constexpr std::size_t max_taus = 64;          // tau index is 6 bits
 inline constexpr std::uint8_t max_node_address = 0xFD;  // J1939: 0xFE null, 0xFF global
@@ -87,6 +88,37 @@ enum class Ieee952Term : std::uint8_t {
 };
 /// The Ieee952 frame's multiplexor value (its "Term" field) of the fit summary page (version 2).
 inline constexpr std::uint8_t ieee952_summary_page = 5;
+/// Version 4: the page of one parameter of the selected model beyond the five terms, and the page
+/// of the model itself (which terms it holds, and its runner-up).
+inline constexpr std::uint8_t ieee952_parameter_page = 6;
+inline constexpr std::uint8_t ieee952_model_page = 7;
+/// Markov terms and sinusoids the protocol carries (version 4; the fit's max_markov, max_sinusoids).
+inline constexpr std::size_t wire_markov_terms = 2;
+inline constexpr std::size_t wire_sinusoids = 2;
+
+/// What an Ieee952 parameter page (version 4) carries; the code is what goes on the wire.
+enum class FitParameter : std::uint8_t {
+  markov_sigma = 0,        // a Markov term's stationary standard deviation sigma, A/s (Resolved)
+  markov_tc = 1,           // its correlation time Tc, s
+  filter_tf = 2,           // the time constant Tf of the sensor's own filter on N's white noise, s
+  sinusoid_amplitude = 3,  // a sinusoid's rate amplitude, A/s (Resolved)
+  sinusoid_frequency = 4,  // its frequency, Hz
+};
+/// Whether a parameter page of this kind carries a Resolved flag (the amplitudes do).
+constexpr bool has_resolved(FitParameter p) {
+  return p == FitParameter::markov_sigma || p == FitParameter::sinusoid_amplitude;
+}
+/// The parameter pages of a version-4 slow cycle, in sending order: sigma and Tc of Markov term 0,
+/// of term 1, the filter's Tf, amplitude and frequency of sinusoid 0, of sinusoid 1.
+inline constexpr std::size_t fit_parameter_pages = 2 * wire_markov_terms + 1 + 2 * wire_sinusoids;
+struct FitParameterSlot {
+  FitParameter parameter = FitParameter::markov_sigma;
+  std::uint8_t index = 0;  // the Markov term or sinusoid (0 for the filter)
+};
+/// Parameter page k (< fit_parameter_pages) of that order, and back (fit_parameter_pages for a
+/// kind and index with no page).
+FitParameterSlot fit_parameter_slot(std::size_t k);
+std::size_t fit_parameter_position(FitParameter parameter, std::uint8_t index);
 
 /// Outcome of the node's IEEE-952 fit (the values of gyrochar::FitStatus, core/ieee952.hpp).
 enum class Ieee952Status : std::uint8_t {
@@ -215,6 +247,39 @@ struct Ieee952SummaryMsg {
   bool operator==(const Ieee952SummaryMsg&) const = default;
 };
 
+/// One parameter of the selected model beyond the five terms (Ieee952 page 6, version 4), in the
+/// slow cycle. Every page of the cycle is sent; those of terms the model (Ieee952ModelMsg) does not
+/// hold carry zeros.
+struct Ieee952ParameterMsg {
+  std::uint8_t seq = 0;
+  FitParameter parameter = FitParameter::markov_sigma;
+  std::uint8_t index = 0;       // the Markov term or sinusoid, 0..1; 0 for filter_tf
+  bool resolved = false;        // markov_sigma, sinusoid_amplitude only: the term is resolved in an
+                                // accepted fit (as Ieee952Msg::resolved); false for the others
+  float value = 0.0f;           // >= 0, finite, in the parameter's unit (see FitParameter)
+  double rel_uncertainty = 0.0; // standard uncertainty / value, >= 0; as Ieee952Msg's on the wire
+                                // (a sinusoid's frequency is given to the fit, not fitted: 0)
+  bool operator==(const Ieee952ParameterMsg&) const = default;
+};
+
+/// The selected model of the fit (Ieee952 page 7, version 4), in the slow cycle: the first page
+/// of the cycle's model list. Every Ieee952 frame of one slow cycle describes the same fit.
+struct Ieee952ModelMsg {
+  std::uint8_t seq = 0;
+  std::uint8_t markov = 0;      // Markov terms in the model, 0..wire_markov_terms
+  std::uint8_t sinusoids = 0;   // sinusoids in the model, 0..wire_sinusoids
+  bool bandwidth = false;       // the sensor's own filter is in the model (its Tf on a parameter page)
+  /// Points with averaging factor m < 2^c were left out because the sensor's filter shapes them in
+  /// a way the model does not describe; 0: none. 0..31 (5 bits).
+  std::uint8_t bandwidth_excluded_below_log2_m = 0;
+  bool runner_up = false;       // a runner-up candidate was fitted; false: its fields are all 0
+  std::uint8_t runner_up_markov = 0, runner_up_sinusoids = 0;  // 0..2 each
+  bool runner_up_bandwidth = false;
+  float criterion_margin = 0.0f;  // the runner-up's information criterion minus the chosen
+                                  // model's; finite (0 without runner-up)
+  bool operator==(const Ieee952ModelMsg&) const = default;
+};
+
 /// Window page 0 (version 3): which window of the node's dynamic Allan deviation the Window frames
 /// of this slow cycle describe. The node restarts a second characterizer every `length` samples
 /// (WindowLengthMsg); window k covers the samples k length .. (k+1) length - 1 of the SampleCount.
@@ -263,7 +328,8 @@ struct CounterInputMsg {
 
 using Message = std::variant<StatusMsg, StatusFaultsMsg, TauDevMsg, TauTermsMsg, TauInfoMsg,
                              MetaSamplingMsg, MetaClockMsg, MetaScaleMsg, MetaConfigMsg, Ieee952Msg,
-                             CounterInputMsg, Ieee952SummaryMsg, WindowMsg, WindowLengthMsg, WindowDevMsg>;
+                             CounterInputMsg, Ieee952SummaryMsg, WindowMsg, WindowLengthMsg, WindowDevMsg,
+                             Ieee952ParameterMsg, Ieee952ModelMsg>;
 
 // ---------------------------------------------------------------------------------------------
 // Codec
@@ -272,7 +338,7 @@ enum class ProtocolError : std::uint8_t {
   none = 0,
   error_frame,    // the controller reported an error frame
   not_extended,   // 11-bit identifier
-  fd_frame,       // CAN FD frame: protocol versions 1 to 3 are classic CAN only
+  fd_frame,       // CAN FD frame: protocol versions 1 to 4 are classic CAN only
   unknown_id,     // not one of the identifiers above (PGN or priority differ)
   bad_address,    // node address 0xFE or 0xFF
   wrong_length,   // data length differs from the frame kind's (8, counter input 6)
@@ -290,6 +356,7 @@ const char* name(AngleUnit u);
 const char* name(InputSource s);
 const char* name(Ieee952Term t);
 const char* name(Ieee952Status s);
+const char* name(FitParameter p);
 
 /// Encodes one message sent by node `node` (0..max_node_address) into `frame`: a classic frame with
 /// an extended identifier, 8 data bytes (counter input: 6), unused data bytes zero.
@@ -309,6 +376,8 @@ ProtocolError encode(const Ieee952SummaryMsg& msg, std::uint8_t node, CanFrame& 
 ProtocolError encode(const WindowMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const WindowLengthMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const WindowDevMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const Ieee952ParameterMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const Ieee952ModelMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Message& msg, std::uint8_t node, CanFrame& frame);
 
@@ -331,34 +400,39 @@ Decoded decode(const CanFrame& frame);
 // per report, chosen by seq; from version 3, a node with window taus appends a part of its window
 // list (window page, window length, one WindowDevMsg per window tau), cut the same way. Both the
 // node (what to send) and the decoder (what to expect) derive a report's frames from seq, tau
-// count, window tau count and the node's protocol version.
+// count, window tau count and the node's protocol version. From version 4 every report appends a
+// part of the model list (the Ieee952 model page, then the fit_parameter_pages parameter pages),
+// cut the same way, after its window part.
 //
 // The version-2 slow list is version 1's with the summary appended; its length 10 + 2T is even
 // where version 1's 9 + 2T is odd, so both cut into parts of the same length ceil(L/4): every frame
 // keeps its position, and one report of the cycle has one frame more. Version 3 keeps every
-// version-2 position too: the window part follows them.
+// version-2 position too: the window part follows them; version 4 keeps every version-3 position:
+// the model part follows the window part.
 
 inline constexpr std::size_t slow_cycle_reports = 4;
 
 enum class Slot : std::uint8_t {
   status, faults, adev, mdev, terms, tau_info, sampling, clock, scale, config, ieee952,
-  window, window_length, window_dev  // version 3
+  window, window_length, window_dev,  // version 3
+  fit_model, fit_parameter            // version 4
 };
-inline constexpr std::size_t slot_kinds = 14;
+inline constexpr std::size_t slot_kinds = 16;
 struct ReportSlot {
   Slot slot = Slot::status;
   std::uint8_t index = 0;  // tau index (adev, mdev, terms, tau_info, window_dev); for ieee952 the
-                           // page: an Ieee952Term (0-4) or ieee952_summary_page (5)
+                           // page: an Ieee952Term (0-4) or ieee952_summary_page (5); for
+                           // fit_parameter the position in fit_parameter_slot()'s order
 };
 
 /// Number of frames in report `seq` for `tau_count` taus (<= max_taus) and `window_taus` window
 /// taus (<= tau_count; 0: no window, and for versions 1 and 2) of a node speaking
-/// `protocol_version` (1, 2, or 3 and above: the current schedule).
+/// `protocol_version` (1, 2, 3, or 4 and above: the current schedule).
 std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version = version,
                                std::size_t window_taus = 0);
 /// Frame `position` (< report_frame_count()) of report `seq`, in sending order: status, faults,
 /// ADEV and MDEV of tau 0, 1, ..., then this report's part of the slow list, then (version 3) its
-/// part of the window list.
+/// part of the window list, then (version 4) its part of the model list.
 ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position,
                        std::uint8_t protocol_version = version, std::size_t window_taus = 0);
 
