@@ -113,10 +113,22 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
   const std::vector<double> grid = log_grid(p.tau_min_s, p.tau_max_s);
   if (truth != nullptr) {
     if (const std::optional<double> to_wire = wire_per_si(node)) {
+      // The truth as a fit in wire units; with Markov terms or sinusoids its exact sampled curve
+      // (from tau0 on), as the fitted model's below.
+      Ieee952Fit f;
       std::array<double, 5> wire{};
-      for (std::size_t k = 0; k < 5; ++k) wire[k] = (*truth)[k] * *to_wire;
-      PlotLine line{std::nullopt, false, "simulated gyro (truth)", grid, {}};
-      for (const double tau : grid) line.dev.push_back(model_adev(wire, tau, u.rate));
+      for (std::size_t k = 0; k < 5; ++k) f.p[k].value = wire[k] = truth->qnbkr[k] * *to_wire;
+      for (const auto& [sigma, tc] : truth->markov)
+        if (f.n_markov < max_markov) f.markov[f.n_markov].sigma.value = sigma * *to_wire, f.markov[f.n_markov++].tc_s = tc;
+      for (const auto& [amplitude, hz] : truth->sinusoids)
+        if (f.n_sinusoids < max_sinusoids)
+          f.sinusoids[f.n_sinusoids].amplitude.value = amplitude * *to_wire, f.sinusoids[f.n_sinusoids++].frequency_hz = hz;
+      const bool beyond = (f.n_markov > 0 || f.n_sinusoids > 0) && node.sampling;
+      const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+      PlotLine line{std::nullopt, false, "simulated gyro (truth)",
+                    beyond ? log_grid(std::max(p.tau_min_s, tau0_s), p.tau_max_s) : grid, {}};
+      for (const double tau : line.tau_s)
+        line.dev.push_back(beyond ? fit_adev(f, tau, tau0_s, u.rate) : model_adev(wire, tau, u.rate));
       p.truth = std::move(line);
     }
   }

@@ -19,9 +19,13 @@
 namespace gyrochar::decoding {
 
 /// The true IEEE-952 parameters of a node's gyro, where known (a simulation's), in SI: Q rad,
-/// N rad/sqrt(s), B rad/s, K rad/s/sqrt(s), R rad/s^2. Shown beside the node's fit; never for a
-/// node reporting pulses (no angle to convert to).
-using TrueTerms = std::array<double, 5>;
+/// N rad/sqrt(s), B rad/s, K rad/s/sqrt(s), R rad/s^2, and the terms beyond them. Shown beside the
+/// node's fit; never for a node reporting pulses (no angle to convert to).
+struct TrueTerms {
+  std::array<double, 5> qnbkr{};
+  std::vector<std::array<double, 2>> markov;     // {sigma rad/s, Tc s} of each Gauss-Markov rate
+  std::vector<std::array<double, 2>> sinusoids;  // {amplitude rad/s, frequency Hz} of each sinusoid
+};
 using TrueTermsByNode = std::map<std::uint8_t, TrueTerms>;
 
 /// The tau below which the node's fit left out the AVAR (k = 0) or MVAR (k = 1) points (periodic

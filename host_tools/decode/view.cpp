@@ -89,7 +89,7 @@ void ieee952_view(std::string& s, const NodeView& v, const Units& u, const TrueT
     } else {
       fmt::format_to(out, "  {} {}", units::ieee952[k].letter, fit ? "not fitted" : "not resolved");
     }
-    if (si_to_wire) fmt::format_to(out, ", simulated {:.4g}", (*truth)[k] * *si_to_wire * shown);
+    if (si_to_wire) fmt::format_to(out, ", simulated {:.4g}", truth->qnbkr[k] * *si_to_wire * shown);
   }
   s += '\n';
   if (fit && fit->status == Ieee952Status::rejected)

@@ -141,7 +141,10 @@ int main(int argc, char** argv) {
     if (i == 1) o.markov = {{0.2, 300.0}};
     if (const auto problem = check_parameters(o)) bad(problem->what, problem->why);
     const Ieee952Truth t = ieee952_truth(o);
-    truth[c.node] = {t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2};
+    decoding::TrueTerms& known = truth[c.node];
+    known.qnbkr = {t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2};
+    for (const MarkovRate& m : t.markov) known.markov.push_back({m.sigma_rad_s, m.tc_s});
+    for (const SinusoidRate& w : t.sinusoids) known.sinusoids.push_back({w.amplitude_rad_s, w.frequency_hz});
     try {
       gyros.push_back(std::make_unique<Node>(c, gyro_parameters(o), bus, clock));
     } catch (const std::exception& e) {

@@ -278,6 +278,36 @@ NodeView node_with_curve(const std::array<float, 5>& qnbkr) {
   return v;
 }
 
+TEST(DecodeOutput, PlotTruthCarriesTheSimulatedMarkovTerm) {
+  // A simulated gyro with N and a Gauss-Markov rate of sigma 0.2 arcsec/s (deg/h) and Tc 30 s: its
+  // truth line is the exact sampled curve from tau0 (0.125 s) on. Oracle: the continuous-time AVAR
+  // of the two, N^2/tau + (sigma Tc / tau)^2 (2 tau/Tc - 3 + 4 e^(-tau/Tc) - e^(-2 tau/Tc)) (IEEE
+  // 952 Annex C), which the sampled one approaches within 0.5 % at tau >= 8 tau0 (the N term is
+  // exact there, the Markov term's sampling correction of order (tau0 / tau)^2).
+  NodeView v = node_with_curve({0.0f, 0.1f, 0.0f, 0.0f, 0.0f});
+  v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::ok, 0.9f, 18, true, {0, 0}};
+  const double arcsec = std::numbers::pi / 648000, n = 0.12, sigma = 0.2, tc = 30;
+  const TrueTerms truth{{0.0, n * arcsec, 0.0, 0.0, 0.0}, {{sigma * arcsec, tc}}, {}};
+  ConfidenceIntervals intervals(0.683);
+  const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals, &truth);
+  ASSERT_TRUE(p.truth.has_value());
+  EXPECT_GE(p.truth->tau_s.front(), 0.125);
+  std::size_t checked = 0;
+  for (std::size_t j = 0; j < p.truth->tau_s.size(); ++j) {
+    const double t = p.truth->tau_s[j], x = t / tc;
+    if (t < 1.0) continue;
+    const double markov = sigma * sigma / (x * x) * (2 * x - 3 + 4 * std::exp(-x) - std::exp(-2 * x));
+    expect_rel(p.truth->dev[j], std::sqrt(n * n / t + markov), 5e-3);
+    ++checked;
+  }
+  EXPECT_GT(checked, 10u);
+  // Without the Markov term the line would be N's alone: near its peak (1.89 Tc) the two differ.
+  const TrueTerms five{{0.0, n * arcsec, 0.0, 0.0, 0.0}, {}, {}};
+  const NodePlot q = plot_data(v, rate_unit("deg/h"), intervals, &five);
+  ASSERT_TRUE(q.truth.has_value());
+  EXPECT_GT(p.truth->dev.back(), 1.5 * q.truth->dev.back());
+}
+
 TEST(DecodeOutput, PlotOfARejectedFitDrawsNoModelAndSaysSo) {
   NodeView v = node_with_curve({2.0f, 0.1f, 0.01f, 0.0f, 0.0f});
   v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::rejected, 12.5f, 20, true, {0, 0}};
@@ -353,7 +383,7 @@ TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
   NodeView v = node_with_curve({0.0f, 0.1f, 0.01f, 0.0f, 0.0f});
   v.ieee952[2].resolved = false;
   v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::ok, 0.875f, 18, false, {3, 2}};
-  const TrueTerms truth{2.5 * std::numbers::pi / 648000, 0.12 * std::numbers::pi / 648000, 0.0, 0.0, 0.0};  // arcsec -> rad
+  const TrueTerms truth{{2.5 * std::numbers::pi / 648000, 0.12 * std::numbers::pi / 648000, 0.0, 0.0, 0.0}, {}, {}};  // arcsec -> rad
   ConfidenceIntervals intervals(0.683);
   const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals, &truth);
   ASSERT_EQ(p.terms.size(), 2u);  // N's own line and the model
@@ -395,7 +425,7 @@ TEST(DecodeOutput, ViewShowsTheSimulatedValueBesideEachTerm) {
            Ieee952SummaryMsg{3, Ieee952Status::ok, 0.93f, 24, true, {0, 0}}})
     decoder.feed(frame_of(m, 0x12), t += 0.01);
   TrueTermsByNode truth;
-  truth[0x12] = {0.0, 0.003 * std::numbers::pi / 180 / 60, 0.01 * std::numbers::pi / 180 / 3600, 0.0, 0.0};
+  truth[0x12] = {{0.0, 0.003 * std::numbers::pi / 180 / 60, 0.01 * std::numbers::pi / 180 / 3600, 0.0, 0.0}, {}, {}};
   InputCounters input;
   ConfidenceIntervals intervals(0.683);
   const std::string view = format_view(decoder, input, NodeFilter{}.set(), rate_unit("deg/h"), intervals, &truth);
