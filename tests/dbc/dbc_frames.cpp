@@ -138,7 +138,7 @@ Expected expected(const CounterInputMsg& m) {
 /// A message of a plausible node for one slot of the schedule.
 Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
   const std::uint8_t i = slot.index;
-  const float tau_s = 0.001f * static_cast<float>(1u << (4 * i));  // m = 1, 16, 256 at tau0 = 1 ms
+  const float tau_s = 0.001f * static_cast<float>(1u << (4 * (i % 8)));  // m = 1, 16, 256 at tau0 = 1 ms (i % 8: the model pages index past 7)
   switch (slot.slot) {
     case Slot::status: return StatusMsg{seq, NodeState::running, 3, 1000 * (report + 1)};
     case Slot::faults: return StatusFaultsMsg{seq, 2, 1, 0, 0};
