@@ -48,29 +48,30 @@ using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
 // the ABI between the clones.
 [[gnu::always_inline]] inline void load(Lanes& v, const double* p) { std::memcpy(&v, p, sizeof v); }
 
-#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void steady_terms(const double* x, const double* ph, const double* pl, std::size_t from, std::size_t size,
-                  std::size_t m, double out[3]) {
-  Lanes sa{0, 0, 0, 0}, st{0, 0, 0, 0}, sh{0, 0, 0, 0};
+// The four lanes' sums as one: (l0 + l1) + (l2 + l3).
+[[gnu::always_inline]] inline double combine(const Lanes& v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+
+// Points e .. e + 3, all three terms, their squares added to the lanes' sums.
+[[gnu::always_inline]] inline void steady_step(const double* x, const double* ph, const double* pl, std::size_t e,
+                                               std::size_t m, Lanes& sa, Lanes& st, Lanes& sh) {
   const Lanes three{3.0, 3.0, 3.0, 3.0};
-  std::size_t e = from;
-  for (; e + 4 <= size; e += 4) {
-    Lanes x0, x1, x2, x3, h0, h1, h2, h3, l0, l1, l2, l3;  // x, and P's hi and lo, at ages 0, m, 2m, 3m
-    load(x0, x + e), load(x1, x + e - m), load(x2, x + e - 2 * m), load(x3, x + e - 3 * m);
-    load(h0, ph + e), load(h1, ph + e - m), load(h2, ph + e - 2 * m), load(h3, ph + e - 3 * m);
-    load(l0, pl + e), load(l1, pl + e - m), load(l2, pl + e - 2 * m), load(l3, pl + e - 3 * m);
-    const Lanes d2 = x1 - x2;
-    const Lanes a = (x0 - x1) - d2;
-    const Lanes h = a - (d2 - (x2 - x3));
-    const Lanes t = ((h0 - h3) + (l0 - l3)) + three * ((h2 - h1) + (l2 - l1));
-    sa += a * a;
-    st += t * t;
-    sh += h * h;
-  }
-  double s[3] = {(sa[0] + sa[1]) + (sa[2] + sa[3]), (st[0] + st[1]) + (st[2] + st[3]), (sh[0] + sh[1]) + (sh[2] + sh[3])};
-  for (; e < size; ++e) {
+  Lanes x0, x1, x2, x3, h0, h1, h2, h3, l0, l1, l2, l3;  // x, and P's hi and lo, at ages 0, m, 2m, 3m
+  load(x0, x + e), load(x1, x + e - m), load(x2, x + e - 2 * m), load(x3, x + e - 3 * m);
+  load(h0, ph + e), load(h1, ph + e - m), load(h2, ph + e - 2 * m), load(h3, ph + e - 3 * m);
+  load(l0, pl + e), load(l1, pl + e - m), load(l2, pl + e - 2 * m), load(l3, pl + e - 3 * m);
+  const Lanes d2 = x1 - x2;
+  const Lanes a = (x0 - x1) - d2;
+  const Lanes h = a - (d2 - (x2 - x3));
+  const Lanes t = ((h0 - h3) + (l0 - l3)) + three * ((h2 - h1) + (l2 - l1));
+  sa += a * a;
+  st += t * t;
+  sh += h * h;
+}
+
+// The last points of a tau (fewer than four, after its lanes are combined into s), one by one.
+[[gnu::always_inline]] inline void tail_terms(const double* x, const double* ph, const double* pl, std::size_t from,
+                                              std::size_t size, std::size_t m, double s[3]) {
+  for (std::size_t e = from; e < size; ++e) {
     double a = 0, h = 0, t = 0;
     FloatArith::x_terms(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h);
     FloatArith::p_term({ph[e], pl[e]}, {ph[e - m], pl[e - m]}, {ph[e - 2 * m], pl[e - 2 * m]},
@@ -79,6 +80,20 @@ void steady_terms(const double* x, const double* ph, const double* pl, std::size
     s[1] += t * t;
     s[2] += h * h;
   }
+}
+
+#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
+#define GYROCHAR_FLOAT_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define GYROCHAR_FLOAT_CLONES
+#endif
+GYROCHAR_FLOAT_CLONES void steady_terms(const double* x, const double* ph, const double* pl, std::size_t from,
+                                        std::size_t size, std::size_t m, double out[3]) {
+  Lanes sa{0, 0, 0, 0}, st{0, 0, 0, 0}, sh{0, 0, 0, 0};
+  std::size_t e = from;
+  for (; e + 4 <= size; e += 4) steady_step(x, ph, pl, e, m, sa, st, sh);
+  double s[3] = {combine(sa), combine(st), combine(sh)};
+  tail_terms(x, ph, pl, e, size, m, s);
   for (std::size_t k = 0; k < 3; ++k) out[k] = s[k];
 }
 
@@ -104,6 +119,130 @@ void decimate(const FloatRecord& r, std::size_t m, TauResult<double>& result, No
     d[0] = x;
     if (have < 3) ++have;
     noise.add(x);
+  }
+}
+
+// Several taus at once (float_batch_taus()). A group's taus go through the record together, a
+// chunk of points at a time: the points of the chunk at the four ages of the group's taus stay in
+// the cache while each tau takes its terms there, so the record streams from memory once a group
+// rather than once a tau. Each tau adds its terms to its sums in float_batch_sums()' order: the
+// AVAR terms alone (2m <= e < 3m) one by one in e's order, then four lanes that keep their points
+// (e = 3m + 4i + lane) from chunk to chunk, combined, and the tail one by one.
+constexpr std::size_t chunk_points = 256;
+
+// One fully overlapped tau (stride 1, 2m < size) while the chunks pass.
+struct Run {
+  std::size_t m = 0;
+  std::size_t alone_end = 0;  // AVAR alone on [2m, alone_end): min(3m, size)
+  std::size_t lanes_end = 0;  // four points a step on [3m, lanes_end), the tail one by one after
+  double alone = 0;           // the squares of the AVAR terms alone so far
+  Lanes sa{0, 0, 0, 0}, st{0, 0, 0, 0}, sh{0, 0, 0, 0};
+};
+
+// The AVAR terms alone of the runs in [c0, c1), eight runs a step: their terms formed into a[][],
+// one row per point with a column per run (0 where a run has no term: adding 0 * 0 leaves a sum of
+// squares as it is), then each row added to the eight sums, two vectors of four lanes: each sum
+// takes its squares in e's order, as point_terms() does, and the eight run side by side.
+constexpr std::size_t alone_lanes = 8;
+GYROCHAR_FLOAT_CLONES void alone_chunk(const double* x, Run* runs, std::size_t count, std::size_t c0, std::size_t c1) {
+  alignas(32) double a[chunk_points][alone_lanes];
+  for (std::size_t g = 0; g < count; g += alone_lanes) {
+    const std::size_t n = count - g < alone_lanes ? count - g : alone_lanes;
+    std::size_t lo = c1, hi = c0, from[alone_lanes], to[alone_lanes];
+    for (std::size_t j = 0; j < alone_lanes; ++j) {
+      from[j] = to[j] = c0;
+      if (j >= n) continue;
+      const Run& r = runs[g + j];
+      from[j] = c0 > 2 * r.m ? c0 : 2 * r.m;
+      to[j] = c1 < r.alone_end ? c1 : r.alone_end;
+      if (from[j] >= to[j]) {
+        from[j] = to[j] = c0;
+        continue;
+      }
+      lo = from[j] < lo ? from[j] : lo;
+      hi = to[j] > hi ? to[j] : hi;
+    }
+    if (lo >= hi) continue;
+    for (std::size_t j = 0; j < alone_lanes; ++j) {
+      const std::size_t m = j < n ? runs[g + j].m : 0;
+      const std::size_t b = from[j] > lo ? from[j] : lo, f = to[j] > b ? to[j] : b;
+      for (std::size_t e = lo; e < b; ++e) a[e - lo][j] = 0;
+      for (std::size_t e = b; e < f; ++e) FloatArith::x_term2(x[e], x[e - m], x[e - 2 * m], a[e - lo][j]);
+      for (std::size_t e = f; e < hi; ++e) a[e - lo][j] = 0;
+    }
+    // The eight sums go in and out of the two vectors through an array: a lane written through
+    // a conditional's vector subscript came out wrong in GCC 12's ASan build.
+    alignas(32) double sums[alone_lanes] = {};
+    for (std::size_t j = 0; j < n; ++j) sums[j] = runs[g + j].alone;
+    Lanes s0, s1;
+    load(s0, sums), load(s1, sums + 4);
+    for (std::size_t i = 0; i < hi - lo; ++i) {
+      Lanes v0, v1;
+      load(v0, a[i]), load(v1, a[i] + 4);
+      s0 += v0 * v0;
+      s1 += v1 * v1;
+    }
+    std::memcpy(sums, &s0, sizeof s0), std::memcpy(sums + 4, &s1, sizeof s1);
+    for (std::size_t j = 0; j < n; ++j) runs[g + j].alone = sums[j];
+  }
+}
+
+// The four-point steps of the runs that start in [c0, c1) (each run's steps start at 3m + 4i, so
+// a step may reach three points past c1).
+GYROCHAR_FLOAT_CLONES void steady_chunk(const double* x, const double* ph, const double* pl, Run* runs,
+                                        std::size_t count, std::size_t c0, std::size_t c1) {
+  for (std::size_t j = 0; j < count; ++j) {
+    Run& r = runs[j];
+    const std::size_t start = 3 * r.m;
+    if (c1 <= start) continue;
+    const std::size_t from = c0 <= start ? start : start + (c0 - start + 3) / 4 * 4;
+    std::size_t to = start + (c1 - start + 3) / 4 * 4;
+    to = to < r.lanes_end ? to : r.lanes_end;
+    if (from >= to) continue;
+    Lanes sa = r.sa, st = r.st, sh = r.sh;
+    for (std::size_t e = from; e < to; e += 4) steady_step(x, ph, pl, e, r.m, sa, st, sh);
+    r.sa = sa, r.st = st, r.sh = sh;
+  }
+}
+
+// The overlapping sums of runs[0 .. count) over the record, chunk by chunk, run j's into
+// out[index[j]].
+void run_group(const FloatRecord& record, Run* runs, const std::size_t* index, std::size_t count,
+               std::span<TauResult<double>> out) {
+  const std::size_t size = record.x.size();
+  const double *x = record.x.data(), *ph = record.p_hi.data(), *pl = record.p_lo.data();
+  std::size_t first = size;
+  for (std::size_t j = 0; j < count; ++j) first = 2 * runs[j].m < first ? 2 * runs[j].m : first;
+  for (std::size_t c0 = first; c0 < size; c0 += chunk_points) {
+    const std::size_t c1 = size - c0 < chunk_points ? size : c0 + chunk_points;
+    alone_chunk(x, runs, count, c0, c1);
+    steady_chunk(x, ph, pl, runs, count, c0, c1);
+  }
+  for (std::size_t j = 0; j < count; ++j) {
+    const Run& r = runs[j];
+    const std::size_t m = r.m;
+    TauResult<double>& result = out[index[j]];
+    Sums s;
+    s.sum[0] = r.alone;
+    s.n[0] = r.alone_end - 2 * m;
+    if (3 * m - 1 < size) {  // the first MVAR term (P_0 = 0), as point_terms() forms it
+      double t = 0;
+      FloatArith::p_term(prefix(record, 3 * m - 1), prefix(record, 2 * m - 1), prefix(record, m - 1), Prefix{}, t);
+      s.sum[1] += t * t;
+      ++s.n[1];
+    }
+    if (size > 3 * m) {
+      double steady[3] = {combine(r.sa), combine(r.st), combine(r.sh)};
+      tail_terms(x, ph, pl, r.lanes_end, size, m, steady);
+      for (std::size_t k = 0; k < 3; ++k) {
+        s.sum[k] += steady[k];
+        s.n[k] += size - 3 * m;
+      }
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      result.sum[k] = s.sum[k];
+      result.n[k] = s.n[k];
+    }
   }
 }
 
@@ -141,6 +280,36 @@ TauResult<double> float_batch_sums(const FloatRecord& record, std::uint64_t m, s
     result.n[k] = s.n[k];
   }
   return result;
+}
+
+void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
+                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise) {
+  const std::size_t size = record.x.size();
+  Run runs[float_batch_group];
+  std::size_t index[float_batch_group];  // runs[j] is tau index[j]
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < m.size() && i < stride.size() && i < out.size() && i < noise.size(); ++i) {
+    if (stride[i] != 1 || m[i] == 0 || m[i] >= size || size - m[i] <= m[i]) {  // strided, or no overlapping term
+      out[i] = float_batch_sums(record, m[i], stride[i], noise[i]);
+      continue;
+    }
+    const auto lag = static_cast<std::size_t>(m[i]);
+    out[i] = TauResult<double>{};
+    out[i].m = m[i];
+    out[i].stride = 1;
+    decimate(record, lag, out[i], noise[i]);
+    Run& r = runs[count];
+    r = Run{};
+    r.m = lag;
+    r.alone_end = 3 * lag < size ? 3 * lag : size;
+    r.lanes_end = size > 3 * lag ? 3 * lag + (size - 3 * lag) / 4 * 4 : 3 * lag;
+    index[count++] = i;
+    if (count == float_batch_group) {
+      run_group(record, runs, index, count, out);
+      count = 0;
+    }
+  }
+  if (count > 0) run_group(record, runs, index, count, out);
 }
 
 }  // namespace gyrochar

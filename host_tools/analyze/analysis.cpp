@@ -408,20 +408,23 @@ struct HeldAllocator {
 template <class T>
 using Held = std::vector<T, HeldAllocator<T>>;
 
-// The sums of taus 0 .. taus - 1, each by sum_tau(i) (independent: each thread takes the next one
-// left until none is), on o.threads threads (0: one per core), telling o.on_summed.
-template <class SumTau>
-std::vector<TauSums> sum_every_tau(std::size_t taus, const AnalysisOptions& o, SumTau sum_tau) {
+// The sums of taus 0 .. taus - 1, `block` consecutive ones at a time by sum_block(first, out)
+// into out = sums[first .. first + block) (shorter at the end; independent: each thread takes the
+// next block left until none is), on o.threads threads (0: one per core), telling o.on_summed.
+template <class SumBlock>
+std::vector<TauSums> sum_every_tau(std::size_t taus, std::size_t block, const AnalysisOptions& o, SumBlock sum_block) {
   std::vector<TauSums> sums(taus);
   std::atomic<std::size_t> next{0}, done{0};
+  const std::size_t blocks = (taus + block - 1) / block;
   const auto sum_taus = [&](bool tell) {
-    for (std::size_t i = next++; i < taus; i = next++) {
-      sums[i] = sum_tau(i);
-      const std::size_t summed = ++done;
+    for (std::size_t b = next++; b < blocks; b = next++) {
+      const std::size_t first = b * block, count = std::min(block, taus - first);
+      sum_block(first, std::span<TauSums>(sums.data() + first, count));
+      const std::size_t summed = done += count;
       if (tell && o.on_summed && summed < taus) o.on_summed(summed, taus);
     }
   };
-  const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), taus);
+  const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), blocks);
   std::vector<std::thread> helpers;
   for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
   sum_taus(true);
@@ -462,11 +465,11 @@ class CountBatchEngine final : public EngineBase {
     a.stride_factor = stride_factor_;
     const std::size_t taus = m_list_.size();
     const std::uint64_t spread = counts_ == 0 ? 0 : static_cast<std::uint64_t>(std::int64_t{highest_} - lowest_);
-    const std::vector<TauSums> sums = sum_every_tau(taus, o, [&](std::size_t i) {
+    const std::vector<TauSums> sums = sum_every_tau(taus, 1, o, [&](std::size_t i, std::span<TauSums> out) {
       BatchTau tau(m_list_[i], stride_of(m_list_[i], stride_factor_));
       if (counts_ > 0 && wide_.empty()) tau.add_segment(PhaseSegment<std::int32_t>{narrow_, 0, slope_, 0, spread});
       if (counts_ > 0 && !wide_.empty()) tau.add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
-      return tau_sums(tau.result(), tau.noise());
+      out[0] = tau_sums(tau.result(), tau.noise());
     });
     read_out(a, sums, DataType::counts, o, record_);
     return a;
@@ -550,7 +553,7 @@ class CountBatchEngine final : public EngineBase {
 
 // Phase or frequency with the record held: the points as the characterizer stages them (relative
 // to the line through the first two phase points, or to the first frequency value) and their
-// double-double prefix sums, every tau summed over them by float_batch_sums() (float_batch.hpp).
+// double-double prefix sums, every tau summed over them by float_batch_taus() (float_batch.hpp).
 class FloatBatchEngine final : public EngineBase {
  public:
   FloatBatchEngine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list,
@@ -582,10 +585,16 @@ class FloatBatchEngine final : public EngineBase {
     a.n_values = type_ == DataType::phase ? a.n_phase : increments_;
     a.stride_factor = stride_factor_;
     const FloatRecord held{x_, p_hi_, p_lo_};
-    const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), o, [&](std::size_t i) {
-      NoiseIdAccumulator noise;
-      const TauResult<double> r = float_batch_sums(held, m_list_[i], stride_of(m_list_[i], stride_factor_), noise);
-      return tau_sums(r, noise);
+    // A group of consecutive taus at a time (float_batch_taus(): the record streams once a group).
+    const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), float_batch_group, o,
+                                                    [&](std::size_t first, std::span<TauSums> out) {
+      const std::span<const std::uint64_t> m(m_list_.data() + first, out.size());
+      std::vector<std::uint64_t> stride(out.size());
+      for (std::size_t j = 0; j < out.size(); ++j) stride[j] = stride_of(m[j], stride_factor_);
+      std::vector<TauResult<double>> r(out.size());
+      std::vector<NoiseIdAccumulator> noise(out.size());
+      float_batch_taus(held, m, stride, r, noise);
+      for (std::size_t j = 0; j < out.size(); ++j) out[j] = tau_sums(r[j], noise[j]);
     });
     read_out(a, sums, type_, o, record_.points);
     return a;

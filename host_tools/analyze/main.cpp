@@ -647,7 +647,8 @@ int main(int argc, char** argv) {
     o.hold_counts = o.type == DataType::counts && o.stride_factor == 0 && n_phase > 0 &&
                     o.values_hint < memory_budget() / 12;
     // Phase and frequency under --taus all hold the staged points and their prefix sums (24 bytes
-    // a point) and sum tau by tau (the characterizer would visit every tau at every point).
+    // a point) and sum 64 consecutive taus at a time (the characterizer would visit every tau at
+    // every point).
     o.hold_phase = o.type != DataType::counts && taus_text == "all" && o.stride_factor == 0 &&
                    o.values_hint < memory_budget() / 24;
     const bool held = o.hold_counts || o.hold_phase;

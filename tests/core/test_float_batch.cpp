@@ -7,6 +7,7 @@
 // frequency (relative to its first value), fully overlapped and strided taus.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -124,6 +125,59 @@ TEST(FloatBatch, ShortRecordsHaveNoTermButTheirDecimatedPoint) {
   NoiseIdAccumulator none;
   EXPECT_EQ(float_batch_sums(Record{}.view(), 1, 1, none).n[0], 0u);
   EXPECT_EQ(none.points(), 0u);
+}
+
+// float_batch_taus() against float_batch_sums() tau by tau (oracle: the per-tau path, itself held
+// to the characterizer above): the same terms added in the same order, so every sum, count and
+// noise sum is the same to the last bit. Random records of several lengths (around the group's
+// chunk of 512 points and below), every m up to N/2 in one list (more than one group of 64), with
+// strided taus, m = 0 and m beyond the record mixed in.
+void expect_taus_match_one_by_one(const Record& record, const std::vector<std::uint64_t>& m,
+                                  const std::vector<std::uint64_t>& stride) {
+  std::vector<TauResult<double>> got(m.size());
+  std::vector<NoiseIdAccumulator> noise(m.size());
+  float_batch_taus(record.view(), m, stride, got, noise);
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    NoiseIdAccumulator one;
+    const auto want = float_batch_sums(record.view(), m[i], stride[i], one);
+    const std::string where = "N=" + std::to_string(record.x.size()) + " m=" + std::to_string(m[i]) +
+                              " stride=" + std::to_string(stride[i]);
+    EXPECT_EQ(got[i].m, want.m) << where;
+    EXPECT_EQ(got[i].stride, want.stride) << where;
+    EXPECT_EQ(got[i].n, want.n) << where;
+    for (std::size_t k = 0; k < sum_kinds; ++k)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].sum[k]), std::bit_cast<std::uint64_t>(want.sum[k]))
+          << where << " kind " << k << ": " << got[i].sum[k] << " vs " << want.sum[k];
+    for (int d = 0; d < 4; ++d) {
+      const Lag1Sums a = noise[i].order(d), b = one.order(d);
+      EXPECT_TRUE(a.n == b.n && a.pairs == b.pairs && a.shift == b.shift && a.sum == b.sum && a.sum_sq == b.sum_sq &&
+                  a.sum_lag == b.sum_lag && a.sum_left == b.sum_left && a.sum_right == b.sum_right)
+          << where << " order " << d;
+    }
+  }
+}
+
+TEST(FloatBatch, TausTogetherGiveTheSumsOfEachAlone) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g;
+  for (const std::size_t n : {1, 2, 3, 4, 7, 8, 13, 100, 511, 512, 513, 1000, 1537, 2051}) {
+    Record record;  // white and random-walk noise of several scales, as phase relative to a line
+    double walk = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      walk += 1e-3 * g(rng);
+      record.stage(walk + 1e-6 * g(rng) * std::exp(g(rng)));
+    }
+    std::vector<std::uint64_t> m, stride;
+    for (std::uint64_t tau = 1; 2 * tau <= n + 1; ++tau) {  // every m with an overlapping term, and one without
+      m.push_back(tau);
+      stride.push_back(1);
+    }
+    expect_taus_match_one_by_one(record, m, stride);
+    // Strided and termless taus among fully overlapped ones, in no order.
+    m = {n + 5, 3, 0, 24, 5, 8, 2, n, 1};
+    stride = {1, 1, 1, 8, 1, 4, 1, 1, 1};
+    expect_taus_match_one_by_one(record, m, stride);
+  }
 }
 
 }  // namespace
