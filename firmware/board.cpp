@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "gyrochar/crc32.hpp"
-#include "hal/exit_codes.hpp"
+#include "hal/program/exit_codes.hpp"
 
 namespace gyrochar::firmware {
 namespace {

@@ -15,7 +15,7 @@
 #include <map>
 #include <memory>
 
-#include "hal/exit_codes.hpp"
+#include "hal/program/exit_codes.hpp"
 #include "hal/linux/can_interface.hpp"
 
 namespace gyrochar::firmware {

@@ -3,7 +3,7 @@
 // resumes from the checkpoint, and runs the board's event loop until SIGTERM or SIGINT, when it
 // writes a last checkpoint. The whole configuration (and the checkpoint's directory) is checked
 // before any hardware is opened, so an invalid configuration exits 2 even without the hardware;
-// then missing hardware exits 3 naming the device (hal/exit_codes.hpp). A run in which a checkpoint
+// then missing hardware exits 3 naming the device (hal/program/exit_codes.hpp). A run in which a checkpoint
 // could not be written exits 4 (an output failed) at its end. Text from the configuration is
 // logged with control bytes escaped (printable()).
 #include <sys/signalfd.h>
@@ -17,7 +17,7 @@
 
 #include "board.hpp"
 #include "config.hpp"
-#include "hal/exit_codes.hpp"
+#include "hal/program/exit_codes.hpp"
 #include "hal/linux/gpio_quadrature.hpp"
 #include "hal/linux/gpio_strobe.hpp"
 #include "hal/linux/socketcan.hpp"

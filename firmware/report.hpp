@@ -11,7 +11,7 @@
 
 #include "gyrochar/characterizer.hpp"
 #include "gyrochar/ieee952.hpp"
-#include "gyrochar/protocol.hpp"
+#include "gyrochar/wire/protocol.hpp"
 #include "capacities.hpp"
 #include "fit_worker.hpp"
 #include "window.hpp"

@@ -6,7 +6,7 @@
 #include <optional>
 #include <span>
 
-#include "gyrochar/can_frame.hpp"
+#include "gyrochar/wire/can_frame.hpp"
 
 namespace gyrochar::hal {
 

@@ -1,6 +1,6 @@
 #include "hal/can_counter.hpp"
 
-#include "gyrochar/protocol.hpp"
+#include "gyrochar/wire/protocol.hpp"
 
 namespace gyrochar::hal {
 

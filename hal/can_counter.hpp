@@ -6,7 +6,7 @@
 // receives on its CAN bus.
 #include <cstdint>
 
-#include "gyrochar/can_frame.hpp"
+#include "gyrochar/wire/can_frame.hpp"
 #include "hal/count_source.hpp"
 
 namespace gyrochar::hal {

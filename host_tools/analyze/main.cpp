@@ -32,7 +32,8 @@
 #include "output_paths.hpp"
 #include "psd.hpp"
 #include "static_plot.hpp"
-#include "hal/exit_codes.hpp"
+#include "hal/program/command_line.hpp"
+#include "hal/program/exit_codes.hpp"
 
 namespace {
 
@@ -475,13 +476,7 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "threads summing the taus of counts at --stride-factor full and of --taus all (default: one per core)")
       ->check(CLI::Range(1u, 1024u));
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return finish(program, app.exit(e));
-  } catch (const CLI::ParseError& e) {
-    bad("options", std::string(e.what()) + " (see --help)");
-  }
+  if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
   std::vector<NamedPath> outputs = plot_outputs("--plot", plot_prefix);
   outputs.insert(outputs.begin(), {"--kalibr", kalibr_path});
   outputs.insert(outputs.begin(), {"--psd", psd_path});

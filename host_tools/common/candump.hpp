@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include "gyrochar/can_frame.hpp"
+#include "gyrochar/wire/can_frame.hpp"
 
 namespace gyrochar {
 

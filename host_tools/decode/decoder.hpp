@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "gyrochar/can_frame.hpp"
-#include "gyrochar/protocol.hpp"
+#include "gyrochar/wire/can_frame.hpp"
+#include "gyrochar/wire/protocol.hpp"
 
 namespace gyrochar {
 

@@ -17,7 +17,8 @@
 #include <vector>
 
 #include "hal/linux/can_interface.hpp"
-#include "hal/exit_codes.hpp"
+#include "hal/program/command_line.hpp"
+#include "hal/program/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
 #include "output_paths.hpp"
 #include "plot.hpp"
@@ -332,13 +333,7 @@ int main(int argc, char** argv) {
       ->option_text("S");
   app.add_option("--node", o.nodes, "show and record only this node address (repeatable; 16 or 0x10)")
       ->option_text("ADDRESS");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return finish(program, app.exit(e));
-  } catch (const CLI::ParseError& e) {
-    fail(exit_code::bad_input, "options", std::string(e.what()) + " (see --help)");
-  }
+  if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
   if (o.log.empty() == o.interface.empty())
     fail(exit_code::bad_input, "options", "give either a LOG or --interface (see --help)");
   if (!o.interface.empty())  // a name no interface can have is bad input; a missing one is hardware

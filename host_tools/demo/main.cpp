@@ -27,7 +27,8 @@
 #include "view.hpp"
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
-#include "hal/exit_codes.hpp"
+#include "hal/program/command_line.hpp"
+#include "hal/program/exit_codes.hpp"
 #include "hal/fake/fake_can_bus.hpp"
 #include "hal/fake/fake_clock.hpp"
 #include "hal/fake/fake_count_source.hpp"
@@ -81,13 +82,7 @@ int main(int argc, char** argv) {
   app.add_option("--plot", plot_prefix, "ADEV/MDEV plot written to PREFIX.svg and PREFIX.png (empty: none)")
       ->capture_default_str();
   app.add_option("--candump", candump_path, "also record the bus as a candump log (canplayer replays it)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return finish(program, app.exit(e));
-  } catch (const CLI::ParseError& e) {
-    bad("options", std::string(e.what()) + " (see --help)");
-  }
+  if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
   // Each rule its own message: the option, what it must be, and what was given.
   if (!(hours > 0) || !std::isfinite(hours)) bad("--hours", fmt::format("must be a positive number of hours, not {}", hours));
   if (!(tau0 > 0) || !std::isfinite(tau0)) bad("--tau0", fmt::format("must be a positive number of seconds, not {}", tau0));

@@ -18,8 +18,9 @@
 #include "hal/linux/can_interface.hpp"
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
-#include "gyrochar/protocol.hpp"
-#include "hal/exit_codes.hpp"
+#include "gyrochar/wire/protocol.hpp"
+#include "hal/program/command_line.hpp"
+#include "hal/program/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
 
 namespace {
@@ -195,13 +196,7 @@ Examples:
   app.add_option("--can-node", can_node, "with --can: address of the simulated electronics, 0..253")
       ->capture_default_str();
   app.add_option("--speed", speed, "with --can: frames every tau0 / SPEED seconds (1: real time)")->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return finish(program, app.exit(e));
-  } catch (const CLI::ParseError& e) {
-    exit_with(exit_code::bad_input, program, "options", std::string(e.what()) + " (see --help)");
-  }
+  if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
   auto bad = [](const char* what, const char* why) {
     print_error(program, what, why);
     return exit_code::bad_input;

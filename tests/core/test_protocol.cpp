@@ -1,4 +1,4 @@
-// The CAN codec (core/include/gyrochar/protocol.hpp, docs/protocol.md): round trips of every frame
+// The CAN codec (core/wire/include/gyrochar/wire/protocol.hpp, docs/protocol.md): round trips of every frame
 // kind, every field at its range limits, saturation and quantization, rejection of malformed frames
 // with the right reason, a fuzz run, the report schedule (versions 1 to 4) and the bus load.
 //
@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "gyrochar/protocol.hpp"
+#include "gyrochar/wire/protocol.hpp"
 
 namespace gyrochar::protocol {
 namespace {

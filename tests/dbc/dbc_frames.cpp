@@ -24,7 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "candump.hpp"
-#include "gyrochar/protocol.hpp"
+#include "gyrochar/wire/protocol.hpp"
 
 namespace {
 

@@ -2,7 +2,7 @@
 // by file and line) names the key and exits bad_input with nothing started, before any hardware is
 // opened; a missing CAN interface or GPIO chip exits no_hardware and names it; reads of the
 // configuration are bounded; control bytes from it are escaped. Oracle: the exit codes of
-// hal/exit_codes.hpp.
+// hal/program/exit_codes.hpp.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -11,7 +11,7 @@
 #include <fstream>
 #include <string>
 
-#include "hal/exit_codes.hpp"
+#include "hal/program/exit_codes.hpp"
 
 namespace {
 

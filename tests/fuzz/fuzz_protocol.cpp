@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "gyrochar/protocol.hpp"
+#include "gyrochar/wire/protocol.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 5) return 0;

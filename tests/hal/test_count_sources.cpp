@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "gyrochar/protocol.hpp"
+#include "gyrochar/wire/protocol.hpp"
 #include "hal/can_counter.hpp"
 #include "hal/quadrature.hpp"
 #include "hal/strobe.hpp"

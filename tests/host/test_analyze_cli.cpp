@@ -1,6 +1,6 @@
 // gyrochar-analyze as a user meets it: every kind of bad input gets one line
 // 'gyrochar-analyze: what: why' on stderr, nothing on stdout and exit code 2; good input gives the
-// documented formats and units. Oracles: the exit codes of hal/exit_codes.hpp; unit identities; the
+// documented formats and units. Oracles: the exit codes of hal/program/exit_codes.hpp; unit identities; the
 // closed-form angle random walk of white rate noise (values themselves: test_analyze_reference);
 // for the IEEE-952 read-off, the ADIS16405 data sheet (README beside the records, which are not part
 // of the project: support/real_imu.hpp), the measured curve itself and the agreement rule of
@@ -25,7 +25,7 @@
 #include <tuple>
 #include <vector>
 
-#include "hal/exit_codes.hpp"
+#include "hal/program/exit_codes.hpp"
 #include "oracle/brute_force.hpp"
 #include "support/real_imu.hpp"
 

@@ -22,8 +22,8 @@
 
 #include "candump.hpp"
 #include "confidence.hpp"
-#include "gyrochar/protocol.hpp"
-#include "hal/exit_codes.hpp"
+#include "gyrochar/wire/protocol.hpp"
+#include "hal/program/exit_codes.hpp"
 
 namespace gyrochar {
 namespace {

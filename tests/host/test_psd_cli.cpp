@@ -2,7 +2,7 @@
 // Oracles: the simulator's truth (a sinusoid of 2 deg/h at 0.05 Hz on ARW 0.02 deg/sqrt(h), the
 // issue's target), white rate noise's one-sided PSD 2 N^2 (N = 0.02 deg/sqrt(h) = 1.2 deg/h
 // sqrt(s): 2.88 (deg/h)^2/Hz), the PNG and SVG file signatures, the exit codes of
-// hal/exit_codes.hpp.
+// hal/program/exit_codes.hpp.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,7 +15,7 @@
 #include <sstream>
 #include <string>
 
-#include "hal/exit_codes.hpp"
+#include "hal/program/exit_codes.hpp"
 
 namespace {
 

@@ -1,10 +1,10 @@
-// The contract every program keeps (hal/exit_codes.hpp): bad input gets one line
+// The contract every program keeps (hal/program/exit_codes.hpp): bad input gets one line
 // "program: what: why" on stderr and exit_code::bad_input; an output that cannot be written,
 // standard output included (`> /dev/full`), exit_code::output_failed; a CAN interface that does
 // not exist exit_code::no_hardware, named by its name; every --help and the README state the same
 // exit codes. gyrochar-analyze and gyrochar-decode have their own suites for their many options
 // (test_analyze_cli, test_decode_cli); gyrochard's start-up is in tests/firmware.
-// Oracle: the exit codes of hal/exit_codes.hpp.
+// Oracle: the exit codes of hal/program/exit_codes.hpp.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -12,7 +12,7 @@
 #include <fstream>
 #include <string>
 
-#include "hal/exit_codes.hpp"
+#include "hal/program/exit_codes.hpp"
 
 namespace {
 
@@ -166,7 +166,7 @@ TEST(ToolErrors, DecoderKalibrNeedsOneNodeWithAFit) {
 
 // An output that is the same file as an input (or as another output) is refused before anything
 // is opened for writing: the input keeps every byte, and no output is created.
-// Oracle: the contract of host_tools/common/output_paths.hpp; exit codes of hal/exit_codes.hpp.
+// Oracle: the contract of host_tools/common/output_paths.hpp; exit codes of hal/program/exit_codes.hpp.
 TEST(ToolErrors, NoOutputOverwritesAnInputOrAnotherOutput) {
   const int bad = exit_code::bad_input;
   const std::string log = temp("same_file.log"), counts = temp("same_file_counts.txt");
@@ -229,7 +229,7 @@ TEST(ToolErrors, EveryHelpAndTheReadmeStateTheSameExitCodes) {
   EXPECT_EQ(board.code, exit_code::ok);
   EXPECT_NE(board.out.find(exit_code::help), std::string::npos) << board.out;
   EXPECT_NE(slurp(GYROCHAR_SOURCE_DIR "/README.md").find(exit_code::help), std::string::npos)
-      << "README.md must quote hal/exit_codes.hpp's help text verbatim";
+      << "README.md must quote hal/program/exit_codes.hpp's help text verbatim";
 }
 
 // Runs `command` as an unprivileged user when this test runs as root (root reads and writes

@@ -2,7 +2,8 @@
 // The contract every gyrochar program keeps with its caller (gyrochard and the host tools alike):
 // data on stdout, each error as one line "program: what: why" on stderr, and an exit code from
 // the table below, which every --help prints (exit_codes_help) and the README repeats. It lives
-// here, at the lowest layer that knows processes, so that firmware/ and host_tools/ share it.
+// in hal/program/ (the target gyrochar_program, with command_line.hpp), at the lowest layer that
+// knows processes, so that firmware/ and host_tools/ share it without linking the HAL.
 #include <cstdio>
 #include <string>
 #include <string_view>

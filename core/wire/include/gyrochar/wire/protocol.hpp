@@ -18,7 +18,7 @@
 #include <cstdint>
 #include <variant>
 
-#include "gyrochar/can_frame.hpp"
+#include "gyrochar/wire/can_frame.hpp"
 
 namespace gyrochar::protocol {
 

@@ -1,6 +1,6 @@
 // The gyrochar CAN codec (docs/protocol.md). Each frame kind has one range check, check(), shared by
 // encode (before packing) and decode (after unpacking), so both accept exactly the same values.
-#include "gyrochar/protocol.hpp"
+#include "gyrochar/wire/protocol.hpp"
 
 #include <algorithm>
 #include <bit>

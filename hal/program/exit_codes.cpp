@@ -1,4 +1,4 @@
-#include "hal/exit_codes.hpp"
+#include "hal/program/exit_codes.hpp"
 
 #include <unistd.h>
 
