@@ -99,6 +99,12 @@ struct PairSums {
 };
 PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b);
 
+/// pair_sums(set, a1, b1) and pair_sums(set, a2, b2), the same to the last bit, in one pass where
+/// the two pairs have the same kernel (the same statistics, m and strides; say the same grids at
+/// two lengths of the run): the covariances at the lags both sums visit are evaluated once.
+void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b1, const TermGrid& a2,
+                      const TermGrid& b2, PairSums& out1, PairSums& out2);
+
 /// The same sums with first-order Gauss-Markov rates beside the noises of `set` (the IEEE-952
 /// fit's exact covariance of a model with Markov terms): c_j the term covariance of Markov rate j
 /// (markov_term_covariance() with a = rates[j], unit stationary variance),
