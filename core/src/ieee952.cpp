@@ -627,7 +627,7 @@ void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
 
 // The sinusoid sums of every pair of points for the given sinusoids (setup.sinusoid_hz), with the
 // power-law noises pair_sums_of_points() kept for that pair. O(P^2 x nodes).
-void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup) {
+void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache) {
   NoiseSet set;
   for (std::size_t t = 0; t < noises; ++t) set.alpha[t] = alphas[t];
   set.count = noises;
@@ -645,7 +645,8 @@ void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup) {
       double* sg = pr.sinusoid_pair_at(i, j);
       for (std::size_t k = 0; k < sinusoid_slots; ++k) sg[k] = 0;
       if (!(pr.hz[0] > 0) && !(pr.hz[max_sinusoids - 1] > 0)) continue;  // none given
-      const SinusoidPairSums s = sinusoid_pair_sums(set, theta, ga, unbroken_grid(b.stat, b.m, b.stride, setup.n_phase));
+      const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, setup.n_phase);
+      const SinusoidPairSums s = cache ? cache->sinusoid_sums(set, theta, ga, gb) : sinusoid_pair_sums(set, theta, ga, gb);
       for (std::size_t k = 0; k < max_sinusoids; ++k)
         for (std::size_t t = 0; t < noises; ++t) sg[k * noises + t] = t == 0 || g[cc_index(t, t)] != 0 ? s.cs[k][t] : 0.0;
     }
@@ -1039,7 +1040,7 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
   for (std::size_t i = 0; i < pr.n; ++i) pr.power[i] = power_design(pr.point[i]->stat, pr.point[i]->m, setup.tau0_s);
   if (!pr.sums_made) {
     pair_sums_of_points(pr, setup, cache);
-    sinusoid_sums_of_points(pr, setup);
+    sinusoid_sums_of_points(pr, setup, cache);
     pr.sums_made = true;
   }
   Candidate runner_up;
