@@ -188,7 +188,12 @@ struct Problem {
   std::uint64_t n_phase = 0;
   double spread = 0;
   Model model;              // the model the rows are made for
-  double* pair = nullptr;   // per pair (i <= j): 10 sums c_t c_u, then 4 sums c_t
+  // Each point's place in the first fit of this call: the pair sums and the sinusoids' sums are
+  // kept by place and made once (a later fit has fewer points, never new ones).
+  std::size_t place[max_fit_points];
+  std::size_t places = 0;
+  bool sums_made = false;
+  double* pair = nullptr;   // per pair of places (i <= j): 10 sums c_t c_u, then 4 sums c_t
   double* markov_pair = nullptr;  // per pair (i <= j): the Markov terms' sums (markov_slots)
   bool exact_markov = false;      // markov_pair holds the sums of model.a: Sigma is exact
   double* sinusoid_pair = nullptr;            // per pair (i <= j): the sums of the given sinusoids
@@ -196,19 +201,26 @@ struct Problem {
   double* sigma = nullptr;  // n x n
   double* rows = nullptr;   // per point: the design, y, Sigma's diagonal, y less the held terms
   double* row(std::size_t i) const { return rows + i * width; }
-  double* pair_at(std::size_t i, std::size_t j) const {
-    if (i > j) {
-      const std::size_t t = i;
-      i = j;
-      j = t;
-    }
-    return pair + (j * (j + 1) / 2 + i) * 14;
+  std::size_t place_pair(std::size_t i, std::size_t j) const {
+    i = place[i];
+    j = place[j];
+    return i > j ? i * (i + 1) / 2 + j : j * (j + 1) / 2 + i;
   }
+  double* pair_at(std::size_t i, std::size_t j) const { return pair + place_pair(i, j) * 14; }
   double* markov_pair_at(std::size_t i, std::size_t j) const {
     return markov_pair + (i > j ? i * (i + 1) / 2 + j : j * (j + 1) / 2 + i) * markov_slots;
   }
-  double* sinusoid_pair_at(std::size_t i, std::size_t j) const {
-    return sinusoid_pair + (i > j ? i * (i + 1) / 2 + j : j * (j + 1) / 2 + i) * sinusoid_slots;
+  double* sinusoid_pair_at(std::size_t i, std::size_t j) const { return sinusoid_pair + place_pair(i, j) * sinusoid_slots; }
+  // Keeps the points for which keep(point) is true, in order, with their places.
+  template <class Keep>
+  void keep_points(Keep&& keep) {
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!keep(*point[i])) continue;
+      place[kept] = place[i];
+      point[kept++] = point[i];
+    }
+    n = kept;
   }
 };
 
@@ -503,19 +515,14 @@ namespace {
 // holds Q at the white level: the quantization is not white.
 void leave_out_quantization(Problem& pr, double qw2, Flags& free, Terms& fixed, Ieee952Fit& out) {
   out.quantization_white = false;
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < pr.n; ++i) {
-    const FitPoint& p = *pr.point[i];
+  pr.keep_points([&](const FitPoint& p) {
     const double white = qw2 * power_design(p.stat, p.m, pr.tau0)[0];
-    if (white >= quantization_left_out * p.variance) {
-      double& below = out.excluded_below_tau_s[p.stat == Stat::avar ? 0 : 1];
-      const double next_octave = 2 * static_cast<double>(p.m) * pr.tau0;
-      if (next_octave > below) below = next_octave;
-      continue;
-    }
-    pr.point[kept++] = pr.point[i];
-  }
-  pr.n = kept;
+    if (!(white >= quantization_left_out * p.variance)) return true;
+    double& below = out.excluded_below_tau_s[p.stat == Stat::avar ? 0 : 1];
+    const double next_octave = 2 * static_cast<double>(p.m) * pr.tau0;
+    if (next_octave > below) below = next_octave;
+    return false;
+  });
   free[0] = false;
   fixed[0] = qw2;
 }
@@ -523,19 +530,14 @@ void leave_out_quantization(Problem& pr, double qw2, Flags& free, Terms& fixed, 
 // Leaves out every point where a first-order filter of a = tau0 / Tf changes white rate noise by
 // bandwidth_left_out or more: below the sensor's bandwidth, its own filter shapes the curve.
 void leave_out_bandwidth(Problem& pr, double a, Ieee952Fit& out) {
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < pr.n; ++i) {
-    const FitPoint& p = *pr.point[i];
+  pr.keep_points([&](const FitPoint& p) {
     const double white = power_design(p.stat, p.m, pr.tau0)[1];
     const double filtered = markov_column(a, p.stat, p.m, pr.tau0) * std::tanh(a / 2) / pr.tau0;
-    if (std::fabs(filtered / white - 1) >= bandwidth_left_out) {
-      const double next_octave = 2 * static_cast<double>(p.m) * pr.tau0;
-      if (next_octave > out.bandwidth_excluded_below_tau_s) out.bandwidth_excluded_below_tau_s = next_octave;
-      continue;
-    }
-    pr.point[kept++] = pr.point[i];
-  }
-  pr.n = kept;
+    if (!(std::fabs(filtered / white - 1) >= bandwidth_left_out)) return true;
+    const double next_octave = 2 * static_cast<double>(p.m) * pr.tau0;
+    if (next_octave > out.bandwidth_excluded_below_tau_s) out.bandwidth_excluded_below_tau_s = next_octave;
+    return false;
+  });
 }
 
 // Before the fit: a point the white quantization alone would dominate lies far below it (three
@@ -576,7 +578,6 @@ void pair_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache
   for (std::size_t i = 0; i < pr.n; ++i) {
     const FitPoint& a = *pr.point[i];
     const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
-    pr.power[i] = power_design(a.stat, a.m, setup.tau0_s);
     for (std::size_t j = 0; j <= i; ++j) {
       const FitPoint& b = *pr.point[j];
       double* g = pr.pair_at(i, j);
@@ -626,7 +627,7 @@ void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
 
 // The sinusoid sums of every pair of points for the given sinusoids (setup.sinusoid_hz), with the
 // power-law noises pair_sums_of_points() kept for that pair. O(P^2 x nodes).
-void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup) {
+void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache) {
   NoiseSet set;
   for (std::size_t t = 0; t < noises; ++t) set.alpha[t] = alphas[t];
   set.count = noises;
@@ -644,7 +645,8 @@ void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup) {
       double* sg = pr.sinusoid_pair_at(i, j);
       for (std::size_t k = 0; k < sinusoid_slots; ++k) sg[k] = 0;
       if (!(pr.hz[0] > 0) && !(pr.hz[max_sinusoids - 1] > 0)) continue;  // none given
-      const SinusoidPairSums s = sinusoid_pair_sums(set, theta, ga, unbroken_grid(b.stat, b.m, b.stride, setup.n_phase));
+      const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, setup.n_phase);
+      const SinusoidPairSums s = cache ? cache->sinusoid_sums(set, theta, ga, gb) : sinusoid_pair_sums(set, theta, ga, gb);
       for (std::size_t k = 0; k < max_sinusoids; ++k)
         for (std::size_t t = 0; t < noises; ++t) sg[k * noises + t] = t == 0 || g[cc_index(t, t)] != 0 ? s.cs[k][t] : 0.0;
     }
@@ -1027,14 +1029,20 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
     out.status = FitStatus::too_few_points;
     return;
   }
+  // Laid out for every place (a later fit of this call finds the sums of the first where they were).
+  const std::size_t places = pr.places;
   pr.pair = workspace.data();
-  pr.sigma = pr.pair + pr.n * (pr.n + 1) / 2 * 14;
-  pr.rows = pr.sigma + pr.n * pr.n;
-  pr.markov_pair = pr.rows + pr.n * width;
-  pr.sinusoid_pair = pr.markov_pair + pr.n * (pr.n + 1) / 2 * markov_slots;
+  pr.sigma = pr.pair + places * (places + 1) / 2 * 14;
+  pr.rows = pr.sigma + places * places;
+  pr.markov_pair = pr.rows + places * width;
+  pr.sinusoid_pair = pr.markov_pair + places * (places + 1) / 2 * markov_slots;
   pr.exact_markov = false;
-  pair_sums_of_points(pr, setup, cache);
-  sinusoid_sums_of_points(pr, setup);
+  for (std::size_t i = 0; i < pr.n; ++i) pr.power[i] = power_design(pr.point[i]->stat, pr.point[i]->m, setup.tau0_s);
+  if (!pr.sums_made) {
+    pair_sums_of_points(pr, setup, cache);
+    sinusoid_sums_of_points(pr, setup, cache);
+    pr.sums_made = true;
+  }
   Candidate runner_up;
   std::array<double, max_markov + 1> nl_sd{};
   const Candidate best = select_model(pr, setup, filter, free, fixed, runner_up, nl_sd);
@@ -1109,6 +1117,8 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
     pr.n = kept;
   }
   if (workspace.size() < ieee952_workspace_doubles(pr.n) || !(setup.tau0_s > 0)) return out;
+  for (std::size_t i = 0; i < pr.n; ++i) pr.place[i] = i;
+  pr.places = pr.n;
 
   // Quantization, where its white level is known (counts): tested before the fit and after it.
   const double qw2 = setup.white_quantization * setup.white_quantization;

@@ -38,11 +38,15 @@ void digamma_row(std::int64_t a, std::array<double, 5>& out) {
   out[0] = out[1] - 1.0 / (z - 2);
 }
 
-double factorial(int n) {
-  double f = 1;
-  for (int i = 2; i <= n; ++i) f *= i;
+// n! for the n that R needs (twice_d <= 8 at level 1: n <= 8), exact in double.
+constexpr std::array<double, 9> factorials = [] {
+  std::array<double, 9> f{};
+  f[0] = 1;
+  for (std::size_t n = 1; n < f.size(); ++n) f[n] = f[n - 1] * static_cast<double>(n);
   return f;
-}
+}();
+
+double factorial(int n) { return factorials[static_cast<std::size_t>(n)]; }
 
 // A term as taps on one process: x (level 0) or its prefix sums P (level 1). Offsets are relative
 // to the newest point e of the term.
@@ -202,37 +206,60 @@ struct PairCounter {
 // the nodes are consecutive lattice points.
 constexpr std::int64_t grading = 16;
 
+// The nodes one at a time, in increasing order, each with its weight (what visit_nodes() visits):
+// two walks over the same kernel can then share the covariances at the lags they have in common.
+class NodeWalker {
+ public:
+  NodeWalker(std::int64_t lo, std::int64_t hi, std::int64_t step, std::int64_t max_step, std::int64_t smooth_lo,
+             std::int64_t smooth_hi, const std::int64_t* breaks, int n_breaks)
+      : hi_(hi), step_(step), max_step_(max_step), smooth_lo_(smooth_lo), smooth_hi_(smooth_hi), lo_(lo),
+        breaks_(breaks), n_breaks_(n_breaks), current_(lo), lattice_(static_cast<double>(step)) {}
+  // False once every node was given.
+  bool next(std::int64_t& lag, double& weight) {
+    if (done_) return false;
+    lag = current_;
+    if (current_ >= hi_) {
+      weight = have_previous_ ? static_cast<double>(current_ - previous_) / (2 * lattice_) + 0.5 : 1.0;
+      done_ = true;
+      return true;
+    }
+    const std::int64_t following = current_ + step_after(current_);
+    const double left = static_cast<double>(current_ - (have_previous_ ? previous_ : current_));
+    weight = (left + static_cast<double>(following - current_)) / (2 * lattice_) + (have_previous_ ? 0.0 : 0.5);
+    previous_ = current_;
+    have_previous_ = true;
+    current_ = following;
+    return true;
+  }
+
+ private:
+  std::int64_t step_after(std::int64_t node) {
+    while (b_ < n_breaks_ && breaks_[b_] <= node) ++b_;
+    const std::int64_t to_previous = node - (b_ > 0 ? breaks_[b_ - 1] : lo_);
+    const std::int64_t to_next = (b_ < n_breaks_ ? breaks_[b_] : hi_) - node;
+    std::int64_t h = ((to_previous < to_next ? to_previous : to_next) / (grading * step_)) * step_;
+    if (node >= smooth_lo_ && node <= smooth_hi_ && h > max_step_) h = max_step_;
+    if (h < step_) h = step_;
+    if (b_ < n_breaks_ && node + h > breaks_[b_]) h = breaks_[b_] - node;
+    if (node + h > hi_) h = hi_ - node;
+    return h;
+  }
+  std::int64_t hi_, step_, max_step_, smooth_lo_, smooth_hi_, lo_;
+  const std::int64_t* breaks_;
+  int n_breaks_;
+  int b_ = 0;
+  std::int64_t previous_ = 0, current_;
+  bool have_previous_ = false, done_ = false;
+  double lattice_;
+};
+
 template <class Visit>
 void visit_nodes(std::int64_t lo, std::int64_t hi, std::int64_t step, std::int64_t max_step, std::int64_t smooth_lo,
                  std::int64_t smooth_hi, const std::int64_t* breaks, int n_breaks, Visit&& visit) {
-  const double lattice = static_cast<double>(step);
-  std::int64_t previous = 0, current = 0;
-  bool have_previous = false, have_current = false;
-  auto emit = [&](std::int64_t next) {  // the weight of `current` is known once `next` is
-    if (have_current) {
-      const double left = static_cast<double>(current - (have_previous ? previous : current));
-      visit(current, (left + static_cast<double>(next - current)) / (2 * lattice) + (have_previous ? 0.0 : 0.5));
-      previous = current;
-      have_previous = true;
-    }
-    current = next;
-    have_current = true;
-  };
-  int b = 0;
-  for (std::int64_t node = lo;;) {
-    emit(node);
-    if (node >= hi) break;
-    while (b < n_breaks && breaks[b] <= node) ++b;
-    const std::int64_t to_previous = node - (b > 0 ? breaks[b - 1] : lo);
-    const std::int64_t to_next = (b < n_breaks ? breaks[b] : hi) - node;
-    std::int64_t h = ((to_previous < to_next ? to_previous : to_next) / (grading * step)) * step;
-    if (node >= smooth_lo && node <= smooth_hi && h > max_step) h = max_step;
-    if (h < step) h = step;
-    if (b < n_breaks && node + h > breaks[b]) h = breaks[b] - node;
-    if (node + h > hi) h = hi - node;
-    node += h;
-  }
-  visit(current, have_previous ? static_cast<double>(current - previous) / (2 * lattice) + 0.5 : 1.0);
+  NodeWalker walk(lo, hi, step, max_step, smooth_lo, smooth_hi, breaks, n_breaks);
+  std::int64_t lag = 0;
+  double weight = 0;
+  while (walk.next(lag, weight)) visit(lag, weight);
 }
 
 }  // namespace
@@ -445,76 +472,137 @@ struct NoiseAtAnyLag {
 
 }  // namespace
 
-PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
-  PairSums out;
+namespace {
+
+// One pair_sums() evaluation: its lags, nodes and sums; the covariances at each node are given to it.
+struct PowerPass {
   PairSetup setup;
-  if (!pair_setup(set, a, b, setup)) return out;
-  const Kernel& k = setup.k;
-  const ManyR& many = setup.many;
-  const auto& twice_d = many.twice_d;
-  const bool flicker = many.flicker;
-  const std::size_t noises = many.count;
-  const std::int64_t step = setup.step;
-  const PairCounter& pairs = setup.pairs;
-  // Lags with pairs, and the reach of c: (-u_max, -u_min) for polynomial noises. Flicker noises
-  // reach further, with c ~ lag^-p (p = the kernel's difference order minus the leading power of
-  // R): summed directly out to three kernel widths, beyond which the sum is the integral of that
-  // power law (its share there is below 1 %, the power law's own error a few percent of it). Far
-  // out, c is a difference of huge nearly equal values and could not be evaluated directly.
-  const std::int64_t extent_lo = setup.extent_lo, extent_hi = setup.extent_hi;
-  const std::int64_t width = k.u_max() - k.u_min() + 1;
-  const std::int64_t reach = flicker ? 3 * width : 0;
-  std::int64_t lo = extent_lo, hi = extent_hi;
-  if (lo < -k.u_max() - reach) lo = ceil_div(-k.u_max() - reach, step) * step;
-  if (hi > -k.u_min() + reach) hi = floor_div(-k.u_min() + reach, step) * step;
-  if (lo > hi) return out;
+  PairSums out;
+  std::int64_t lo = 0, hi = 0, max_step = 0;
   std::array<std::int64_t, 72> breaks{};
-  const int n_breaks = pair_breaks(setup, lo, hi, breaks);
-  const std::int64_t max_step = smooth_step(a, b, step);
-  auto accumulate = [&](double w, const std::array<double, max_noises>& c) {
-    for (std::size_t t = 0; t < noises; ++t) {
+  int n_breaks = 0;
+
+  // False when there is nothing to sum (out stays zero).
+  bool prepare(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
+    if (!pair_setup(set, a, b, setup)) return false;
+    const Kernel& k = setup.k;
+    const std::int64_t step = setup.step;
+    // Lags with pairs, and the reach of c: (-u_max, -u_min) for polynomial noises. Flicker noises
+    // reach further, with c ~ lag^-p (p = the kernel's difference order minus the leading power of
+    // R): summed directly out to three kernel widths, beyond which the sum is the integral of that
+    // power law (its share there is below 1 %, the power law's own error a few percent of it). Far
+    // out, c is a difference of huge nearly equal values and could not be evaluated directly.
+    const std::int64_t width = k.u_max() - k.u_min() + 1;
+    const std::int64_t reach = setup.many.flicker ? 3 * width : 0;
+    lo = setup.extent_lo, hi = setup.extent_hi;
+    if (lo < -k.u_max() - reach) lo = ceil_div(-k.u_max() - reach, step) * step;
+    if (hi > -k.u_min() + reach) hi = floor_div(-k.u_min() + reach, step) * step;
+    if (lo > hi) return false;
+    n_breaks = pair_breaks(setup, lo, hi, breaks);
+    max_step = smooth_step(a, b, step);
+    return true;
+  }
+  NodeWalker walker() const {
+    return NodeWalker(lo, hi, setup.step, max_step, -setup.k.u_max(), -setup.k.u_min(), breaks.data(), n_breaks);
+  }
+  // The node's weight times its pairs (0: nothing to add there).
+  double weight_at(std::int64_t lag, double weight) const { return weight * static_cast<double>(setup.pairs(lag)); }
+  void accumulate(double w, const std::array<double, max_noises>& c) {
+    for (std::size_t t = 0; t < setup.many.count; ++t) {
       out.c[t] += w * c[t];
       for (std::size_t u = 0; u <= t; ++u) out.cc[t][u] += w * c[t] * c[u];
     }
-  };
-  visit_nodes(lo, hi, step, max_step, -k.u_max(), -k.u_min(), breaks.data(), n_breaks,
-              [&](std::int64_t lag, double weight) {
-                const double w = weight * static_cast<double>(pairs(lag));
-                if (w == 0) return;
-                std::array<double, max_noises> c{};
-                covariances(k, many, lag, c);
-                accumulate(w, c);
-              });
-  if (flicker) {  // the power-law tails beyond lo and hi, out to the lags that have pairs
-    const double center = -0.5 * static_cast<double>(k.u_min() + k.u_max());
-    const std::array<double, max_noises> p = tail_powers(setup, a, b);
-    for (const std::int64_t edge : {lo, hi}) {
-      const bool left = edge == lo;
-      if (left ? extent_lo >= lo : extent_hi <= hi) continue;
-      const double pairs_at = static_cast<double>(pairs(edge));
-      if (pairs_at == 0) continue;
-      const double L = std::fabs(static_cast<double>(edge) - center);
-      const double L_max = std::fabs(static_cast<double>(left ? extent_lo : extent_hi) - center);
-      std::array<double, max_noises> c{};
-      covariances(k, many, edge, c);
-      // sum over the lattice beyond the edge = integral / step - f(edge) / 2 (Euler-Maclaurin),
-      // with f = pairs(edge) c_t c_u (L / x)^(p_t + p_u) and the pair count taken as constant.
-      for (std::size_t t = 0; t < noises; ++t) {
-        if (twice_d[t] % 2 == 0) continue;
-        const double lin = L / (p[t] - 1) * (1 - std::pow(L / L_max, p[t] - 1)) / static_cast<double>(step) - 0.5;
-        out.c[t] += pairs_at * c[t] * lin;
-        for (std::size_t u = 0; u <= t; ++u) {
-          if (twice_d[u] % 2 == 0) continue;
-          const double q = p[t] + p[u];
-          const double sq = L / (q - 1) * (1 - std::pow(L / L_max, q - 1)) / static_cast<double>(step) - 0.5;
-          out.cc[t][u] += pairs_at * c[t] * c[u] * sq;
+  }
+  // The power-law tails beyond lo and hi, out to the lags that have pairs; cc made symmetric.
+  void finish(const TermGrid& a, const TermGrid& b) {
+    const Kernel& k = setup.k;
+    const auto& twice_d = setup.many.twice_d;
+    const std::size_t noises = setup.many.count;
+    const PairCounter& pairs = setup.pairs;
+    if (setup.many.flicker) {
+      const double center = -0.5 * static_cast<double>(k.u_min() + k.u_max());
+      const std::array<double, max_noises> p = tail_powers(setup, a, b);
+      for (const std::int64_t edge : {lo, hi}) {
+        const bool left = edge == lo;
+        if (left ? setup.extent_lo >= lo : setup.extent_hi <= hi) continue;
+        const double pairs_at = static_cast<double>(pairs(edge));
+        if (pairs_at == 0) continue;
+        const double L = std::fabs(static_cast<double>(edge) - center);
+        const double L_max = std::fabs(static_cast<double>(left ? setup.extent_lo : setup.extent_hi) - center);
+        std::array<double, max_noises> c{};
+        covariances(k, setup.many, edge, c);
+        // sum over the lattice beyond the edge = integral / step - f(edge) / 2 (Euler-Maclaurin),
+        // with f = pairs(edge) c_t c_u (L / x)^(p_t + p_u) and the pair count taken as constant.
+        for (std::size_t t = 0; t < noises; ++t) {
+          if (twice_d[t] % 2 == 0) continue;
+          const double lin = L / (p[t] - 1) * (1 - std::pow(L / L_max, p[t] - 1)) / static_cast<double>(setup.step) - 0.5;
+          out.c[t] += pairs_at * c[t] * lin;
+          for (std::size_t u = 0; u <= t; ++u) {
+            if (twice_d[u] % 2 == 0) continue;
+            const double q = p[t] + p[u];
+            const double sq = L / (q - 1) * (1 - std::pow(L / L_max, q - 1)) / static_cast<double>(setup.step) - 0.5;
+            out.cc[t][u] += pairs_at * c[t] * c[u] * sq;
+          }
         }
       }
     }
+    for (std::size_t t = 0; t < noises; ++t)
+      for (std::size_t u = 0; u < t; ++u) out.cc[u][t] = out.cc[t][u];
   }
-  for (std::size_t t = 0; t < noises; ++t)
-    for (std::size_t u = 0; u < t; ++u) out.cc[u][t] = out.cc[t][u];
-  return out;
+};
+
+}  // namespace
+
+PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
+  PowerPass pass;
+  if (!pass.prepare(set, a, b)) return pass.out;
+  NodeWalker walk = pass.walker();
+  std::int64_t lag = 0;
+  double weight = 0;
+  while (walk.next(lag, weight)) {
+    const double w = pass.weight_at(lag, weight);
+    if (w == 0) continue;
+    std::array<double, max_noises> c{};
+    covariances(pass.setup.k, pass.setup.many, lag, c);
+    pass.accumulate(w, c);
+  }
+  pass.finish(a, b);
+  return pass.out;
+}
+
+void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b1, const TermGrid& a2,
+                      const TermGrid& b2, PairSums& out1, PairSums& out2) {
+  const bool same_kernel = a1.stat == a2.stat && a1.m == a2.m && b1.stat == b2.stat && b1.m == b2.m &&
+                           a1.stride == a2.stride && b1.stride == b2.stride;
+  PowerPass one, two;
+  const bool has_one = one.prepare(set, a1, b1), has_two = two.prepare(set, a2, b2);
+  if (!same_kernel || !has_one || !has_two) {
+    out1 = pair_sums(set, a1, b1);
+    out2 = pair_sums(set, a2, b2);
+    return;
+  }
+  // The two walks in step: a lag both visit has its covariances evaluated once.
+  NodeWalker walk1 = one.walker(), walk2 = two.walker();
+  std::int64_t lag1 = 0, lag2 = 0;
+  double weight1 = 0, weight2 = 0;
+  bool more1 = walk1.next(lag1, weight1), more2 = walk2.next(lag2, weight2);
+  while (more1 || more2) {
+    const bool take1 = more1 && (!more2 || lag1 <= lag2), take2 = more2 && (!more1 || lag2 <= lag1);
+    const std::int64_t lag = take1 ? lag1 : lag2;
+    const double w1 = take1 ? one.weight_at(lag, weight1) : 0.0, w2 = take2 ? two.weight_at(lag, weight2) : 0.0;
+    if (w1 != 0 || w2 != 0) {
+      std::array<double, max_noises> c{};
+      covariances(one.setup.k, one.setup.many, lag, c);
+      if (w1 != 0) one.accumulate(w1, c);
+      if (w2 != 0) two.accumulate(w2, c);
+    }
+    if (take1) more1 = walk1.next(lag1, weight1);
+    if (take2) more2 = walk2.next(lag2, weight2);
+  }
+  one.finish(a1, b1);
+  two.finish(a2, b2);
+  out1 = one.out;
+  out2 = two.out;
 }
 
 MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rates, const TermGrid& a,
@@ -826,7 +914,8 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b) {
     const std::uint64_t n1 = first + (from + 2) * coarse, n2 = n1 + 8 * span + 8 * coarse;
     const TermGrid a1 = unbroken_grid(a.stat, a.m, a.stride, n1), b1 = unbroken_grid(b.stat, b.m, b.stride, n1);
     const TermGrid a2 = unbroken_grid(a.stat, a.m, a.stride, n2), b2 = unbroken_grid(b.stat, b.m, b.stride, n2);
-    const PairSums s1 = pair_sums(set, a1, b1), s2 = pair_sums(set, a2, b2);
+    PairSums s1, s2;
+    pair_sums_of_two(set, a1, b1, a2, b2, s1, s2);
     const double c1 = static_cast<double>(a_coarse ? a1.n : b1.n), c2 = static_cast<double>(a_coarse ? a2.n : b2.n);
     PairSums minus;
     add_scaled(minus, s1, -1.0, PairSums{});
@@ -845,8 +934,43 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b) {
   return entry->sums;
 }
 
+namespace {
+
+bool same_grid(const TermGrid& a, const TermGrid& b) {
+  return a.stat == b.stat && a.m == b.m && a.stride == b.stride && a.first == b.first && a.n == b.n;
+}
+
+}  // namespace
+
+SinusoidPairSums PairSumCache::sinusoid_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a,
+                                             const TermGrid& b) {
+  const std::size_t count = thetas.size() < max_sinusoid_rates ? thetas.size() : max_sinusoid_rates;
+  std::uint64_t h = (a.m * 0x9E3779B97F4A7C15u) ^ (b.m * 0xC2B2AE3D27D4EB4Fu) ^ (a.n << 7) ^ (b.n << 13) ^
+                    (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5);
+  for (std::size_t probe = 0; probe < sinusoids_.size() && probe < 64; ++probe) {
+    SinusoidEntry& e = sinusoids_[static_cast<std::size_t>((h + probe) % sinusoids_.size())];
+    if (e.used) {
+      bool same = e.count == count && e.set.count == set.count && same_grid(e.a, a) && same_grid(e.b, b);
+      for (std::size_t t = 0; same && t < set.count; ++t) same = e.set.alpha[t] == set.alpha[t];
+      for (std::size_t j = 0; same && j < count; ++j) same = e.thetas[j] == thetas[j];
+      if (same) return e.sums;
+      continue;
+    }
+    e.used = true;
+    e.set = set;
+    e.a = a;
+    e.b = b;
+    e.count = count;
+    for (std::size_t j = 0; j < count; ++j) e.thetas[j] = thetas[j];
+    e.sums = sinusoid_pair_sums(set, thetas, a, b);
+    return e.sums;
+  }
+  return sinusoid_pair_sums(set, thetas, a, b);
+}
+
 void PairSumCache::clear() {
   for (Entry& e : entries_) e = Entry{};
+  for (SinusoidEntry& e : sinusoids_) e = SinusoidEntry{};
 }
 
 double exact_edf(int alpha, const TermGrid& g) {

@@ -201,10 +201,11 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   std::vector<CurveFit> fits;
   if (points.empty()) return fits;
   std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
-  // The three fits share the covariance sums of their points: computed once, in a cache with room
-  // for every pair.
+  // The three fits share the covariance sums of their points (and the sinusoids' with them):
+  // computed once, in a cache with room for every pair.
   std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
-  PairSumCache cache(entries);
+  std::vector<PairSumCache::SinusoidEntry> sinusoid_entries(points.size() * points.size() + 16);
+  PairSumCache cache(entries, sinusoid_entries);
   FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
   setup.sinusoid_hz = sinusoid_hz;
   const int used = long_tau != LongTau::oadev && !record.phase.empty() ? static_cast<int>(long_tau) : 0;

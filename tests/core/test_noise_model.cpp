@@ -133,6 +133,73 @@ TEST(NoiseModel, PairSumsEqualTheSumOverEveryPair) {
   }
 }
 
+// Every sum of two PairSums equal to the last bit.
+void expect_same_sums(const PairSums& got, const PairSums& want, const char* what) {
+  for (std::size_t t = 0; t < max_noises; ++t) {
+    EXPECT_EQ(got.c[t], want.c[t]) << what << " c " << t;
+    for (std::size_t u = 0; u < max_noises; ++u) EXPECT_EQ(got.cc[t][u], want.cc[t][u]) << what << " cc " << t << u;
+  }
+}
+
+TEST(NoiseModel, TwoPairSumsInOnePassAreTheSumsOfEach) {
+  // Oracle: pair_sums() of each pair alone; the pass that shares the lags both visit must give the
+  // same numbers to the bit (same nodes, weights and order of summation for each).
+  const NoiseSet set = allan_noises();
+  struct Case {
+    Stat a, b;
+    std::uint64_t m_a, m_b, stride_a, stride_b, n1, n2;
+  };
+  const Case cases[] = {
+      {Stat::avar, Stat::avar, 64, 64, 1, 1, 3000, 9000},    {Stat::avar, Stat::mvar, 16, 256, 1, 1, 7000, 20000},
+      {Stat::mvar, Stat::mvar, 1024, 32, 1, 1, 40000, 90000}, {Stat::avar, Stat::avar, 512, 128, 8, 4, 30000, 31000},
+      {Stat::mvar, Stat::avar, 8, 8, 1, 1, 100, 100},         {Stat::avar, Stat::avar, 4, 4, 1, 1, 5, 6000},
+  };
+  for (const Case& k : cases) {
+    const TermGrid a1 = unbroken_grid(k.a, k.m_a, k.stride_a, k.n1), b1 = unbroken_grid(k.b, k.m_b, k.stride_b, k.n1);
+    const TermGrid a2 = unbroken_grid(k.a, k.m_a, k.stride_a, k.n2), b2 = unbroken_grid(k.b, k.m_b, k.stride_b, k.n2);
+    PairSums one, two;
+    pair_sums_of_two(set, a1, b1, a2, b2, one, two);
+    expect_same_sums(one, pair_sums(set, a1, b1), "first");
+    expect_same_sums(two, pair_sums(set, a2, b2), "second");
+  }
+  // Different kernels: each pair alone.
+  const TermGrid a = unbroken_grid(Stat::avar, 8, 1, 5000), b = unbroken_grid(Stat::mvar, 32, 1, 5000);
+  PairSums one, two;
+  pair_sums_of_two(set, a, b, b, a, one, two);
+  expect_same_sums(one, pair_sums(set, a, b), "first of two kernels");
+  expect_same_sums(two, pair_sums(set, b, a), "second of two kernels");
+}
+
+TEST(NoiseModel, TheCacheKeepsSinusoidSumsExactly) {
+  // Oracle: sinusoid_pair_sums() itself; the cache must give its numbers to the bit, the first time
+  // and when asked again, and tell apart grids and frequencies.
+  NoiseSet set;
+  set.alpha = {2, 0, -1, -2};
+  set.count = 4;
+  std::vector<PairSumCache::Entry> entries(8);
+  std::vector<PairSumCache::SinusoidEntry> kept(8);
+  PairSumCache cache(entries, kept);
+  const double thetas[] = {0.02, 0.3}, other[] = {0.02, 0.31};
+  const TermGrid a = unbroken_grid(Stat::avar, 16, 1, 20000), b = unbroken_grid(Stat::mvar, 64, 1, 20000);
+  const TermGrid c = unbroken_grid(Stat::mvar, 64, 1, 30000);
+  for (int round = 0; round < 2; ++round) {
+    const SinusoidPairSums got_ab = cache.sinusoid_sums(set, thetas, a, b), want_ab = sinusoid_pair_sums(set, thetas, a, b);
+    const SinusoidPairSums got_ac = cache.sinusoid_sums(set, thetas, a, c), want_ac = sinusoid_pair_sums(set, thetas, a, c);
+    const SinusoidPairSums got_o = cache.sinusoid_sums(set, other, a, b), want_o = sinusoid_pair_sums(set, other, a, b);
+    for (std::size_t j = 0; j < max_sinusoid_rates; ++j)
+      for (std::size_t t = 0; t < set.count; ++t) {
+        EXPECT_EQ(got_ab.cs[j][t], want_ab.cs[j][t]) << round << " " << j << " " << t;
+        EXPECT_EQ(got_ac.cs[j][t], want_ac.cs[j][t]) << round << " " << j << " " << t;
+        EXPECT_EQ(got_o.cs[j][t], want_o.cs[j][t]) << round << " " << j << " " << t;
+      }
+    EXPECT_NE(want_ab.cs[0][2], want_ac.cs[0][2]);  // the cases differ: the test can tell a mix-up
+    EXPECT_NE(want_ab.cs[1][2], want_o.cs[1][2]);
+  }
+  // Without storage for them, computed afresh.
+  PairSumCache plain(entries);
+  EXPECT_EQ(plain.sinusoid_sums(set, thetas, a, b).cs[0][2], sinusoid_pair_sums(set, thetas, a, b).cs[0][2]);
+}
+
 TEST(NoiseModel, ClosedFormsOfTheEdf) {
   // White FM, m = 1, N = 4096 phase points: n = 4094 AVAR terms y_{k+1} - y_k of white y, with
   // c(0) = 2, c(1) = -1: EDF = 4 n^2 / (6 n - 2) = 2729.6. Greenhall's approximation gives 3204.

@@ -99,6 +99,12 @@ struct PairSums {
 };
 PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b);
 
+/// pair_sums(set, a1, b1) and pair_sums(set, a2, b2), the same to the last bit, in one pass where
+/// the two pairs have the same kernel (the same statistics, m and strides; say the same grids at
+/// two lengths of the run): the covariances at the lags both sums visit are evaluated once.
+void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b1, const TermGrid& a2,
+                      const TermGrid& b2, PairSums& out1, PairSums& out2);
+
 /// The same sums with first-order Gauss-Markov rates beside the noises of `set` (the IEEE-952
 /// fit's exact covariance of a model with Markov terms): c_j the term covariance of Markov rate j
 /// (markov_term_covariance() with a = rates[j], unit stationary variance),
@@ -201,9 +207,24 @@ class PairSumCache {
     std::uint64_t n_a = 0, n_b = 0; // not linear: the term counts of `sums`
     PairSums slope, sums;           // linear: sums = slope * n + sums (the intercept)
   };
-  explicit PairSumCache(std::span<Entry> storage) : entries_(storage) {}
+  /// sinusoid_pair_sums() of one pair of grids at given frequencies, kept exactly as computed.
+  struct SinusoidEntry {
+    bool used = false;
+    NoiseSet set;
+    TermGrid a, b;
+    std::array<double, max_sinusoid_rates> thetas{};
+    std::size_t count = 0;
+    SinusoidPairSums sums;
+  };
+  explicit PairSumCache(std::span<Entry> storage, std::span<SinusoidEntry> sinusoids = {})
+      : entries_(storage), sinusoids_(sinusoids) {}
   /// pair_sums(allan_noises(), a, b), from the cache where it can. O(1) once cached.
   PairSums get(const TermGrid& a, const TermGrid& b);
+  /// sinusoid_pair_sums(set, thetas, a, b), the same to the last bit: kept in the sinusoid storage
+  /// (when there is one) for the next fit of the same grids and frequencies (the analyzer fits
+  /// both curves and each alone). O(1) once kept; a full storage computes afresh.
+  SinusoidPairSums sinusoid_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a,
+                                 const TermGrid& b);
   /// Asks `source` first from now on (null: none); it must outlive its use here.
   void attach(const PairSumSource* source) { source_ = source; }
   /// Forgets everything (a new configuration). O(capacity).
@@ -212,6 +233,7 @@ class PairSumCache {
  private:
   Entry* slot(const TermGrid& a, const TermGrid& b);  // null: not kept
   std::span<Entry> entries_;
+  std::span<SinusoidEntry> sinusoids_;
   const PairSumSource* source_ = nullptr;
 };
 
