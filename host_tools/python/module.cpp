@@ -162,16 +162,20 @@ py::dict stat_arrays(const std::vector<AnalysisRow>& rows, DevStat stat, const R
   return d;
 }
 
-// gyrochar-analyze on values in memory: the same plan (plan.hpp), engine (analysis.hpp) and fit
-// (analysis_report.hpp). taus: "octave", "decade", "all", or "list" with `listed`. stride_factor
-// and total_stride_factor 0: full and exact. Returns a dict (see gyrochar/__init__.py).
-py::dict analyze(const py::buffer& buffer, double tau0, const std::string& type_text, const std::string& unit,
-                 double pulse_value, const std::string& pulse_unit, const std::string& rate, const std::vector<std::string>& stat_names,
-                 const std::string& taus, const std::vector<std::uint64_t>& listed, std::uint32_t stride_factor,
-                 std::uint32_t total_stride_factor, double confidence, std::optional<int> alpha, bool fit,
-                 unsigned threads) {
-  Values values(buffer);
+// What a run is asked for: the options, the units, the statistics shown, whether to fit.
+struct Setup {
   AnalysisOptions o;
+  ReportUnits units;
+  std::vector<DevStat> shown;
+  bool fit = false;
+};
+
+Setup make_setup(double tau0, const std::string& type_text, const std::string& unit, double pulse_value,
+                 const std::string& pulse_unit, const std::string& rate, const std::vector<std::string>& stat_names,
+                 std::uint32_t stride_factor, std::uint32_t total_stride_factor, double confidence,
+                 std::optional<int> alpha, bool fit, unsigned threads) {
+  Setup s;
+  AnalysisOptions& o = s.o;
   o.type = data_type(type_text);
   o.tau0_s = tau0;
   o.confidence = confidence;
@@ -180,80 +184,90 @@ py::dict analyze(const py::buffer& buffer, double tau0, const std::string& type_
   o.total_stride_factor = total_stride_factor;
   o.threads = threads;
   o.stats.clear();
-  for (const std::string& s : stat_names) {
-    const auto st = parse_dev_stat(s);
-    if (!st) throw py::value_error("unknown statistic '" + s + "'");
+  for (const std::string& name : stat_names) {
+    const auto st = parse_dev_stat(name);
+    if (!st) throw py::value_error("unknown statistic '" + name + "'");
     o.stats.push_back(*st);
   }
-  const std::vector<DevStat> shown = o.stats;
+  s.shown = o.stats;
+  s.fit = fit;
   if (fit)  // the fit uses both curves, as gyrochar-analyze --fit
-    for (const DevStat s : {DevStat::oadev, DevStat::mdev})
-      if (std::find(o.stats.begin(), o.stats.end(), s) == o.stats.end()) o.stats.push_back(s);
-  const ReportUnits units = report_units(o.type, unit, pulse_value, pulse_unit, rate);
-  if (values.size() == 0) throw py::value_error("no values");
-  const std::uint64_t n_values = values.size();
-  const std::uint64_t n_phase = o.type == DataType::phase ? n_values : n_values + 1;
-  // The length is known: "all" plans on it; the other rules plan, as gyrochar-analyze on a file,
-  // on an upper bound (twice it), so that "full" overlaps every tau up to N/2.
-  o.values_hint = n_values;
-  const TauPlan plan = plan_taus(o, taus, listed, taus == "all" ? n_phase : 2 * n_phase, memory_budget());
-  if (o.m_list.empty()) throw py::value_error(fmt::format("{} phase points are too few for any tau", n_phase));
+    for (const DevStat st : {DevStat::oadev, DevStat::mdev})
+      if (std::find(o.stats.begin(), o.stats.end(), st) == o.stats.end()) o.stats.push_back(st);
+  s.units = report_units(o.type, unit, pulse_value, pulse_unit, rate);
+  return s;
+}
+
+// The taus and the stride factor (plan.hpp) over at most n_phase phase points (0: unknown), and the
+// analyzer for them.
+std::unique_ptr<Analyzer> planned_analyzer(Setup& s, const std::string& taus, const std::vector<std::uint64_t>& listed,
+                                           std::uint64_t n_phase) {
+  AnalysisOptions& o = s.o;
+  const TauPlan plan = plan_taus(o, taus, listed, n_phase, memory_budget());
+  if (o.m_list.empty()) throw py::value_error(fmt::format("{} phase points are too few for any tau", n_phase / 2));
   for (const std::uint64_t m : plan.not_formed)
-    if (m <= n_phase / 2)
+    if (n_phase == 0 || m <= n_phase / 2)
       throw py::value_error(fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must "
                                         "be a multiple of its stride (m/S rounded up to a power of two)", m, o.stride_factor));
   if (!plan.held && history_bytes(o.type, o.stride_factor, o.m_list.back()) > memory_budget())
     throw py::value_error(fmt::format("stride factor {} with taus up to {} needs more memory than this process may use "
                                       "({}): give a smaller stride factor or fewer taus", o.stride_factor,
                                       o.m_list.back(), memory_budget_reason()));
-  std::unique_ptr<Analyzer> analyzer;
   try {
-    analyzer = std::make_unique<Analyzer>(o);
+    return std::make_unique<Analyzer>(o);
   } catch (const std::invalid_argument& e) {
     throw py::value_error(e.what());
   }
+}
 
+// Adds the values in blocks of 2^20 without the GIL; between them a pending KeyboardInterrupt stops
+// the call. `added`: values added so far, counted on (up to a refused value, which is not added).
+void feed(Analyzer& analyzer, Values& values, std::uint64_t& added) {
+  constexpr std::size_t chunk = 1 << 20, block = 1 << 14;
+  std::size_t done = 0;
+  while (done < values.size()) {
+    const std::size_t end = std::min(values.size(), done + chunk);
+    {
+      py::gil_scoped_release release;
+      for (std::size_t i = done; i < end; i += block) {
+        const std::size_t n = std::min(block, end - i);
+        try {
+          analyzer.add(values.block(i, n));
+        } catch (const BadValue& e) {
+          added += e.index();
+          throw std::invalid_argument(fmt::format("values[{}]: {}", added, e.what()));
+        } catch (const std::range_error& e) {
+          throw std::invalid_argument(fmt::format("values[{}:{}]: {}", added, added + n, e.what()));
+        }
+        added += n;
+      }
+    }
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    done = end;
+  }
+}
+
+// The results so far as a dict (see gyrochar/__init__.py), computed (and fitted) without the GIL.
+py::dict results(const Analyzer& analyzer, const Setup& s) {
+  const ReportUnits& units = s.units;
   Analysis a;
   std::vector<CurveFit> fits;
   {
-    // Blocks of 2^20 values without the GIL; between them a pending KeyboardInterrupt stops the call.
-    constexpr std::size_t chunk = 1 << 20, block = 1 << 14;
-    std::size_t done = 0;
-    while (done < values.size()) {
-      const std::size_t end = std::min(values.size(), done + chunk);
-      {
-        py::gil_scoped_release release;
-        try {
-          for (std::size_t i = done; i < end; i += block) {
-            const std::size_t n = std::min(block, end - i);
-            try {
-              analyzer->add(values.block(i, n));
-            } catch (const BadValue& e) {
-              throw std::invalid_argument(fmt::format("values[{}]: {}", i + e.index(), e.what()));
-            }
-          }
-        } catch (const std::range_error& e) {
-          throw std::invalid_argument(fmt::format("by values[{}]: {}", end - 1, e.what()));
-        }
-      }
-      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-      done = end;
-    }
     py::gil_scoped_release release;
     try {
-      a = analyzer->result();
+      a = analyzer.result();
     } catch (const std::range_error& e) {
       throw std::invalid_argument(e.what());
     }
-    if (fit)
-      fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
-                        LongTau::oadev, analyzer->record());
+    if (s.fit)
+      fits = fit_curves(a, units, s.o.tau0_s, s.o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
+                        LongTau::oadev, analyzer.record());
   }
-  if (std::none_of(a.rows.begin(), a.rows.end(),
-                   [&](const AnalysisRow& r) { return std::find(shown.begin(), shown.end(), r.stat) != shown.end(); }))
+  const auto shown = [&](const AnalysisRow& r) { return std::find(s.shown.begin(), s.shown.end(), r.stat) != s.shown.end(); };
+  if (std::none_of(a.rows.begin(), a.rows.end(), shown))
     throw py::value_error(fmt::format("{} values are too few for any of the taus asked", a.n_values));
   for (const AnalysisRow& r : a.rows)  // the output unit must not take a value out of range
-    if (std::find(shown.begin(), shown.end(), r.stat) != shown.end() &&
+    if (shown(r) &&
         (!std::isfinite(r.dev * units.factor()) || (r.dev != 0 && !(std::fabs(r.dev * units.factor()) >= 2.2250738585072014e-308))))
       throw py::value_error(fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) leaves a "
                                         "double's range", name(r.stat), r.tau_s, r.m, r.dev, units.factor(),
@@ -264,23 +278,66 @@ py::dict analyze(const py::buffer& buffer, double tau0, const std::string& type_
   out["stride_factor"] = a.stride_factor;
   out["units_input"] = units.input;
   py::dict stats;
-  for (const DevStat s : shown) stats[name(s)] = stat_arrays(a.rows, s, units);
+  for (const DevStat st : s.shown) stats[name(st)] = stat_arrays(a.rows, st, units);
   out["stats"] = stats;
-  if (fit) {
+  if (s.fit) {
     // The fit's part of gyrochar-analyze's JSON report, as text for json.loads.
-    const Report report{a, o.type, o.tau0_s, o.confidence, units, std::move(fits), std::nullopt, "values", DataRange{},
+    const Report report{a, s.o.type, s.o.tau0_s, s.o.confidence, units, std::move(fits), std::nullopt, "values", DataRange{},
                         std::nullopt, std::nullopt};
     out["fit_json"] = to_json(report)["fit"].dump();
   }
   return out;
 }
 
+// gyrochar-analyze on values in memory: the same plan (plan.hpp), engine (analysis.hpp) and fit
+// (analysis_report.hpp). taus: "octave", "decade", "all", or "list" with `listed`. stride_factor
+// and total_stride_factor 0: full and exact.
+py::dict analyze(const py::buffer& buffer, Setup s, const std::string& taus, const std::vector<std::uint64_t>& listed) {
+  Values values(buffer);
+  if (values.size() == 0) throw py::value_error("no values");
+  const std::uint64_t n_values = values.size();
+  const std::uint64_t n_phase = s.o.type == DataType::phase ? n_values : n_values + 1;
+  // The length is known: "all" plans on it; the other rules plan, as gyrochar-analyze on a file,
+  // on an upper bound (twice it), so that "full" overlaps every tau up to N/2.
+  s.o.values_hint = n_values;
+  const std::unique_ptr<Analyzer> analyzer = planned_analyzer(s, taus, listed, taus == "all" ? n_phase : 2 * n_phase);
+  std::uint64_t added = 0;
+  feed(*analyzer, values, added);
+  return results(*analyzer, s);
+}
+
+// The streaming characterizer: gyrochar-analyze on standard input (length unknown: taus up to
+// 2^39 or the list, stride factor "full" = 2^16), fed any number of blocks of any size.
+class Stream {
+ public:
+  Stream(Setup s, const std::string& taus, const std::vector<std::uint64_t>& listed)
+      : setup_(std::move(s)), analyzer_(planned_analyzer(setup_, taus, listed, 0)) {}
+  void add(const py::buffer& buffer) {
+    Values values(buffer);
+    feed(*analyzer_, values, added_);
+  }
+  py::dict estimates() const { return results(*analyzer_, setup_); }
+  std::uint64_t values() const { return added_; }
+
+ private:
+  Setup setup_;
+  std::unique_ptr<Analyzer> analyzer_;
+  std::uint64_t added_ = 0;
+};
+
 }  // namespace
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "gyrochar's engine (the analyzer's C++ code); use the gyrochar package, not this module";
-  m.def("analyze", &analyze, py::arg("values"), py::arg("tau0"), py::arg("type"), py::arg("unit"),
-        py::arg("pulse_value"), py::arg("pulse_unit"), py::arg("rate_unit"), py::arg("stats"), py::arg("taus"),
-        py::arg("listed"), py::arg("stride_factor"), py::arg("total_stride_factor"), py::arg("confidence"),
-        py::arg("alpha"), py::arg("fit"), py::arg("threads"));
+  py::class_<Setup>(m, "Setup");
+  m.def("setup", &make_setup, py::arg("tau0"), py::arg("type"), py::arg("unit"), py::arg("pulse_value"),
+        py::arg("pulse_unit"), py::arg("rate_unit"), py::arg("stats"), py::arg("stride_factor"),
+        py::arg("total_stride_factor"), py::arg("confidence"), py::arg("alpha"), py::arg("fit"), py::arg("threads"));
+  m.def("analyze", &analyze, py::arg("values"), py::arg("setup"), py::arg("taus"), py::arg("listed"));
+  py::class_<Stream>(m, "Characterizer")
+      .def(py::init<Setup, const std::string&, const std::vector<std::uint64_t>&>(), py::arg("setup"), py::arg("taus"),
+           py::arg("listed"))
+      .def("add", &Stream::add, py::arg("values"))
+      .def("estimates", &Stream::estimates)
+      .def_property_readonly("values", &Stream::values);
 }

@@ -137,3 +137,38 @@ def test_bad_arguments_raise_with_the_cause(kwargs, error, words):
     with pytest.raises(error) as e:
         gyrochar.analyze(args.pop("values"), args.pop("tau0"), **args)
     assert words in str(e.value)
+
+
+def program_json_stdin(program, path, args):
+    with open(path, "rb") as f:
+        out = subprocess.run([program, "--format", "json", *args, "-"], stdin=f, check=True, capture_output=True)
+    return json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("chunk", [1, 1000, 7919])
+def test_characterizer_in_blocks_equals_program_on_standard_input(analyze_program, tmp_path, chunk):
+    # The oracle: gyrochar-analyze reading the same counts from standard input (length unknown).
+    counts, path = counts_record(tmp_path, 30000)
+    stats = ["oadev", "mdev", "ohdev"]
+    report = program_json_stdin(analyze_program, path, ["--type", "counts", "--tau0", "0.01", "--pulse-weight",
+                                                        "1arcsec", "--stats", ",".join(stats)])
+    c = gyrochar.Characterizer(0.01, type="counts", pulse_weight="1arcsec", stats=stats)
+    values = counts[:5000] if chunk == 1 else counts
+    for i in range(0, len(values), chunk):
+        c.add(values[i:i + chunk])
+    if chunk == 1:  # one at a time for the first 5000, then the rest at once
+        c.add(counts[5000:])
+    assert c.values == len(counts)
+    assert_rows_equal(c.estimates(), report, stats)
+
+
+def test_characterizer_estimates_at_any_time_and_refuses_bad_values():
+    c = gyrochar.Characterizer(1.0, type="phase", stats=("oadev",), stride_factor=8)
+    c.add(np.arange(100.0) ** 2)
+    first = c.estimates().oadev
+    with pytest.raises(ValueError, match=r"values\[102\]"):
+        c.add([1.0, 2.0, np.inf])
+    assert c.values == 102  # the two values before the refused one stay added
+    assert len(first) > 0
+    with pytest.raises(ValueError, match="needs the length"):
+        gyrochar.Characterizer(1.0, taus="all")

@@ -19,7 +19,7 @@ import numpy as _np
 
 from . import _native
 
-__all__ = ["analyze", "Analysis", "StatResult", "STATS"]
+__all__ = ["analyze", "Characterizer", "Analysis", "StatResult", "STATS"]
 
 #: The statistics analyze() computes, by gyrochar-analyze's names.
 STATS = ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev", "theo1",
@@ -144,6 +144,22 @@ def analyze(values, tau0, type="phase", unit="", pulse_weight=None, stats=("oade
     Returns an Analysis. Raises TypeError or ValueError naming the cause for bad arguments or
     values (a value that is not finite, a count that is not an integer, too few values).
     """
+    setup, rule, listed = _setup(tau0, type, unit, pulse_weight, stats, taus, stride_factor, confidence, fit, rate_unit,
+                                 alpha, total_stride_factor, threads)
+    return Analysis(_native.analyze(_array(values), setup, rule, listed), float(tau0), type, float(confidence))
+
+
+def _array(values):
+    """values as an array the engine reads in place (float64 or int64; a narrower one is widened once)."""
+    data = values if isinstance(values, _np.ndarray) else _np.asarray(values, dtype=float)
+    if data.dtype == _np.float32 or data.dtype == _np.int32:
+        data = data.astype(float)
+    return data
+
+
+def _setup(tau0, type, unit, pulse_weight, stats, taus, stride_factor, confidence, fit, rate_unit, alpha,
+           total_stride_factor, threads):
+    """The checked arguments as the engine's setup, the tau rule and the listed taus."""
     if isinstance(tau0, bool) or not isinstance(tau0, _numbers.Real):
         raise TypeError("tau0 must be a number of seconds, not %r" % (tau0,))
     tau0 = float(tau0)
@@ -186,9 +202,40 @@ def analyze(values, tau0, type="phase", unit="", pulse_weight=None, stats=("oade
     if alpha is not None and (isinstance(alpha, bool) or not isinstance(alpha, _numbers.Integral)
                               or not -4 <= alpha <= 2):
         raise ValueError("alpha must be None (identified per tau) or an integer from -4 to 2, not %r" % (alpha,))
-    data = values if isinstance(values, _np.ndarray) else _np.asarray(values, dtype=float)
-    if data.dtype == _np.float32 or data.dtype == _np.int32:
-        data = data.astype(float)  # the engine reads float64 or int64; a narrower array is widened once
-    raw = _native.analyze(data, tau0, type, unit, pulse_value, pulse_unit, rate_unit, stats, rule, listed, sf, tsf,
-                          float(confidence), alpha, fit is not None, int(threads))
-    return Analysis(raw, tau0, type, float(confidence))
+    setup = _native.setup(tau0, type, unit, pulse_value, pulse_unit, rate_unit, stats, sf, tsf, float(confidence), alpha,
+                          fit is not None, int(threads))
+    return setup, rule, listed
+
+
+class Characterizer:
+    """The streaming characterizer: add() blocks of values of any size in order, estimates() at any
+    time; what gyrochar-analyze gives for the same values on standard input (length unknown: octave
+    or decade taus without end, "full" = stride factor 2^16 and taus above it strided, or a list).
+    Arguments as analyze() but taus "octave", "decade" or a list; estimates() returns an Analysis.
+    Memory stays fixed whatever the number of values (the history of the stride factor); a record
+    is held only for the total family.
+    """
+
+    def __init__(self, tau0, type="phase", unit="", pulse_weight=None, stats=("oadev", "mdev"), taus="octave",
+                 stride_factor="full", confidence=0.683, fit=None, rate_unit="deg/h", alpha=None,
+                 total_stride_factor=16, threads=0):
+        if taus == "all":
+            raise ValueError("taus='all' needs the length: use analyze()")
+        setup, rule, listed = _setup(tau0, type, unit, pulse_weight, stats, taus, stride_factor, confidence, fit,
+                                     rate_unit, alpha, total_stride_factor, threads)
+        self._native = _native.Characterizer(setup, rule, listed)
+        self._args = (float(tau0), type, float(confidence))
+
+    def add(self, values):
+        """Adds the next values (float64 or int64, read in place). A bad value raises ValueError
+        naming its index since the first value; the values before it stay added."""
+        self._native.add(_array(values))
+
+    def estimates(self):
+        """The Analysis of the values so far."""
+        return Analysis(self._native.estimates(), *self._args)
+
+    @property
+    def values(self):
+        """The number of values added."""
+        return self._native.values
