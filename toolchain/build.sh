@@ -14,12 +14,14 @@ esac
 
 # Debian packages: the host build, then what only the tests need (cross compilers for the
 # microcontroller build of the core). The host preset configures the tests too, so their own
-# libraries are here (libfftw3-dev: the analyzer's PSD and the power-law noise of tests/support).
+# libraries are here (libfftw3-dev: the analyzer's PSD and the power-law noise of tests/support;
+# pybind11 and pytest: the Python package host_tools/python and its tests).
 packages=(
   g++ cmake ninja-build pkg-config
   libgtest-dev libgmock-dev libbenchmark-dev libfftw3-dev
   libboost-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libplplot-dev plplot-driver-cairo
   libgpiod-dev
+  python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest
 )
 if [ "$job" = test ]; then
   # The board (aarch64, tests under qemu-aarch64-static) needs Debian's arm64 multiarch packages.
@@ -30,6 +32,7 @@ if [ "$job" = test ]; then
   packages+=(g++-aarch64-linux-gnu qemu-user-static libgtest-dev:arm64 libgpiod-dev:arm64)
   packages+=(gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi
              python3-canmatrix python3-can clang libclang-rt-14-dev)
+  packages+=(python3-scipy)  # the allantools peer the Python tests compare with, when it is beside the checkout
   # The QEMU bench (toolchain/bench/build.sh adds the kernel headers of the kernel it boots).
   packages+=(qemu-system-x86 busybox-static cpio can-utils)
 fi

@@ -4,7 +4,6 @@
 // host_tools/analyze/analysis.*, the output formats host_tools/analyze/analysis_report.*.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -30,6 +29,7 @@
 #include "dynamic.hpp"
 #include "heat_map.hpp"
 #include "output_paths.hpp"
+#include "plan.hpp"
 #include "psd.hpp"
 #include "static_plot.hpp"
 #include "hal/program/command_line.hpp"
@@ -306,26 +306,6 @@ class Progress {
 
 [[noreturn]] void bad_data(const std::string& source, const DataFileError& e) {
   bad(source, e.line() ? fmt::format("line {}: {}", e.line(), e.what()) : e.what());
-}
-
-// Memory the history may take: half the machine's memory, or of the process's address space
-// limit when one is set; and where that comes from, for a message.
-std::uint64_t machine_budget() {
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  return pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2
-                               : std::uint64_t{1} << 32;
-}
-std::uint64_t memory_budget() {
-  std::uint64_t budget = machine_budget();
-  rlimit limit{};
-  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) budget = std::min<std::uint64_t>(budget, limit.rlim_cur / 2);
-  return budget;
-}
-std::string memory_budget_reason() {
-  rlimit limit{};
-  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur / 2 < machine_budget())
-    return fmt::format("half of its address-space limit, ulimit -v {} KiB", limit.rlim_cur >> 10);
-  return "half of the machine's memory";
 }
 
 // The longest window or step of --dynamic, in values: longer than any file (10^15 values are
@@ -626,10 +606,7 @@ int main(int argc, char** argv) {
     } catch (const DataFileError& e) {
       bad_data(source, e);
     }
-    // full: every tau up to N/4 fully overlapped; for --taus all every m up to N/2 (all of them).
-    // Counts of a known length under full hold their record and take the batch kernel (the same
-    // sums as the characterizer's, at 4 bytes a point instead of its history near N/4) while the
-    // record fits in memory at its worst (12 bytes a point while it widens to int64).
+    // The taus, the stride factor "full" resolves to and the held record (plan.hpp).
     o.values_hint = taus_text == "all" ? kept.size() : file->values_bound();
     o.threads = threads;
     if (show_progress)
@@ -639,37 +616,15 @@ int main(int argc, char** argv) {
         progress_line_open = done < total;
         std::fprintf(stderr, "\rgyrochar-analyze: summing: %zu of %zu taus%s", done, total, done < total ? "" : "\n");
       };
-    o.hold_counts = o.type == DataType::counts && o.stride_factor == 0 && n_phase > 0 &&
-                    o.values_hint < memory_budget() / 12;
-    // Phase and frequency under --taus all hold the staged points and their prefix sums (24 bytes
-    // a point) and sum 64 consecutive taus at a time (the characterizer would visit every tau at
-    // every point).
-    o.hold_phase = o.type != DataType::counts && taus_text == "all" && o.stride_factor == 0 &&
-                   o.values_hint < memory_budget() / 24;
-    const bool held = o.hold_counts || o.hold_phase;
-    if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus_text == "all" ? 2 * n_phase : n_phase);
-    const std::uint32_t s = o.stride_factor;
-    std::vector<std::uint64_t> not_formed;  // decade taus the stride factor cannot form
-    const bool generated = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
-    if (taus_text == "octave") {
-      o.m_list = octave_taus(n_phase);
-    } else if (taus_text == "decade") {
-      for (const std::uint64_t m : decade_taus(n_phase ? n_phase : std::uint64_t{1} << 40))
-        (tau_representable(m, s) ? o.m_list : not_formed).push_back(m);
-    } else if (taus_text == "all") {
-      o.m_list = all_taus(n_phase, s);
-    } else {
-      o.m_list = parse_tau_list(taus_text);
-    }
-    if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
-    // Generated taus stop where their history would not fit in memory (a large S on standard
-    // input); a list that does not fit is refused.
     const std::uint64_t budget = memory_budget();
-    std::uint64_t cut_above = 0;
-    while (!held && generated && o.m_list.size() > 1 && history_bytes(o.type, s, o.m_list.back()) > budget) {
-      cut_above = o.m_list.back();
-      o.m_list.pop_back();
-    }
+    const bool generated = taus_text == "octave" || taus_text == "decade" || taus_text == "all";
+    const TauPlan plan = plan_taus(o, taus_text, generated ? std::vector<std::uint64_t>{} : parse_tau_list(taus_text),
+                                   n_phase, budget);
+    const std::vector<std::uint64_t>& not_formed = plan.not_formed;
+    const bool held = plan.held;
+    const std::uint64_t cut_above = plan.cut_above;
+    const std::uint32_t s = o.stride_factor;
+    if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
     // More memory than the process may use, or an allocation that failed: a stride factor given is
     // the user's choice (bad input); under the default the cause is the memory limit (exit 1).
     const auto too_big = [&] {
@@ -688,7 +643,6 @@ int main(int argc, char** argv) {
                        budget >> 20, memory_budget_reason()));
     };
     if (!held && history_bytes(o.type, s, o.m_list.back()) > budget) too_big();
-    o.theo_m_list = theo_taus(generated ? taus_text : "list", o.m_list, n_phase);
 
     std::unique_ptr<Analyzer> analyzer;
     try {

@@ -1,0 +1,174 @@
+# gyrochar.analyze() against gyrochar-analyze --format json on the same values (the oracle: the
+# program, whose engine the module shares; every number must be equal to the last bit), and its
+# argument checks.
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import gyrochar
+from conftest import load
+
+ROW_FIELDS = ("tau", "m", "n", "dev", "ci_low", "ci_high", "alpha", "edf", "stride")
+
+
+def program_json(program, path, args):
+    out = subprocess.run([program, "--format", "json", *args, str(path)], check=True, capture_output=True, text=True)
+    return json.loads(out.stdout)
+
+
+def assert_rows_equal(result, report, stats):
+    """Every row of the program's JSON equals the module's arrays bit for bit (null: NaN or None)."""
+    for stat in stats:
+        rows = [r for r in report["results"] if r["stat"] == stat]
+        got = result.stats[stat]
+        assert len(rows) > 0 and len(got) == len(rows), stat
+        for field in ROW_FIELDS:
+            want = np.array([np.nan if r[field] is None else r[field] for r in rows], dtype=float)
+            np.testing.assert_array_equal(np.asarray(getattr(got, field), dtype=float), want, err_msg=f"{stat} {field}")
+        assert list(got.noise_id) == [r["noise_id"] for r in rows], stat
+        assert got.unit == rows[0]["unit"]
+
+
+CASES = [
+    # (file under tests/data, program options, analyze() keywords, how the module gets the values)
+    ("phasedat/PHASE.DAT", ["--type", "phase", "--tau0", "1"], dict(type="phase"), None),
+    ("nbs14/nbs14_1000point_freq.txt", ["--type", "freq", "--tau0", "1"], dict(type="freq"), None),
+    ("ocxo/ocxo_frequency.txt", ["--type", "freq", "--tau0", "1", "--nominal-hz", "1e7"], dict(type="freq"),
+     lambda f: (f - 1e7) / 1e7),  # the program's --nominal-hz conversion, (f - F0) / F0
+    ("Keysight53230A_ti_noise_floor/tic_phase.txt", ["--type", "phase", "--tau0", "1"], dict(type="phase"), None),
+]
+ALLAN = ["adev", "oadev", "mdev", "tdev", "hdev", "ohdev"]
+
+
+@pytest.mark.parametrize("taus", ["octave", "decade"])
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_allan_family_equals_program(analyze_program, data_dir, case, taus):
+    name, args, kwargs, convert = case
+    path = data_dir / name
+    values = load(path)
+    if convert:
+        values = convert(values)
+    report = program_json(analyze_program, path, args + ["--taus", taus, "--stats", ",".join(ALLAN)])
+    result = gyrochar.analyze(values, 1.0, stats=ALLAN, taus=taus, **kwargs)
+    assert result.n_values == report["n_samples"]
+    assert_rows_equal(result, report, ALLAN)
+
+
+@pytest.mark.parametrize("taus", ["octave", "all"])
+def test_total_family_equals_program(analyze_program, data_dir, taus):
+    stats = ["oadev", "totdev", "mtotdev", "ttotdev", "htotdev", "theo1", "theoh"]
+    path = data_dir / "phasedat" / "PHASE.DAT"
+    report = program_json(analyze_program, path, ["--type", "phase", "--tau0", "1", "--taus", taus, "--stats", ",".join(stats)])
+    result = gyrochar.analyze(load(path), 1.0, type="phase", stats=stats, taus=taus)
+    assert_rows_equal(result, report, stats)
+
+
+def counts_record(tmp_path, n=20000):
+    """Counts of a simulated gyro: white rate noise and a random walk of 1 arcsec pulses (seeded)."""
+    rng = np.random.default_rng(21)
+    rate = 40 + rng.normal(0, 3, n) + np.cumsum(rng.normal(0, 0.05, n))
+    counts = np.diff(np.floor(np.concatenate([[0.0], np.cumsum(rate)]))).astype(np.int64)
+    path = tmp_path / "counts.txt"
+    np.savetxt(path, counts, fmt="%d")
+    return counts, path
+
+
+def test_counts_with_fit_equal_program(analyze_program, tmp_path):
+    counts, path = counts_record(tmp_path)
+    report = program_json(analyze_program, path, ["--type", "counts", "--tau0", "0.01", "--pulse-weight", "1arcsec",
+                                                  "--stats", "oadev,mdev,ohdev", "--fit", "ieee952",
+                                                  "--no-sinusoid-search"])
+    result = gyrochar.analyze(counts, 0.01, type="counts", pulse_weight="1arcsec", stats=("oadev", "mdev", "ohdev"),
+                              fit="ieee952")
+    assert_rows_equal(result, report, ["oadev", "mdev", "ohdev"])
+    assert result.fit == report["fit"]
+    assert result.fit[0]["recommended"] and result.fit[0]["N"]["unit"] == "deg/sqrt(h)"
+
+
+def test_list_taus_stride_factor_and_confidence_equal_program(analyze_program, data_dir):
+    path = data_dir / "phasedat" / "PHASE.DAT"
+    report = program_json(analyze_program, path, ["--type", "phase", "--tau0", "2.5", "--taus", "1,3,10,64",
+                                                  "--stride-factor", "8", "--confidence", "0.95", "--stats", "oadev,mdev"])
+    result = gyrochar.analyze(load(path), 2.5, stats=("oadev", "mdev"), taus=[1, 3, 10, 64], stride_factor=8,
+                              confidence=0.95)
+    assert result.stride_factor == report["stride_factor"] == 8
+    assert_rows_equal(result, report, ["oadev", "mdev"])
+
+
+def test_strided_and_int64_inputs_read_in_place_give_the_same_rows(tmp_path):
+    counts, _ = counts_record(tmp_path, 5000)
+    wide = np.zeros((len(counts), 3))
+    wide[:, 1] = counts  # a column of a 2-D array: strided, read without a copy
+    base = gyrochar.analyze(counts.astype(float), 0.01, type="counts", pulse_weight=(1, "arcsec"))
+    for values in (counts, wide[:, 1]):
+        other = gyrochar.analyze(values, 0.01, type="counts", pulse_weight="1 arcsec")
+        for field in ROW_FIELDS:
+            np.testing.assert_array_equal(getattr(other.oadev, field), getattr(base.oadev, field))
+
+
+@pytest.mark.parametrize("kwargs, error, words", [
+    (dict(values=[1.0, np.nan, 3.0, 4.0]), ValueError, "values[1]"),
+    (dict(values=np.array(["a", "b"])), TypeError, "float64 or int64"),
+    (dict(values=np.zeros((4, 4))), ValueError, "one-dimensional"),
+    (dict(values=[]), ValueError, "no values"),
+    (dict(tau0=0), ValueError, "tau0"),
+    (dict(tau0="1"), TypeError, "tau0"),
+    (dict(type="rate"), ValueError, "'phase', 'freq' or 'counts'"),
+    (dict(stats=("oadev", "allan")), ValueError, "unknown statistic 'allan'"),
+    (dict(stats=("oadev", "oadev")), ValueError, "twice"),
+    (dict(taus="octaves"), ValueError, "taus must be"),
+    (dict(taus=[4, 2]), ValueError, "strictly increasing"),
+    (dict(taus=[1.5]), TypeError, "integer averaging factors"),
+    (dict(stride_factor=6), ValueError, "power of two"),
+    (dict(confidence=1.5), ValueError, "between 0 and 1"),
+    (dict(fit="ieee"), ValueError, "ieee952"),
+    (dict(unit="furlong"), ValueError, "not 'furlong'"),
+    (dict(type="counts"), ValueError, "pulse_weight"),
+    (dict(type="counts", pulse_weight="1 parsec"), ValueError, "unknown pulse_weight unit 'parsec'"),
+    (dict(type="counts", pulse_weight="1arcsec", values=[1.0, 2.5, 3.0, 4.0]), ValueError, "values[1]"),
+    (dict(pulse_weight="1arcsec"), ValueError, "only applies to type='counts'"),
+    (dict(values=[1.0, 2.0]), ValueError, "too few"),
+])
+def test_bad_arguments_raise_with_the_cause(kwargs, error, words):
+    args = dict(values=np.arange(100.0) ** 2, tau0=1.0)
+    args.update(kwargs)
+    with pytest.raises(error) as e:
+        gyrochar.analyze(args.pop("values"), args.pop("tau0"), **args)
+    assert words in str(e.value)
+
+
+def program_json_stdin(program, path, args):
+    with open(path, "rb") as f:
+        out = subprocess.run([program, "--format", "json", *args, "-"], stdin=f, check=True, capture_output=True)
+    return json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("chunk", [1, 1000, 7919])
+def test_characterizer_in_blocks_equals_program_on_standard_input(analyze_program, tmp_path, chunk):
+    # The oracle: gyrochar-analyze reading the same counts from standard input (length unknown).
+    counts, path = counts_record(tmp_path, 30000)
+    stats = ["oadev", "mdev", "ohdev"]
+    report = program_json_stdin(analyze_program, path, ["--type", "counts", "--tau0", "0.01", "--pulse-weight",
+                                                        "1arcsec", "--stats", ",".join(stats)])
+    c = gyrochar.Characterizer(0.01, type="counts", pulse_weight="1arcsec", stats=stats)
+    values = counts[:5000] if chunk == 1 else counts
+    for i in range(0, len(values), chunk):
+        c.add(values[i:i + chunk])
+    if chunk == 1:  # one at a time for the first 5000, then the rest at once
+        c.add(counts[5000:])
+    assert c.values == len(counts)
+    assert_rows_equal(c.estimates(), report, stats)
+
+
+def test_characterizer_estimates_at_any_time_and_refuses_bad_values():
+    c = gyrochar.Characterizer(1.0, type="phase", stats=("oadev",), stride_factor=8)
+    c.add(np.arange(100.0) ** 2)
+    first = c.estimates().oadev
+    with pytest.raises(ValueError, match=r"values\[102\]"):
+        c.add([1.0, 2.0, np.inf])
+    assert c.values == 102  # the two values before the refused one stay added
+    assert len(first) > 0
+    with pytest.raises(ValueError, match="needs the length"):
+        gyrochar.Characterizer(1.0, taus="all")
