@@ -172,3 +172,25 @@ def test_characterizer_estimates_at_any_time_and_refuses_bad_values():
     assert len(first) > 0
     with pytest.raises(ValueError, match="needs the length"):
         gyrochar.Characterizer(1.0, taus="all")
+
+
+def test_edf_of_gives_the_programs_exact_edf(analyze_program, data_dir):
+    # Oracle: the program's rows at the same taus with a stride factor that overlaps every tau
+    # fully (the smallest power of two at or above the largest m), whose EDF is the exact one.
+    import gyrochar.allantools as ga
+    path = data_dir / "phasedat" / "PHASE.DAT"
+    values = load(path)
+    taus, edf, low, high = ga.edf_of(ga.oadev, values, rate=1.0, data_type="phase", taus="octave")
+    stride = 2
+    while stride < taus[-1]:
+        stride *= 2
+    report = program_json(analyze_program, path, ["--type", "phase", "--tau0", "1", "--stats", "oadev",
+                                                  "--taus", ",".join(str(int(t)) for t in taus),
+                                                  "--stride-factor", str(stride)])
+    rows = {r["m"]: r for r in report["results"] if r["stat"] == "oadev"}
+    assert len(taus) > 5 and len(rows) == len(taus)
+    for t, e, lo, hi in zip(taus, edf, low, high):
+        r = rows[int(t)]
+        assert e == r["edf"] and lo == r["ci_low"] and hi == r["ci_high"], t
+    with pytest.raises(ValueError, match="edf_of takes a function"):
+        ga.edf_of(len, values)
