@@ -863,16 +863,32 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
   for (std::size_t k = 0; k < setup.markov_terms && k < max_markov && 4 * tau_lo <= tau_hi; ++k) {
     pr.model = best.model;
     pr.model.markov = k + 1;
-    const bool inside = search(pr, free, fixed, &pr.model.a[k], 2 * pr.tau0 / tau_hi, pr.tau0 / (2 * tau_lo), 4);
+    const double lo = 2 * pr.tau0 / tau_hi, hi = pr.tau0 / (2 * tau_lo);
+    bool inside = search(pr, free, fixed, &pr.model.a[k], lo, hi, 4);
+    // The terms found before were placed without this one: each moves to where it belongs beside
+    // it (two passes over +-2 octaves). Without this the first of two Markov terms (20 s and
+    // 300 s) sat at 26-31 s, its hump taking up part of the second, which was then not
+    // significant, and B and R stood in for it.
+    for (int pass = 0; pass < 2 && k > 0; ++pass)
+      for (std::size_t j = 0; j <= k; ++j) {
+        const double at = pr.model.a[j];
+        search(pr, free, fixed, &pr.model.a[j], std::fmax(lo, at / 4), std::fmin(hi, at * 4), 8);
+      }
+    for (std::size_t j = 0; j <= k; ++j) {
+      constexpr double margin = 1.05;
+      inside &= pr.model.a[j] > lo * margin && pr.model.a[j] < hi / margin;
+    }
     const Candidate c = fit_model(pr, free, fixed, false, 12);
-    const double sd = log_sd(pr, free, fixed, &pr.model.a[k]);
+    std::array<double, max_markov + 1> sds = nonlinear_sd;
+    for (std::size_t j = 0; j <= k; ++j) sds[j] = log_sd(pr, free, fixed, &pr.model.a[j]);
+    const double sd = sds[k];
     // Its Tc inside the range and determined (chi2 curves around it), every Markov term significant
     // (a second one that splits the first in two is not), and none taking white rate noise's place
     // (N fitted before, not after: that is N again).
     bool holds = inside && sd > 0 && (!best.sol.active[1] || c.sol.active[1]);
     for (std::size_t j = 0; j <= k; ++j) holds &= column_significant(c, power_terms + j);
     const bool better = consider(c, holds);
-    if (better) nonlinear_sd[k] = sd;
+    if (better) nonlinear_sd = sds;
     settle();
     if (!better) break;
   }

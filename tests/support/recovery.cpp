@@ -95,6 +95,14 @@ std::vector<Scenario> standard_scenarios() {
              o.arw_deg_per_sqrt_h = 0.02;
              o.markov = {{0.5, 20}, {0.4, 1500}};
            }),
+      // The same with the second term's hump well inside the record (its Tc 1/96 of it, not 1/19):
+      // what the fit can do where the record shows both humps whole.
+      make("ARW + two Markov terms inside the record", 8, 0.1,
+           [](SimOptions& o) {
+             o.white_angle_arcsec = 1;
+             o.arw_deg_per_sqrt_h = 0.02;
+             o.markov = {{0.5, 20}, {0.4, 300}};
+           }),
       // A sinusoidal rate (a thermal cycle of 100 s; its Allan bump near 37 s, twice the white
       // rate noise's level there), alone and beside a Markov term whose bump lies an octave above.
       make("ARW + sinusoid", 8, 0.1,
