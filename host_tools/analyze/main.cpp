@@ -716,11 +716,8 @@ int main(int argc, char** argv) {
               fmt::format("{} rate values are too few for a segment of {}", rate.size(), segment ? segment : 16));
         print_error(program, "note", fmt::format("no PSD: {} rate values are too few for a spectrum", rate.size()));
       } else {
-        Spectrum sp;
-        sp.psd = welch_psd(rate, o.tau0_s, segment, o.confidence);
-        sp.searched = !no_sinusoid_search;
+        Spectrum sp = spectrum_of(*rates, o.tau0_s, segment, o.confidence, !no_sinusoid_search);
         if (sp.searched) {
-          sp.search = find_sinusoids(sp.psd);
           std::vector<std::pair<double, double>> oadev;  // the Allan curve's nulls at tau = 1/f, on dense taus
           for (const AnalysisRow& r : a.rows)
             if (r.stat == DevStat::oadev) oadev.emplace_back(r.tau_s, r.dev);

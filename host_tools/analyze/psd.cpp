@@ -179,6 +179,71 @@ void check_adev_nulls(PeakSearch& search, const std::vector<std::pair<double, do
   }
 }
 
+std::pair<double, double> PulsePattern::band(int k, double bin_hz, double offset_hz) const {
+  const double nyquist = 1 / (2 * tau0_s);
+  double f = std::fmod(k * rate_hz + offset_hz, 2 * nyquist);
+  if (f < 0) f += 2 * nyquist;
+  if (f > nyquist) f = 2 * nyquist - f;
+  return {f, 3 * k * spread_hz + 5 * line_half_width(k) + 3 * bin_hz};
+}
+
+double PulsePattern::line_half_width(int k) const { return std::numbers::pi * k * k * diffusion / tau0_s; }
+
+PulsePattern pulse_pattern(std::span<const double> pulses_per_s, double tau0_s, std::size_t block) {
+  PulsePattern p;
+  p.tau0_s = tau0_s;
+  const std::size_t blocks = block ? pulses_per_s.size() / block : 0;
+  double sum = 0, sum2 = 0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    double mean = 0;
+    for (std::size_t n = 0; n < block; ++n) mean += pulses_per_s[b * block + n];
+    mean /= static_cast<double>(block);
+    sum += mean;
+    sum2 += mean * mean;
+  }
+  if (blocks < 2) return p;
+  const double nb = static_cast<double>(blocks);
+  p.rate_hz = sum / nb;
+  p.spread_hz = std::sqrt(std::max(0.0, (sum2 - sum * sum / nb) / (nb - 1)));
+  const double per_sample = p.spread_hz * tau0_s;  // sd of a block's mean in pulses a sample
+  p.diffusion = per_sample * per_sample * static_cast<double>(block);
+  return p;
+}
+
+void mark_pulse_lines(PeakSearch& search, const PulsePattern& pattern, double bin_hz, int harmonics) {
+  int last = 0;  // the highest harmonic whose line is narrow enough to be found
+  while (last < harmonics && pattern.line_half_width(last + 1) <= static_cast<double>(max_neighbours) * bin_hz) ++last;
+  auto mark = [&](int k, double offset_hz, const SpectralPeak* except) {
+    const auto [centre, half_width] = pattern.band(k, bin_hz, offset_hz);
+    for (SpectralPeak& p : search.peaks)
+      if (&p != except && p.pulse_harmonic == 0 && std::fabs(p.frequency_hz - centre) <= half_width) p.pulse_harmonic = k;
+  };
+  for (int k = 1; k <= last; ++k) mark(k, 0, nullptr);
+  std::vector<SpectralPeak*> lines;
+  for (SpectralPeak& p : search.peaks) lines.push_back(&p);
+  std::sort(lines.begin(), lines.end(), [](const SpectralPeak* a, const SpectralPeak* b) { return a->frequency_hz < b->frequency_hz; });
+  for (const SpectralPeak* line : lines) {
+    if (line->pulse_harmonic != 0) continue;
+    for (int k = 1; k <= last; ++k)
+      for (const double offset : {-2.0, -1.0, 1.0, 2.0}) mark(k, offset * line->frequency_hz, line);
+  }
+}
+
+Spectrum spectrum_of(const RateRecord& rates, double tau0_s, std::size_t segment, double confidence, bool search) {
+  Spectrum sp;
+  const std::vector<double>& rate = rates.rate();
+  if (segment == 0) segment = default_psd_segment(rate.size());
+  sp.psd = welch_psd(rate, tau0_s, segment, confidence);
+  sp.searched = search;
+  if (!search) return sp;
+  sp.search = find_sinusoids(sp.psd);
+  if (rates.counts()) {
+    sp.pattern = pulse_pattern(rate, tau0_s, segment);
+    mark_pulse_lines(sp.search, *sp.pattern, sp.psd.bin_hz());
+  }
+  return sp;
+}
+
 void RateRecord::add(std::span<const double> values) {
   for (const double v : values) {
     if (!phase_) {
@@ -197,7 +262,7 @@ std::array<double, max_sinusoids> Spectrum::fit_hz() const {
   for (const double f : given_hz)
     if (n < hz.size()) hz[n++] = f;
   for (const SpectralPeak& p : search.peaks)
-    if (n < hz.size()) hz[n++] = p.frequency_hz;
+    if (n < hz.size() && p.pulse_harmonic == 0) hz[n++] = p.frequency_hz;
   return hz;
 }
 
@@ -229,9 +294,12 @@ std::string spectrum_table(const Spectrum& s) {
     fmt::format_to(to, "#   peak at {:.6g} +- {:.2g} Hz: amplitude {:.4g} +- {:.2g} {} (PSD {:.3g} x its background){}\n",
                    q.frequency_hz, q.frequency_uncertainty_hz, q.amplitude * s.factor, q.amplitude_uncertainty * s.factor,
                    s.unit, q.ratio,
-                   q.adev_null < 0 ? ""
-                                   : fmt::format("; OADEV {} at tau = 1/f = {:.4g} s (smallest at {:.4g} s)",
-                                                 q.adev_null ? "dips" : "does not dip", 1 / q.frequency_hz, q.adev_null_tau_s));
+                   q.pulse_harmonic > 0
+                       ? fmt::format("; a line of the pulse pattern (harmonic {} of {:.6g} Hz), not offered to the fit",
+                                     q.pulse_harmonic, s.pattern ? s.pattern->rate_hz : 0.0)
+                   : q.adev_null < 0 ? ""
+                                     : fmt::format("; OADEV {} at tau = 1/f = {:.4g} s (smallest at {:.4g} s)",
+                                                   q.adev_null ? "dips" : "does not dip", 1 / q.frequency_hz, q.adev_null_tau_s));
   return out;
 }
 
@@ -260,7 +328,8 @@ nlohmann::json spectrum_json(const Spectrum& s) {
                      {"ratio", q.ratio},
                      {"threshold", q.threshold},
                      {"adev_null", q.adev_null < 0 ? json(nullptr)
-                                                   : json{{"found", q.adev_null == 1}, {"tau", q.adev_null_tau_s}}}});
+                                                   : json{{"found", q.adev_null == 1}, {"tau", q.adev_null_tau_s}}},
+                     {"pulse_harmonic", q.pulse_harmonic > 0 ? json(q.pulse_harmonic) : json(nullptr)}});
   return {{"unit", s.psd_unit()},
           {"segment", p.segment},
           {"segments", p.segments},
@@ -277,6 +346,10 @@ nlohmann::json spectrum_json(const Spectrum& s) {
                                        {"bins_tested", s.search.bins_tested},
                                        {"threshold", s.search.threshold}}
                                 : json(nullptr)},
+          {"pulse_pattern", s.pattern ? json{{"rate_hz", s.pattern->rate_hz},
+                                             {"spread_hz", s.pattern->spread_hz},
+                                             {"line_half_width_hz", s.pattern->line_half_width(1)}}
+                                      : json(nullptr)},
           {"peaks", std::move(peaks)}};
 }
 

@@ -26,6 +26,8 @@
 // background's (the median's sampling error, the same for every bin of the peak).
 #include <array>
 #include <cstddef>
+#include <optional>
+#include <utility>
 #include <span>
 #include <string>
 #include <vector>
@@ -70,6 +72,9 @@ struct SpectralPeak {
   // 0 no dip near tau = 1/f, 1 the smallest OADEV near 1/f lies within 10 % of it; its tau.
   int adev_null = -1;
   double adev_null_tau_s = 0;
+  // Counted pulses only (mark_pulse_lines()): k > 0 when the peak lies on the k-th harmonic of
+  // the pulse pattern, a line of the quantization, not of the rate (never offered to the fit).
+  int pulse_harmonic = 0;
 };
 
 struct PeakSearch {
@@ -91,6 +96,35 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm = 0.01);
 /// 0.9 x the largest. O(peaks x points).
 void check_adev_nulls(PeakSearch& search, const std::vector<std::pair<double, double>>& oadev);
 
+/// Counted pulses quantize into a pattern: with the angle moving at rho pulses a second, the
+/// quantization error is a sawtooth of fundamental rho Hz, and its harmonics k rho fold into the
+/// band below 1/(2 tau0). Over a record rho wanders (the rate's own noise) and the pattern's phase
+/// diffuses (white rate noise of s pulses a sample spreads harmonic k into a Lorentzian of half
+/// width pi k^2 s^2 / tau0 Hz): each line is a hump, which the search finds where no rate
+/// sinusoid is (a gyro at 0.15 pulse a sample of earth rate showed 3 to 8 peaks near 15 Hz in
+/// every record). The pattern is read from the counts themselves: rho and its spread from the
+/// means of non-overlapping blocks of `block` values (sd(block mean) = s / sqrt(block) under
+/// white rate noise, which gives s).
+struct PulsePattern {
+  double rate_hz = 0;    // rho: mean pulses a second
+  double spread_hz = 0;  // sd of rho between blocks
+  double diffusion = 0;  // s^2: white rate noise, pulses^2 a sample
+  double tau0_s = 0;
+  /// The Lorentzian half width of harmonic k, Hz.
+  double line_half_width(int k) const;
+  /// The band of harmonic k moved by offset_hz (folded): centre and half width (3 spreads, 5 line
+  /// half widths, 3 bins).
+  std::pair<double, double> band(int k, double bin_hz, double offset_hz = 0) const;
+};
+PulsePattern pulse_pattern(std::span<const double> pulses_per_s, double tau0_s, std::size_t block);
+/// Marks the peaks of `search` that lie in the band of one of the first `harmonics` harmonics of
+/// the pattern whose line half width stays under 64 bins (wider, the search's neighbourhood
+/// follows the line and finds no peak on it), and then their sidebands: a rate line at f
+/// modulates the pattern's frequency, which puts lines at k rho +- f and k rho +- 2 f (taken from
+/// the lowest rate line up; a rate line that is itself such a sideband of a lower one is marked
+/// too: a limit). O(peaks^2 x k).
+void mark_pulse_lines(PeakSearch& search, const PulsePattern& pattern, double bin_hz, int harmonics = 8);
+
 /// Rate values from the analyzer's input: freq values as they are, counts divided by tau0 (pulses
 /// per second), phase points differenced over tau0. The result is in the engine's rate unit
 /// (analysis.hpp: phase unit per second). add() is O(n), allocates.
@@ -99,6 +133,7 @@ class RateRecord {
   RateRecord(bool phase, bool counts, double tau0_s) : phase_(phase), counts_(counts), tau0_s_(tau0_s) {}
   void add(std::span<const double> values);
   const std::vector<double>& rate() const { return rate_; }
+  bool counts() const { return counts_; }
 
  private:
   bool phase_, counts_;
@@ -112,14 +147,15 @@ class RateRecord {
 /// and the frequencies given by hand, and how to show them (factor: engine rate -> output rate).
 struct Spectrum {
   Psd psd;
+  std::optional<PulsePattern> pattern;  // counted pulses
   bool searched = false;         // false: --no-sinusoid-search
   PeakSearch search;
   std::vector<double> given_hz;  // --sinusoid-hz
   double factor = 1;             // engine rate unit -> `unit`
   std::string unit;              // the output rate unit, e.g. "deg/h"; "1" for fractional frequency
 
-  /// The frequencies offered to the IEEE-952 fit: the given ones, then the strongest peaks found,
-  /// at most max_sinusoids (0: none). O(peaks).
+  /// The frequencies offered to the IEEE-952 fit: the given ones, then the strongest peaks found
+  /// that are not pulse lines, at most max_sinusoids (0: none). O(peaks).
   std::array<double, max_sinusoids> fit_hz() const;
   /// "(deg/h)^2/Hz"
   std::string psd_unit() const;
@@ -127,6 +163,10 @@ struct Spectrum {
 
 /// CSV of every bin: freq,psd,ci_low,ci_high (Hz, the output unit^2/Hz). O(bins).
 std::string spectrum_csv(const Spectrum& s);
+/// Welch's PSD and the search with the analyzer's defaults (`segment` 0: default_psd_segment()),
+/// pulse lines marked when `rates` are counts. Throws std::invalid_argument as welch_psd().
+Spectrum spectrum_of(const RateRecord& rates, double tau0_s, std::size_t segment, double confidence, bool search);
+
 /// The table's lines ("# PSD ..." and one per peak). O(peaks).
 std::string spectrum_table(const Spectrum& s);
 /// The JSON "psd" block: the Welch parameters, the PSD decimated to about 20 bins a decade

@@ -7,6 +7,7 @@
 #include <complex>
 #include <numbers>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "psd.hpp"
@@ -127,3 +128,75 @@ TEST(WelchPsd, RefusesASegmentThatDoesNotFit) {
 }
 
 }  // namespace
+
+namespace {
+
+// Counts of an angle that moves by `per_sample` pulses a sample plus white rate noise of `s`
+// pulses a sample, quantized to whole pulses (floor of the running angle, differenced).
+RateRecord counted(std::size_t n, double per_sample, double s, double tau0, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, s);
+  RateRecord r(false, true, tau0);
+  double angle = 0.37, last = std::floor(angle);
+  for (std::size_t k = 0; k < n; ++k) {
+    angle += per_sample + g(rng);
+    const double now = std::floor(angle), count = now - last;
+    last = now;
+    r.add(std::span(&count, 1));
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(PulseLines, ThePatternIsReadFromTheCounts) {
+  // Oracle: the construction. 0.15 pulse a sample at tau0 0.01 s is 15 pulses a second; white
+  // rate noise of 0.02 pulse a sample has s^2 = 4e-4 (the blocks' means estimate it with
+  // 2^20 / 2^14 = 64 blocks: relative sd of a variance sqrt(2/63) = 18 %, 3 sd allowed).
+  const RateRecord r = counted(1u << 20, 0.15, 0.02, 0.01, 3);
+  const PulsePattern p = pulse_pattern(r.rate(), 0.01, 1u << 14);
+  EXPECT_NEAR(p.rate_hz, 15.0, 0.01);  // the mean of 2^20 counts: within a few pulses of 157 286
+  EXPECT_NEAR(p.diffusion, 4e-4, 3 * 0.18 * 4e-4);
+  // Harmonic 1 sits at 15 Hz; harmonic 4 (60 Hz, above the Nyquist frequency 50 Hz) folds to 40 Hz.
+  EXPECT_NEAR(p.band(1, 0.006).first, p.rate_hz, 1e-12);
+  EXPECT_NEAR(p.band(4, 0.006).first, 100 - 4 * p.rate_hz, 1e-9);
+  // Half width of harmonic 1: pi s^2 / tau0 (the Lorentzian of a phase diffusing by (2 pi s)^2 a sample).
+  EXPECT_NEAR(p.line_half_width(1), std::numbers::pi * p.diffusion / 0.01, 1e-15);
+}
+
+TEST(PulseLines, ThePulsePatternsHumpIsNotOfferedToTheFitButARateSinusoidIs) {
+  // Oracle: the construction. Counts at 0.15 pulse a sample quantize into a pattern at 15 Hz
+  // (the search finds humps there, ThePatternIsReadFromTheCounts); a rate sinusoid of 0.005 pulse
+  // a sample at 2 Hz is a line of the rate and lies in no harmonic's band (15, 30, 45, 40 Hz ...).
+  // It modulates the pattern's frequency by +-0.5 Hz (index 0.25): its sidebands at 15 +- 2 and
+  // 15 +- 4 Hz are marked too; the third ones are 3000 times weaker than the line (Bessel J3).
+  const double tau0 = 0.01;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g(0.0, 0.005);  // lines of half width pi 0.005^2 / tau0 = 0.008 Hz
+  RateRecord r(false, true, tau0);
+  double angle = 0.37, last = std::floor(angle);
+  for (std::size_t k = 0; k < (1u << 20); ++k) {
+    angle += 0.15 + g(rng) + 0.005 * std::sin(2 * std::numbers::pi * 2.0 * tau0 * static_cast<double>(k));
+    const double now = std::floor(angle), count = now - last;
+    last = now;
+    r.add(std::span(&count, 1));
+  }
+  const Spectrum sp = spectrum_of(r, tau0, 0, 0.683, true);
+  ASSERT_TRUE(sp.pattern.has_value());
+  std::size_t lines = 0;
+  bool rate_line_found = false;
+  for (const SpectralPeak& q : sp.search.peaks) {
+    if (std::fabs(q.frequency_hz - 2.0) < 0.01) {
+      rate_line_found = true;
+      EXPECT_EQ(q.pulse_harmonic, 0);
+    } else {
+      EXPECT_GT(q.pulse_harmonic, 0) << "a peak at " << q.frequency_hz << " Hz on no harmonic";
+      lines += q.pulse_harmonic > 0;
+    }
+  }
+  EXPECT_TRUE(rate_line_found);
+  EXPECT_GT(lines, 0u);  // the pattern's hump was found, and marked
+  const auto hz = sp.fit_hz();
+  EXPECT_NEAR(hz[0], 2.0, 0.01);
+  for (std::size_t j = 1; j < hz.size(); ++j) EXPECT_EQ(hz[j], 0.0);
+}

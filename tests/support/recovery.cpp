@@ -144,14 +144,10 @@ Recovery recover(const SimOptions& sim, bool long_tau) {
   std::array<double, max_sinusoids> offered_hz{};
   const std::size_t segment = default_psd_segment(rates.rate().size());
   if (segment != 0) {
-    Spectrum spectrum;
     // FFTW's planner is not thread-safe and the study's workers run recover() side by side.
     static std::mutex fftw_planner;
     const std::lock_guard lock(fftw_planner);
-    spectrum.psd = welch_psd(rates.rate(), sim.tau0_s, segment, 0.683);
-    spectrum.searched = true;
-    spectrum.search = find_sinusoids(spectrum.psd);
-    offered_hz = spectrum.fit_hz();
+    offered_hz = spectrum_of(rates, sim.tau0_s, segment, 0.683, true).fit_hz();
   }
   ReportUnits units;
   units.gyro = true;
