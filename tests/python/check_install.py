@@ -29,11 +29,6 @@ print(json.dumps({"file": gyrochar.__file__, "dev": r.oadev.dev.tolist() + r.mde
 
 def main(source, build):
     source, build = pathlib.Path(source), pathlib.Path(build)
-    try:
-        import ensurepip  # noqa: F401  (Debian: python3-venv; a venv gets its pip from it, offline)
-    except ImportError:
-        print("skipped: no ensurepip for venvs (Debian package python3-venv)")
-        sys.exit(77)
     with tempfile.TemporaryDirectory(prefix="gyrochar-install-") as tmp:
         tmp = pathlib.Path(tmp)
         package = tmp / "src" / "host_tools" / "python"
@@ -42,7 +37,12 @@ def main(source, build):
             shutil.copy(source / "host_tools" / "python" / name, package / name)
         shutil.copy(source / "CMakeLists.txt", tmp / "src" / "CMakeLists.txt")
         venv = tmp / "venv"
-        subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", str(venv)], check=True)
+        made = subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", str(venv)], capture_output=True,
+                              text=True)
+        if made.returncode != 0 and "ensurepip" in made.stdout + made.stderr:
+            print("skipped: venvs get no pip here (Debian package python3-venv):", made.stdout + made.stderr)
+            sys.exit(77)
+        made.check_returncode()
         python = venv / "bin" / "python"
         env = {"PATH": "/usr/bin:/bin", "GYROCHAR_CMAKE_BUILD_DIR": str(build), "PIP_NO_INDEX": "1",
                "PIP_DISABLE_PIP_VERSION_CHECK": "1", "HOME": str(tmp)}
