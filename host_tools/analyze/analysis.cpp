@@ -9,6 +9,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 #include <map>
 #include <new>
 #include <span>
@@ -277,7 +278,28 @@ struct EngineBase {
   virtual void add(std::span<const double> values) = 0;
   virtual Analysis result(const AnalysisOptions& o) const = 0;
   virtual PhaseRecord record(const AnalysisOptions& o) const = 0;
+  virtual std::vector<std::byte> checkpoint() const { throw std::invalid_argument(no_checkpoint); }
+  virtual std::string restore(std::span<const std::byte>) { throw std::invalid_argument(no_checkpoint); }
+  static constexpr const char* no_checkpoint =
+      "a checkpoint holds the characterizer's state, not a held record: not with the total family or a "
+      "record of known length held in memory";
 };
+
+// A refused checkpoint in words (the core's RestoreStatus).
+std::string restore_reason(RestoreStatus s, const char* field) {
+  switch (s) {
+    case RestoreStatus::ok: return "";
+    case RestoreStatus::truncated: return "truncated: fewer bytes than the checkpoint needs";
+    case RestoreStatus::not_a_checkpoint: return "not a gyrochar checkpoint (wrong magic number)";
+    case RestoreStatus::wrong_version: return "written by another checkpoint format version";
+    case RestoreStatus::corrupted: return "CRC mismatch (corrupted)";
+    case RestoreStatus::config_mismatch:
+      return "written under another configuration (data type, tau0, units, stride factor or taus)";
+    case RestoreStatus::other_identity: return "written for another instrument";
+    case RestoreStatus::invalid_state: return std::string("invalid state: ") + field;
+  }
+  return "refused";
+}
 
 // The record for the total family, in the characterizer's phase representation: phase relative
 // to the first point (the statistics ignore a constant), or the running sum of the increments.
@@ -305,11 +327,12 @@ class Engine final : public EngineBase {
   using Entry = typename Arith::Entry;
 
  public:
-  Engine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list, bool keep_record)
+  Engine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list, bool keep_record,
+         std::uint32_t tag)
       : type_(type), record_(type, keep_record), history_(history_entries(stride_factor, m_list.back())),
         states_(m_list.size()), characterizer_(history_, states_) {
     if (!history_.data()) throw std::bad_alloc();
-    if (characterizer_.configure({stride_factor, 0}, m_list) != ConfigureStatus::ok)
+    if (characterizer_.configure({stride_factor, tag}, m_list) != ConfigureStatus::ok)
       throw std::invalid_argument("the taus do not fit the stride factor");
   }
 
@@ -353,6 +376,18 @@ class Engine final : public EngineBase {
 
   PhaseRecord record(const AnalysisOptions& o) const override {
     return {record_.points, type_ == DataType::freq ? o.tau0_s : 1.0};
+  }
+
+  std::vector<std::byte> checkpoint() const override {
+    if (record_.on) return EngineBase::checkpoint();
+    std::vector<std::byte> bytes(characterizer_.checkpoint_size());
+    bytes.resize(characterizer_.save(bytes));
+    return bytes;
+  }
+
+  std::string restore(std::span<const std::byte> bytes) override {
+    if (record_.on) return EngineBase::restore(bytes);
+    return restore_reason(characterizer_.restore(bytes), characterizer_.restore_field());
   }
 
  private:
@@ -427,8 +462,15 @@ std::vector<TauSums> sum_every_tau(std::size_t taus, std::size_t block, const An
   const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), blocks);
   std::vector<std::thread> helpers;
   for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
-  sum_taus(true);
+  std::exception_ptr stopped;  // on_summed threw (the caller stops the work): the helpers end first
+  try {
+    sum_taus(true);
+  } catch (...) {
+    stopped = std::current_exception();
+    next = blocks;
+  }
   for (std::thread& t : helpers) t.join();
+  if (stopped) std::rethrow_exception(stopped);
   if (o.on_summed) o.on_summed(taus, taus);
   return sums;
 }
@@ -654,9 +696,9 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   else if (o.type != DataType::counts && o.hold_phase)
     impl_->engine = std::make_unique<FloatBatchEngine>(o.type, s, o.m_list, keep_record, o.values_hint);
   else if (o.type == DataType::counts)
-    impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record);
+    impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record, o.checkpoint_tag);
   else
-    impl_->engine = std::make_unique<Engine<FloatArith>>(o.type, s, o.m_list, keep_record);
+    impl_->engine = std::make_unique<Engine<FloatArith>>(o.type, s, o.m_list, keep_record, o.checkpoint_tag);
 }
 
 Analyzer::~Analyzer() = default;
@@ -666,5 +708,9 @@ void Analyzer::add(std::span<const double> values) { impl_->engine->add(values);
 Analysis Analyzer::result() const { return impl_->engine->result(impl_->options); }
 
 PhaseRecord Analyzer::record() const { return impl_->engine->record(impl_->options); }
+
+std::vector<std::byte> Analyzer::checkpoint() const { return impl_->engine->checkpoint(); }
+
+std::string Analyzer::restore(std::span<const std::byte> bytes) { return impl_->engine->restore(bytes); }
 
 }  // namespace gyrochar

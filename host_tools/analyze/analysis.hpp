@@ -11,6 +11,7 @@
 // Units: deviations come out in "phase unit per second", where the phase unit is the unit of the
 // values (phase data: the value's unit, e.g. s or deg; counts: one pulse; frequency data: the
 // value's unit times s, so deviations are in the value's unit). TDEV is in the phase unit.
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <functional>
@@ -101,8 +102,12 @@ struct AnalysisOptions {
   // Threads summing the held record's taus (each tau on one; they are independent); 0: one per
   // core the system offers.
   unsigned threads = 0;
+  // The caller's configuration fingerprint, kept in checkpoints (Analyzer::checkpoint): a
+  // checkpoint restores only under the same tag.
+  std::uint32_t checkpoint_tag = 0;
   // Told, from the thread that calls result(), how many of the held record's taus are summed, of
-  // how many (the sums of every tau, --taus all, take minutes at 10^6 values). May be empty.
+  // how many (the sums of every tau, --taus all, take minutes at 10^6 values). May be empty. May
+  // throw to stop result() (the Python module's KeyboardInterrupt): the exception comes out of it.
   std::function<void(std::size_t done, std::size_t total)> on_summed;
 };
 
@@ -174,6 +179,17 @@ class Analyzer {
   /// The record held for the total family (empty unless a total statistic or keep_record was
   /// asked for); valid until the next add(). O(1).
   PhaseRecord record() const;
+  /// The state as the core characterizer's checkpoint (characterizer.hpp: header with the format
+  /// version, stride factor, taus and checkpoint_tag, the run state, history and tau states, a
+  /// CRC-32; native byte order), the bytes the board writes for its characterizer. Throws
+  /// std::invalid_argument when a record is held (the total family, keep_record, hold_counts,
+  /// hold_phase): the format does not carry it. O(history + taus).
+  std::vector<std::byte> checkpoint() const;
+  /// Restores a checkpoint() of an analyzer with the same options. The next value starts a new
+  /// segment, as on the board after a restart (no term spans the restore). Returns "" or why the
+  /// bytes were refused (the core's RestoreStatus in words); then nothing changed.
+  /// O(history + taus).
+  std::string restore(std::span<const std::byte> bytes);
 
  private:
   struct Impl;

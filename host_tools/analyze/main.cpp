@@ -28,6 +28,7 @@
 #include "datafile.hpp"
 #include "dynamic.hpp"
 #include "heat_map.hpp"
+#include "input_units.hpp"
 #include "output_paths.hpp"
 #include "plan.hpp"
 #include "psd.hpp"
@@ -181,30 +182,6 @@ std::vector<DevStat> parse_stats(const std::string& text) {
   }
   if (stats.empty()) bad("--stats", "empty list");
   return stats;
-}
-
-// "1.5arcsec", "1.5 arcsec" or "1.5" (unit from --pulse-unit) -> rad.
-double parse_pulse_weight_rad(const std::string& text, const std::string& pulse_unit, bool pulse_unit_given,
-                              std::string& described) {
-  double value = 0;
-  const char* const end = text.data() + text.size();
-  const auto [rest, ec] = std::from_chars(text.data(), end, value);
-  if (ec != std::errc() || !(value > 0) || !std::isfinite(value))
-    bad("--pulse-weight", "'" + text + "' is not a positive angle such as 1.5arcsec");
-  std::string unit(rest, end);
-  unit.erase(0, unit.find_first_not_of(' '));
-  if (unit.empty()) {
-    unit = pulse_unit;
-  } else if (pulse_unit_given && unit != pulse_unit) {
-    bad("--pulse-weight", "unit " + unit + " contradicts --pulse-unit " + pulse_unit);
-  }
-  const auto rad = angle_unit_rad(unit);
-  if (!rad) bad("--pulse-weight", "unknown angle unit '" + unit + "' (rad, mrad, urad, deg, arcsec)");
-  described = fmt::format("counts of {} {}", value, unit);
-  if (!std::isnormal(value * *rad))  // 1e-320arcsec: every deviation would be 0 in the output unit
-    bad("--pulse-weight", fmt::format("{} {} is {:g} rad, below the smallest normal double (2.2e-308): the deviations "
-                                      "would underflow to 0", value, unit, value * *rad));
-  return value * *rad;
 }
 
 // What the values say about numerical collapse, as they are read: --nominal-hz's conversion
@@ -516,51 +493,24 @@ int main(int argc, char** argv) {
       for (const DevStat s : {DevStat::oadev, DevStat::mdev})
         if (std::find(o.stats.begin(), o.stats.end(), s) == o.stats.end()) o.stats.push_back(s);
 
-    // Units: what the values are, and the output unit of gyro data.
+    // Units: what the values are, and the output unit of gyro data (input_units.hpp).
     ReportUnits units;
-    if (o.type == DataType::counts) {
-      if (!value_unit.empty()) bad("--unit", "counts take --pulse-weight instead");
-      if (pulse_weight_text.empty()) bad("--pulse-weight", "counts need the angle of one pulse, e.g. 1.5arcsec");
-      units.gyro = true;
-      units.phase_unit_si = parse_pulse_weight_rad(pulse_weight_text, pulse_unit, app.count("--pulse-unit") > 0, units.input);
-    } else {
-      if (!pulse_weight_text.empty() || app.count("--pulse-unit")) bad("--pulse-weight", "only applies to --type counts");
-      if (o.type == DataType::phase) {
-        if (value_unit.empty() || value_unit == "s") {
-          units.input = "phase in s";
-        } else if (const auto rad = angle_unit_rad(value_unit)) {
-          units.gyro = true;
-          units.phase_unit_si = *rad;
-          units.input = "angle in " + value_unit;
-        } else {
-          bad("--unit", "phase is in s or an angle unit (rad, mrad, urad, deg, arcsec), not '" + value_unit + "'");
-        }
-        if (app.count("--nominal-hz")) bad("--nominal-hz", "only applies to --type freq");
-      } else if (app.count("--nominal-hz")) {
-        if (!(nominal_hz > 0) || !std::isfinite(nominal_hz)) bad("--nominal-hz", "must be a positive frequency in Hz");
-        if (!value_unit.empty() && value_unit != "Hz") bad("--unit", "--nominal-hz means the values are in Hz");
-        units.input = fmt::format("frequency in Hz, nominal {} Hz", nominal_hz);
-      } else if (value_unit.empty() || value_unit == "1") {
-        units.input = "fractional frequency";
-      } else if (const auto rate = rate_unit(value_unit)) {
-        units.gyro = true;
-        units.phase_unit_si = rate->rad_per_s;
-        units.input = "rate in " + value_unit;
-      } else if (value_unit == "Hz") {
-        bad("--unit", "frequency in Hz needs --nominal-hz");
-      } else {
-        bad("--unit", "freq is in 1 (fractional), Hz or a rate unit (deg/h, deg/s, rad/s), not '" + value_unit + "'");
-      }
+    try {
+      UnitOptions uo;
+      uo.type = o.type;
+      uo.unit = value_unit;
+      uo.pulse_weight = pulse_weight_text;
+      uo.pulse_unit = pulse_unit;
+      uo.pulse_unit_given = app.count("--pulse-unit") > 0;
+      if (app.count("--nominal-hz")) uo.nominal_hz = nominal_hz;
+      uo.rate_unit = rate_text;
+      uo.rate_unit_given = app.count("--rate-unit") > 0;
+      units = resolve_units(uo);
+    } catch (const UnitError& e) {
+      bad(e.option(), e.what());
     }
     if (!kalibr_path.empty() && !units.gyro)
       bad("--kalibr", "needs gyro data: counts, or --unit with an angle or a rate");
-    if (units.gyro) {
-      const auto rate = rate_unit(rate_text);
-      if (!rate) bad("--rate-unit", "unknown unit '" + rate_text + "' (deg/h, deg/s, rad/s)");
-      units.rate = *rate;
-    } else if (app.count("--rate-unit")) {
-      bad("--rate-unit", "only applies to gyro data (counts, or --unit with an angle or a rate)");
-    }
 
     const bool show_progress = progress || isatty(STDERR_FILENO);
     const std::string source = path == "-" ? "standard input" : path;

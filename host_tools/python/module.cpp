@@ -21,6 +21,8 @@
 
 #include "analysis.hpp"
 #include "analysis_report.hpp"
+#include "gyrochar/crc32.hpp"
+#include "input_units.hpp"
 #include "plan.hpp"
 #include "units.hpp"
 
@@ -79,44 +81,18 @@ DataType data_type(const std::string& t) {
   throw py::value_error("type must be 'phase', 'freq' or 'counts', not '" + t + "'");
 }
 
-// What the values are and the unit the deviations come out in, as gyrochar-analyze's --unit,
-// --pulse-weight and --rate-unit (ReportUnits: analysis_report.hpp).
-ReportUnits report_units(DataType type, const std::string& unit, double pulse_value, const std::string& pulse_unit,
-                         const std::string& rate) {
-  ReportUnits u;
-  if (type == DataType::counts) {
-    const auto rad = angle_unit_rad(pulse_unit);
-    if (!rad) throw py::value_error("unknown pulse_weight unit '" + pulse_unit + "' (rad, mrad, urad, deg, arcsec)");
-    if (!(pulse_value > 0) || !std::isnormal(pulse_value * *rad))
-      throw py::value_error(fmt::format("pulse_weight {} {} is not a positive normal angle", pulse_value, pulse_unit));
-    u.gyro = true;
-    u.phase_unit_si = pulse_value * *rad;
-    u.input = fmt::format("counts of {} {}", pulse_value, pulse_unit);
-  } else if (type == DataType::phase) {
-    if (unit.empty() || unit == "s") {
-      u.input = "phase in s";
-    } else if (const auto rad = angle_unit_rad(unit)) {
-      u.gyro = true;
-      u.phase_unit_si = *rad;
-      u.input = "angle in " + unit;
-    } else {
-      throw py::value_error("phase is in 's' or an angle unit (rad, mrad, urad, deg, arcsec), not '" + unit + "'");
-    }
-  } else if (unit.empty() || unit == "1") {
-    u.input = "fractional frequency";
-  } else if (const auto r = rate_unit(unit)) {
-    u.gyro = true;
-    u.phase_unit_si = r->rad_per_s;
-    u.input = "rate in " + unit;
-  } else {
-    throw py::value_error("freq is in '1' (fractional) or a rate unit (deg/h, deg/s, rad/s), not '" + unit + "'");
+// What the values are and the unit the deviations come out in: the analyzer's own resolution of
+// --unit, --pulse-weight and --rate-unit (input_units.hpp), its refusals as ValueError naming the
+// argument ("pulse_weight: unknown angle unit 'parsec' ...").
+ReportUnits report_units(const UnitOptions& options) {
+  try {
+    return resolve_units(options);
+  } catch (const UnitError& e) {
+    std::string argument = e.option().substr(2);  // "--pulse-weight" -> "pulse_weight"
+    std::replace(argument.begin(), argument.end(), '-', '_');
+    if (argument == "pulse_unit") argument = "pulse_weight";  // one argument in Python: (1.5, 'arcsec')
+    throw py::value_error(argument + ": " + e.what());
   }
-  if (u.gyro) {
-    const auto r = rate_unit(rate);
-    if (!r) throw py::value_error("unknown rate_unit '" + rate + "' (deg/h, deg/s, rad/s)");
-    u.rate = *r;
-  }
-  return u;
 }
 
 template <typename T>
@@ -168,10 +144,13 @@ struct Setup {
   ReportUnits units;
   std::vector<DevStat> shown;
   bool fit = false;
+  std::vector<std::uint64_t> not_formed;  // decade taus the stride factor cannot form (plan.hpp)
 };
 
-Setup make_setup(double tau0, const std::string& type_text, const std::string& unit, double pulse_value,
-                 const std::string& pulse_unit, const std::string& rate, const std::vector<std::string>& stat_names,
+// unit, pulse_weight, pulse_unit, rate_unit: the program's --unit, --pulse-weight, --pulse-unit and
+// --rate-unit (empty: not given).
+Setup make_setup(double tau0, const std::string& type_text, const std::string& unit, const std::string& pulse_weight,
+                 const std::string& pulse_unit, const std::string& rate_unit, const std::vector<std::string>& stat_names,
                  std::uint32_t stride_factor, std::uint32_t total_stride_factor, double confidence,
                  std::optional<int> alpha, bool fit, unsigned threads) {
   Setup s;
@@ -194,9 +173,25 @@ Setup make_setup(double tau0, const std::string& type_text, const std::string& u
   if (fit)  // the fit uses both curves, as gyrochar-analyze --fit
     for (const DevStat st : {DevStat::oadev, DevStat::mdev})
       if (std::find(o.stats.begin(), o.stats.end(), st) == o.stats.end()) o.stats.push_back(st);
-  s.units = report_units(o.type, unit, pulse_value, pulse_unit, rate);
+  UnitOptions units;
+  units.type = o.type;
+  units.unit = unit;
+  units.pulse_weight = pulse_weight;
+  units.pulse_unit_given = !pulse_unit.empty();
+  if (units.pulse_unit_given) units.pulse_unit = pulse_unit;
+  units.rate_unit_given = !rate_unit.empty();
+  if (units.rate_unit_given) units.rate_unit = rate_unit;
+  s.units = report_units(units);
+  // What a checkpoint must be restored under besides the taus and the stride factor, which the core
+  // checks itself: what the values are.
+  const std::string fingerprint = fmt::format("type={} tau0={:.17g} input={}", type_text, tau0, s.units.input);
+  o.checkpoint_tag = crc32(std::as_bytes(std::span(fingerprint.data(), fingerprint.size())));
   return s;
 }
+
+// Thrown by the engine's progress callback when Python has a KeyboardInterrupt pending (its error
+// indicator set by PyErr_CheckSignals).
+struct Interrupted {};
 
 // The taus and the stride factor (plan.hpp) over at most n_phase phase points (0: unknown), and the
 // analyzer for them.
@@ -205,14 +200,17 @@ std::unique_ptr<Analyzer> planned_analyzer(Setup& s, const std::string& taus, co
   AnalysisOptions& o = s.o;
   const TauPlan plan = plan_taus(o, taus, listed, n_phase, memory_budget());
   if (o.m_list.empty()) throw py::value_error(fmt::format("{} phase points are too few for any tau", n_phase / 2));
-  for (const std::uint64_t m : plan.not_formed)
-    if (n_phase == 0 || m <= n_phase / 2)
-      throw py::value_error(fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must "
-                                        "be a multiple of its stride (m/S rounded up to a power of two)", m, o.stride_factor));
+  s.not_formed = plan.not_formed;  // refused once the data reaches them (results()), as the program does
   if (!plan.held && history_bytes(o.type, o.stride_factor, o.m_list.back()) > memory_budget())
     throw py::value_error(fmt::format("stride factor {} with taus up to {} needs more memory than this process may use "
                                       "({}): give a smaller stride factor or fewer taus", o.stride_factor,
                                       o.m_list.back(), memory_budget_reason()));
+  // The sums of a held record (taus "all", counts of a known length) may take minutes: between
+  // blocks of taus a pending KeyboardInterrupt stops them (results()).
+  o.on_summed = [](std::size_t, std::size_t) {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw Interrupted{};
+  };
   try {
     return std::make_unique<Analyzer>(o);
   } catch (const std::invalid_argument& e) {
@@ -252,17 +250,26 @@ py::dict results(const Analyzer& analyzer, const Setup& s) {
   const ReportUnits& units = s.units;
   Analysis a;
   std::vector<CurveFit> fits;
+  bool interrupted = false;
   {
     py::gil_scoped_release release;
     try {
       a = analyzer.result();
     } catch (const std::range_error& e) {
       throw std::invalid_argument(e.what());
+    } catch (const Interrupted&) {
+      interrupted = true;
     }
-    if (s.fit)
+    if (s.fit && !interrupted)
       fits = fit_curves(a, units, s.o.tau0_s, s.o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
                         LongTau::oadev, analyzer.record());
   }
+  if (interrupted) throw py::error_already_set();  // the KeyboardInterrupt PyErr_CheckSignals raised
+  for (const std::uint64_t m : s.not_formed)
+    if (m <= a.n_phase / 2)
+      throw py::value_error(fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must "
+                                        "be a multiple of its stride (m/S rounded up to a power of two)", m,
+                                        a.stride_factor));
   const auto shown = [&](const AnalysisRow& r) { return std::find(s.shown.begin(), s.shown.end(), r.stat) != s.shown.end(); };
   if (std::none_of(a.rows.begin(), a.rows.end(), shown))
     throw py::value_error(fmt::format("{} values are too few for any of the taus asked", a.n_values));
@@ -318,6 +325,19 @@ class Stream {
   }
   py::dict estimates() const { return results(*analyzer_, setup_); }
   std::uint64_t values() const { return added_; }
+  /// The core characterizer's checkpoint (the board's format), as bytes.
+  py::bytes checkpoint() const {
+    const std::vector<std::byte> bytes = analyzer_->checkpoint();
+    return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+  }
+  /// Restores checkpoint() bytes of a characterizer with the same arguments; refused ones raise
+  /// ValueError with the core's reason and change nothing.
+  void restore(const py::bytes& checkpoint) {
+    const std::string_view text = checkpoint;
+    if (const std::string why = analyzer_->restore(std::as_bytes(std::span(text.data(), text.size()))); !why.empty())
+      throw py::value_error("checkpoint refused: " + why);
+    added_ = analyzer_->result().n_values;
+  }
 
  private:
   Setup setup_;
@@ -330,7 +350,7 @@ class Stream {
 PYBIND11_MODULE(_native, m) {
   m.doc() = "gyrochar's engine (the analyzer's C++ code); use the gyrochar package, not this module";
   py::class_<Setup>(m, "Setup");
-  m.def("setup", &make_setup, py::arg("tau0"), py::arg("type"), py::arg("unit"), py::arg("pulse_value"),
+  m.def("setup", &make_setup, py::arg("tau0"), py::arg("type"), py::arg("unit"), py::arg("pulse_weight"),
         py::arg("pulse_unit"), py::arg("rate_unit"), py::arg("stats"), py::arg("stride_factor"),
         py::arg("total_stride_factor"), py::arg("confidence"), py::arg("alpha"), py::arg("fit"), py::arg("threads"));
   m.def("analyze", &analyze, py::arg("values"), py::arg("setup"), py::arg("taus"), py::arg("listed"));
@@ -339,5 +359,7 @@ PYBIND11_MODULE(_native, m) {
            py::arg("listed"))
       .def("add", &Stream::add, py::arg("values"))
       .def("estimates", &Stream::estimates)
-      .def_property_readonly("values", &Stream::values);
+      .def_property_readonly("values", &Stream::values)
+      .def("checkpoint", &Stream::checkpoint)
+      .def("restore", &Stream::restore, py::arg("checkpoint"));
 }

@@ -87,6 +87,22 @@ def test_counts_with_fit_equal_program(analyze_program, tmp_path):
     assert result.fit[0]["recommended"] and result.fit[0]["N"]["unit"] == "deg/sqrt(h)"
 
 
+@pytest.mark.parametrize("args, kwargs", [
+    (["--type", "freq", "--unit", "deg/s", "--rate-unit", "rad/s"], dict(type="freq", unit="deg/s", rate_unit="rad/s")),
+    (["--type", "phase", "--unit", "mrad"], dict(type="phase", unit="mrad")),
+    (["--type", "counts", "--pulse-weight", "0.5", "--pulse-unit", "urad", "--rate-unit", "deg/s"],
+     dict(type="counts", pulse_weight=(0.5, "urad"), rate_unit="deg/s")),
+])
+def test_gyro_units_equal_program(analyze_program, tmp_path, args, kwargs):
+    # The unit arguments resolve as the program's options (one function, input_units.cpp): same
+    # units_input, same rows in the same output unit.
+    counts, path = counts_record(tmp_path, 4000)
+    report = program_json(analyze_program, path, args + ["--tau0", "0.01", "--stats", "oadev,tdev"])
+    result = gyrochar.analyze(counts, 0.01, stats=("oadev", "tdev"), **kwargs)
+    assert result.units_input == report["units"]["input"]
+    assert_rows_equal(result, report, ["oadev", "tdev"])
+
+
 def test_list_taus_stride_factor_and_confidence_equal_program(analyze_program, data_dir):
     path = data_dir / "phasedat" / "PHASE.DAT"
     report = program_json(analyze_program, path, ["--type", "phase", "--tau0", "2.5", "--taus", "1,3,10,64",
@@ -124,11 +140,23 @@ def test_strided_and_int64_inputs_read_in_place_give_the_same_rows(tmp_path):
     (dict(stride_factor=6), ValueError, "power of two"),
     (dict(confidence=1.5), ValueError, "between 0 and 1"),
     (dict(fit="ieee"), ValueError, "ieee952"),
-    (dict(unit="furlong"), ValueError, "not 'furlong'"),
-    (dict(type="counts"), ValueError, "pulse_weight"),
-    (dict(type="counts", pulse_weight="1 parsec"), ValueError, "unknown pulse_weight unit 'parsec'"),
+    # The unit arguments with gyrochar-analyze's messages (input_units.cpp: test_input_units.cpp
+    # has the program's side), its option named as the argument.
+    (dict(unit="furlong"), ValueError, "unit: phase is in s or an angle unit (rad, mrad, urad, deg, arcsec), "
+                                       "not 'furlong'"),
+    (dict(type="freq", unit="furlong"), ValueError, "unit: freq is in 1 (fractional), Hz or a rate unit"),
+    (dict(type="freq", unit="Hz"), ValueError, "unit: frequency in Hz needs its nominal frequency"),
+    (dict(type="counts"), ValueError, "pulse_weight: counts need the angle of one pulse, e.g. 1.5arcsec"),
+    (dict(type="counts", unit="deg", pulse_weight="1arcsec"), ValueError, "unit: counts take --pulse-weight instead"),
+    (dict(type="counts", pulse_weight="1 parsec"), ValueError, "pulse_weight: unknown angle unit 'parsec'"),
+    (dict(type="counts", pulse_weight=(0, "arcsec")), ValueError, "pulse_weight: '0.0' is not a positive angle"),
+    (dict(type="counts", pulse_weight=(1, "")), ValueError, "pulse_weight: (1, '') has no unit"),
+    (dict(type="counts", pulse_weight=("1", "arcsec")), TypeError, "pulse_weight must be"),
+    (dict(type="counts", pulse_weight="1e-320arcsec"), ValueError, "below the smallest normal double"),
+    (dict(type="counts", pulse_weight="1arcsec", rate_unit="mph"), ValueError, "rate_unit: unknown unit 'mph'"),
+    (dict(rate_unit="deg/s"), ValueError, "rate_unit: only applies to gyro data"),
     (dict(type="counts", pulse_weight="1arcsec", values=[1.0, 2.5, 3.0, 4.0]), ValueError, "values[1]"),
-    (dict(pulse_weight="1arcsec"), ValueError, "only applies to type='counts'"),
+    (dict(pulse_weight="1arcsec"), ValueError, "pulse_weight: only applies to --type counts"),
     (dict(values=[1.0, 2.0]), ValueError, "too few"),
 ])
 def test_bad_arguments_raise_with_the_cause(kwargs, error, words):
@@ -160,6 +188,30 @@ def test_characterizer_in_blocks_equals_program_on_standard_input(analyze_progra
         c.add(counts[5000:])
     assert c.values == len(counts)
     assert_rows_equal(c.estimates(), report, stats)
+
+
+def test_characterizer_decade_taus_equal_program_on_standard_input(analyze_program, tmp_path):
+    # Decade taus without end: those the stride factor 2^16 cannot form (10^7, ...) are refused only
+    # once the data reaches them, as the program does (oracle: the program on standard input).
+    counts, path = counts_record(tmp_path, 30000)
+    report = program_json_stdin(analyze_program, path, ["--type", "counts", "--tau0", "0.01", "--pulse-weight",
+                                                        "1arcsec", "--taus", "decade", "--stats", "oadev,mdev"])
+    c = gyrochar.Characterizer(0.01, type="counts", pulse_weight="1arcsec", taus="decade")
+    c.add(counts)
+    assert_rows_equal(c.estimates(), report, ["oadev", "mdev"])
+
+
+def test_a_decade_tau_the_stride_factor_cannot_form_is_refused_as_by_the_program(analyze_program, tmp_path):
+    # m = 10 with S = 4 needs a multiple of its stride 4 (plan.hpp): refused by both, with one message.
+    values = np.cumsum(np.random.default_rng(8).normal(size=200))
+    path = tmp_path / "phase.txt"
+    np.savetxt(path, values, fmt="%.17g")
+    out = subprocess.run([analyze_program, "--type", "phase", "--tau0", "1", "--taus", "decade", "--stride-factor", "4",
+                          str(path)], capture_output=True, text=True)
+    assert out.returncode == 2
+    with pytest.raises(ValueError) as e:
+        gyrochar.analyze(values, 1.0, taus="decade", stride_factor=4)
+    assert str(e.value) in out.stderr and "averaging factor 10 cannot be formed with stride factor 4" in str(e.value)
 
 
 def test_characterizer_estimates_at_any_time_and_refuses_bad_values():

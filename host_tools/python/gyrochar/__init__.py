@@ -13,10 +13,10 @@ functions with allantools' arguments and return shape (docs/python.md).
 
 import json as _json
 import numbers as _numbers
-import re as _re
 
 import numpy as _np
 
+from . import _display
 from . import _native
 
 __all__ = ["analyze", "Characterizer", "Analysis", "StatResult", "STATS"]
@@ -51,6 +51,11 @@ class StatResult:
     def __repr__(self):
         return "<gyrochar.StatResult %s: %d taus, unit %s>" % (self.stat, len(self), self.unit)
 
+    def to_pandas(self):
+        """The rows as a pandas DataFrame, one row per tau: tau, m, n, dev, ci_low, ci_high, alpha,
+        edf, noise_id, stride, unit. Needs pandas (ImportError saying so otherwise)."""
+        return _display.stat_frame(self)
+
 
 class Analysis:
     """What analyze() returns: one StatResult per statistic asked for (as attributes and in `stats`),
@@ -76,6 +81,18 @@ class Analysis:
         raise AttributeError("no statistic or attribute '%s' in this analysis (statistics: %s)"
                              % (name, ", ".join(stats) or "none"))
 
+    def to_pandas(self):
+        """Every statistic in one long pandas DataFrame: a column `stat`, then the columns of
+        StatResult.to_pandas(); rows by statistic (in the order asked), then by tau. One statistic:
+        `df[df.stat == "oadev"]`, or `r.oadev.to_pandas()`. Needs pandas."""
+        return _display.analysis_frame(self)
+
+    def plot(self, ax=None, stats=None, fit=True):
+        """Log-log plot of the deviations with their confidence intervals as error bars, and the
+        IEEE-952 model where a fit exists: see gyrochar._display.plot. Returns the matplotlib
+        Axes (a new figure's unless `ax` is given). Needs matplotlib."""
+        return _display.plot(self, ax=ax, stats=stats, fit=fit)
+
     def __repr__(self):
         return "<gyrochar.Analysis of %d %s values: %s>" % (self.n_values, self.type, ", ".join(self.stats))
 
@@ -89,17 +106,18 @@ def _power_of_two(value, what, low, high):
 
 
 def _pulse_weight(pulse_weight):
-    """(value, unit) of a pulse weight given as '1.5arcsec', '1.5 arcsec' or (1.5, 'arcsec')."""
+    """(text, unit) of a pulse weight for the engine, which reads it as gyrochar-analyze's
+    --pulse-weight and --pulse-unit: '1.5arcsec' or '1.5 arcsec' as is, (1.5, 'arcsec') as
+    ('1.5', 'arcsec'). None: not given."""
+    if pulse_weight is None:
+        return "", ""
     if isinstance(pulse_weight, str):
-        match = _re.fullmatch(r"\s*([0-9.eE+-]+)\s*([A-Za-z]+)\s*", pulse_weight)
-        if not match:
-            raise ValueError("pulse_weight '%s' is not an angle such as '1.5arcsec'" % pulse_weight)
-        try:
-            return float(match.group(1)), match.group(2)
-        except ValueError:
-            raise ValueError("pulse_weight '%s' is not an angle such as '1.5arcsec'" % pulse_weight) from None
-    if isinstance(pulse_weight, tuple) and len(pulse_weight) == 2 and isinstance(pulse_weight[1], str):
-        return float(pulse_weight[0]), pulse_weight[1]
+        return pulse_weight.strip(), ""
+    if isinstance(pulse_weight, tuple) and len(pulse_weight) == 2 and isinstance(pulse_weight[1], str) \
+            and isinstance(pulse_weight[0], _numbers.Real) and not isinstance(pulse_weight[0], bool):
+        if not pulse_weight[1]:
+            raise ValueError("pulse_weight: %r has no unit (rad, mrad, urad, deg, arcsec)" % (pulse_weight,))
+        return repr(float(pulse_weight[0])), pulse_weight[1]
     raise TypeError("pulse_weight must be a string such as '1.5arcsec' or a tuple (1.5, 'arcsec'), not %r"
                     % (pulse_weight,))
 
@@ -120,7 +138,7 @@ def _taus(taus):
 
 
 def analyze(values, tau0, type="phase", unit="", pulse_weight=None, stats=("oadev", "mdev"), taus="octave",
-            stride_factor="full", confidence=0.683, fit=None, rate_unit="deg/h", alpha=None,
+            stride_factor="full", confidence=0.683, fit=None, rate_unit=None, alpha=None,
             total_stride_factor=16, threads=0):
     """gyrochar-analyze on an array of values (float64 or int64, one-dimensional, any strides; read in
     place). Arguments as the program's options:
@@ -130,7 +148,7 @@ def analyze(values, tau0, type="phase", unit="", pulse_weight=None, stats=("oade
     unit        phase: 's' (default) or an angle unit (rad, mrad, urad, deg, arcsec); freq: '1'
                 (fractional, default) or a rate unit (deg/h, deg/s, rad/s); not for counts
     pulse_weight counts only: the angle of one pulse, '1.5arcsec' or (1.5, 'arcsec')
-    rate_unit   output unit of gyro data (deg/h, deg/s, rad/s)
+    rate_unit   output unit of gyro data (deg/h, deg/s, rad/s; None: deg/h); not for clock data
     stats       any of STATS, in the order the results keep
     taus        'octave', 'decade', 'all' or a list of averaging factors m (tau = m tau0)
     stride_factor 'full' (every tau up to N/2 fully overlapped) or a power of two from 2 to 2^24
@@ -141,8 +159,9 @@ def analyze(values, tau0, type="phase", unit="", pulse_weight=None, stats=("oade
     total_stride_factor  S of the decimated total/Theo estimators, a power of two from 2 to 2^20, or 'exact'
     threads     threads summing the held record's taus (0: one per core)
 
-    Returns an Analysis. Raises TypeError or ValueError naming the cause for bad arguments or
-    values (a value that is not finite, a count that is not an integer, too few values).
+    Returns an Analysis. Raises TypeError or ValueError naming the cause for bad arguments (unit,
+    pulse_weight and rate_unit with gyrochar-analyze's own messages) or values (a value that is not
+    finite, a count that is not an integer, too few values).
     """
     setup, rule, listed = _setup(tau0, type, unit, pulse_weight, stats, taus, stride_factor, confidence, fit, rate_unit,
                                  alpha, total_stride_factor, threads)
@@ -169,16 +188,12 @@ def _setup(tau0, type, unit, pulse_weight, stats, taus, stride_factor, confidenc
         raise ValueError("type must be 'phase', 'freq' or 'counts', not %r" % (type,))
     if not isinstance(unit, str):
         raise TypeError("unit must be a string, not %r" % (unit,))
-    if type == "counts":
-        if unit:
-            raise ValueError("counts take pulse_weight instead of unit")
-        if pulse_weight is None:
-            raise ValueError("counts need pulse_weight, the angle of one pulse, e.g. '1.5arcsec'")
-        pulse_value, pulse_unit = _pulse_weight(pulse_weight)
-    else:
-        if pulse_weight is not None:
-            raise ValueError("pulse_weight only applies to type='counts'")
-        pulse_value, pulse_unit = 0.0, ""
+    if unit == "Hz":  # the program's --nominal-hz is not here
+        raise ValueError("unit: frequency in Hz needs its nominal frequency f0, which analyze() does not take: "
+                         "give the fractional frequency (f - f0) / f0 with unit='1'")
+    if rate_unit is not None and not isinstance(rate_unit, str):
+        raise TypeError("rate_unit must be a string such as 'deg/h', not %r" % (rate_unit,))
+    pulse_text, pulse_unit = _pulse_weight(pulse_weight)
     if isinstance(stats, str):
         stats = (stats,)
     stats = list(stats)
@@ -202,7 +217,7 @@ def _setup(tau0, type, unit, pulse_weight, stats, taus, stride_factor, confidenc
     if alpha is not None and (isinstance(alpha, bool) or not isinstance(alpha, _numbers.Integral)
                               or not -4 <= alpha <= 2):
         raise ValueError("alpha must be None (identified per tau) or an integer from -4 to 2, not %r" % (alpha,))
-    setup = _native.setup(tau0, type, unit, pulse_value, pulse_unit, rate_unit, stats, sf, tsf, float(confidence), alpha,
+    setup = _native.setup(tau0, type, unit, pulse_text, pulse_unit, rate_unit or "", stats, sf, tsf, float(confidence), alpha,
                           fit is not None, int(threads))
     return setup, rule, listed
 
@@ -217,7 +232,7 @@ class Characterizer:
     """
 
     def __init__(self, tau0, type="phase", unit="", pulse_weight=None, stats=("oadev", "mdev"), taus="octave",
-                 stride_factor="full", confidence=0.683, fit=None, rate_unit="deg/h", alpha=None,
+                 stride_factor="full", confidence=0.683, fit=None, rate_unit=None, alpha=None,
                  total_stride_factor=16, threads=0):
         if taus == "all":
             raise ValueError("taus='all' needs the length: use analyze()")
@@ -234,6 +249,21 @@ class Characterizer:
     def estimates(self):
         """The Analysis of the values so far."""
         return Analysis(self._native.estimates(), *self._args)
+
+    def checkpoint(self):
+        """The state as bytes: the core characterizer's checkpoint, the format the board writes (format
+        version, stride factor, taus and a fingerprint of type, tau0 and unit in the header, a CRC-32
+        at the end; native byte order). Not with the total family, whose record it does not carry."""
+        return self._native.checkpoint()
+
+    def restore(self, checkpoint):
+        """Takes up the state of checkpoint() bytes written by a Characterizer with the same arguments.
+        The next value starts a new segment, as on the board after a restart: no term spans the
+        restore. Bytes that are truncated, corrupted or written under other arguments raise ValueError
+        with the core's reason, and the characterizer stays as it was."""
+        if not isinstance(checkpoint, (bytes, bytearray, memoryview)):
+            raise TypeError("a checkpoint is bytes from Characterizer.checkpoint(), not %s" % type(checkpoint).__name__)
+        self._native.restore(bytes(checkpoint))
 
     @property
     def values(self):
