@@ -24,15 +24,16 @@ struct CheckpointLayout<CountArith> {
   using C = Characterizer<CountArith>;
   using Run = C::RunState;
   using Tau = C::TauState;
+  using Header = CheckpointCodec<CountArith>::Header;
   template <class S, class F>
   static std::size_t offset(const S& s, const F& f) {
     return static_cast<std::size_t>(reinterpret_cast<const char*>(&f) - reinterpret_cast<const char*>(&s));
   }
   static std::size_t identity() {
-    const C::Header h;
+    const Header h;
     return offset(h, h.identity);
   }
-  static std::size_t run(const C& c) { return sizeof(C::Header) + c.tau_count() * sizeof(std::uint64_t); }
+  static std::size_t run(const C& c) { return sizeof(Header) + c.tau_count() * sizeof(std::uint64_t); }
   static std::size_t history(const C& c) { return run(c) + sizeof(Run); }
   static std::size_t tau(const C& c, std::size_t i) {
     return history(c) + c.used_history() * sizeof(C::Entry) + i * sizeof(Tau);
