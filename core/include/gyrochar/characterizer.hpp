@@ -16,27 +16,15 @@
 // The pyramid. Terms of tau = r * 2^L (1 <= r <= S, S the stride factor) are formed every 2^L
 // phase points ("level L"), so their stride is m/S (1 for m <= S: exactly the fully overlapped
 // estimator, with Stable32's number of terms n). They need x and P at ages m, 2m, 3m. Past points
-// live in a multi-resolution history: ring level 0 keeps the last 3S points; ring level l >= 1
-// keeps the multiples of 2^l with ages in (3S 2^(l-1), 3S 2^l], i.e. 3S/2 entries. A point leaving
-// level l moves on to level l+1 if it is a multiple of 2^(l+1). Memory is therefore
-// 3S + (levels - 1) * 3S/2 entries, independent of run length, and the work per point is O(S)
-// amortized (level L runs every 2^L points; the decimation of tau m rides on its level).
+// live in a multi-resolution history (pyramid_history.hpp) of 3S + (levels - 1) * 3S/2 entries,
+// independent of run length, and the work per point is O(S) amortized (level L runs every 2^L
+// points; the decimation of tau m rides on its level).
 //
 // Gaps. A gap starts a new segment: no term and no difference of the decimated series spans it;
 // sums and term counts go on, so the pooled estimate stays unbiased and n counts only the terms
 // actually formed.
 //
-// Arithmetic policies:
-//   CountArith  integer counts, exact. x is int64, P is a 128-bit two's complement integer, the sums
-//               of squares are unsigned 128-bit. Every term and every sum equals the exact integer
-//               computation whatever the run length, as long as (1) |x| < 2^63 (total pulses),
-//               (2) each term fits in 63 bits plus sign, (3) each sum of squares stays below 2^127.
-//               Each condition is checked: (1) flags the stream, (2) skips the term and counts it in
-//               TauResult::out_of_range, (3) sets TauResult::sum_overflow.
-//   FloatArith  floating phase (files). Phase points are kept relative to the line through the
-//               first two points, frequency increments relative to the first one (differences of
-//               order two and more do not change), P is a double-double so the third differences of
-//               P do not cancel catastrophically; sums are double.
+// Arithmetic policies (arith.hpp): CountArith, integer counts, exact; FloatArith, floating phase.
 #include <array>
 #include <bit>
 #include <cmath>
@@ -45,151 +33,15 @@
 #include <cstring>
 #include <span>
 
+#include "gyrochar/arith.hpp"
 #include "gyrochar/block_kernel.hpp"
 #include "gyrochar/checkpoint.hpp"
 #include "gyrochar/noise_id.hpp"
-#include "gyrochar/stat.hpp"
+#include "gyrochar/pyramid_history.hpp"
+#include "gyrochar/tau_result.hpp"
 #include "gyrochar/wide.hpp"
 
 namespace gyrochar {
-
-// ---------------------------------------------------------------------------------------------
-// Arithmetic policies
-
-struct CountArith {
-  struct Entry {
-    std::int64_t x = 0;  // phase x_e in pulses
-    Int128 p;            // P_{e+1} = sum_{i<=e} x_i
-  };
-  using X = std::int64_t;
-  using Sum = UInt128;
-  using Increment = std::int32_t;  // pulses per tau0: the exactness bounds rely on |c| < 2^31
-  using NoiseSums = IntegerNoiseIdAccumulator;  // the decimated phase is integer: exact sums
-  static constexpr bool exact = true;
-
-  static constexpr Int128 add_prefix(Int128 p, std::int64_t x) { return p + widen(x); }
-
-  /// Second and third differences of x; false when a value does not fit in int64.
-  static constexpr bool x_terms(std::int64_t x0, std::int64_t x1, std::int64_t x2, std::int64_t x3,
-                                std::int64_t& a, std::int64_t& h) {
-    std::int64_t d1 = 0, d2 = 0, d3 = 0, e2 = 0;
-    unsigned bad = __builtin_sub_overflow(x0, x1, &d1);
-    bad |= __builtin_sub_overflow(x1, x2, &d2);
-    bad |= __builtin_sub_overflow(x2, x3, &d3);
-    bad |= __builtin_sub_overflow(d1, d2, &a);
-    bad |= __builtin_sub_overflow(d2, d3, &e2);
-    bad |= __builtin_sub_overflow(a, e2, &h);
-    return bad == 0;
-  }
-  static constexpr bool x_term2(std::int64_t x0, std::int64_t x1, std::int64_t x2, std::int64_t& a) {
-    std::int64_t d1 = 0, d2 = 0;
-    unsigned bad = __builtin_sub_overflow(x0, x1, &d1);
-    bad |= __builtin_sub_overflow(x1, x2, &d2);
-    bad |= __builtin_sub_overflow(d1, d2, &a);
-    return bad == 0;
-  }
-  /// Third difference of P; false when it does not fit in int64.
-  static constexpr bool p_term(Int128 p0, Int128 p1, Int128 p2, Int128 p3, std::int64_t& t) {
-    const Int128 d = (p0 - p3) + ((p2 - p1) + (p2 - p1) + (p2 - p1));
-    return narrow(d, t);
-  }
-  /// sum += v^2; returns a word whose top bit is set when the sum reached 2^127 (see add_high_word).
-  static constexpr std::uint64_t accumulate(Sum& sum, std::int64_t v) { return add_high_word(sum, square(v)); }
-  static constexpr double to_double(const Sum& s) { return gyrochar::to_double(s); }
-};
-
-struct FloatArith {
-  /// Double-double: value = hi + lo with |lo| <= ulp(hi)/2.
-  struct Prefix {
-    double hi = 0.0;
-    double lo = 0.0;
-  };
-  struct Entry {
-    double x = 0.0;  // phase relative to the reference line
-    Prefix p;        // P_{e+1} relative to the reference line's prefix sums
-  };
-  using X = double;
-  using Sum = double;
-  using Increment = double;
-  using NoiseSums = NoiseIdAccumulator;
-  static constexpr bool exact = false;
-
-  static constexpr Prefix add_prefix(Prefix a, double b) {  // Knuth two-sum, then renormalize
-    const double s = a.hi + b;
-    const double bb = s - a.hi;
-    const double err = (a.hi - (s - bb)) + (b - bb);
-    const double lo = a.lo + err;
-    const double hi = s + lo;
-    return {hi, lo - (hi - s)};
-  }
-  static constexpr double diff(Prefix a, Prefix b) { return (a.hi - b.hi) + (a.lo - b.lo); }
-
-  static constexpr bool x_terms(double x0, double x1, double x2, double x3, double& a, double& h) {
-    a = (x0 - x1) - (x1 - x2);
-    h = a - ((x1 - x2) - (x2 - x3));
-    return true;
-  }
-  static constexpr bool x_term2(double x0, double x1, double x2, double& a) {
-    a = (x0 - x1) - (x1 - x2);
-    return true;
-  }
-  static constexpr bool p_term(Prefix p0, Prefix p1, Prefix p2, Prefix p3, double& t) {
-    t = diff(p0, p3) + 3.0 * diff(p2, p1);
-    return true;
-  }
-  static constexpr std::uint64_t accumulate(Sum& sum, double v) {
-    sum += v * v;
-    return 0;
-  }
-  static constexpr double to_double(Sum s) { return s; }
-};
-
-// ---------------------------------------------------------------------------------------------
-// Results
-
-/// The sums of one tau. Overlapping sums (terms every `stride` points) and non-overlapped sums
-/// (terms every m points, on the decimated series). variance() turns them into variances.
-enum class SumKind : std::uint8_t { avar = 0, mvar = 1, hvar = 2, avar_nonoverlapped = 3, hvar_nonoverlapped = 4 };
-inline constexpr std::size_t sum_kinds = 5;
-
-template <class Sum>
-struct TauResult {
-  std::uint64_t m = 0;                       // averaging factor, tau = m * tau0
-  std::uint64_t stride = 1;                  // overlapping sums: terms every `stride` points
-  std::array<Sum, sum_kinds> sum{};          // sums of squared terms, indexed by SumKind
-  std::array<std::uint64_t, sum_kinds> n{};  // number of terms, indexed by SumKind
-  std::uint32_t out_of_range = 0;            // terms skipped: value beyond int64 (CountArith)
-  bool sum_overflow = false;                 // a sum of squares reached 2^127 (CountArith)
-};
-
-/// The statistic a sum belongs to, and its term stride.
-constexpr Stat stat_of(SumKind k) {
-  return k == SumKind::mvar ? Stat::mvar : (k == SumKind::hvar || k == SumKind::hvar_nonoverlapped) ? Stat::hvar : Stat::avar;
-}
-template <class Sum>
-constexpr std::uint64_t term_stride(const TauResult<Sum>& r, SumKind k) {
-  return k == SumKind::avar_nonoverlapped || k == SumKind::hvar_nonoverlapped ? r.m : r.stride;
-}
-
-/// Variance in (phase unit / s)^2 from the sums of kind k: tau0_s the sample interval, unit the
-/// phase unit per x step (e.g. the pulse weight in rad for counts, 1 for phase in s). 0 when
-/// n = 0. O(1), no allocation. TVAR is tau^2 MVAR / 3.
-template <class Sum>
-constexpr double variance(const TauResult<Sum>& r, SumKind k, double tau0_s, double unit = 1.0) {
-  const auto i = static_cast<std::size_t>(k);
-  if (r.n[i] == 0) return 0.0;
-  const double m = static_cast<double>(r.m);
-  const double tau = m * tau0_s;
-  double sum = 0.0;
-  if constexpr (sizeof(Sum) == sizeof(UInt128)) {
-    sum = gyrochar::to_double(r.sum[i]);
-  } else {
-    sum = r.sum[i];
-  }
-  const Stat s = stat_of(k);
-  const double scale = s == Stat::avar ? 2.0 : s == Stat::mvar ? 2.0 * m * m : 6.0;
-  return sum * unit * unit / (scale * static_cast<double>(r.n[i]) * tau * tau);
-}
 
 // ---------------------------------------------------------------------------------------------
 // The characterizer over caller-owned storage
@@ -207,13 +59,6 @@ struct CharacterizerConfig {
   std::uint32_t tag = 0;            // the caller's configuration fingerprint, kept in checkpoints
   std::uint32_t identity = 0;       // what the data belongs to (the caller's instrument), kept too
 };
-
-/// Entries of history needed for stride factor S and taus up to m_max. O(log m_max).
-constexpr std::size_t history_entries(std::uint32_t stride_factor, std::uint64_t m_max) {
-  std::size_t levels = 1;
-  while ((std::uint64_t{stride_factor} << (levels - 1)) < m_max) ++levels;
-  return 3u * stride_factor + (levels - 1) * (3u * stride_factor / 2);
-}
 
 template <class Arith>
 class Characterizer {
@@ -251,7 +96,7 @@ class Characterizer {
     const std::uint32_t s = config.stride_factor;
     if (s < 2 || s > (1u << 24) || !std::has_single_bit(s)) return ConfigureStatus::bad_stride_factor;
     if (m_list.size() > taus_.size()) return ConfigureStatus::too_many_taus;
-    stride_ = s;
+    history_.configure(s, history_.levels());  // the levels follow once the taus are known
     tag_ = config.tag;
     identity_ = config.identity;
     ntaus_ = m_list.size();
@@ -270,21 +115,16 @@ class Characterizer {
       t.result.stride = std::uint64_t{1} << level;
       t.level = static_cast<std::uint8_t>(level);
       for (unsigned k = 1; k <= 3; ++k) {
-        const std::uint64_t age = k * m;
-        unsigned ring = 0;
-        while (3 * (std::uint64_t{s} << ring) < age) ++ring;
-        t.ring_of[k - 1] = static_cast<std::uint8_t>(ring);
-        // Ring 0 holds ages 1..3S: back = age. Ring l >= 1 holds ages (3S/2, 3S] * 2^l, whose
-        // distance in slots, age >> l, exceeds the ring size 3S/2 once: take it off.
-        const std::uint64_t back = ring == 0 ? age : (age >> ring) - 3u * s / 2;
-        t.back[k - 1] = static_cast<std::uint32_t>(back);
+        const HistorySlot slot = history_slot(s, k * m);
+        t.ring_of[k - 1] = slot.ring;
+        t.back[k - 1] = slot.back;
       }
       if (level > max_level) max_level = level;
     }
-    ring_levels_ = max_level + 1;
+    history_.configure(s, max_level + 1);
     fast_count_ = 0;
     while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0) ++fast_count_;
-    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.size()) return ConfigureStatus::history_too_small;
+    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.capacity()) return ConfigureStatus::history_too_small;
     restart();
     return ConfigureStatus::ok;
   }
@@ -303,7 +143,7 @@ class Characterizer {
       t.noise = typename Arith::NoiseSums{};
     }
     run_ = RunState{};
-    run_.steady_from = 3u * stride_;
+    run_.steady_from = 3u * stride();
     staged_count_ = 0;
   }
 
@@ -386,7 +226,7 @@ class Characterizer {
     run_.increment_min = RunState{}.increment_min;
     run_.increment_max = RunState{}.increment_max;
     run_.segment_start = run_.next_e;
-    run_.steady_from = run_.segment_start + 3u * stride_;
+    run_.steady_from = run_.segment_start + 3u * stride();
     run_.p_segment_start = run_.p;
     ++run_.gaps;
     for (std::size_t i = 0; i < ntaus_; ++i) {
@@ -429,7 +269,7 @@ class Characterizer {
   /// Gaps marked so far (restores and phase overflows included).
   std::uint64_t gaps() const { return run_.gaps; }
   std::size_t tau_count() const { return ntaus_; }
-  std::uint32_t stride_factor() const { return stride_; }
+  std::uint32_t stride_factor() const { return history_.stride_factor(); }
   std::uint32_t tag() const { return tag_; }
   std::uint32_t identity() const { return identity_; }
   /// After restore() returned invalid_state: the first field that failed its check.
@@ -450,7 +290,7 @@ class Characterizer {
   }
 
  private:
-  std::size_t used_history() const { return 3u * stride_ + (ring_levels_ - 1) * (3u * stride_ / 2); }
+  std::uint32_t stride() const { return history_.stride_factor(); }
 
   // add_increment() at a segment's start or a phase overflow, and for floating increments.
   [[gnu::noinline]] void add_increment_general(typename Arith::Increment dx) {
@@ -495,8 +335,7 @@ class Characterizer {
       // are all of this segment (gaps flush first) and differ by increments, the first one from
       // the last point processed unless it opens the segment.
       if (run_.next_e != run_.segment_start) {
-        const auto last = static_cast<std::size_t>((run_.next_e - 1) % (3u * stride_));  // its slot in ring 0
-        const std::array<std::int64_t, 2> first{history_[last].x, staged_[0]};
+        const std::array<std::int64_t, 2> first{history_.recent(run_.next_e - 1).x, staged_[0]};
         difference_range(first.data(), 2, run_.increment_min, run_.increment_max);
       }
       difference_range(staged_.data(), n, run_.increment_min, run_.increment_max);
@@ -512,7 +351,7 @@ class Characterizer {
     const std::uint64_t e = run_.next_e++;
     run_.p = Arith::add_prefix(run_.p, x);
     const Entry current{x, run_.p};
-    const unsigned fired = advance_heads(e);
+    const unsigned fired = history_.advance_heads(e, run_.head);
     if (e == 0) {  // point 0 is a multiple of every m
       for (std::size_t i = 0; i < ntaus_; ++i) decimate(taus_[i], x);
     }
@@ -526,17 +365,7 @@ class Characterizer {
       }
     }
     later_levels(i, e, fired, current);
-    insert(e, current);
-  }
-
-  // Levels 0 .. countr_zero(e) run at e; their ring heads move on by one slot. Returns how many.
-  unsigned advance_heads(std::uint64_t e) {
-    const unsigned fired = e == 0 ? 0 : static_cast<unsigned>(std::countr_zero(e)) + 1;
-    const unsigned moved = fired < ring_levels_ ? fired : ring_levels_;
-    for (unsigned ring = 0; ring < moved; ++ring) {
-      if (++run_.head[ring] == ring_size(ring)) run_.head[ring] = 0;
-    }
-    return fired;
+    history_.insert(e, current, run_.head);
   }
 
   // Terms and decimation of the taus from index `first` on whose level runs at e.
@@ -568,7 +397,7 @@ class Characterizer {
       requires(Arith::exact)
     {
       if (j >= age) return {x[j - age], Int128{p_lo[j - age], p_hi[j - age]}};
-      return c.history_[static_cast<std::size_t>((e0 + j - age) % (3u * c.stride_))];
+      return c.history_.recent(e0 + j - age);
     }
   };
 
@@ -576,13 +405,13 @@ class Characterizer {
     requires(Arith::exact)
   {
     // The window: the last `depth` points before the block (from ring 0), then the block.
-    const std::uint32_t ring0 = 3u * stride_;
+    const std::uint32_t ring0 = 3u * stride();
     const std::size_t depth = ring0 < window_depth ? ring0 : window_depth;
     std::array<std::int64_t, window_depth + block_points> wx;
     std::array<std::uint64_t, window_depth + block_points> wp;
     std::array<std::uint64_t, block_points> p_hi;
     const auto oldest = static_cast<std::uint32_t>((run_.next_e - depth) % ring0);
-    from_ring(&history_[0], ring0, oldest, depth, wx.data(), wp.data());
+    history_.copy_out(0, oldest, depth, wx.data(), wp.data());
     // P in two words: x sign-extended adds the carry out of the low word, less one when x < 0.
     std::uint64_t p_lo = run_.p.lo, p_high = run_.p.hi;
     for (std::size_t j = 0; j < n; ++j) {
@@ -626,65 +455,17 @@ class Characterizer {
     const std::uint64_t e = run_.next_e++;
     run_.p = p;
     const Entry current{x, p};
-    later_levels(first, e, advance_heads(e), current);
-    insert(e, current);
+    later_levels(first, e, history_.advance_heads(e, run_.head), current);
+    history_.insert(e, current, run_.head);
   }
 
-  // Points a = run_.next_e (>= 1) .. b = a + n - 1 enter the history as insert() would take them
-  // one by one, and run_ moves on past them. After point e, ring l holds the multiples q of 2^l
-  // with q <= e - ring_lag(l), the newest ring_size(l) of them, q at slot (q >> l) mod the size.
-  // So ring l takes the multiples that cross its lag within [a, b] (the newest ring_size(l)), from
-  // these points or from the lower ring that held them before; the rings are written from the top
-  // down, so each reads the rings below it before they change. O(n + rings), no allocation.
+  // Points run_.next_e (>= 1) .. + n - 1 enter the history at once, and run_ moves on past them.
   void insert_run(const X* x, const std::uint64_t* p_lo, const std::uint64_t* p_hi, std::size_t n)
     requires(Arith::exact)
   {
-    const std::uint64_t a = run_.next_e, b = a + n - 1;
-    // Only the rings with a multiple of 2^l in [a, b] move (their lags are multiples of 2^l too).
-    const auto width = static_cast<unsigned>(std::bit_width((a - 1) ^ b));
-    const unsigned moved = width < ring_levels_ ? width : ring_levels_;
-    for (unsigned l = moved; l-- > 0;) {
-      const std::uint64_t lag = ring_lag(l), size = ring_size(l);
-      if (b < lag) continue;
-      const std::uint64_t newest = (b - lag) >> l;
-      std::uint64_t first = a > lag ? ((a - 1 - lag) >> l) + 1 : 0;  // not in ring l before
-      if (newest >= first + size) first = newest + 1 - size;
-      Entry* ring = &history_[ring_offset(l)];
-      auto slot = static_cast<std::uint32_t>(first % size);
-      std::uint64_t k = first;
-      // The multiples q < a, from the rings below that held them (older q sit higher): each ring
-      // holds a run of consecutive multiples, read at a fixed step of slots. Ring 0 holds every q
-      // in [a - 3S, a).
-      for (unsigned r = l; k <= newest && (k << l) < a;) {
-        while (!held(--r, k << l, a - 1)) {}
-        const std::uint64_t last = r == 0 ? a - 1 : (a - 1 - ring_lag(r)) >> r << r;  // ring r's newest
-        const std::uint32_t from_size = ring_size(r);
-        const auto step = static_cast<std::uint32_t>((std::uint64_t{1} << (l - r)) % from_size);
-        const Entry* from = &history_[ring_offset(r)];
-        auto from_slot = static_cast<std::uint32_t>(((k << l) >> r) % from_size);
-        for (; k <= newest && (k << l) <= last; ++k) {
-          ring[slot] = from[from_slot];
-          if (++slot == size) slot = 0;
-          from_slot += step;
-          if (from_slot >= from_size) from_slot -= from_size;
-        }
-        ++r;  // the next multiple may still sit in ring r - 1 (held() steps down from r - 1)
-      }
-      // The multiples q >= a, from the run itself.
-      for (auto j = static_cast<std::size_t>((k << l) - a); k <= newest; ++k, j += std::size_t{1} << l) {
-        ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
-        if (++slot == size) slot = 0;
-      }
-    }
-    for (unsigned l = 0; l < moved; ++l) run_.head[l] = static_cast<std::uint32_t>((b >> l) % ring_size(l));
-    run_.next_e = b + 1;
+    history_.insert_run(run_.next_e, x, p_lo, p_hi, n, run_.head);
+    run_.next_e += n;
     run_.p = {p_lo[n - 1], p_hi[n - 1]};
-  }
-
-  // Whether ring l holds point q (a multiple of 2^l) after point e.
-  bool held(unsigned l, std::uint64_t q, std::uint64_t e) const {
-    const std::uint64_t lag = ring_lag(l);
-    return e >= lag && q <= e - lag && (q >> l) + ring_size(l) > ((e - lag) >> l);
   }
 
   static constexpr std::size_t window_depth = 96;  // points before a block copied next to it
@@ -700,22 +481,21 @@ class Characterizer {
   {
     std::size_t done = fast_count_;
     const std::uint64_t e0 = level0.e0;
-    const std::size_t depth = 3u * stride_;
+    const std::size_t depth = 3u * stride();
     if (e0 % block_points != 0) return done;
     std::array<std::array<std::int64_t, window_depth + block_points / 2>, 2> x_buf;  // level 1 on: half the points
     std::array<std::array<std::uint64_t, window_depth + block_points / 2>, 2> p_buf;
     std::size_t n = level0.n;
     // Levels with at least two points in the block: a single point costs less through block_point().
-    for (unsigned level = 1; (std::size_t{2} << level) <= block_points && level < ring_levels_; ++level) {
+    for (unsigned level = 1; (std::size_t{2} << level) <= block_points && level < history_.levels(); ++level) {
       if (done == ntaus_ || taus_[done].level != level || e0 < run_.segment_start + (std::uint64_t{depth} << level))
         return done;
       std::int64_t* x_next = x_buf[level % 2].data();
       std::uint64_t* p_next = p_buf[level % 2].data();
       const std::size_t half = depth / 2;
-      const std::uint32_t ring = 3u * stride_ / 2;
+      const std::uint32_t ring = 3u * stride() / 2;
       // Ages (3S 2^(L-1), 3S 2^L]: ring L; the younger ones and the block: every other one.
-      from_ring(&history_[ring_offset(level)], ring, static_cast<std::uint32_t>(((e0 >> level) - depth) % ring), half,
-                x_next, p_next);
+      history_.copy_out(level, static_cast<std::uint32_t>(((e0 >> level) - depth) % ring), half, x_next, p_next);
       n = (n + 1) / 2;
       // depth = 3S is even: x_prev[0] is of level L.
       every_other(reinterpret_cast<const std::uint64_t*>(x_prev), reinterpret_cast<std::uint64_t*>(x_next + half),
@@ -732,19 +512,6 @@ class Characterizer {
     return done;
   }
 
-
-  // x and the low word of P of `count` entries of a ring of `size` slots, from `slot` on.
-  static void from_ring(const Entry* ring, std::uint32_t size, std::uint32_t slot, std::size_t count,
-                        std::int64_t* __restrict x, std::uint64_t* __restrict p) {
-    for (std::size_t i = 0; i < count;) {
-      const std::size_t run = count - i < size - slot ? count - i : size - slot;
-      for (std::size_t k = 0; k < run; ++k, ++i) {
-        x[i] = ring[slot + k].x;
-        p[i] = ring[slot + k].p.lo;
-      }
-      slot = 0;
-    }
-  }
 
   // The block's terms of one level-0 tau, and its decimated points.
   // The terms of tau m fit in int64 when 2 m^2 (largest increment - smallest) < 2^63 (|a| <= m
@@ -884,7 +651,7 @@ class Characterizer {
     requires(Arith::exact)
   {
     const std::size_t from_history = age < b.n ? static_cast<std::size_t>(age) : b.n;
-    const std::uint32_t size = 3u * stride_;
+    const std::uint32_t size = 3u * stride();
     std::uint32_t slot = static_cast<std::uint32_t>((b.e0 - age) % size);
     for (std::size_t j = 0; j < from_history; ++j) {
       x[j] = history_[slot].x;
@@ -929,7 +696,7 @@ class Characterizer {
   // contract |increment| < 2^31 bounds |x[e] - x[e-k]| by k 2^31, so with m <= 2^15 the AVAR and HVAR
   // terms stay below 2^50 and the MVAR term below 2m^2 2^31 <= 2^62: no range checks are needed.
   void fast_terms(TauState& t, const Entry& now) {
-    const std::uint32_t head = run_.head[0], size = 3u * stride_;
+    const std::uint32_t head = run_.head[0], size = 3u * stride();
     auto back = [&](std::uint32_t b) -> const Entry& { return history_[head >= b ? head - b : head + size - b]; };
     const Entry& e1 = back(t.back[0]);
     const Entry& e2 = back(t.back[1]);
@@ -994,47 +761,16 @@ class Characterizer {
     ++ts.result.n[1];
   }
 
-  // Ring 0 holds 3S entries from offset 0; ring l >= 1 holds 3S/2 entries from offset (l+1) 3S/2.
-  // run_.head[l] is the slot of phase point e >> l within ring l, i.e. (e >> l) mod ring_size(l).
-  std::uint32_t ring_size(unsigned ring) const { return ring == 0 ? 3u * stride_ : 3u * stride_ / 2; }
-  std::size_t ring_offset(unsigned ring) const { return ring == 0 ? 0 : (ring + 1) * (3u * stride_ / 2); }
-  // Age at which points enter ring l: 0 for ring 0, 3S 2^(l-1) above (they leave ring l-1).
-  std::uint64_t ring_lag(unsigned ring) const { return ring == 0 ? 0 : std::uint64_t{3u * stride_} << (ring - 1); }
-
   // The point of age (k+1) m for tau t.
-  const Entry& at(const TauState& t, unsigned k) const {
-    const unsigned ring = t.ring_of[k];
-    const std::uint32_t head = run_.head[ring];
-    const std::uint32_t back = t.back[k];
-    const std::uint32_t slot = head >= back ? head - back : head + ring_size(ring) - back;
-    return history_[ring_offset(ring) + slot];
-  }
+  const Entry& at(const TauState& t, unsigned k) const { return history_.behind(t.ring_of[k], t.back[k], run_.head); }
 
-  // Stores point e in ring 0; the point it replaces (age 3S) moves on to ring 1 if it is even,
-  // and so on: the point leaving ring l has age 3S 2^l and goes to ring l+1 at its head slot
-  // when it is a multiple of 2^(l+1), which is when e is.
-  void insert(std::uint64_t e, Entry entry) {
-    const std::uint64_t cascade_span = 3u * stride_;  // age at which a point leaves ring 0
-    for (unsigned ring = 0;; ++ring) {
-      Entry& cell = history_[ring_offset(ring) + run_.head[ring]];
-      const Entry evicted = cell;
-      cell = entry;
-      const unsigned next = ring + 1;
-      if (next >= ring_levels_ || (e & ((std::uint64_t{1} << next) - 1)) != 0) return;
-      if (e < (cascade_span << ring)) return;  // the replaced cell was never filled
-      entry = evicted;
-    }
-  }
-
-  std::span<Entry> history_;
+  PyramidHistory<Entry> history_;
   std::span<TauState> taus_;
   std::size_t ntaus_ = 0;
-  std::uint32_t stride_ = 8;
   std::uint32_t tag_ = 0;
   std::uint32_t identity_ = 0;
   std::uint32_t restored_identity_ = 0;
   const char* restore_field_ = nullptr;
-  unsigned ring_levels_ = 1;
   std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
   static constexpr std::size_t block_points = 256;  // staged points per block (a power of two)
   std::array<X, block_points> staged_{};
@@ -1056,7 +792,7 @@ class Characterizer {
     bool phase_overflow = false;
     // CountArith: the smallest and largest increment of this segment (they bound the terms).
     std::int32_t increment_min = INT32_MAX, increment_max = INT32_MIN;
-    std::array<std::uint32_t, 64> head{};  // head[l]: slot of (e >> l) in ring l
+    HistoryHeads head{};  // head[l]: slot of (e >> l) in ring l
   };
   RunState run_;
 };

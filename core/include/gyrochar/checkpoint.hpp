@@ -51,7 +51,7 @@ class CheckpointCodec {
   /// Bytes save() writes for c's configuration. O(1).
   static std::size_t size(const C& c) {
     return sizeof(Header) + c.ntaus_ * sizeof(std::uint64_t) + sizeof(typename C::RunState) +
-           c.used_history() * sizeof(typename C::Entry) + c.ntaus_ * sizeof(typename C::TauState) +
+           c.history_.used() * sizeof(typename C::Entry) + c.ntaus_ * sizeof(typename C::TauState) +
            sizeof(std::uint32_t);
   }
 
@@ -64,7 +64,7 @@ class CheckpointCodec {
     p = put(p, &h, sizeof h);
     for (std::size_t i = 0; i < c.ntaus_; ++i) p = put(p, &c.taus_[i].result.m, sizeof(std::uint64_t));
     p = put(p, &c.run_, sizeof c.run_);
-    p = put(p, c.history_.data(), c.used_history() * sizeof(typename C::Entry));
+    p = put(p, c.history_.data(), c.history_.used() * sizeof(typename C::Entry));
     p = put(p, c.taus_.data(), c.ntaus_ * sizeof(typename C::TauState));
     const std::uint32_t crc = crc32({out.data(), static_cast<std::size_t>(p - out.data())});
     p = put(p, &crc, sizeof crc);
@@ -100,7 +100,7 @@ class CheckpointCodec {
     // The CRC guards against accidents, not against a state that was never valid (a file on a
     // board's flash can be written by anything): every field is checked before any is taken.
     const std::size_t run_bytes = sizeof(typename C::RunState);
-    const std::size_t history_bytes = c.used_history() * sizeof(typename C::Entry);
+    const std::size_t history_bytes = c.history_.used() * sizeof(typename C::Entry);
     c.restore_field_ = invalid_field(c, p, p + run_bytes, p + run_bytes + history_bytes);
     if (c.restore_field_ != nullptr) return RestoreStatus::invalid_state;
     c.staged_count_ = 0;  // the restored state replaces the points not yet processed
@@ -127,7 +127,7 @@ class CheckpointCodec {
   };
   static Header header(const C& c) {
     Header h;
-    h.stride = c.stride_;
+    h.stride = c.stride();
     h.tag = c.tag_;
     h.identity = c.identity_;
     h.ntaus = c.ntaus_;
@@ -154,7 +154,7 @@ class CheckpointCodec {
     std::memcpy(&r, run_bytes, sizeof r);
     if (byte_of(&r.phase_overflow) > (Arith::exact ? 1 : 0)) return "phase_overflow";
     const std::uint64_t e = r.next_e;
-    const std::uint32_t s = c.stride_;
+    const std::uint32_t s = c.stride();
     if (e > max_phase_points) return "next_e (phase points)";
     if (r.segment_start > e) return "segment_start";
     if (r.gaps > max_phase_points) return "gaps";  // as many calls as points can have: the count never wraps
@@ -169,7 +169,8 @@ class CheckpointCodec {
     }
     // The last point's entry in ring 0 holds the running phase and P (a NaN never compares equal).
     typename C::Entry last{};
-    if (e > 0) std::memcpy(&last, history_bytes + static_cast<std::size_t>((e - 1) % (3u * s)) * sizeof last, sizeof last);
+    const auto last_slot = static_cast<std::size_t>((e - 1) % (3u * s));
+    if (e > 0) std::memcpy(&last, history_bytes + last_slot * sizeof last, sizeof last);
     if (r.p.hi != last.p.hi || r.p.lo != last.p.lo) return "p (prefix sum)";
     if (r.x != (Arith::exact || r.line_points == 0 ? last.x : typename C::X{})) return "x (running phase)";
     if constexpr (Arith::exact) {
@@ -181,7 +182,7 @@ class CheckpointCodec {
     }
     for (std::size_t l = 0; l < r.head.size(); ++l) {
       const std::uint64_t want =
-          l < c.ring_levels_ && e > 0 ? ((e - 1) >> l) % c.ring_size(static_cast<unsigned>(l)) : 0;
+          l < c.history_.levels() && e > 0 ? ((e - 1) >> l) % c.history_.ring_size(static_cast<unsigned>(l)) : 0;
       if (r.head[l] != want) return "head (history position)";
     }
     for (std::size_t i = 0; i < c.ntaus_; ++i) {
