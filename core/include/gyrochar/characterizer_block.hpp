@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "gyrochar/characterizer.hpp"
+#include "gyrochar/term_kernel.hpp"
 
 namespace gyrochar {
 
@@ -209,8 +210,8 @@ inline void Characterizer<Arith>::block_sums(TauState& t, const Block& b, std::s
   if (proved_small(t.result.m, b.n, terms)) {
     ProvedSums s;
     if (b.level == 0) {  // the MVAR terms as the running sum of the HVAR terms, from the first one's P
-      const std::uint64_t d = p2[0] - p1[0];
-      s = proved_running_terms(b.n, b.x, x1, x2, x3, (b.p_lo[0] - p3[0]) + (d + d + d), a.data(), h.data());
+      const std::uint64_t t_first = term::mvar(b.p_lo[0], p1[0], p2[0], p3[0]);
+      s = proved_running_terms(b.n, b.x, x1, x2, x3, t_first, a.data(), h.data());
     } else {
       s = proved_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data());
     }
