@@ -3,6 +3,7 @@
 
 #include <bit>
 
+#include "gyrochar/assert.hpp"
 #include "gyrochar/term_kernel.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
@@ -413,6 +414,9 @@ std::int64_t point(const PhaseSegment<R>& s, std::size_t j) {
 }  // namespace
 
 BatchTau::BatchTau(std::uint64_t m, std::uint64_t stride) {
+  GYROCHAR_ASSERT(m >= 1);
+  GYROCHAR_ASSERT(std::has_single_bit(stride));
+  GYROCHAR_ASSERT(stride == 1 || m % stride == 0);
   result_.m = m;
   result_.stride = stride;
 }

@@ -34,6 +34,7 @@
 #include <span>
 
 #include "gyrochar/arith.hpp"
+#include "gyrochar/assert.hpp"
 #include "gyrochar/block_kernel.hpp"
 #include "gyrochar/checkpoint.hpp"
 #include "gyrochar/noise_id.hpp"
@@ -126,6 +127,7 @@ class Characterizer {
     while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0) ++fast_count_;
     if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.capacity())
       return ConfigureStatus::history_too_small;
+    GYROCHAR_ASSERT(history_.used() <= history_.capacity());
     restart();
     return ConfigureStatus::ok;
   }
@@ -279,6 +281,7 @@ class Characterizer {
   std::uint32_t checkpoint_identity() const { return restored_identity_; }
   /// Sums of tau i (0 <= i < tau_count()), valid at any time.
   Result result(std::size_t i) const {
+    GYROCHAR_ASSERT(i < ntaus_);
     flush();
     Result r = taus_[i].result;
     r.sum_overflow = (taus_[i].sticky >> 63) != 0;
@@ -286,6 +289,7 @@ class Characterizer {
   }
   /// The lag-1 autocorrelation sums of tau i's decimated series.
   const typename Arith::NoiseSums& noise(std::size_t i) const {
+    GYROCHAR_ASSERT(i < ntaus_);
     flush();
     return taus_[i].noise;
   }
@@ -329,6 +333,7 @@ class Characterizer {
   [[gnu::noinline]] void process_staged() {
     const std::size_t n = staged_count_;
     if (n == 0) return;
+    GYROCHAR_ASSERT(n <= block_points);  // stage() flushes a full block at once
     staged_count_ = 0;
     std::size_t i = 0;
     if constexpr (Arith::exact) {

@@ -235,6 +235,7 @@ inline void Characterizer<Arith>::block_sums(TauState& t, const Block& b, std::s
   }
   // The countdown stays in 1..m, so for m = 1 every point is decimated and the block's partial
   // sums are already the non-overlapped ones.
+  GYROCHAR_ASSERT(t.countdown >= 1 && t.countdown <= m);
   const auto first = static_cast<std::size_t>(t.countdown - 1);
   const std::size_t count = (b.n - 1 - first) / m + 1;
   const std::size_t j = first + (count - 1) * m;  // the newest decimated point

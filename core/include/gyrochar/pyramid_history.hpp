@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <span>
 
+#include "gyrochar/assert.hpp"
 #include "gyrochar/wide.hpp"
 
 namespace gyrochar {
@@ -118,6 +119,7 @@ class PyramidHistory {
   /// down, so each reads the rings below it before they change. O(n + rings), no allocation.
   void insert_run(std::uint64_t a, const std::int64_t* x, const std::uint64_t* p_lo, const std::uint64_t* p_hi,
                   std::size_t n, HistoryHeads& heads) {
+    GYROCHAR_ASSERT(a >= 1 && n >= 1);
     const std::uint64_t b = a + n - 1;
     // Only the rings with a multiple of 2^l in [a, b] move (their lags are multiples of 2^l too).
     const auto width = static_cast<unsigned>(std::bit_width((a - 1) ^ b));
@@ -135,7 +137,8 @@ class PyramidHistory {
       // holds a run of consecutive multiples, read at a fixed step of slots. Ring 0 holds every q
       // in [a - 3S, a).
       for (unsigned r = l; k <= newest && (k << l) < a;) {
-        while (!held(--r, k << l, a - 1)) {}
+        do GYROCHAR_ASSERT(r > 0);  // ring 0 holds every point of the last 3S
+        while (!held(--r, k << l, a - 1));
         const std::uint64_t last = r == 0 ? a - 1 : (a - 1 - ring_lag(r)) >> r << r;  // ring r's newest
         const std::uint32_t from_size = ring_size(r);
         const auto step = static_cast<std::uint32_t>((std::uint64_t{1} << (l - r)) % from_size);
@@ -161,6 +164,7 @@ class PyramidHistory {
   /// x and the low word of P of `count` entries of ring `ring`, from `slot` on.
   void copy_out(unsigned ring, std::uint32_t slot, std::size_t count, std::int64_t* __restrict x,
                 std::uint64_t* __restrict p) const {
+    GYROCHAR_ASSERT(slot < ring_size(ring) && count <= ring_size(ring));
     const Entry* from = &entries_[ring_offset(ring)];
     const std::uint32_t size = ring_size(ring);
     for (std::size_t i = 0; i < count;) {
