@@ -3,6 +3,9 @@
 
 #include <bit>
 
+#include "gyrochar/assert.hpp"
+#include "gyrochar/term_kernel.hpp"
+
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #include <immintrin.h>
 #define GYROCHAR_BATCH_AVX2 1
@@ -55,13 +58,13 @@ template <class R>
                                                      std::int64_t* __restrict a, std::int64_t* __restrict h) {
   ChunkSquares sq;
   for (std::size_t j = 0; j < n; ++j) {
-    const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
-    const std::uint64_t d2 = u1 - u2;
-    const auto av = static_cast<std::int64_t>((u0 - u1) - d2);
+    const std::uint64_t u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
+    const std::uint64_t au = term::avar(word(x0[j]), u1, u2);
+    const auto av = static_cast<std::int64_t>(au);
     a[j] = av;
     sq.a.add(av);
     if (hvar) {
-      const auto hv = static_cast<std::int64_t>(static_cast<std::uint64_t>(av) - (d2 - (u2 - word(x0[j - 3 * m]))));
+      const auto hv = static_cast<std::int64_t>(term::hvar(au, u1, u2, word(x0[j - 3 * m])));
       h[j] = hv;
       sq.h.add(hv);
     }
@@ -131,6 +134,21 @@ inline void add_selected(Totals& tot, int k, const std::int64_t* v, std::size_t 
 struct ChunkSquares3 {
   Squares a, h, t;
 };
+// The terms from index `from` to n - 1, scalar, after a vector loop stopped there: the scalar tail
+// the AVX2 and AVX-512 loops share. t: the running MVAR sum before `from`; returns it at n - 1.
+inline std::uint64_t scalar_tail(const std::int32_t* x0, std::size_t m, std::size_t from, std::size_t n, std::uint64_t t,
+                                 ChunkSquares3& sq) {
+  for (std::size_t j = from; j < n; ++j) {  // as avar_hvar() and running_sum()
+    const std::uint64_t u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
+    const std::uint64_t a = term::avar(word(x0[j]), u1, u2);
+    const std::uint64_t h = term::hvar(a, u1, u2, word(x0[j - 3 * m]));
+    t += h;
+    sq.a.add(static_cast<std::int64_t>(a));
+    sq.h.add(static_cast<std::int64_t>(h));
+    sq.t.add(static_cast<std::int64_t>(t));
+  }
+  return t;
+}
 // The vectors' bound is the OR of v + 2^27 (modulo 2^64): below 2^28 exactly when every v is in
 // [-2^27, 2^27), where the low halves are the terms and 256 squares stay below 2^62. One
 // operation fewer a term than Squares' OR of magnitudes; reduce() turns it into Squares' bound
@@ -176,17 +194,7 @@ static_assert(chunk <= 1024, "2 * 27 + bit_width(chunk) <= 64");
   }
   ChunkSquares3 sq{reduce(ba, sa), reduce(bh, sh), reduce(bt, st)};
   std::uint64_t t = n4 > 0 ? static_cast<std::uint64_t>(_mm256_extract_epi64(tv, 3)) : previous;
-  for (std::size_t j = n4; j < n; ++j) {  // the tail, as avar_hvar() and running_sum()
-    const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
-    const std::uint64_t d2 = u1 - u2;
-    const std::uint64_t a = (u0 - u1) - d2;
-    const std::uint64_t h = a - (d2 - (u2 - word(x0[j - 3 * m])));
-    t += h;
-    sq.a.add(static_cast<std::int64_t>(a));
-    sq.h.add(static_cast<std::int64_t>(h));
-    sq.t.add(static_cast<std::int64_t>(t));
-  }
-  previous = t;
+  previous = scalar_tail(x0, m, n4, n, t, sq);
   return sq;
 }
 // The AVAR terms alone (2m <= s < 3m), likewise: their squares only.
@@ -199,8 +207,7 @@ static_assert(chunk <= 1024, "2 * 27 + bit_width(chunk) <= 64");
   }
   Squares sq = reduce(ba, sa);
   for (std::size_t j = n4; j < n; ++j) {
-    const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
-    sq.add(static_cast<std::int64_t>((u0 - u1) - (u1 - u2)));
+    sq.add(static_cast<std::int64_t>(term::avar(word(x0[j]), word(x0[j - m]), word(x0[j - 2 * m]))));
   }
   return sq;
 }
@@ -250,17 +257,7 @@ static_assert(chunk <= 1024, "2 * 27 + bit_width(chunk) <= 64");
   const std::uint64_t b = in_range ? square_range - 1 : ~std::uint64_t{0};
   ChunkSquares3 sq{{b, lane_sum(sa)}, {b, lane_sum(sh)}, {b, lane_sum(st)}};
   std::uint64_t t = n8 > 0 ? static_cast<std::uint64_t>(_mm_extract_epi64(_mm512_extracti32x4_epi32(tv, 3), 1)) : previous;
-  for (std::size_t j = n8; j < n; ++j) {  // the tail, as avar_hvar() and running_sum()
-    const std::uint64_t u0 = word(x0[j]), u1 = word(x0[j - m]), u2 = word(x0[j - 2 * m]);
-    const std::uint64_t d2 = u1 - u2;
-    const std::uint64_t a = (u0 - u1) - d2;
-    const std::uint64_t h = a - (d2 - (u2 - word(x0[j - 3 * m])));
-    t += h;
-    sq.a.add(static_cast<std::int64_t>(a));
-    sq.h.add(static_cast<std::int64_t>(h));
-    sq.t.add(static_cast<std::int64_t>(t));
-  }
-  previous = t;
+  previous = scalar_tail(x0, m, n8, n, t, sq);
   return sq;
 }
 #pragma GCC diagnostic pop
@@ -393,10 +390,9 @@ GYROCHAR_CLONES DecimatedChunk decimated_chunk(const std::int64_t* v, std::size_
   for (std::size_t k = 0; k < n; ++k) {
     const auto u0 = static_cast<std::uint64_t>(v[3 + k]), u1 = static_cast<std::uint64_t>(v[2 + k]);
     const auto u2 = static_cast<std::uint64_t>(v[1 + k]), u3 = static_cast<std::uint64_t>(v[k]);
-    const std::uint64_t d2 = u1 - u2;
-    const std::uint64_t av = (u0 - u1) - d2;
+    const std::uint64_t av = term::avar(u0, u1, u2);
     a[k] = k >= first_a ? static_cast<std::int64_t>(av) : 0;
-    h[k] = k >= first_h ? static_cast<std::int64_t>(av - (d2 - (u2 - u3))) : 0;
+    h[k] = k >= first_h ? static_cast<std::int64_t>(term::hvar(av, u1, u2, u3)) : 0;
     c.a.add(a[k]);
     c.h.add(h[k]);
   }
@@ -418,6 +414,9 @@ std::int64_t point(const PhaseSegment<R>& s, std::size_t j) {
 }  // namespace
 
 BatchTau::BatchTau(std::uint64_t m, std::uint64_t stride) {
+  GYROCHAR_ASSERT(m >= 1);
+  GYROCHAR_ASSERT(std::has_single_bit(stride));
+  GYROCHAR_ASSERT(stride == 1 || m % stride == 0);
   result_.m = m;
   result_.stride = stride;
 }

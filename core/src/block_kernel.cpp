@@ -1,5 +1,7 @@
 #include "gyrochar/block_kernel.hpp"
 
+#include "gyrochar/term_kernel.hpp"
+
 #if defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__)
 #include <immintrin.h>
 #define GYROCHAR_KERNEL_AVX2 1
@@ -35,14 +37,12 @@ void proved_points(std::size_t from, std::size_t n, const Ages& g, std::uint64_t
   for (std::size_t j = from; j < n; ++j) {
     const auto u0 = static_cast<std::uint64_t>(g.x0[j]), u1 = static_cast<std::uint64_t>(g.x1[j]);
     const auto u2 = static_cast<std::uint64_t>(g.x2[j]), u3 = static_cast<std::uint64_t>(g.x3[j]);
-    const std::uint64_t d2 = u1 - u2;
-    const std::uint64_t a = (u0 - u1) - d2;
-    const std::uint64_t h = a - (d2 - (u2 - u3));
+    const std::uint64_t a = term::avar(u0, u1, u2);
+    const std::uint64_t h = term::hvar(a, u1, u2, u3);
     if constexpr (Running) {
       t += h;
     } else {
-      const std::uint64_t d = g.p2[j] - g.p1[j];
-      t = (g.p0[j] - g.p3[j]) + (d + d + d);
+      t = term::mvar(g.p0[j], g.p1[j], g.p2[j], g.p3[j]);
     }
     avar_out[j] = static_cast<std::int64_t>(a);
     hvar_out[j] = static_cast<std::int64_t>(h);
@@ -174,7 +174,7 @@ ProvedSums proved_running_terms(std::size_t n, const std::int64_t* x0, const std
   // t_{-1} = t_0 - h_0 (modulo 2^64, like every term here).
   const auto u0 = static_cast<std::uint64_t>(x0[0]), u1 = static_cast<std::uint64_t>(x1[0]);
   const auto u2 = static_cast<std::uint64_t>(x2[0]), u3 = static_cast<std::uint64_t>(x3[0]);
-  const std::uint64_t t = t_first - ((u0 - 3 * u1) + (3 * u2 - u3));
+  const std::uint64_t t = t_first - term::hvar(term::avar(u0, u1, u2), u1, u2, u3);
   return proved<true>(n, {x0, x1, x2, x3, nullptr, nullptr, nullptr, nullptr}, t, avar_out, hvar_out);
 }
 
@@ -192,10 +192,9 @@ BlockTerms block_terms(std::size_t n, const std::int64_t* __restrict x0, const s
     // Modular arithmetic: exact whenever the true value fits in int64.
     const auto u0 = static_cast<std::uint64_t>(x0[j]), u1 = static_cast<std::uint64_t>(x1[j]);
     const auto u2 = static_cast<std::uint64_t>(x2[j]), u3 = static_cast<std::uint64_t>(x3[j]);
-    const std::uint64_t a = (u0 - u1) - (u1 - u2);
-    const std::uint64_t h = a - ((u1 - u2) - (u2 - u3));
-    const std::uint64_t d = p2[j] - p1[j];
-    const std::uint64_t t = (p0[j] - p3[j]) + (d + d + d);
+    const std::uint64_t a = term::avar(u0, u1, u2);
+    const std::uint64_t h = term::hvar(a, u1, u2, u3);
+    const std::uint64_t t = term::mvar(p0[j], p1[j], p2[j], p3[j]);
     avar_out[j] = static_cast<std::int64_t>(a);
     hvar_out[j] = static_cast<std::int64_t>(h);
     mvar_out[j] = static_cast<std::int64_t>(t);

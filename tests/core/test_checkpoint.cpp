@@ -24,22 +24,23 @@ struct CheckpointLayout<CountArith> {
   using C = Characterizer<CountArith>;
   using Run = C::RunState;
   using Tau = C::TauState;
+  using Header = CheckpointCodec<CountArith>::Header;
   template <class S, class F>
   static std::size_t offset(const S& s, const F& f) {
     return static_cast<std::size_t>(reinterpret_cast<const char*>(&f) - reinterpret_cast<const char*>(&s));
   }
   static std::size_t identity() {
-    const C::Header h;
+    const Header h;
     return offset(h, h.identity);
   }
-  static std::size_t run(const C& c) { return sizeof(C::Header) + c.tau_count() * sizeof(std::uint64_t); }
+  static std::size_t run(const C& c) { return sizeof(Header) + c.tau_count() * sizeof(std::uint64_t); }
   static std::size_t history(const C& c) { return run(c) + sizeof(Run); }
   static std::size_t tau(const C& c, std::size_t i) {
-    return history(c) + c.used_history() * sizeof(C::Entry) + i * sizeof(Tau);
+    return history(c) + c.history_.used() * sizeof(C::Entry) + i * sizeof(Tau);
   }
   static std::size_t entry_bytes() { return sizeof(C::Entry); }
-  static std::size_t ring_size(const C& c, unsigned l) { return c.ring_size(l); }
-  static unsigned ring_levels(const C& c) { return c.ring_levels_; }
+  static std::size_t ring_size(const C& c, unsigned l) { return c.history_.ring_size(l); }
+  static unsigned ring_levels(const C& c) { return c.history_.levels(); }
 };
 
 namespace {

@@ -16,27 +16,15 @@
 // The pyramid. Terms of tau = r * 2^L (1 <= r <= S, S the stride factor) are formed every 2^L
 // phase points ("level L"), so their stride is m/S (1 for m <= S: exactly the fully overlapped
 // estimator, with Stable32's number of terms n). They need x and P at ages m, 2m, 3m. Past points
-// live in a multi-resolution history: ring level 0 keeps the last 3S points; ring level l >= 1
-// keeps the multiples of 2^l with ages in (3S 2^(l-1), 3S 2^l], i.e. 3S/2 entries. A point leaving
-// level l moves on to level l+1 if it is a multiple of 2^(l+1). Memory is therefore
-// 3S + (levels - 1) * 3S/2 entries, independent of run length, and the work per point is O(S)
-// amortized (level L runs every 2^L points; the decimation of tau m rides on its level).
+// live in a multi-resolution history (pyramid_history.hpp) of 3S + (levels - 1) * 3S/2 entries,
+// independent of run length, and the work per point is O(S) amortized (level L runs every 2^L
+// points; the decimation of tau m rides on its level).
 //
 // Gaps. A gap starts a new segment: no term and no difference of the decimated series spans it;
 // sums and term counts go on, so the pooled estimate stays unbiased and n counts only the terms
 // actually formed.
 //
-// Arithmetic policies:
-//   CountArith  integer counts, exact. x is int64, P is a 128-bit two's complement integer, the sums
-//               of squares are unsigned 128-bit. Every term and every sum equals the exact integer
-//               computation whatever the run length, as long as (1) |x| < 2^63 (total pulses),
-//               (2) each term fits in 63 bits plus sign, (3) each sum of squares stays below 2^127.
-//               Each condition is checked: (1) flags the stream, (2) skips the term and counts it in
-//               TauResult::out_of_range, (3) sets TauResult::sum_overflow.
-//   FloatArith  floating phase (files). Phase points are kept relative to the line through the
-//               first two points, frequency increments relative to the first one (differences of
-//               order two and more do not change), P is a double-double so the third differences of
-//               P do not cancel catastrophically; sums are double.
+// Arithmetic policies (arith.hpp): CountArith, integer counts, exact; FloatArith, floating phase.
 #include <array>
 #include <bit>
 #include <cmath>
@@ -45,151 +33,16 @@
 #include <cstring>
 #include <span>
 
+#include "gyrochar/arith.hpp"
+#include "gyrochar/assert.hpp"
 #include "gyrochar/block_kernel.hpp"
-#include "gyrochar/crc32.hpp"
+#include "gyrochar/checkpoint.hpp"
 #include "gyrochar/noise_id.hpp"
-#include "gyrochar/stat.hpp"
+#include "gyrochar/pyramid_history.hpp"
+#include "gyrochar/tau_result.hpp"
 #include "gyrochar/wide.hpp"
 
 namespace gyrochar {
-
-// ---------------------------------------------------------------------------------------------
-// Arithmetic policies
-
-struct CountArith {
-  struct Entry {
-    std::int64_t x = 0;  // phase x_e in pulses
-    Int128 p;            // P_{e+1} = sum_{i<=e} x_i
-  };
-  using X = std::int64_t;
-  using Sum = UInt128;
-  using Increment = std::int32_t;  // pulses per tau0: the exactness bounds rely on |c| < 2^31
-  using NoiseSums = IntegerNoiseIdAccumulator;  // the decimated phase is integer: exact sums
-  static constexpr bool exact = true;
-
-  static constexpr Int128 add_prefix(Int128 p, std::int64_t x) { return p + widen(x); }
-
-  /// Second and third differences of x; false when a value does not fit in int64.
-  static constexpr bool x_terms(std::int64_t x0, std::int64_t x1, std::int64_t x2, std::int64_t x3,
-                                std::int64_t& a, std::int64_t& h) {
-    std::int64_t d1 = 0, d2 = 0, d3 = 0, e2 = 0;
-    unsigned bad = __builtin_sub_overflow(x0, x1, &d1);
-    bad |= __builtin_sub_overflow(x1, x2, &d2);
-    bad |= __builtin_sub_overflow(x2, x3, &d3);
-    bad |= __builtin_sub_overflow(d1, d2, &a);
-    bad |= __builtin_sub_overflow(d2, d3, &e2);
-    bad |= __builtin_sub_overflow(a, e2, &h);
-    return bad == 0;
-  }
-  static constexpr bool x_term2(std::int64_t x0, std::int64_t x1, std::int64_t x2, std::int64_t& a) {
-    std::int64_t d1 = 0, d2 = 0;
-    unsigned bad = __builtin_sub_overflow(x0, x1, &d1);
-    bad |= __builtin_sub_overflow(x1, x2, &d2);
-    bad |= __builtin_sub_overflow(d1, d2, &a);
-    return bad == 0;
-  }
-  /// Third difference of P; false when it does not fit in int64.
-  static constexpr bool p_term(Int128 p0, Int128 p1, Int128 p2, Int128 p3, std::int64_t& t) {
-    const Int128 d = (p0 - p3) + ((p2 - p1) + (p2 - p1) + (p2 - p1));
-    return narrow(d, t);
-  }
-  /// sum += v^2; returns a word whose top bit is set when the sum reached 2^127 (see add_high_word).
-  static constexpr std::uint64_t accumulate(Sum& sum, std::int64_t v) { return add_high_word(sum, square(v)); }
-  static constexpr double to_double(const Sum& s) { return gyrochar::to_double(s); }
-};
-
-struct FloatArith {
-  /// Double-double: value = hi + lo with |lo| <= ulp(hi)/2.
-  struct Prefix {
-    double hi = 0.0;
-    double lo = 0.0;
-  };
-  struct Entry {
-    double x = 0.0;  // phase relative to the reference line
-    Prefix p;        // P_{e+1} relative to the reference line's prefix sums
-  };
-  using X = double;
-  using Sum = double;
-  using Increment = double;
-  using NoiseSums = NoiseIdAccumulator;
-  static constexpr bool exact = false;
-
-  static constexpr Prefix add_prefix(Prefix a, double b) {  // Knuth two-sum, then renormalize
-    const double s = a.hi + b;
-    const double bb = s - a.hi;
-    const double err = (a.hi - (s - bb)) + (b - bb);
-    const double lo = a.lo + err;
-    const double hi = s + lo;
-    return {hi, lo - (hi - s)};
-  }
-  static constexpr double diff(Prefix a, Prefix b) { return (a.hi - b.hi) + (a.lo - b.lo); }
-
-  static constexpr bool x_terms(double x0, double x1, double x2, double x3, double& a, double& h) {
-    a = (x0 - x1) - (x1 - x2);
-    h = a - ((x1 - x2) - (x2 - x3));
-    return true;
-  }
-  static constexpr bool x_term2(double x0, double x1, double x2, double& a) {
-    a = (x0 - x1) - (x1 - x2);
-    return true;
-  }
-  static constexpr bool p_term(Prefix p0, Prefix p1, Prefix p2, Prefix p3, double& t) {
-    t = diff(p0, p3) + 3.0 * diff(p2, p1);
-    return true;
-  }
-  static constexpr std::uint64_t accumulate(Sum& sum, double v) {
-    sum += v * v;
-    return 0;
-  }
-  static constexpr double to_double(Sum s) { return s; }
-};
-
-// ---------------------------------------------------------------------------------------------
-// Results
-
-/// The sums of one tau. Overlapping sums (terms every `stride` points) and non-overlapped sums
-/// (terms every m points, on the decimated series). variance() turns them into variances.
-enum class SumKind : std::uint8_t { avar = 0, mvar = 1, hvar = 2, avar_nonoverlapped = 3, hvar_nonoverlapped = 4 };
-inline constexpr std::size_t sum_kinds = 5;
-
-template <class Sum>
-struct TauResult {
-  std::uint64_t m = 0;                       // averaging factor, tau = m * tau0
-  std::uint64_t stride = 1;                  // overlapping sums: terms every `stride` points
-  std::array<Sum, sum_kinds> sum{};          // sums of squared terms, indexed by SumKind
-  std::array<std::uint64_t, sum_kinds> n{};  // number of terms, indexed by SumKind
-  std::uint32_t out_of_range = 0;            // terms skipped: value beyond int64 (CountArith)
-  bool sum_overflow = false;                 // a sum of squares reached 2^127 (CountArith)
-};
-
-/// The statistic a sum belongs to, and its term stride.
-constexpr Stat stat_of(SumKind k) {
-  return k == SumKind::mvar ? Stat::mvar : (k == SumKind::hvar || k == SumKind::hvar_nonoverlapped) ? Stat::hvar : Stat::avar;
-}
-template <class Sum>
-constexpr std::uint64_t term_stride(const TauResult<Sum>& r, SumKind k) {
-  return k == SumKind::avar_nonoverlapped || k == SumKind::hvar_nonoverlapped ? r.m : r.stride;
-}
-
-/// Variance in (phase unit / s)^2 from the sums of kind k: tau0_s the sample interval, unit the
-/// phase unit per x step (e.g. the pulse weight in rad for counts, 1 for phase in s). 0 when
-/// n = 0. O(1), no allocation. TVAR is tau^2 MVAR / 3.
-template <class Sum>
-constexpr double variance(const TauResult<Sum>& r, SumKind k, double tau0_s, double unit = 1.0) {
-  const auto i = static_cast<std::size_t>(k);
-  if (r.n[i] == 0) return 0.0;
-  const double m = static_cast<double>(r.m);
-  const double tau = m * tau0_s;
-  double sum = 0.0;
-  if constexpr (sizeof(Sum) == sizeof(UInt128)) {
-    sum = gyrochar::to_double(r.sum[i]);
-  } else {
-    sum = r.sum[i];
-  }
-  const Stat s = stat_of(k);
-  const double scale = s == Stat::avar ? 2.0 : s == Stat::mvar ? 2.0 * m * m : 6.0;
-  return sum * unit * unit / (scale * static_cast<double>(r.n[i]) * tau * tau);
-}
 
 // ---------------------------------------------------------------------------------------------
 // The characterizer over caller-owned storage
@@ -202,38 +55,17 @@ enum class ConfigureStatus : std::uint8_t {
   history_too_small,     // storage cannot hold the history for the largest tau at this S
 };
 
-enum class RestoreStatus : std::uint8_t {
-  ok,
-  truncated,        // fewer bytes than the checkpoint needs
-  not_a_checkpoint, // wrong magic number
-  wrong_version,    // written by another checkpoint format version
-  corrupted,        // CRC mismatch
-  config_mismatch,  // another arithmetic, stride factor, tau list or caller tag than now
-  other_identity,   // written for another identity (another instrument): checkpoint_identity() has it
-  invalid_state,    // the CRC holds but a field breaks the state's invariants: restore_field() names it
-};
-
 struct CharacterizerConfig {
   std::uint32_t stride_factor = 8;  // S
   std::uint32_t tag = 0;            // the caller's configuration fingerprint, kept in checkpoints
   std::uint32_t identity = 0;       // what the data belongs to (the caller's instrument), kept too
 };
 
-/// Entries of history needed for stride factor S and taus up to m_max. O(log m_max).
-constexpr std::size_t history_entries(std::uint32_t stride_factor, std::uint64_t m_max) {
-  std::size_t levels = 1;
-  while ((std::uint64_t{stride_factor} << (levels - 1)) < m_max) ++levels;
-  return 3u * stride_factor + (levels - 1) * (3u * stride_factor / 2);
-}
-
-/// Tests craft checkpoints field by field through a specialization of this (the library has none).
-template <class Arith>
-struct CheckpointLayout;
-
 template <class Arith>
 class Characterizer {
   template <class>
   friend struct CheckpointLayout;
+  friend class CheckpointCodec<Arith>;
 
  public:
   using Entry = typename Arith::Entry;
@@ -265,7 +97,7 @@ class Characterizer {
     const std::uint32_t s = config.stride_factor;
     if (s < 2 || s > (1u << 24) || !std::has_single_bit(s)) return ConfigureStatus::bad_stride_factor;
     if (m_list.size() > taus_.size()) return ConfigureStatus::too_many_taus;
-    stride_ = s;
+    history_.configure(s, history_.levels());  // the levels follow once the taus are known
     tag_ = config.tag;
     identity_ = config.identity;
     ntaus_ = m_list.size();
@@ -284,21 +116,18 @@ class Characterizer {
       t.result.stride = std::uint64_t{1} << level;
       t.level = static_cast<std::uint8_t>(level);
       for (unsigned k = 1; k <= 3; ++k) {
-        const std::uint64_t age = k * m;
-        unsigned ring = 0;
-        while (3 * (std::uint64_t{s} << ring) < age) ++ring;
-        t.ring_of[k - 1] = static_cast<std::uint8_t>(ring);
-        // Ring 0 holds ages 1..3S: back = age. Ring l >= 1 holds ages (3S/2, 3S] * 2^l, whose
-        // distance in slots, age >> l, exceeds the ring size 3S/2 once: take it off.
-        const std::uint64_t back = ring == 0 ? age : (age >> ring) - 3u * s / 2;
-        t.back[k - 1] = static_cast<std::uint32_t>(back);
+        const HistorySlot slot = history_slot(s, k * m);
+        t.ring_of[k - 1] = slot.ring;
+        t.back[k - 1] = slot.back;
       }
       if (level > max_level) max_level = level;
     }
-    ring_levels_ = max_level + 1;
+    history_.configure(s, max_level + 1);
     fast_count_ = 0;
     while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0) ++fast_count_;
-    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.size()) return ConfigureStatus::history_too_small;
+    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.capacity())
+      return ConfigureStatus::history_too_small;
+    GYROCHAR_ASSERT(history_.used() <= history_.capacity());
     restart();
     return ConfigureStatus::ok;
   }
@@ -317,7 +146,7 @@ class Characterizer {
       t.noise = typename Arith::NoiseSums{};
     }
     run_ = RunState{};
-    run_.steady_from = 3u * stride_;
+    run_.steady_from = 3u * stride();
     staged_count_ = 0;
   }
 
@@ -400,7 +229,7 @@ class Characterizer {
     run_.increment_min = RunState{}.increment_min;
     run_.increment_max = RunState{}.increment_max;
     run_.segment_start = run_.next_e;
-    run_.steady_from = run_.segment_start + 3u * stride_;
+    run_.steady_from = run_.segment_start + 3u * stride();
     run_.p_segment_start = run_.p;
     ++run_.gaps;
     for (std::size_t i = 0; i < ntaus_; ++i) {
@@ -410,80 +239,26 @@ class Characterizer {
   }
 
   // -------------------------------------------------------------------------------------------
-  // Checkpoints: the whole state as bytes (native byte order: restore on the same kind of board),
-  // with a format version, the caller's tag and a CRC-32 at the end. The caller stores them
-  // (atomically: firmware/checkpoint.hpp).
+  // Checkpoints: the whole state as bytes, validated field by field on restore (checkpoint.hpp
+  // has the format and the checks). The caller stores them (atomically: firmware/checkpoint.hpp).
 
-  static constexpr std::uint32_t checkpoint_magic = 0x43525947;  // "GYRC"
-  static constexpr std::uint16_t checkpoint_version = 5;  // 5: the identity in the header
-  /// Phase points (and gaps) a checkpoint may count: 2^62 (146 000 years at 1 MHz); indices and
-  /// counts stay far from wrapping around.
-  static constexpr std::uint64_t max_phase_points = std::uint64_t{1} << 62;
+  static constexpr std::uint32_t checkpoint_magic = CheckpointCodec<Arith>::magic;
+  static constexpr std::uint16_t checkpoint_version = CheckpointCodec<Arith>::version;
+  static constexpr std::uint64_t max_phase_points = CheckpointCodec<Arith>::max_phase_points;
 
   /// Bytes save() writes for the current configuration. O(1).
-  std::size_t checkpoint_size() const {
-    return sizeof(Header) + ntaus_ * sizeof(std::uint64_t) + sizeof(RunState) + used_history() * sizeof(Entry) +
-           ntaus_ * sizeof(TauState) + sizeof(std::uint32_t);
-  }
+  std::size_t checkpoint_size() const { return CheckpointCodec<Arith>::size(*this); }
 
   /// Writes the state into `out`; returns the bytes written, 0 when `out` is too small.
   /// O(history + taus), no allocation, does not disturb accumulation.
-  std::size_t save(std::span<std::byte> out) const {
-    if (out.size() < checkpoint_size()) return 0;
-    flush();
-    std::byte* p = out.data();
-    const Header h = header();
-    p = put(p, &h, sizeof h);
-    for (std::size_t i = 0; i < ntaus_; ++i) p = put(p, &taus_[i].result.m, sizeof(std::uint64_t));
-    p = put(p, &run_, sizeof run_);
-    p = put(p, history_.data(), used_history() * sizeof(Entry));
-    p = put(p, taus_.data(), ntaus_ * sizeof(TauState));
-    const std::uint32_t crc = crc32({out.data(), static_cast<std::size_t>(p - out.data())});
-    p = put(p, &crc, sizeof crc);
-    return static_cast<std::size_t>(p - out.data());
-  }
+  std::size_t save(std::span<std::byte> out) const { return CheckpointCodec<Arith>::save(*this, out); }
 
   /// Restores a state written by save() under the same configuration and identity (configure()
   /// first). Any byte pattern is safe: a state whose fields break the invariants of accumulation
-  /// (invalid_field()) is refused as invalid_state. On success the restart is a gap: a new segment
-  /// starts at the next point, sums and counts go on. On failure nothing changes but what
-  /// restore_field() and checkpoint_identity() report. O(history + taus), no allocation.
-  RestoreStatus restore(std::span<const std::byte> in) {
-    Header h{};
-    if (in.size() < sizeof h.magic) return RestoreStatus::truncated;
-    std::memcpy(&h.magic, in.data(), sizeof h.magic);
-    if (h.magic != checkpoint_magic) return RestoreStatus::not_a_checkpoint;
-    if (in.size() < sizeof h) return RestoreStatus::truncated;
-    std::memcpy(&h, in.data(), sizeof h);
-    if (h.version != checkpoint_version) return RestoreStatus::wrong_version;
-    const Header mine = header();
-    if (h.exact != mine.exact || h.entry_bytes != mine.entry_bytes || h.tau_bytes != mine.tau_bytes ||
-        h.stride != mine.stride || h.ntaus != mine.ntaus || h.tag != mine.tag)
-      return RestoreStatus::config_mismatch;
-    const std::size_t size = checkpoint_size();
-    if (in.size() < size) return RestoreStatus::truncated;
-    std::uint32_t crc = 0;
-    std::memcpy(&crc, in.data() + size - sizeof crc, sizeof crc);
-    if (crc != crc32(in.first(size - sizeof crc))) return RestoreStatus::corrupted;
-    restored_identity_ = h.identity;
-    if (h.identity != identity_) return RestoreStatus::other_identity;
-    const std::byte* p = in.data() + sizeof h;
-    for (std::size_t i = 0; i < ntaus_; ++i) {
-      std::uint64_t m = 0;
-      p = get(p, &m, sizeof m);
-      if (m != taus_[i].result.m) return RestoreStatus::config_mismatch;
-    }
-    // The CRC guards against accidents, not against a state that was never valid (a file on a
-    // board's flash can be written by anything): every field is checked before any is taken.
-    restore_field_ = invalid_field(p, p + sizeof(RunState), p + sizeof(RunState) + used_history() * sizeof(Entry));
-    if (restore_field_ != nullptr) return RestoreStatus::invalid_state;
-    staged_count_ = 0;  // the restored state replaces the points not yet processed
-    p = get(p, &run_, sizeof run_);
-    p = get(p, history_.data(), used_history() * sizeof(Entry));
-    get(p, taus_.data(), ntaus_ * sizeof(TauState));
-    mark_gap();
-    return RestoreStatus::ok;
-  }
+  /// is refused as invalid_state. On success the restart is a gap: a new segment starts at the
+  /// next point, sums and counts go on. On failure nothing changes but what restore_field() and
+  /// checkpoint_identity() report. O(history + taus), no allocation.
+  RestoreStatus restore(std::span<const std::byte> in) { return CheckpointCodec<Arith>::restore(*this, in); }
 
   // -------------------------------------------------------------------------------------------
   // Read-out (the extractors of estimates.hpp build on these). All O(1), no allocation.
@@ -497,7 +272,7 @@ class Characterizer {
   /// Gaps marked so far (restores and phase overflows included).
   std::uint64_t gaps() const { return run_.gaps; }
   std::size_t tau_count() const { return ntaus_; }
-  std::uint32_t stride_factor() const { return stride_; }
+  std::uint32_t stride_factor() const { return history_.stride_factor(); }
   std::uint32_t tag() const { return tag_; }
   std::uint32_t identity() const { return identity_; }
   /// After restore() returned invalid_state: the first field that failed its check.
@@ -506,6 +281,7 @@ class Characterizer {
   std::uint32_t checkpoint_identity() const { return restored_identity_; }
   /// Sums of tau i (0 <= i < tau_count()), valid at any time.
   Result result(std::size_t i) const {
+    GYROCHAR_ASSERT(i < ntaus_);
     flush();
     Result r = taus_[i].result;
     r.sum_overflow = (taus_[i].sticky >> 63) != 0;
@@ -513,122 +289,13 @@ class Characterizer {
   }
   /// The lag-1 autocorrelation sums of tau i's decimated series.
   const typename Arith::NoiseSums& noise(std::size_t i) const {
+    GYROCHAR_ASSERT(i < ntaus_);
     flush();
     return taus_[i].noise;
   }
 
  private:
-  struct Header {
-    std::uint32_t magic = checkpoint_magic;
-    std::uint16_t version = checkpoint_version;
-    std::uint8_t exact = Arith::exact;
-    std::uint8_t reserved = 0;
-    std::uint32_t entry_bytes = sizeof(Entry);
-    std::uint32_t tau_bytes = sizeof(TauState);
-    std::uint32_t stride = 0;
-    std::uint32_t tag = 0;
-    std::uint32_t identity = 0;
-    std::uint32_t reserved2 = 0;
-    std::uint64_t ntaus = 0;
-  };
-  Header header() const {
-    Header h;
-    h.stride = stride_;
-    h.tag = tag_;
-    h.identity = identity_;
-    h.ntaus = ntaus_;
-    return h;
-  }
-  std::size_t used_history() const { return 3u * stride_ + (ring_levels_ - 1) * (3u * stride_ / 2); }
-  static std::byte* put(std::byte* p, const void* from, std::size_t n) {
-    std::memcpy(p, from, n);
-    return p + n;
-  }
-  static const std::byte* get(const std::byte* p, void* to, std::size_t n) {
-    std::memcpy(to, p, n);
-    return p + n;
-  }
-
-  // The invariants restore() checks on a checkpoint's run state, history and tau states, before
-  // taking anything. Returns the first field that fails, nullptr when all hold. Every field that
-  // positions, counts or bounds must be what accumulation since configure() can produce. Two kinds
-  // may hold anything: what restore()'s gap resets (p_segment_start, increment_min/max, the
-  // decimated points), and the history's values but the last point's (no term reads a point
-  // across that gap). Flags are read as bytes first: any byte pattern is safe. O(history + taus).
-  const char* invalid_field(const std::byte* run_bytes, const std::byte* history_bytes, const std::byte* tau_bytes) const {
-    RunState r;
-    std::memcpy(&r, run_bytes, sizeof r);
-    if (byte_of(&r.phase_overflow) > (Arith::exact ? 1 : 0)) return "phase_overflow";
-    const std::uint64_t e = r.next_e;
-    if (e > max_phase_points) return "next_e (phase points)";
-    if (r.segment_start > e) return "segment_start";
-    if (r.gaps > max_phase_points) return "gaps";  // as many calls as points can have: the count never wraps
-    if (r.steady_from != r.segment_start + 3u * stride_) return "steady_from";
-    // Points come from increments, one each plus one at each segment's start (gaps + 1 segments
-    // at most, each opened by an increment), or (floating phase input) from add_phase_point().
-    if (Arith::exact || r.line_points == 0) {
-      if (r.increments > e || e - r.increments > r.increments || (e > r.increments && e - r.increments - 1 > r.gaps))
-        return "increments (samples)";
-    } else if (r.increments != 0 || r.line_points != e) {
-      return "line_points";
-    }
-    // The last point's entry in ring 0 holds the running phase and P (a NaN never compares equal).
-    Entry last{};
-    if (e > 0) std::memcpy(&last, history_bytes + static_cast<std::size_t>((e - 1) % (3u * stride_)) * sizeof(Entry), sizeof last);
-    if (r.p.hi != last.p.hi || r.p.lo != last.p.lo) return "p (prefix sum)";
-    if (r.x != (Arith::exact || r.line_points == 0 ? last.x : X{})) return "x (running phase)";
-    if constexpr (Arith::exact) {
-      if (r.line_points != 0 || r.line_x0 != 0 || r.line_slope != 0 || r.first_increment != 0)
-        return "line (floating input only)";
-    } else {
-      if (!std::isfinite(r.first_increment) || !std::isfinite(r.line_x0) || !std::isfinite(r.line_slope))
-        return "line (reference line or first increment)";
-    }
-    for (std::size_t l = 0; l < r.head.size(); ++l) {
-      const std::uint64_t want = l < ring_levels_ && e > 0 ? ((e - 1) >> l) % ring_size(static_cast<unsigned>(l)) : 0;
-      if (r.head[l] != want) return "head (history position)";
-    }
-    for (std::size_t i = 0; i < ntaus_; ++i) {
-      TauState t;
-      std::memcpy(&t, tau_bytes + i * sizeof(TauState), sizeof t);
-      if (const char* field = invalid_tau(t, taus_[i], e)) return field;
-    }
-    return nullptr;
-  }
-
-  // A tau state against the configured one, after e phase points.
-  static const char* invalid_tau(const TauState& t, const TauState& configured, std::uint64_t e) {
-    const Result& r = t.result;
-    if (r.m != configured.result.m || r.stride != configured.result.stride || t.level != configured.level ||
-        t.ring_of != configured.ring_of || t.back != configured.back)
-      return "tau (averaging factor, stride or history position)";
-    // Point 0 and every multiple of m are decimated; the countdown counts the level's runs to the next.
-    const std::uint64_t countdown = e == 0 ? 0 : (r.m >> t.level) - (((e - 1) % r.m) >> t.level);
-    if (t.countdown != countdown) return "countdown (decimation)";
-    if (t.decimated_count > 3) return "decimated_count";
-    if (byte_of(&r.sum_overflow) != 0) return "sum_overflow";  // kept in sticky, false in the state
-    // Terms form at most at every stride-th point (overlapping) or every m-th (decimated).
-    const std::uint64_t formed = e / r.stride, decimated = e / r.m;
-    for (std::size_t k = 0; k < sum_kinds; ++k) {
-      if (r.n[k] > (k < 3 ? formed : decimated)) return "n (term count)";
-      if constexpr (Arith::exact) {
-        if (r.n[k] == 0 && (r.sum[k].lo | r.sum[k].hi) != 0) return "sum (of squares, without terms)";
-        if ((r.sum[k].hi & ~t.sticky) != 0) return "sticky (the sums' high words)";
-      } else {
-        if (!std::isfinite(r.sum[k]) || r.sum[k] < 0 || (r.n[k] == 0 && r.sum[k] != 0)) return "sum (of squares)";
-      }
-    }
-    if (!Arith::exact && t.sticky != 0) return "sticky (the sums' high words)";
-    if (r.out_of_range > 2 * formed) return "out_of_range";
-    if (!t.noise.plausible(e == 0 ? 0 : (e - 1) / r.m + 1)) return "noise (lag-1 sums)";
-    return nullptr;
-  }
-
-  static std::uint8_t byte_of(const bool* flag) {
-    std::uint8_t b = 0;
-    std::memcpy(&b, flag, 1);
-    return b;
-  }
+  std::uint32_t stride() const { return history_.stride_factor(); }
 
   // add_increment() at a segment's start or a phase overflow, and for floating increments.
   [[gnu::noinline]] void add_increment_general(typename Arith::Increment dx) {
@@ -666,6 +333,7 @@ class Characterizer {
   [[gnu::noinline]] void process_staged() {
     const std::size_t n = staged_count_;
     if (n == 0) return;
+    GYROCHAR_ASSERT(n <= block_points);  // stage() flushes a full block at once
     staged_count_ = 0;
     std::size_t i = 0;
     if constexpr (Arith::exact) {
@@ -673,8 +341,7 @@ class Characterizer {
       // are all of this segment (gaps flush first) and differ by increments, the first one from
       // the last point processed unless it opens the segment.
       if (run_.next_e != run_.segment_start) {
-        const auto last = static_cast<std::size_t>((run_.next_e - 1) % (3u * stride_));  // its slot in ring 0
-        const std::array<std::int64_t, 2> first{history_[last].x, staged_[0]};
+        const std::array<std::int64_t, 2> first{history_.recent(run_.next_e - 1).x, staged_[0]};
         difference_range(first.data(), 2, run_.increment_min, run_.increment_max);
       }
       difference_range(staged_.data(), n, run_.increment_min, run_.increment_max);
@@ -690,7 +357,7 @@ class Characterizer {
     const std::uint64_t e = run_.next_e++;
     run_.p = Arith::add_prefix(run_.p, x);
     const Entry current{x, run_.p};
-    const unsigned fired = advance_heads(e);
+    const unsigned fired = history_.advance_heads(e, run_.head);
     if (e == 0) {  // point 0 is a multiple of every m
       for (std::size_t i = 0; i < ntaus_; ++i) decimate(taus_[i], x);
     }
@@ -704,17 +371,7 @@ class Characterizer {
       }
     }
     later_levels(i, e, fired, current);
-    insert(e, current);
-  }
-
-  // Levels 0 .. countr_zero(e) run at e; their ring heads move on by one slot. Returns how many.
-  unsigned advance_heads(std::uint64_t e) {
-    const unsigned fired = e == 0 ? 0 : static_cast<unsigned>(std::countr_zero(e)) + 1;
-    const unsigned moved = fired < ring_levels_ ? fired : ring_levels_;
-    for (unsigned ring = 0; ring < moved; ++ring) {
-      if (++run_.head[ring] == ring_size(ring)) run_.head[ring] = 0;
-    }
-    return fired;
+    history_.insert(e, current, run_.head);
   }
 
   // Terms and decimation of the taus from index `first` on whose level runs at e.
@@ -746,343 +403,33 @@ class Characterizer {
       requires(Arith::exact)
     {
       if (j >= age) return {x[j - age], Int128{p_lo[j - age], p_hi[j - age]}};
-      return c.history_[static_cast<std::size_t>((e0 + j - age) % (3u * c.stride_))];
+      return c.history_.recent(e0 + j - age);
     }
   };
 
+  // Defined in characterizer_block.hpp, each with its contract.
   void push_block(const X* x, std::size_t n)
-    requires(Arith::exact)
-  {
-    // The window: the last `depth` points before the block (from ring 0), then the block.
-    const std::uint32_t ring0 = 3u * stride_;
-    const std::size_t depth = ring0 < window_depth ? ring0 : window_depth;
-    std::array<std::int64_t, window_depth + block_points> wx;
-    std::array<std::uint64_t, window_depth + block_points> wp;
-    std::array<std::uint64_t, block_points> p_hi;
-    const auto oldest = static_cast<std::uint32_t>((run_.next_e - depth) % ring0);
-    from_ring(&history_[0], ring0, oldest, depth, wx.data(), wp.data());
-    // P in two words: x sign-extended adds the carry out of the low word, less one when x < 0.
-    std::uint64_t p_lo = run_.p.lo, p_high = run_.p.hi;
-    for (std::size_t j = 0; j < n; ++j) {
-      const auto v = static_cast<std::uint64_t>(x[j]);
-      const std::uint64_t sum = p_lo + v;
-      p_high += static_cast<std::uint64_t>(sum < p_lo) - (v >> 63);
-      p_lo = sum;
-      wp[depth + j] = p_lo;
-      p_hi[j] = p_high;
-    }
-    std::memcpy(&wx[depth], x, n * sizeof(X));
-    const Block b{run_.next_e, n, x, &wp[depth], p_hi.data(), &wx[depth], depth, 0};
-    for (std::size_t i = 0; i < fast_count_; ++i) level0_block(taus_[i], b);
-    const std::size_t done = depth == ring0 ? higher_levels(b, wx.data(), wp.data()) : fast_count_;
-    // The history and the remaining levels. The taus the kernel left run at the multiples of
-    // 2^level of the lowest of them: those points go one by one, as push() takes them, the runs
-    // between them enter the history at once. Below level 4 they run too often for that to pay.
-    const bool later = done < ntaus_;
-    if (later && taus_[done].level < 4) {
-      for (std::size_t j = 0; j < n; ++j) block_point(done, x[j], {wp[depth + j], p_hi[j]});
-      return;
-    }
-    const std::uint64_t every = later ? std::uint64_t{1} << taus_[done].level : 0;
-    for (std::size_t j = 0; j < n;) {
-      std::size_t k = n;  // the next point at which a later tau runs
-      if (later) {
-        const std::uint64_t wait = (every - (run_.next_e & (every - 1))) & (every - 1);
-        if (wait < n - j) k = j + static_cast<std::size_t>(wait);
-      }
-      if (k > j) insert_run(x + j, &wp[depth + j], p_hi.data() + j, k - j);
-      if (k == n) break;
-      block_point(done, x[k], {wp[depth + k], p_hi[k]});
-      j = k + 1;
-    }
-  }
-
-  // One point of a block (P: its prefix) through the history and the taus from `first` on.
+    requires(Arith::exact);
   void block_point(std::size_t first, X x, Int128 p)
-    requires(Arith::exact)
-  {
-    const std::uint64_t e = run_.next_e++;
-    run_.p = p;
-    const Entry current{x, p};
-    later_levels(first, e, advance_heads(e), current);
-    insert(e, current);
-  }
-
-  // Points a = run_.next_e (>= 1) .. b = a + n - 1 enter the history as insert() would take them
-  // one by one, and run_ moves on past them. After point e, ring l holds the multiples q of 2^l
-  // with q <= e - ring_lag(l), the newest ring_size(l) of them, q at slot (q >> l) mod the size.
-  // So ring l takes the multiples that cross its lag within [a, b] (the newest ring_size(l)), from
-  // these points or from the lower ring that held them before; the rings are written from the top
-  // down, so each reads the rings below it before they change. O(n + rings), no allocation.
+    requires(Arith::exact);
   void insert_run(const X* x, const std::uint64_t* p_lo, const std::uint64_t* p_hi, std::size_t n)
-    requires(Arith::exact)
-  {
-    const std::uint64_t a = run_.next_e, b = a + n - 1;
-    // Only the rings with a multiple of 2^l in [a, b] move (their lags are multiples of 2^l too).
-    const auto width = static_cast<unsigned>(std::bit_width((a - 1) ^ b));
-    const unsigned moved = width < ring_levels_ ? width : ring_levels_;
-    for (unsigned l = moved; l-- > 0;) {
-      const std::uint64_t lag = ring_lag(l), size = ring_size(l);
-      if (b < lag) continue;
-      const std::uint64_t newest = (b - lag) >> l;
-      std::uint64_t first = a > lag ? ((a - 1 - lag) >> l) + 1 : 0;  // not in ring l before
-      if (newest >= first + size) first = newest + 1 - size;
-      Entry* ring = &history_[ring_offset(l)];
-      auto slot = static_cast<std::uint32_t>(first % size);
-      std::uint64_t k = first;
-      // The multiples q < a, from the rings below that held them (older q sit higher): each ring
-      // holds a run of consecutive multiples, read at a fixed step of slots. Ring 0 holds every q
-      // in [a - 3S, a).
-      for (unsigned r = l; k <= newest && (k << l) < a;) {
-        while (!held(--r, k << l, a - 1)) {}
-        const std::uint64_t last = r == 0 ? a - 1 : (a - 1 - ring_lag(r)) >> r << r;  // ring r's newest
-        const std::uint32_t from_size = ring_size(r);
-        const auto step = static_cast<std::uint32_t>((std::uint64_t{1} << (l - r)) % from_size);
-        const Entry* from = &history_[ring_offset(r)];
-        auto from_slot = static_cast<std::uint32_t>(((k << l) >> r) % from_size);
-        for (; k <= newest && (k << l) <= last; ++k) {
-          ring[slot] = from[from_slot];
-          if (++slot == size) slot = 0;
-          from_slot += step;
-          if (from_slot >= from_size) from_slot -= from_size;
-        }
-        ++r;  // the next multiple may still sit in ring r - 1 (held() steps down from r - 1)
-      }
-      // The multiples q >= a, from the run itself.
-      for (auto j = static_cast<std::size_t>((k << l) - a); k <= newest; ++k, j += std::size_t{1} << l) {
-        ring[slot] = Entry{x[j], Int128{p_lo[j], p_hi[j]}};
-        if (++slot == size) slot = 0;
-      }
-    }
-    for (unsigned l = 0; l < moved; ++l) run_.head[l] = static_cast<std::uint32_t>((b >> l) % ring_size(l));
-    run_.next_e = b + 1;
-    run_.p = {p_lo[n - 1], p_hi[n - 1]};
-  }
-
-  // Whether ring l holds point q (a multiple of 2^l) after point e.
-  bool held(unsigned l, std::uint64_t q, std::uint64_t e) const {
-    const std::uint64_t lag = ring_lag(l);
-    return e >= lag && q <= e - lag && (q >> l) + ring_size(l) > ((e - lag) >> l);
-  }
-
+    requires(Arith::exact);
   static constexpr std::size_t window_depth = 96;  // points before a block copied next to it
-
-  // Levels 1, 2, ... of a block that starts at a multiple of block_points, with 3S <= window_depth:
-  // the points of level L (the multiples of 2^L) form a series in which a tau r 2^L of that level
-  // is a level-0 tau of lag r, so the same kernel takes them, over a window of the series' last 3S
-  // points (the younger half from level L-1's window, the older half from ring L) and the block's
-  // points of level L. Stops at the first level not yet steady in this segment or whose terms are
-  // not proved to fit. Returns how many taus (a prefix of the list) the kernel took.
   std::size_t higher_levels(const Block& level0, const std::int64_t* x_prev, const std::uint64_t* p_prev)
-    requires(Arith::exact)
-  {
-    std::size_t done = fast_count_;
-    const std::uint64_t e0 = level0.e0;
-    const std::size_t depth = 3u * stride_;
-    if (e0 % block_points != 0) return done;
-    std::array<std::array<std::int64_t, window_depth + block_points / 2>, 2> x_buf;  // level 1 on: half the points
-    std::array<std::array<std::uint64_t, window_depth + block_points / 2>, 2> p_buf;
-    std::size_t n = level0.n;
-    // Levels with at least two points in the block: a single point costs less through block_point().
-    for (unsigned level = 1; (std::size_t{2} << level) <= block_points && level < ring_levels_; ++level) {
-      if (done == ntaus_ || taus_[done].level != level || e0 < run_.segment_start + (std::uint64_t{depth} << level))
-        return done;
-      std::int64_t* x_next = x_buf[level % 2].data();
-      std::uint64_t* p_next = p_buf[level % 2].data();
-      const std::size_t half = depth / 2;
-      const std::uint32_t ring = 3u * stride_ / 2;
-      // Ages (3S 2^(L-1), 3S 2^L]: ring L; the younger ones and the block: every other one.
-      from_ring(&history_[ring_offset(level)], ring, static_cast<std::uint32_t>(((e0 >> level) - depth) % ring), half,
-                x_next, p_next);
-      n = (n + 1) / 2;
-      // depth = 3S is even: x_prev[0] is of level L.
-      every_other(reinterpret_cast<const std::uint64_t*>(x_prev), reinterpret_cast<std::uint64_t*>(x_next + half),
-                  depth - half + n);
-      every_other(p_prev, p_next + half, depth - half + n);
-      const Block b{e0, n, x_next + depth, p_next + depth, nullptr, x_next + depth, depth, level};
-      for (; done < ntaus_ && taus_[done].level == level; ++done) {
-        if (!terms_fit(taus_[done].result.m)) return done;
-        level0_block(taus_[done], b);
-      }
-      x_prev = x_next;
-      p_prev = p_next;
-    }
-    return done;
-  }
-
-
-  // x and the low word of P of `count` entries of a ring of `size` slots, from `slot` on.
-  static void from_ring(const Entry* ring, std::uint32_t size, std::uint32_t slot, std::size_t count,
-                        std::int64_t* __restrict x, std::uint64_t* __restrict p) {
-    for (std::size_t i = 0; i < count;) {
-      const std::size_t run = count - i < size - slot ? count - i : size - slot;
-      for (std::size_t k = 0; k < run; ++k, ++i) {
-        x[i] = ring[slot + k].x;
-        p[i] = ring[slot + k].p.lo;
-      }
-      slot = 0;
-    }
-  }
-
-  // The block's terms of one level-0 tau, and its decimated points.
-  // The terms of tau m fit in int64 when 2 m^2 (largest increment - smallest) < 2^63 (|a| <= m
-  // span, |h| <= 2 m span, |t| <= m^2 span), always for m <= 2^15 since increments are int32.
-  bool terms_fit(std::uint64_t m) const {
-    if (m > (std::uint64_t{1} << 31)) return false;
-    const std::uint64_t span = run_.increment_max >= run_.increment_min
-                                   ? static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min)
-                                   : 0;
-    return span <= (~std::uint64_t{0} >> 1) / (2 * m * m);
-  }
-
-  // Whether every term of tau m is small enough that the 64-bit sums of n of their squares are
-  // exact (squares_exact()), from the segment's increment spread D: |a| <= m D, |h| <= 2 m D,
-  // |t| <= m^2 D (t sums m consecutive AVAR terms). The bounds go to `terms` (their sums are the
-  // caller's to fill). terms_fit(m) holds: m^2 D < 2^62.
-  bool proved_small(std::uint64_t m, std::size_t n, BlockTerms& terms) const {
-    const std::uint64_t span = run_.increment_max >= run_.increment_min
-                                   ? static_cast<std::uint64_t>(std::int64_t{run_.increment_max} - run_.increment_min)
-                                   : 0;
-    terms.avar.magnitude_bits = m * span;
-    terms.hvar.magnitude_bits = 2 * m * span;
-    terms.mvar.magnitude_bits = m * m * span;
-    return squares_exact(terms.hvar, n) && squares_exact(terms.mvar, n);
-  }
-
-  // A bound on |x[e] - x[e-m]| (m increments) in this segment, 0 when it does not fit in 62 bits.
-  std::uint64_t step_bound(std::uint64_t m) const {
-    const std::int64_t lo = run_.increment_min, hi = run_.increment_max;
-    if (hi < lo || m > (std::uint64_t{1} << 31)) return 0;
-    const auto largest = static_cast<std::uint64_t>(-lo > hi ? -lo : hi);
-    return m * largest;
-  }
-
+    requires(Arith::exact);
+  bool terms_fit(std::uint64_t m) const;
+  bool proved_small(std::uint64_t m, std::size_t n, BlockTerms& terms) const;
+  std::uint64_t step_bound(std::uint64_t m) const;
   void level0_block(TauState& t, const Block& b)
-    requires(Arith::exact)
-  {
-    const auto m = static_cast<std::size_t>(t.result.m >> b.level);  // the lag in the block's series (<= S)
-    if (!terms_fit(t.result.m)) {  // level 0 only (higher_levels() checks first)
-      for (std::size_t j = 0; j < b.n; ++j) {  // the checked path, point by point
-        const Entry now = b.at(*this, j, 0);
-        checked_terms(t, now, b.at(*this, j, m), b.at(*this, j, 2 * m), b.at(*this, j, 3 * m));
-        if (--t.countdown == 0) decimate(t, now.x);
-      }
-      return;
-    }
-    // The points at ages m, 2m, 3m: in the window, or gathered from ring 0 (S > 32).
-    if (3 * m <= b.depth) {
-      block_sums(t, b, m, b.wx - m, b.wx - 2 * m, b.wx - 3 * m, b.p_lo - m, b.p_lo - 2 * m, b.p_lo - 3 * m);
-    } else {
-      gathered_sums(t, b, m);
-    }
-  }
-
-  // The gathered points live in this function's frame only, not in the usual path's.
+    requires(Arith::exact);
   [[gnu::noinline]] void gathered_sums(TauState& t, const Block& b, std::size_t m)
-    requires(Arith::exact)
-  {
-    std::array<std::int64_t, block_points> x1, x2, x3;
-    std::array<std::uint64_t, block_points> p1, p2, p3;
-    gather(b, m, x1.data(), p1.data());
-    gather(b, 2 * m, x2.data(), p2.data());
-    gather(b, 3 * m, x3.data(), p3.data());
-    block_sums(t, b, m, x1.data(), x2.data(), x3.data(), p1.data(), p2.data(), p3.data());
-  }
-
-  // The block's terms of a tau of lag m from the points at ages m, 2m, 3m, their sums, the
-  // decimated points and the noise sums.
+    requires(Arith::exact);
   void block_sums(TauState& t, const Block& b, std::size_t m, const std::int64_t* x1, const std::int64_t* x2,
                   const std::int64_t* x3, const std::uint64_t* p1, const std::uint64_t* p2, const std::uint64_t* p3)
-    requires(Arith::exact)
-  {
-    std::array<std::int64_t, block_points> a, h, mt;
-    BlockTerms terms;
-    if (proved_small(t.result.m, b.n, terms)) {
-      ProvedSums s;
-      if (b.level == 0) {  // the MVAR terms as the running sum of the HVAR terms, from the first one's P
-        const std::uint64_t d = p2[0] - p1[0];
-        s = proved_running_terms(b.n, b.x, x1, x2, x3, (b.p_lo[0] - p3[0]) + (d + d + d), a.data(), h.data());
-      } else {
-        s = proved_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data());
-      }
-      terms.avar.sum = s.avar;
-      terms.mvar.sum = s.mvar;
-      terms.hvar.sum = s.hvar;
-    } else {
-      terms = block_terms(b.n, b.x, x1, x2, x3, b.p_lo, p1, p2, p3, a.data(), h.data(), mt.data());
-    }
-    Result& r = t.result;
-    t.sticky |= add_block(r.sum[0], terms.avar, a.data(), b.n) | add_block(r.sum[1], terms.mvar, mt.data(), b.n) |
-                add_block(r.sum[2], terms.hvar, h.data(), b.n);
-    r.n[0] += b.n;
-    r.n[1] += b.n;
-    r.n[2] += b.n;
-    // The decimated series: its terms are the overlapping ones at the multiples of m, so the
-    // block's bound covers their squares too.
-    if (t.countdown > b.n) {
-      t.countdown -= b.n;
-      return;
-    }
-    // The countdown stays in 1..m, so for m = 1 every point is decimated and the block's partial
-    // sums are already the non-overlapped ones.
-    const auto first = static_cast<std::size_t>(t.countdown - 1);
-    const std::size_t count = (b.n - 1 - first) / m + 1;
-    const std::size_t j = first + (count - 1) * m;  // the newest decimated point
-    BlockSquares da = terms.avar, dh = terms.hvar;
-    if (m > 1) {
-      da.sum = 0;
-      dh.sum = 0;
-      for (std::size_t k = first; k <= j; k += m) {
-        da.sum += static_cast<std::uint64_t>(a[k]) * static_cast<std::uint64_t>(a[k]);
-        dh.sum += static_cast<std::uint64_t>(h[k]) * static_cast<std::uint64_t>(h[k]);
-      }
-    }
-    const auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
-    const auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
-    if (squares_exact(da, b.n)) {
-      t.sticky |= add_high_word(r.sum[avar_d], UInt128{da.sum, 0});
-    } else {
-      for (std::size_t k = first; k <= j; k += m) t.sticky |= Arith::accumulate(r.sum[avar_d], a[k]);
-    }
-    if (squares_exact(dh, b.n)) {
-      t.sticky |= add_high_word(r.sum[hvar_d], UInt128{dh.sum, 0});
-    } else {
-      for (std::size_t k = first; k <= j; k += m) t.sticky |= Arith::accumulate(r.sum[hvar_d], h[k]);
-    }
-    r.n[avar_d] += count;
-    r.n[hvar_d] += count;
-    t.noise.add(b.x + first, count, m, step_bound(t.result.m));
-    t.decimated = {b.x[j], x1[j], x2[j]};
-    t.decimated_count = 3;
-    t.countdown = m - (b.n - 1 - j);
-  }
-
-  // x and the low word of P at age `age` of each point of the block.
+    requires(Arith::exact);
   void gather(const Block& b, std::uint64_t age, std::int64_t* x, std::uint64_t* p) const
-    requires(Arith::exact)
-  {
-    const std::size_t from_history = age < b.n ? static_cast<std::size_t>(age) : b.n;
-    const std::uint32_t size = 3u * stride_;
-    std::uint32_t slot = static_cast<std::uint32_t>((b.e0 - age) % size);
-    for (std::size_t j = 0; j < from_history; ++j) {
-      x[j] = history_[slot].x;
-      p[j] = history_[slot].p.lo;
-      if (++slot == size) slot = 0;
-    }
-    for (std::size_t j = from_history; j < b.n; ++j) {
-      x[j] = b.x[j - age];
-      p[j] = b.p_lo[j - age];
-    }
-  }
-
-  // Adds a block's squares to a 128-bit sum: the 64-bit partial sum when it is exact, else the
-  // terms one by one. Returns the sum's high word (for the sticky overflow bit).
-  static std::uint64_t add_block(UInt128& sum, const BlockSquares& s, const std::int64_t* terms, std::size_t n) {
-    if (squares_exact(s, n)) return add_high_word(sum, UInt128{s.sum, 0});
-    std::uint64_t high = 0;
-    for (std::size_t j = 0; j < n; ++j) high |= add_high_word(sum, square(terms[j]));
-    return high;
-  }
+    requires(Arith::exact);
+  static std::uint64_t add_block(UInt128& sum, const BlockSquares& s, const std::int64_t* terms, std::size_t n);
 
   // A point of the decimated series x[k m]: the non-overlapped second and third differences, and
   // the noise identification sums. The countdown restarts at m / 2^level runs of the level.
@@ -1107,7 +454,7 @@ class Characterizer {
   // contract |increment| < 2^31 bounds |x[e] - x[e-k]| by k 2^31, so with m <= 2^15 the AVAR and HVAR
   // terms stay below 2^50 and the MVAR term below 2m^2 2^31 <= 2^62: no range checks are needed.
   void fast_terms(TauState& t, const Entry& now) {
-    const std::uint32_t head = run_.head[0], size = 3u * stride_;
+    const std::uint32_t head = run_.head[0], size = 3u * stride();
     auto back = [&](std::uint32_t b) -> const Entry& { return history_[head >= b ? head - b : head + size - b]; };
     const Entry& e1 = back(t.back[0]);
     const Entry& e2 = back(t.back[1]);
@@ -1172,47 +519,16 @@ class Characterizer {
     ++ts.result.n[1];
   }
 
-  // Ring 0 holds 3S entries from offset 0; ring l >= 1 holds 3S/2 entries from offset (l+1) 3S/2.
-  // run_.head[l] is the slot of phase point e >> l within ring l, i.e. (e >> l) mod ring_size(l).
-  std::uint32_t ring_size(unsigned ring) const { return ring == 0 ? 3u * stride_ : 3u * stride_ / 2; }
-  std::size_t ring_offset(unsigned ring) const { return ring == 0 ? 0 : (ring + 1) * (3u * stride_ / 2); }
-  // Age at which points enter ring l: 0 for ring 0, 3S 2^(l-1) above (they leave ring l-1).
-  std::uint64_t ring_lag(unsigned ring) const { return ring == 0 ? 0 : std::uint64_t{3u * stride_} << (ring - 1); }
-
   // The point of age (k+1) m for tau t.
-  const Entry& at(const TauState& t, unsigned k) const {
-    const unsigned ring = t.ring_of[k];
-    const std::uint32_t head = run_.head[ring];
-    const std::uint32_t back = t.back[k];
-    const std::uint32_t slot = head >= back ? head - back : head + ring_size(ring) - back;
-    return history_[ring_offset(ring) + slot];
-  }
+  const Entry& at(const TauState& t, unsigned k) const { return history_.behind(t.ring_of[k], t.back[k], run_.head); }
 
-  // Stores point e in ring 0; the point it replaces (age 3S) moves on to ring 1 if it is even,
-  // and so on: the point leaving ring l has age 3S 2^l and goes to ring l+1 at its head slot
-  // when it is a multiple of 2^(l+1), which is when e is.
-  void insert(std::uint64_t e, Entry entry) {
-    const std::uint64_t cascade_span = 3u * stride_;  // age at which a point leaves ring 0
-    for (unsigned ring = 0;; ++ring) {
-      Entry& cell = history_[ring_offset(ring) + run_.head[ring]];
-      const Entry evicted = cell;
-      cell = entry;
-      const unsigned next = ring + 1;
-      if (next >= ring_levels_ || (e & ((std::uint64_t{1} << next) - 1)) != 0) return;
-      if (e < (cascade_span << ring)) return;  // the replaced cell was never filled
-      entry = evicted;
-    }
-  }
-
-  std::span<Entry> history_;
+  PyramidHistory<Entry> history_;
   std::span<TauState> taus_;
   std::size_t ntaus_ = 0;
-  std::uint32_t stride_ = 8;
   std::uint32_t tag_ = 0;
   std::uint32_t identity_ = 0;
   std::uint32_t restored_identity_ = 0;
   const char* restore_field_ = nullptr;
-  unsigned ring_levels_ = 1;
   std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
   static constexpr std::size_t block_points = 256;  // staged points per block (a power of two)
   std::array<X, block_points> staged_{};
@@ -1234,7 +550,7 @@ class Characterizer {
     bool phase_overflow = false;
     // CountArith: the smallest and largest increment of this segment (they bound the terms).
     std::int32_t increment_min = INT32_MAX, increment_max = INT32_MIN;
-    std::array<std::uint32_t, 64> head{};  // head[l]: slot of (e >> l) in ring l
+    HistoryHeads head{};  // head[l]: slot of (e >> l) in ring l
   };
   RunState run_;
 };
@@ -1271,3 +587,5 @@ class StaticCharacterizer : private CharacterizerStorage<Arith, Octaves, MaxStri
 };
 
 }  // namespace gyrochar
+
+#include "gyrochar/characterizer_block.hpp"  // the block path's definitions
