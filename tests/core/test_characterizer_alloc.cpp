@@ -56,7 +56,7 @@ TEST(CharacterizerAllocation, StateSizeForFortyOctavesStrideEight) {
   // The board's state for 40 octave taus at S = 8: the pyramid (history and sums, 15 816 bytes
   // before the noise sums moved in) plus per tau the decimated series and the lag-1 sums of noise
   // identification, and the staged block. Budget 36 KiB (oracle: sizeof against the documented
-  // figure, docs/core.md; issue 11's target of 16 KiB is missed, BENCHMARKS.md).
+  // figure, docs/core.md; the target of 16 KiB is missed, BENCHMARKS.md).
   using C = StaticCharacterizer<CountArith, 40, 8>;
   const std::size_t history = CharacterizerStorage<CountArith, 40, 8, 40>::history_capacity() * sizeof(CountArith::Entry);
   const std::size_t taus = 40 * sizeof(Characterizer<CountArith>::TauState);

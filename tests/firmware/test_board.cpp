@@ -387,7 +387,7 @@ void reseal(std::string& b, std::size_t begin, std::size_t end) {
   std::memcpy(b.data() + end, &crc, sizeof crc);
 }
 
-// issue 19's reproducers: random bytes over 256 bytes of the run state, a body of 0xFF, and the
+// The hostile-checkpoint reproducers: random bytes over 256 bytes of the run state, a body of 0xFF, and the
 // sample count alone set to 0xFF..., each with the CRC recomputed, crashed, hung or resumed
 // nonsense. Each is now refused naming a field, kept aside, and the run starts fresh.
 TEST_F(BoardCheckpoint, AValidCrcOverAStateThatWasNeverValidIsRefusedNamingTheField) {

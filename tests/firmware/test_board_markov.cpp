@@ -1,7 +1,7 @@
 // The board's fit with model selection on a gyro with a Gauss-Markov rate term: simulated counts
 // (gyro_sim.hpp) -> the board's reports (report.hpp, the fit inline) -> the codec -> the host
 // decoder, which must hear an accepted fit whose model holds the Markov term. Oracle: the simulated
-// truth, sigma 0.5 deg/h and Tc 300 s beside an angle random walk of 0.02 deg/sqrt(h) (issue 18's
+// truth, sigma 0.5 deg/h and Tc 300 s beside an angle random walk of 0.02 deg/sqrt(h) (the real-sensor work's
 // scenario for the analyzer, `gyrochar-sim --duration 28800 --tau0 0.1 --arw 0.02 --markov 0.5,300`),
 // with its target: the term back within 3 stated standard uncertainties and 30 %. On the board's
 // octave taus (one point per octave of each curve) this seed meets it for sigma (0.554 deg/h,

@@ -98,7 +98,7 @@ TEST(SimulatedGyro, APatternAboveThePulseRateIsFoundAfterTheFit) {
 }
 
 TEST(SimulatedGyro, AMarkovTermComesBackBesideTheFiveTerms) {
-  // Issue 18's case: gyrochar-sim --duration 28800 --tau0 0.1 --arw 0.02 --markov 0.5,300 (seed 1)
+  // The documented Markov case: gyrochar-sim --duration 28800 --tau0 0.1 --arw 0.02 --markov 0.5,300 (seed 1)
   // through the analyzer (octave taus, stride factor 8 here). The five terms alone take the hump for
   // rate random walk; the selection must add the Markov term, within 3 stated sigma and 30 % of
   // the simulated sigma and Tc.

@@ -2,7 +2,7 @@
 // sanitizer build does not). Same oracles and acceptance as test_sim_truth.cpp (closed forms of
 // IEEE Std 952 Annex C; the exact EDF, the seed spread or the quantization bound; p = 1e-4 per
 // comparison), plus: the EDF itself checked against the spread over seeds, the bias-instability
-// floor at the default band, the symptom of issue 9 (ARW 0.005 deg/sqrt(h) + B 0.05 deg/h, 4 h at
+// floor at the default band, the symptom of an old bias-instability bias (ARW 0.005 deg/sqrt(h) + B 0.05 deg/h, 4 h at
 // tau0 0.1 s) on the simulator's side, and the departures of non-white quantization. Each test
 // prints the figures docs/metrology.md quotes.
 #include <gtest/gtest.h>
@@ -158,7 +158,7 @@ TEST(SimTruthLong, BiasInstabilityRollsOffBelowTheBand) {
 }
 
 TEST(SimTruthLong, ArwPlusBiasInstabilityFourHoursAtTenthSecond) {
-  // The simulator's side of issue 9's symptom (the fit returned B about 0.105-0.111 deg/h): 16
+  // The simulator's side of that symptom (the fit returned B about 0.105-0.111 deg/h): 16
   // seeds of gyrochar-sim --duration 14400 --tau0 0.1 --arw 0.005 --bias-instability 0.05 (earth
   // rate, 1 arcsec pulses). Oracle: 3 Q^2 / tau^2 + N^2 / tau + (0.664 B)^2 with Q = 1/sqrt(12)
   // arcsec, wherever the quantization is white at lag m: the angle random walk spreads the angle

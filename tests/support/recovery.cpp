@@ -82,7 +82,7 @@ std::vector<Scenario> standard_scenarios() {
              o.bias_deg_per_h = 0.05;
              o.rrw_deg_per_h_sqrt_h = 0.15;
            }),
-      // Issue 18's Markov gyro as gyrochar-sim makes it (1.5 pulses of earth rate a sample: periodic
+      // The documented Markov gyro as gyrochar-sim makes it (1.5 pulses of earth rate a sample: periodic
       // quantization), and two Markov terms far apart in Tc over a whitened quantization.
       make("ARW + Markov, periodic quantization", 8, 0.1,
            [](SimOptions& o) {

@@ -1,5 +1,5 @@
 #!/bin/bash
-# gyrochard's memory in steady state (issue 5: steady-state RSS and zero allocations after
+# gyrochard's memory in steady state (steady-state RSS and zero allocations after
 # start-up): one gyrochard node on vcan0, fed by its simulated gyro electronics in real time
 # (tau0 0.01 s: 100 CounterInput frames/s) and reporting every second, with tests/bench's
 # malloc_count.so preloaded (it counts every malloc, calloc, realloc and aligned allocation).
