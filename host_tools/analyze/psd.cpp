@@ -237,7 +237,7 @@ Spectrum spectrum_of(const RateRecord& rates, double tau0_s, std::size_t segment
   sp.searched = search;
   if (!search) return sp;
   sp.search = find_sinusoids(sp.psd);
-  if (rates.counts()) {
+  if (rates.counts() && rate.size() / segment >= 2) {  // the pattern needs two blocks' means
     sp.pattern = pulse_pattern(rate, tau0_s, segment);
     mark_pulse_lines(sp.search, *sp.pattern, sp.psd.bin_hz());
   }
