@@ -779,6 +779,33 @@ double log_sd(Problem& pr, const Flags& free, const Terms& fixed, double* value)
   return curvature > 0 && std::isfinite(curvature) ? h * std::sqrt(2 / curvature) : 0.0;
 }
 
+// The standard deviation of ln(*value) from its profile: half the width of the interval where chi2
+// (the linear terms solved again at each step, on the fitted model's covariance) lies within 1 of
+// its minimum, walked out in steps of 0.1 to at most 3 either side. A Markov term's profile
+// flattens away from its minimum, so the curvature there (log_sd()) says too little: in the
+// recovery study its Tc lay within one such sigma of the truth in 38 % of the runs, not 68 %.
+double profile_log_sd(Problem& pr, const Flags& free, const Terms& fixed, double* value) {
+  constexpr double step = 0.1, reach = 3.0;
+  const double at = *value;
+  const double mid = profile_chi2(pr, free, fixed);
+  double half[2] = {reach, reach};
+  for (int side = 0; side < 2; ++side) {
+    double before = 0;
+    for (double l = step; l <= reach + 1e-9; l += step) {
+      *value = at * std::exp(side == 0 ? -l : l);
+      const double rise = profile_chi2(pr, free, fixed) - mid;
+      if (rise >= 1) {
+        half[side] = std::isfinite(rise) ? l - step + step * (1 - before) / (rise - before) : l - step / 2;
+        break;
+      }
+      before = std::fmax(rise, 0.0);
+    }
+  }
+  *value = at;
+  set_rows(pr);
+  return std::isfinite(mid) ? (half[0] + half[1]) / 2 : 0.0;
+}
+
 // True when column t of candidate c lies more than two standard uncertainties (Birge-scaled) above
 // zero. Not "resolved": a Markov term shares its rising side with K and its falling side with N,
 // and need not be the largest anywhere to be there (the fit still says whether it is resolved).
@@ -1023,7 +1050,7 @@ bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const 
     return false;
   }
   chosen = exact;
-  for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = log_sd(pr, free, fixed, &pr.model.a[k]);
+  for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = profile_log_sd(pr, free, fixed, &pr.model.a[k]);
   if (runner_up.valid) {
     pr.model = runner_up.model;
     runner_up.sol.chi2 = profile_chi2(pr, free, fixed);
