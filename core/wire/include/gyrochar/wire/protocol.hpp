@@ -436,6 +436,9 @@ std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uin
 ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position,
                        std::uint8_t protocol_version = version, std::size_t window_taus = 0);
 
+/// Data bytes of every report frame (the counter-input frame has 6).
+inline constexpr std::uint8_t report_frame_len = 8;
+
 /// Worst-case bits on the wire of a classic data frame with a 29-bit identifier and `data_bytes`
 /// (<= 8) data bytes, with the maximum number of stuff bits and the 3-bit interframe space:
 /// 67 + 8 data_bytes + floor((53 + 8 data_bytes) / 4); 160 for 8 bytes.
