@@ -104,6 +104,13 @@ struct TheoBiasRatio {
 TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
                               std::uint64_t ratio_taus);
 
+/// The last index i of TheoBR's definition for N >= 24 phase points: floor(N / 6 - 3), less one when
+/// AVAR(9 + 3 i) would need N + 1 points. O(1).
+std::uint64_t theo_bias_last(std::uint64_t n_phase);
+/// The j-th of `count` indices spread evenly over 0..last (first and last included; j itself when
+/// count = last + 1). O(1).
+std::uint64_t theo_bias_index(std::uint64_t j, std::uint64_t count, std::uint64_t last);
+
 /// TheoH's switch point k in samples: the largest power of two at or below (N - 1) / 10 (at least 1).
 /// AVAR rows below it (m < k), TheoBR rows at 0.75 m >= k.
 std::uint64_t theoh_switch(std::uint64_t n_phase);
