@@ -4,6 +4,7 @@
 
 #include "confidence.hpp"
 #include "gyrochar/total.hpp"
+#include "gyrochar/total_fast.hpp"
 
 namespace gyrochar {
 namespace {
@@ -61,9 +62,21 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
       ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S)).ratio;
       if (!(ratio > 0)) return rows;
     }
+    // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for: the
+    // record prepared once (O(N log N), about 5 N + 4 fft_length(2 N) doubles), then each tau.
+    std::vector<double> work;
+    Theo1Workspace prepared;
+    auto estimate = [&](std::uint64_t m) {
+      if (o.theo_decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));
+      if (!prepared.ready) {
+        work.resize(theo1_workspace_size(N));
+        prepared = theo1_prepare(x, work);
+      }
+      return theo1_fast(prepared, m, tau0);
+    };
     for (const std::uint64_t m : o.theo_m_list) {
       if (stat == DevStat::theoh && 3 * m < 4 * k) continue;  // 0.75 m < k: ADEV's part
-      const TotalVariance v = theo1(x, m, tau0, theo1_stride(m, N, S));
+      const TotalVariance v = estimate(m);
       if (v.n == 0) continue;
       const AnalysisRow* a = allan_row(allan, DevStat::oadev, 0.75 * static_cast<double>(m));
       const double edf = known(a) ? edf_theo1(*a->alpha, n, static_cast<double>(m)) : 0.0;
