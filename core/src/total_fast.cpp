@@ -107,72 +107,95 @@ void load(double* d, Index n, std::span<const double> a, std::span<const double>
 // Theo1's end correction (docs/total.md): with v every other residual of one end of the record
 // (r[2p] or r[2p+1] of the first m, or of the last m reversed), the sum over pairs p <= q with
 // p + q < c of v[p] v[q] / (h - (q - p)), h = m / 2: the pairs at even distance whose midpoint lies
-// in the end's first half. Dyadic split of the triangle: a square of pairs by one FFT
-// cross-correlation, two half-size triangles recursively. O(c log^2 c).
-struct Triangle {
-  std::span<const double> v;
+// in the end's first half. Both ends at once (the same c): their FFTs share the inverse transform.
+// Dyadic split of the triangle: a square of pairs by FFT cross-correlation, two half-size
+// triangles recursively. O(c log^2 c).
+struct Sums {
+  double head = 0.0, tail = 0.0;
+  Sums operator+(const Sums& o) const { return {head + o.head, tail + o.tail}; }
+};
+
+struct Triangles {
+  std::span<const double> head, tail;  // the two ends' sequences, c values each
   Index c, h;
   Theo1Workspace& w;
   static constexpr Index direct_side = 96;
 
   double weight(std::ptrdiff_t d) const { return 1.0 / (as_double(h) - static_cast<double>(d < 0 ? -d : d)); }
-  double pair(Index i, Index j) const {
-    return weight(static_cast<std::ptrdiff_t>(j) - static_cast<std::ptrdiff_t>(i)) * v[i] * v[j];
+  Sums pair(Index i, Index j) const {
+    const double k = weight(static_cast<std::ptrdiff_t>(j) - static_cast<std::ptrdiff_t>(i));
+    return {k * head[i] * head[j], k * tail[i] * tail[j]};
   }
 
   // Pairs i in [a, a + s), j in [b, b + s): the whole square.
-  double square(Index a, Index b, Index s) const {
+  Sums square(Index a, Index b, Index s) const {
+    Sums sum;
     if (s <= direct_side) {
-      double sum = 0.0;
       for (Index p = 0; p < s; ++p)
-        for (Index q = 0; q < s; ++q) sum += pair(a + p, b + q);
+        for (Index q = 0; q < s; ++q) sum = sum + pair(a + p, b + q);
       return sum;
     }
     const Index n = fft_length(2 * s);
     double* d = w.buffer.data();
-    load(d, n, v.subspan(a, s), v.subspan(b, s));
+    double* e = d + 2 * n;
+    load(d, n, head.subspan(a, s), head.subspan(b, s));
+    load(e, n, tail.subspan(a, s), tail.subspan(b, s));
     forward_bitreversed(d, n, w.twiddle.data());
+    forward_bitreversed(e, n, w.twiddle.data());
     combine(d, n, true);
+    combine(e, n, true);
+    for (Index k = 0; k < n; ++k) {  // both real correlations in one inverse: head + i tail
+      const double re = d[2 * k] - e[2 * k + 1], im = d[2 * k + 1] + e[2 * k];
+      d[2 * k] = re, d[2 * k + 1] = im;
+    }
     inverse_from_bitreversed(d, n, w.twiddle.data());
-    double sum = 0.0;  // c(e) at e mod n, e = q - p in (-s, s); the pair's distance is b - a + e
+    // c(f) at f mod n, f = q - p in (-s, s); the pair's distance is b - a + f
     const auto base = static_cast<std::ptrdiff_t>(b) - static_cast<std::ptrdiff_t>(a);
-    for (Index e = 0; e < s; ++e) sum += weight(base + static_cast<std::ptrdiff_t>(e)) * d[2 * e];
-    for (Index e = 1; e < s; ++e) sum += weight(base - static_cast<std::ptrdiff_t>(e)) * d[2 * (n - e)];
-    return sum / as_double(n);
+    for (Index f = 0; f < s; ++f) {
+      const double k = weight(base + static_cast<std::ptrdiff_t>(f));
+      sum.head += k * d[2 * f], sum.tail += k * d[2 * f + 1];
+    }
+    for (Index f = 1; f < s; ++f) {
+      const double k = weight(base - static_cast<std::ptrdiff_t>(f));
+      sum.head += k * d[2 * (n - f)], sum.tail += k * d[2 * (n - f) + 1];
+    }
+    return {sum.head / as_double(n), sum.tail / as_double(n)};
   }
 
   // Pairs i in [a, a + s), j in [b, b + s) with (i - a) + (j - b) < s.
-  double triangle(Index a, Index b, Index s) const {
-    if (s == 0) return 0.0;
+  Sums triangle(Index a, Index b, Index s) const {
+    Sums sum;
     if (s <= direct_side) {
-      double sum = 0.0;
       for (Index p = 0; p < s; ++p)
-        for (Index q = 0; p + q < s; ++q) sum += pair(a + p, b + q);
+        for (Index q = 0; p + q < s; ++q) sum = sum + pair(a + p, b + q);
       return sum;
     }
     const Index big = (s + 1) / 2, small = s / 2;
     return square(a, b, big) + triangle(a, b + big, small) + triangle(a + big, b, small);
   }
 
-  // The pairs p <= q of the triangle p + q < c (each unordered pair once).
-  double half() const {
+  // The pairs p <= q of the triangle p + q < c (each unordered pair once), both ends.
+  Sums half() const {
     const Index big = (c + 1) / 2, small = c / 2;
     // The triangle over all ordered pairs: its two off-square parts mirror each other.
-    const double full = square(0, 0, big) + 2.0 * triangle(0, big, small);
-    double diagonal = 0.0;  // p = q, 2 p < c
-    for (Index p = 0; 2 * p < c; ++p) diagonal += v[p] * v[p];
-    return 0.5 * (full + diagonal / as_double(h));
+    const Sums corner = triangle(0, big, small), full = square(0, 0, big) + corner + corner;
+    Sums diagonal;  // p = q, 2 p < c
+    for (Index p = 0; 2 * p < c; ++p) diagonal = diagonal + Sums{head[p] * head[p], tail[p] * tail[p]};
+    return {0.5 * (full.head + diagonal.head / as_double(h)), 0.5 * (full.tail + diagonal.tail / as_double(h))};
   }
 };
 
-// Both triangles of one end: `end(p)` the end's p-th residual (p < m) from the record's edge.
-template <class End>
-double end_correction(End end, Index M, Theo1Workspace& w) {
-  const Index h = M / 2;
-  const std::span<double> even = w.reversed.first(h), odd = w.reversed.subspan(h, h - 1);
-  for (Index p = 0; p < h; ++p) even[p] = end(2 * p);
-  for (Index p = 0; p + 1 < h; ++p) odd[p] = end(2 * p + 1);
-  return Triangle{even, h, h, w}.half() + Triangle{odd, h - 1, h, w}.half();
+// All four triangles (even and odd residuals of the first m and of the last m reversed): the end
+// corrections H + T of docs/total.md.
+double end_corrections(std::span<const double> r, Index M, Theo1Workspace& w) {
+  const Index N = r.size(), h = M / 2;
+  const std::span<double> head_even = w.ends.first(h), tail_even = w.ends.subspan(h, h);
+  const std::span<double> head_odd = w.ends.subspan(2 * h, h - 1), tail_odd = w.ends.subspan(3 * h - 1, h - 1);
+  for (Index p = 0; p < h; ++p) head_even[p] = r[2 * p], tail_even[p] = r[N - 1 - 2 * p];
+  for (Index p = 0; p + 1 < h; ++p) head_odd[p] = r[2 * p + 1], tail_odd[p] = r[N - 2 - 2 * p];
+  const Sums even = Triangles{head_even, tail_even, h, h, w}.half();
+  const Sums odd = Triangles{head_odd, tail_odd, h - 1, h, w}.half();
+  return even.head + even.tail + odd.head + odd.tail;
 }
 
 }  // namespace
@@ -222,7 +245,7 @@ void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle,
 }
 
 std::size_t theo1_workspace_size(std::size_t n_phase) {
-  return 5 * n_phase + 2 + 4 * fft_length(2 * n_phase);
+  return 6 * n_phase + 2 + 4 * fft_length(2 * n_phase);
 }
 
 Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) {
@@ -236,7 +259,7 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) 
     at += count;
     return s;
   };
-  w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N), w.reversed = take(N);
+  w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N), w.ends = take(2 * N);
   w.twiddle = take(2 * w.P), w.buffer = take(2 * w.P);
   // Least-squares quadratic of d = x - x[0] in the orthogonal basis 1, t, t^2 - mean(t^2) (t centred,
   // symmetric), fitted and removed in long double: the residual then carries the rounding of its
@@ -308,9 +331,7 @@ TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s) {
   // The product r[i+k] r[i+m-k] over i in [k, k + L) is the whole record's lag sum less the pairs at
   // either end (midpoint in the first or last m / 2 points), weighted 1 / k: two triangles.
   // (The end autocorrelations above live in the buffer, which the triangles' FFTs now reuse.)
-  const double head = end_correction([&](Index p) { return r[p]; }, M, w);
-  const double tail = end_correction([&](Index p) { return r[N - 1 - p]; }, M, w);
-  sum -= 2.0 * (head + tail);
+  sum -= 2.0 * end_corrections(r, M, w);
   const double tau = as_double(m) * tau0_s;
   return {sum / (0.75 * as_double(L) * tau * tau), static_cast<std::uint64_t>(L) * h, 1};
 }

@@ -63,7 +63,7 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
       if (!(ratio > 0)) return rows;
     }
     // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for: the
-    // record prepared once (O(N log N), about 5 N + 4 fft_length(2 N) doubles), then each tau.
+    // record prepared once (O(N log N), 6 N + 4 fft_length(2 N) doubles), then each tau.
     std::vector<double> work;
     Theo1Workspace prepared;
     auto estimate = [&](std::uint64_t m) {

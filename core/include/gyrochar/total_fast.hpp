@@ -30,7 +30,7 @@ void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle,
 void fft_twiddles(std::span<double> twiddle, std::size_t P);
 
 /// Doubles of workspace theo1_prepare needs for a record of N phase points: the residual, its two
-/// prefix sums, its autocorrelation, a reversed end piece (5 N + 2) and the FFT's twiddles and
+/// prefix sums, its autocorrelation, the ends' pieces (6 N + 2) and the FFT's twiddles and
 /// buffer (4 P, P = fft_length(2 N)).
 std::size_t theo1_workspace_size(std::size_t n_phase);
 
@@ -38,7 +38,7 @@ struct Theo1Workspace {
   std::span<double> r;          // x less its least-squares quadratic
   std::span<double> s1, s2;     // prefix sums of r and r^2 (N + 1 each)
   std::span<double> ac;         // sum_i r[i] r[i+d], d < N
-  std::span<double> reversed;   // per-tau scratch: the last m residuals, reversed
+  std::span<double> ends;       // per-tau scratch: every other residual of both ends (2 N)
   std::span<double> twiddle, buffer;
   std::size_t P = 0;            // the twiddle table's FFT length
   double curvature = 0.0;       // the removed quadratic's coefficient of i^2
