@@ -5,6 +5,7 @@
 #include "confidence.hpp"
 #include "gyrochar/total.hpp"
 #include "gyrochar/total_fast.hpp"
+#include "plan.hpp"
 
 namespace gyrochar {
 namespace {
@@ -62,12 +63,14 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
       ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S)).ratio;
       if (!(ratio > 0)) return rows;
     }
-    // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for: the
-    // record prepared once (O(N log N), 6 N + 4 fft_length(2 N) doubles), then each tau.
+    // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for or its
+    // workspace would pass the memory budget (plan.hpp): the record prepared once (O(N log N),
+    // 6 N + 4 fft_length(2 N) doubles), then each tau. The rows' stride says which estimator ran.
     std::vector<double> work;
     Theo1Workspace prepared;
+    const bool decimated = o.theo_decimated || 8 * static_cast<std::uint64_t>(theo1_workspace_size(N)) > memory_budget();
     auto estimate = [&](std::uint64_t m) {
-      if (o.theo_decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));
+      if (decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));
       if (!prepared.ready) {
         work.resize(theo1_workspace_size(N));
         prepared = theo1_prepare(x, work);

@@ -5,7 +5,8 @@
 // and writes the figures into BENCHMARKS.md.
 //
 //   bench_total octave FILE S   MTOTDEV and Theo1 at octave taus of the phase values in FILE (one
-//                               per line), exact (S = 0) or with the plan for S; one line per tau
+//                               per line), exact (S = 0) or with the plan for S; one line per tau;
+//                               then Theo1 by lag sums (exact) at the same taus
 //   bench_total long N S        N points of random-walk plus white phase: TOTDEV, MTOTDEV and
 //                               TheoH at octave taus; time per statistic and peak RSS
 //   bench_total lagsums N S     N points as for `long`: exact Theo1 by lag sums (total_fast.hpp) at
@@ -87,6 +88,19 @@ int octave(const char* file, std::uint32_t S) {
                 static_cast<unsigned long long>(v.stride));
   }
   std::printf("theo1,total,%.9f\n", total);
+  auto t0 = Clock::now();  // the exact lag-sum Theo1 (total_fast.hpp), its preparation included
+  std::vector<double> work(theo1_workspace_size(x.size()));
+  Theo1Workspace w = theo1_prepare(x, work);
+  total = seconds_since(t0);
+  std::printf("theo1-lagsums,prepare,%.9f\n", total);
+  for (std::uint64_t m = 2; m <= x.size() - 1; m *= 2) {
+    t0 = Clock::now();
+    const TotalVariance v = theo1_fast(w, m, 1.0);
+    const double s = seconds_since(t0);
+    total += s;
+    std::printf("theo1-lagsums,%llu,%.9f,%.6e,1\n", static_cast<unsigned long long>(m), s, std::sqrt(v.var));
+  }
+  std::printf("theo1-lagsums,total,%.9f\n", total);
   return 0;
 }
 
