@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -102,8 +103,9 @@ int octave(const char* file, std::uint32_t S) {
   }
   std::printf("theo1,total,%.9f\n", total);
   auto t0 = Clock::now();  // the exact lag-sum Theo1 (total_fast.hpp), its preparation included
-  std::vector<double> work(theo1_workspace_size(x.size()));
-  Theo1Workspace w = theo1_prepare(x, work);
+  const std::size_t size = theo1_workspace_size(x.size());
+  const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   total = seconds_since(t0);
   std::printf("theo1-lagsums,prepare,%.9f\n", total);
   total += lag_sum_octaves(w);
@@ -126,9 +128,10 @@ std::vector<double> simulated(std::uint64_t n) {
 int lag_sums(std::uint64_t n, std::uint32_t S) {
   const std::vector<double> x = simulated(n);
   auto t0 = Clock::now();
-  std::vector<double> work(theo1_workspace_size(n));
-  Theo1Workspace w = theo1_prepare(x, work);
-  std::printf("prepare: %.2f s (%.0f MB of workspace)\n", seconds_since(t0), 8e-6 * static_cast<double>(work.size()));
+  const std::size_t size = theo1_workspace_size(n);
+  const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  Theo1Workspace w = theo1_prepare(x, {work.get(), size});
+  std::printf("prepare: %.2f s (%.0f MB of workspace)\n", seconds_since(t0), 8e-6 * static_cast<double>(size));
   std::printf("theo1 exact: every octave m in %.2f s after prepare\n", lag_sum_octaves(w));
   t0 = Clock::now();
   const std::uint64_t k = theoh_switch(n);
