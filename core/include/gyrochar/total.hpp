@@ -34,7 +34,8 @@
 //            or below 10 % of the record.
 //
 // Cost. TOTVAR is O(N) per tau. The exact MTOTVAR/HTOTVAR cost O(m) per sub-sequence, O(N m) per
-// tau, and Theo1 O(N m / 2): fine up to 10^5 points and moderate m, hopeless at 10^7 and m = 10^6.
+// tau, and Theo1 O(N m / 2): fine up to 10^5 points and moderate m, hopeless at 10^7 and m = 10^6
+// (total_fast.hpp computes the same Theo1 from lag sums: O(N log N) once, about O(m log^2 m) a tau).
 // So each has a decimated variant with a stride factor S (a different estimator of the same
 // quantity, documented in docs/total.md with its error against the exact one):
 //   - MTOTVAR/HTOTVAR on blocks of b = m / S samples (b a power of two dividing m): the record as
