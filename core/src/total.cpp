@@ -161,20 +161,29 @@ TotalVariance oavar(std::span<const double> x, std::uint64_t m, double tau0_s, s
   return {sum / (2.0 * as_double(n) * tau * tau), n, stride};
 }
 
+std::uint64_t theo_bias_last(std::uint64_t n_phase) {
+  std::uint64_t last = n_phase / 6 - 3;  // n of the definition, floor(N / 6 - 3)
+  if (2 * (9 + 3 * last) + 1 > n_phase) --last;  // its AVAR would need N + 1 points
+  return last;
+}
+
+std::uint64_t theo_bias_index(std::uint64_t j, std::uint64_t count, std::uint64_t last) {
+  // Evenly spread over 0..last, first and last included.
+  return count == last + 1 ? j : (j * last + (count - 1) / 2) / (count - 1);
+}
+
 TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
                               std::uint64_t ratio_taus) {
   const std::uint64_t N = x.size();
   if (N < 24 || ratio_taus < 2 || !(tau0_s > 0)) return {};
-  std::uint64_t last = N / 6 - 3;  // n of the definition, floor(N / 6 - 3)
-  if (2 * (9 + 3 * last) + 1 > N) --last;  // its AVAR would need N + 1 points
+  const std::uint64_t last = theo_bias_last(N);
   const std::uint64_t count = last + 1 <= ratio_taus ? last + 1 : ratio_taus;
   TheoBiasRatio out;
   out.defined = last + 1;
   out.exact = count == last + 1 && stride_factor == 0;
   double sum = 0.0;
   for (std::uint64_t j = 0; j < count; ++j) {
-    // Evenly spread over 0..last, first and last included.
-    const std::uint64_t i = count == last + 1 ? j : (j * last + (count - 1) / 2) / (count - 1);
+    const std::uint64_t i = theo_bias_index(j, count, last);
     const std::uint64_t mt = 12 + 4 * i, ma = 9 + 3 * i;
     const TotalVariance t = theo1(x, mt, tau0_s, stride_factor == 0 || mt <= stride_factor ? 1 : mt / stride_factor);
     const TotalVariance a = oavar(x, ma, tau0_s, stride_factor == 0 || ma <= stride_factor ? 1 : ma / stride_factor);

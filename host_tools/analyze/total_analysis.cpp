@@ -1,9 +1,12 @@
 #include "total_analysis.hpp"
 
 #include <cmath>
+#include <memory>
 
 #include "confidence.hpp"
 #include "gyrochar/total.hpp"
+#include "gyrochar/total_fast.hpp"
+#include "plan.hpp"
 
 namespace gyrochar {
 namespace {
@@ -61,9 +64,23 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
       ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S)).ratio;
       if (!(ratio > 0)) return rows;
     }
+    // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for or its
+    // workspace would pass the memory budget (plan.hpp): the record prepared once (O(N log N),
+    // 6 N + 4 fft_length(2 N) doubles), then each tau. The rows' stride says which estimator ran.
+    std::unique_ptr<double[]> work;  // not zero-filled: prepare writes before it reads (1.6 GB at 10^7)
+    Theo1Workspace prepared;
+    const bool decimated = o.theo_decimated || 8 * static_cast<std::uint64_t>(theo1_workspace_size(N)) > memory_budget();
+    auto estimate = [&](std::uint64_t m) {
+      if (decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));
+      if (!prepared.ready) {
+        work = std::make_unique_for_overwrite<double[]>(theo1_workspace_size(N));
+        prepared = theo1_prepare(x, {work.get(), theo1_workspace_size(N)});
+      }
+      return theo1_fast(prepared, m, tau0);
+    };
     for (const std::uint64_t m : o.theo_m_list) {
       if (stat == DevStat::theoh && 3 * m < 4 * k) continue;  // 0.75 m < k: ADEV's part
-      const TotalVariance v = theo1(x, m, tau0, theo1_stride(m, N, S));
+      const TotalVariance v = estimate(m);
       if (v.n == 0) continue;
       const AnalysisRow* a = allan_row(allan, DevStat::oadev, 0.75 * static_cast<double>(m));
       const double edf = known(a) ? edf_theo1(*a->alpha, n, static_cast<double>(m)) : 0.0;

@@ -5,9 +5,13 @@
 // and writes the figures into BENCHMARKS.md.
 //
 //   bench_total octave FILE S   MTOTDEV and Theo1 at octave taus of the phase values in FILE (one
-//                               per line), exact (S = 0) or with the plan for S; one line per tau
+//                               per line), exact (S = 0) or with the plan for S; one line per tau;
+//                               then Theo1 by lag sums (exact) at the same taus
 //   bench_total long N S        N points of random-walk plus white phase: TOTDEV, MTOTDEV and
 //                               TheoH at octave taus; time per statistic and peak RSS
+//   bench_total lagsums N S     N points as for `long`: exact Theo1 by lag sums (total_fast.hpp) at
+//                               every octave m, then TheoH with exact Theo1 rows (its bias ratio
+//                               with the plan for S); time of each part and peak RSS
 //   bench_total decimation FILE S [freq]
 //                               the decimated estimators against the exact ones at octave taus
 //                               (a markdown table; freq: FILE holds frequencies in Hz of 10 MHz)
@@ -17,11 +21,13 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "gyrochar/total.hpp"
+#include "gyrochar/total_fast.hpp"
 
 namespace {
 
@@ -56,6 +62,19 @@ std::vector<double> read_phase(const char* file, bool frequency_hz) {
   return x;
 }
 
+// Theo1 by lag sums at every octave m of a prepared record: one line per tau, their seconds returned.
+double lag_sum_octaves(Theo1Workspace& w) {
+  double total = 0;
+  for (std::uint64_t m = 2; m <= w.r.size() - 1; m *= 2) {
+    const auto t0 = Clock::now();
+    const TotalVariance v = theo1_fast(w, m, 1.0);
+    const double s = seconds_since(t0);
+    total += s;
+    std::printf("theo1-lagsums,%llu,%.9f,%.6e,1\n", static_cast<unsigned long long>(m), s, std::sqrt(v.var));
+  }
+  return total;
+}
+
 int octave(const char* file, std::uint32_t S) {
   const std::vector<double> x = read_phase(file, false);
   if (x.size() < 10) {
@@ -83,10 +102,19 @@ int octave(const char* file, std::uint32_t S) {
                 static_cast<unsigned long long>(v.stride));
   }
   std::printf("theo1,total,%.9f\n", total);
+  auto t0 = Clock::now();  // the exact lag-sum Theo1 (total_fast.hpp), its preparation included
+  const std::size_t size = theo1_workspace_size(x.size());
+  const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  Theo1Workspace w = theo1_prepare(x, {work.get(), size});
+  total = seconds_since(t0);
+  std::printf("theo1-lagsums,prepare,%.9f\n", total);
+  total += lag_sum_octaves(w);
+  std::printf("theo1-lagsums,total,%.9f\n", total);
   return 0;
 }
 
-int long_record(std::uint64_t n, std::uint32_t S) {
+// Random-walk plus white phase, seed 1 (the `long` and `lagsums` record).
+std::vector<double> simulated(std::uint64_t n) {
   auto t0 = Clock::now();
   std::vector<double> x(n);
   std::mt19937_64 rng(1);
@@ -94,8 +122,38 @@ int long_record(std::uint64_t n, std::uint32_t S) {
   double walk = 0;
   for (double& v : x) v = (walk += 0.1 * z(rng)) + z(rng);
   std::printf("record: %llu points, %.2f s to simulate\n", static_cast<unsigned long long>(n), seconds_since(t0));
+  return x;
+}
 
+int lag_sums(std::uint64_t n, std::uint32_t S) {
+  const std::vector<double> x = simulated(n);
+  auto t0 = Clock::now();
+  const std::size_t size = theo1_workspace_size(n);
+  const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  Theo1Workspace w = theo1_prepare(x, {work.get(), size});
+  std::printf("prepare: %.2f s (%.0f MB of workspace)\n", seconds_since(t0), 8e-6 * static_cast<double>(size));
+  std::printf("theo1 exact: every octave m in %.2f s after prepare\n", lag_sum_octaves(w));
   t0 = Clock::now();
+  const std::uint64_t k = theoh_switch(n);
+  int rows = 0;
+  for (std::uint64_t m = 1; m < k; m *= 2, ++rows) oavar(x, m, 1.0);
+  const double t_avar = seconds_since(t0);
+  t0 = Clock::now();
+  const TheoBiasRatio ratio = theo_bias_ratio(x, 1.0, S, theo_bias_taus(n, S));
+  const double t_ratio = seconds_since(t0);
+  t0 = Clock::now();
+  for (std::uint64_t m = 2 * k; m <= n - 1; m *= 2, ++rows) theo1_fast(w, m, 1.0);
+  std::printf("theoh: %d taus: AVAR %.2f s, ratio %.4f over %llu taus (%s) %.2f s, exact Theo1 rows %.2f s\n", rows,
+              t_avar, ratio.ratio, static_cast<unsigned long long>(ratio.taus), ratio.exact ? "exact" : "plan", t_ratio,
+              seconds_since(t0));
+  std::printf("peak RSS: %ld KiB\n", peak_rss_kib());
+  return 0;
+}
+
+int long_record(std::uint64_t n, std::uint32_t S) {
+  const std::vector<double> x = simulated(n);
+  auto t0 = Clock::now();
+
   int rows = 0;
   for (std::uint64_t m = 1; 2 * m <= n; m *= 2, ++rows) totvar(x, m, 1.0);
   std::printf("totdev: %d taus in %.2f s\n", rows, seconds_since(t0));
@@ -171,8 +229,10 @@ int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
   if (argc == 4 && mode == "octave") return octave(argv[2], static_cast<std::uint32_t>(std::stoul(argv[3])));
   if (argc == 4 && mode == "long") return long_record(std::stoull(argv[2]), static_cast<std::uint32_t>(std::stoul(argv[3])));
+  if (argc == 4 && mode == "lagsums") return lag_sums(std::stoull(argv[2]), static_cast<std::uint32_t>(std::stoul(argv[3])));
   if ((argc == 4 || argc == 5) && mode == "decimation")
     return decimation(argv[2], static_cast<std::uint32_t>(std::stoul(argv[3])), argc == 5 && std::string(argv[4]) == "freq");
-  std::fprintf(stderr, "usage: bench_total octave FILE S | bench_total long N S | bench_total decimation FILE S [freq]\n");
+  std::fprintf(stderr, "usage: bench_total octave FILE S | bench_total long N S | bench_total lagsums N S | "
+                       "bench_total decimation FILE S [freq]\n");
   return 2;
 }

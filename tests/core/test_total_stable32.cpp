@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "gyrochar/total.hpp"
+#include "gyrochar/total_fast.hpp"
 
 namespace gyrochar {
 namespace {
@@ -77,7 +78,14 @@ double printed(std::uint64_t n) {
   return static_cast<double>((n + unit / 2) / unit * unit);
 }
 
-enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr };
+enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr, theo1_fast, theobr_fast };
+
+// PHASE.DAT prepared for the lag-sum Theo1 (total_fast.hpp).
+Theo1Workspace& phase_dat_prepared() {
+  static std::vector<double> work(theo1_workspace_size(phase_dat().size()));
+  static Theo1Workspace w = theo1_prepare(phase_dat(), work);
+  return w;
+}
 
 // The deviation of `kind` at row r, Stable32's bias correction for the row's alpha included.
 TotalVariance compute(Kind kind, const std::vector<double>& x, const Row& r, double& dev) {
@@ -103,6 +111,16 @@ TotalVariance compute(Kind kind, const std::vector<double>& x, const Row& r, dou
       t = theo1(x, r.m, 1.0);
       if (kind == Kind::theobr) {
         static const double ratio = theo_bias_ratio(phase_dat(), 1.0, 0, ~0ull).ratio;  // every tau, exact
+        dev = std::sqrt(t.var * ratio);
+      } else {
+        dev = std::sqrt(t.var);
+      }
+      break;
+    case Kind::theo1_fast:
+    case Kind::theobr_fast:
+      t = theo1_fast(phase_dat_prepared(), r.m, 1.0);
+      if (kind == Kind::theobr_fast) {
+        static const double ratio = theo_bias_ratio_fast(phase_dat(), phase_dat_prepared(), 1.0, ~0ull).ratio;
         dev = std::sqrt(t.var * ratio);
       } else {
         dev = std::sqrt(t.var);
@@ -162,6 +180,12 @@ TEST(Stable32Total, Theo1AndTheoBR) {
   compare(Kind::theo1, phase_dat(), ref + "/phasedat/phase_dat_theo1_alpha0.txt", 1e-4);
   compare(Kind::theo1, phase_dat(), ref + "/phasedat/phase_dat_theo1_alpha0_decade.txt", 1e-4);
   compare(Kind::theobr, phase_dat(), ref + "/phasedat/phase_dat_theo1.txt", 1e-4);
+}
+
+TEST(Stable32Total, Theo1AndTheoBRFromLagSums) {  // total_fast.hpp: every Theo1 and the ratio exact
+  compare(Kind::theo1_fast, phase_dat(), ref + "/phasedat/phase_dat_theo1_alpha0.txt", 1e-4);
+  compare(Kind::theo1_fast, phase_dat(), ref + "/phasedat/phase_dat_theo1_alpha0_decade.txt", 1e-4);
+  compare(Kind::theobr_fast, phase_dat(), ref + "/phasedat/phase_dat_theo1.txt", 1e-4);
 }
 
 }  // namespace

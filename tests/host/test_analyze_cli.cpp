@@ -455,16 +455,52 @@ TEST(AnalyzeCli, TotalFamilyInEveryFormat) {
     EXPECT_DOUBLE_EQ(row["tau"].get<double>(), 0.75 * row["m"].get<double>() * 0.001);
   }
   // Each row says which estimator made it: the plan of core/total.hpp (its own test), exact below
-  // 2^26 operations (mtotdev and htotdev to m = 128 here, theo1 at every m), blocks of m/16 beyond.
+  // 2^26 operations (mtotdev and htotdev to m = 128 here), blocks of m/16 beyond; theo1 and theoh
+  // exact at every m (lag sums, total_fast.hpp).
   for (const auto& [stat, rows] : by_stat)
     for (const auto& row : rows) {
       const std::uint64_t m = row["m"];
-      const std::uint64_t want = stat == "mtotdev" || stat == "ttotdev" || stat == "htotdev" ? gyrochar::total_block(m, 20001, 16)
-                                 : stat == "theo1" || (stat == "theoh" && row["tau"] != m * 0.001) ? gyrochar::theo1_stride(m, 20001, 16)
-                                                                                                   : 1;
+      const std::uint64_t want = stat == "mtotdev" || stat == "ttotdev" || stat == "htotdev" ? gyrochar::total_block(m, 20001, 16) : 1;
       EXPECT_EQ(row["stride"].get<std::uint64_t>(), want) << stat << " m=" << m;
     }
   EXPECT_EQ(by_stat["mtotdev"].back()["stride"], 256) << "m = 4096: blocks of 256";
+}
+
+TEST(AnalyzeCli, TheoRowsAreExactUnlessTheDecimatedEstimatorIsAsked) {
+  // 40000 phase points of white noise: Theo1 from m = 4096 to 32768 costs over 2^26 operations
+  // directly. Oracles: the direct exact theo1 (total.hpp) for the default rows, the plan's stride
+  // theo1_stride(m, N, 16) for --theo-decimated rows.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> z;
+  std::vector<double> x(40000);
+  std::string s;
+  for (double& v : x) {
+    v = z(rng);
+    s += std::to_string(v) + "\n";
+  }
+  x.clear();
+  std::istringstream back(s);  // the values as the file holds them
+  for (double v; back >> v;) x.push_back(v);
+  const std::string path = file_with("white_theo.txt", s);
+  const std::string args = "--type phase --tau0 1 --stats oadev,theo1 --format json ";
+  for (const bool decimated : {false, true}) {
+    const Outcome r = run(args + (decimated ? "--theo-decimated " : "") + path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    int strided = 0;
+    const auto j = nlohmann::json::parse(r.out);
+    for (const auto& row : j["results"]) {
+      if (row["stat"].get<std::string>() != "theo1") continue;
+      const std::uint64_t m = row["m"];
+      const std::uint64_t want = decimated ? gyrochar::theo1_stride(m, x.size(), 16) : 1;
+      EXPECT_EQ(row["stride"].get<std::uint64_t>(), want) << m;
+      strided += want > 1;
+      if (!decimated) {
+        const double exact = std::sqrt(gyrochar::theo1(x, m, 1.0).var);
+        EXPECT_NEAR(row["dev"].get<double>() / exact, 1.0, 1e-9) << m;  // two summation orders
+      }
+    }
+    EXPECT_EQ(strided, decimated ? 4 : 0);  // m = 4096 to 32768
+  }
 }
 
 TEST(AnalyzeCli, UnwritableOutputIsOutputFailed) {

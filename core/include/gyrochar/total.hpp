@@ -34,7 +34,8 @@
 //            or below 10 % of the record.
 //
 // Cost. TOTVAR is O(N) per tau. The exact MTOTVAR/HTOTVAR cost O(m) per sub-sequence, O(N m) per
-// tau, and Theo1 O(N m / 2): fine up to 10^5 points and moderate m, hopeless at 10^7 and m = 10^6.
+// tau, and Theo1 O(N m / 2): fine up to 10^5 points and moderate m, hopeless at 10^7 and m = 10^6
+// (total_fast.hpp computes the same Theo1 from lag sums: O(N log N) once, about O(m log^2 m) a tau).
 // So each has a decimated variant with a stride factor S (a different estimator of the same
 // quantity, documented in docs/total.md with its error against the exact one):
 //   - MTOTVAR/HTOTVAR on blocks of b = m / S samples (b a power of two dividing m): the record as
@@ -103,6 +104,13 @@ struct TheoBiasRatio {
 /// ratio_taus >= n + 1). O(taus N S) when decimated, O(N^3) exact; no allocation.
 TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
                               std::uint64_t ratio_taus);
+
+/// The last index i of TheoBR's definition for N >= 24 phase points: floor(N / 6 - 3), less one when
+/// AVAR(9 + 3 i) would need N + 1 points. O(1).
+std::uint64_t theo_bias_last(std::uint64_t n_phase);
+/// The j-th of `count` indices spread evenly over 0..last (first and last included; j itself when
+/// count = last + 1). O(1).
+std::uint64_t theo_bias_index(std::uint64_t j, std::uint64_t count, std::uint64_t last);
 
 /// TheoH's switch point k in samples: the largest power of two at or below (N - 1) / 10 (at least 1).
 /// AVAR rows below it (m < k), TheoBR rows at 0.75 m >= k.

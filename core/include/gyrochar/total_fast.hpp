@@ -1,0 +1,61 @@
+#pragma once
+// Exact Theo1 without the O(N m) double sum (derivation in docs/total.md, "Exact Theo1 in
+// O(N log N + m log^2 m)"). The record is prepared once: a least-squares quadratic removed (Theo1's
+// terms do not see a line and see a quadratic only as a known constant, added back exactly), the
+// prefix sums of the residual and of its square, and the residual's autocorrelation at every lag
+// by FFT. Each Theo1(m) is then a sum over k of a few lag sums, corrected at the record's two ends
+// by the autocorrelations of its first and last m points and by two triangular sums (pairs of
+// points whose midpoint lies in the first, or last, m / 2 points), each by FFT.
+//
+// Freestanding: no heap; the caller passes one workspace of theo1_workspace_size(N) doubles.
+// Rounding: the estimate is a difference of sums of products of residual phase values, so its
+// absolute error is a few units of rounding times log2(N) times the sum of the squared residuals
+// weighted by the harmonic sum over k; docs/total.md states the bound and where it matters.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "gyrochar/total.hpp"
+
+namespace gyrochar {
+
+/// Smallest power of two at or above n (n >= 1). O(log n).
+std::size_t fft_length(std::size_t n);
+
+/// In-place complex FFT of `data` (n interleaved re, im pairs, n a power of two up to the table's
+/// length): forward exp(-2 pi i k p / n), inverse exp(+2 pi i k p / n) unscaled. O(n log n).
+void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle, bool inverse);
+/// Fills the twiddle table of FFTs up to length P (2 P doubles: cos, sin of 2 pi k / len at complex
+/// index len / 2 + k for every stage len <= P, k < len / 2). O(P).
+void fft_twiddles(std::span<double> twiddle, std::size_t P);
+
+/// Doubles of workspace theo1_prepare needs for a record of N phase points: the residual, its two
+/// prefix sums, its autocorrelation, the ends' pieces (6 N + 2) and the FFT's twiddles and
+/// buffer (4 P, P = fft_length(2 N)).
+std::size_t theo1_workspace_size(std::size_t n_phase);
+
+struct Theo1Workspace {
+  std::span<double> r;          // x less its least-squares quadratic
+  std::span<double> s1, s2;     // prefix sums of r and r^2 (N + 1 each)
+  std::span<double> ac;         // sum_i r[i] r[i+d], d < N
+  std::span<double> ends;       // per-tau scratch: every other residual of both ends (2 N)
+  std::span<double> twiddle, buffer;
+  std::size_t P = 0;            // the twiddle table's FFT length
+  double curvature = 0.0;       // the removed quadratic's coefficient of i^2
+  bool ready = false;           // false: N < 3 or the workspace too small
+};
+
+/// Prepares x (N >= 3) in `work` (theo1_workspace_size(N) doubles). O(N log N).
+Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work);
+
+/// Theo1 at averaging factor m (even, 2 <= m <= N - 1), exactly the estimator theo1(x, m, tau0_s, 1)
+/// computes (same n, stride 1), to rounding. O(N + m log^2 m) on a prepared record (the O(N) part is
+/// a few passes over the lags below m). Undefined input gives n = 0.
+TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s);
+
+/// theo_bias_ratio with every Theo1 and AVAR exact, Theo1 by theo1_fast: at most `ratio_taus` of the
+/// definition's taus, evenly spread (all when ratio_taus >= n + 1). O(taus (N + m log^2 m)).
+TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s,
+                                   std::uint64_t ratio_taus);
+
+}  // namespace gyrochar

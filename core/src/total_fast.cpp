@@ -1,0 +1,361 @@
+// Exact Theo1 from lag sums; the derivation in docs/total.md, the interface in total_fast.hpp.
+#include "gyrochar/total_fast.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace gyrochar {
+namespace {
+
+using Index = std::size_t;
+double as_double(std::uint64_t v) { return static_cast<double>(v); }
+
+// The FFTs below leave the spectrum in bit-reversed order (forward, decimation in frequency) and
+// take it back from there (inverse, decimation in time): no reordering pass, and the blocks that
+// fit the cache are finished before the next is touched. Products of spectra pair frequency k with
+// n - k: `Spectrum` walks k in order and gives both positions, with rev(n - k) = (n - 1) ^ rev(k - 1).
+constexpr Index cached = 2048;  // complex values a block keeps in the first-level cache
+
+// One stage's butterflies on a block of 2 half values, u its first half, t its second; tw the
+// stage's twiddles. Forward (decimation in frequency): u + t, (u - t) w^-k. Inverse (in time):
+// u + t w^k, u - t w^k.
+void forward_butterflies(double* u, double* t, const double* tw, Index half) {
+  for (Index k = 0; k < half; ++k) {
+    const double ar = u[2 * k], ai = u[2 * k + 1], br = t[2 * k], bi = t[2 * k + 1];
+    const double wr = tw[2 * k], wi = -tw[2 * k + 1];
+    u[2 * k] = ar + br, u[2 * k + 1] = ai + bi;
+    const double dr = ar - br, di = ai - bi;
+    t[2 * k] = dr * wr - di * wi, t[2 * k + 1] = dr * wi + di * wr;
+  }
+}
+void inverse_butterflies(double* u, double* t, const double* tw, Index half) {
+  for (Index k = 0; k < half; ++k) {
+    const double wr = tw[2 * k], wi = tw[2 * k + 1];
+    const double br = t[2 * k] * wr - t[2 * k + 1] * wi, bi = t[2 * k] * wi + t[2 * k + 1] * wr;
+    t[2 * k] = u[2 * k] - br, t[2 * k + 1] = u[2 * k + 1] - bi;
+    u[2 * k] += br, u[2 * k + 1] += bi;
+  }
+}
+
+void forward_bitreversed(double* d, Index n, const double* table) {
+  if (n > cached) {  // one stage over the whole, then each half while it stays in the cache
+    const Index half = n / 2;
+    forward_butterflies(d, d + 2 * half, table + 2 * half, half);
+    forward_bitreversed(d, half, table);
+    forward_bitreversed(d + 2 * half, half, table);
+    return;
+  }
+  for (Index len = n; len >= 2; len /= 2)
+    for (Index i = 0; i < n; i += len) forward_butterflies(d + 2 * i, d + 2 * (i + len / 2), table + len, len / 2);
+}
+
+void inverse_from_bitreversed(double* d, Index n, const double* table) {
+  if (n > cached) {
+    const Index half = n / 2;
+    inverse_from_bitreversed(d, half, table);
+    inverse_from_bitreversed(d + 2 * half, half, table);
+    inverse_butterflies(d, d + 2 * half, table + 2 * half, half);
+    return;
+  }
+  for (Index len = 2; len <= n; len *= 2)
+    for (Index i = 0; i < n; i += len) inverse_butterflies(d + 2 * i, d + 2 * (i + len / 2), table + len, len / 2);
+}
+
+// Frequencies k = 0..n/2 with the positions of k and n - k in a bit-reversed spectrum of length n.
+struct Spectrum {
+  Index n, k = 0, rev = 0, rev_before = 0;  // rev(k), rev(k - 1)
+  Index here() const { return rev; }
+  Index mirror() const { return k == 0 ? 0 : (n - 1) ^ rev_before; }
+  bool next() {  // false past n / 2
+    rev_before = rev;
+    Index bit = n >> 1;
+    for (; (rev & bit) != 0; bit >>= 1) rev ^= bit;
+    rev ^= bit;
+    return 2 * ++k <= n;
+  }
+};
+
+// Replaces the (bit-reversed) spectrum of a + i b, length n, by that of corr(a, b) (cross = true:
+// c(e) = sum_p a[p] b[p+e], real) or of acf(a) + i acf(b) (cross = false). The spectra of the two
+// real sequences: A_k = (Z_k + conj Z_{n-k}) / 2, B_k = (Z_k - conj Z_{n-k}) / (2i).
+void combine(double* d, Index n, bool cross) {
+  Spectrum s{n};
+  do {
+    const Index k = s.here(), j = s.mirror();
+    const double zr = d[2 * k], zi = d[2 * k + 1], wr = d[2 * j], wi = d[2 * j + 1];
+    const double ar = 0.5 * (zr + wr), ai = 0.5 * (zi - wi), br = 0.5 * (zi + wi), bi = -0.5 * (zr - wr);
+    if (cross) {  // conj(A) B; at n - k its conjugate
+      const double re = ar * br + ai * bi, im = ar * bi - ai * br;
+      d[2 * k] = re, d[2 * k + 1] = im;
+      d[2 * j] = re, d[2 * j + 1] = -im;
+    } else {  // |A|^2 + i |B|^2, the same at n - k
+      const double re = ar * ar + ai * ai, im = br * br + bi * bi;
+      d[2 * k] = re, d[2 * k + 1] = im;
+      d[2 * j] = re, d[2 * j + 1] = im;
+    }
+  } while (n > 1 && s.next());
+}
+
+// Loads a (and b, or zeros) into the FFT buffer of length n, zero-padded.
+void load(double* d, Index n, std::span<const double> a, std::span<const double> b) {
+  for (Index p = 0; p < n; ++p) {
+    d[2 * p] = p < a.size() ? a[p] : 0.0;
+    d[2 * p + 1] = p < b.size() ? b[p] : 0.0;
+  }
+}
+
+// Theo1's end correction (docs/total.md): with v every other residual of one end of the record
+// (r[2p] or r[2p+1] of the first m, or of the last m reversed), the sum over pairs p <= q with
+// p + q < c of v[p] v[q] / (h - (q - p)), h = m / 2: the pairs at even distance whose midpoint lies
+// in the end's first half. Both ends at once (the same c): their FFTs share the inverse transform.
+// Dyadic split of the triangle: a square of pairs by FFT cross-correlation, two half-size
+// triangles recursively. O(c log^2 c).
+struct Sums {
+  double head = 0.0, tail = 0.0;
+  Sums operator+(const Sums& o) const { return {head + o.head, tail + o.tail}; }
+};
+
+struct Triangles {
+  std::span<const double> head, tail;  // the two ends' sequences, c values each
+  Index c, h;
+  Theo1Workspace& w;
+  static constexpr Index direct_side = 96;
+
+  double weight(std::ptrdiff_t d) const { return 1.0 / (as_double(h) - static_cast<double>(d < 0 ? -d : d)); }
+  Sums pair(Index i, Index j) const {
+    const double k = weight(static_cast<std::ptrdiff_t>(j) - static_cast<std::ptrdiff_t>(i));
+    return {k * head[i] * head[j], k * tail[i] * tail[j]};
+  }
+
+  // Pairs i in [a, a + s), j in [b, b + s): the whole square.
+  Sums square(Index a, Index b, Index s) const {
+    Sums sum;
+    if (s <= direct_side) {
+      for (Index p = 0; p < s; ++p)
+        for (Index q = 0; q < s; ++q) sum = sum + pair(a + p, b + q);
+      return sum;
+    }
+    const Index n = fft_length(2 * s);
+    double* d = w.buffer.data();
+    double* e = d + 2 * n;
+    load(d, n, head.subspan(a, s), head.subspan(b, s));
+    load(e, n, tail.subspan(a, s), tail.subspan(b, s));
+    forward_bitreversed(d, n, w.twiddle.data());
+    forward_bitreversed(e, n, w.twiddle.data());
+    combine(d, n, true);
+    combine(e, n, true);
+    for (Index k = 0; k < n; ++k) {  // both real correlations in one inverse: head + i tail
+      const double re = d[2 * k] - e[2 * k + 1], im = d[2 * k + 1] + e[2 * k];
+      d[2 * k] = re, d[2 * k + 1] = im;
+    }
+    inverse_from_bitreversed(d, n, w.twiddle.data());
+    // c(f) at f mod n, f = q - p in (-s, s); the pair's distance is b - a + f
+    const auto base = static_cast<std::ptrdiff_t>(b) - static_cast<std::ptrdiff_t>(a);
+    for (Index f = 0; f < s; ++f) {
+      const double k = weight(base + static_cast<std::ptrdiff_t>(f));
+      sum.head += k * d[2 * f], sum.tail += k * d[2 * f + 1];
+    }
+    for (Index f = 1; f < s; ++f) {
+      const double k = weight(base - static_cast<std::ptrdiff_t>(f));
+      sum.head += k * d[2 * (n - f)], sum.tail += k * d[2 * (n - f) + 1];
+    }
+    return {sum.head / as_double(n), sum.tail / as_double(n)};
+  }
+
+  // Pairs i in [a, a + s), j in [b, b + s) with (i - a) + (j - b) < s.
+  Sums triangle(Index a, Index b, Index s) const {
+    Sums sum;
+    if (s <= direct_side) {
+      for (Index p = 0; p < s; ++p)
+        for (Index q = 0; p + q < s; ++q) sum = sum + pair(a + p, b + q);
+      return sum;
+    }
+    const Index big = (s + 1) / 2, small = s / 2;
+    return square(a, b, big) + triangle(a, b + big, small) + triangle(a + big, b, small);
+  }
+
+  // The pairs p <= q of the triangle p + q < c (each unordered pair once), both ends.
+  Sums half() const {
+    const Index big = (c + 1) / 2, small = c / 2;
+    // The triangle over all ordered pairs: its two off-square parts mirror each other.
+    const Sums corner = triangle(0, big, small), full = square(0, 0, big) + corner + corner;
+    Sums diagonal;  // p = q, 2 p < c
+    for (Index p = 0; 2 * p < c; ++p) diagonal = diagonal + Sums{head[p] * head[p], tail[p] * tail[p]};
+    return {0.5 * (full.head + diagonal.head / as_double(h)), 0.5 * (full.tail + diagonal.tail / as_double(h))};
+  }
+};
+
+// All four triangles (even and odd residuals of the first m and of the last m reversed): the end
+// corrections H + T of docs/total.md.
+double end_corrections(std::span<const double> r, Index M, Theo1Workspace& w) {
+  const Index N = r.size(), h = M / 2;
+  const std::span<double> head_even = w.ends.first(h), tail_even = w.ends.subspan(h, h);
+  const std::span<double> head_odd = w.ends.subspan(2 * h, h - 1), tail_odd = w.ends.subspan(3 * h - 1, h - 1);
+  for (Index p = 0; p < h; ++p) head_even[p] = r[2 * p], tail_even[p] = r[N - 1 - 2 * p];
+  for (Index p = 0; p + 1 < h; ++p) head_odd[p] = r[2 * p + 1], tail_odd[p] = r[N - 2 - 2 * p];
+  const Sums even = Triangles{head_even, tail_even, h, h, w}.half();
+  const Sums odd = Triangles{head_odd, tail_odd, h - 1, h, w}.half();
+  return even.head + even.tail + odd.head + odd.tail;
+}
+
+}  // namespace
+
+std::size_t fft_length(std::size_t n) {
+  std::size_t p = 1;
+  while (p < n) p *= 2;
+  return p;
+}
+
+void fft_twiddles(std::span<double> twiddle, std::size_t P) {
+  // Stage by stage, each contiguous: exp(2 pi i k / len) at complex index len / 2 + k, k < len / 2;
+  // the largest stage computed, the others read from it.
+  const double step = 2.0 * std::numbers::pi / static_cast<double>(P);
+  for (Index k = 0; 2 * k < P; ++k) {
+    twiddle[2 * (P / 2 + k)] = std::cos(step * static_cast<double>(k));
+    twiddle[2 * (P / 2 + k) + 1] = std::sin(step * static_cast<double>(k));
+  }
+  for (Index len = P / 2; len >= 2; len /= 2)
+    for (Index k = 0; 2 * k < len; ++k) {
+      twiddle[2 * (len / 2 + k)] = twiddle[2 * (P / 2 + k * (P / len))];
+      twiddle[2 * (len / 2 + k) + 1] = twiddle[2 * (P / 2 + k * (P / len)) + 1];
+    }
+}
+
+void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle, bool inverse) {
+  double* d = data.data();
+  auto reorder = [&] {
+    for (Index i = 1, j = 0; i < n; ++i) {  // bit-reversed order <-> natural order
+      Index bit = n >> 1;
+      for (; (j & bit) != 0; bit >>= 1) j ^= bit;
+      j ^= bit;
+      if (i < j) {
+        const double tr = d[2 * i], ti = d[2 * i + 1];
+        d[2 * i] = d[2 * j], d[2 * i + 1] = d[2 * j + 1];
+        d[2 * j] = tr, d[2 * j + 1] = ti;
+      }
+    }
+  };
+  if (inverse) {
+    reorder();
+    inverse_from_bitreversed(d, n, twiddle.data());
+  } else {
+    forward_bitreversed(d, n, twiddle.data());
+    reorder();
+  }
+}
+
+std::size_t theo1_workspace_size(std::size_t n_phase) {
+  return 6 * n_phase + 2 + 4 * fft_length(2 * n_phase);
+}
+
+Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) {
+  const Index N = x.size();
+  Theo1Workspace w;
+  if (N < 3 || work.size() < theo1_workspace_size(N)) return w;
+  w.P = fft_length(2 * N);
+  Index at = 0;
+  auto take = [&](Index count) {
+    const std::span<double> s = work.subspan(at, count);
+    at += count;
+    return s;
+  };
+  w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N), w.ends = take(2 * N);
+  w.twiddle = take(2 * w.P), w.buffer = take(2 * w.P);
+  // Least-squares quadratic of d = x - x[0] in the orthogonal basis 1, t, t^2 - mean(t^2) (t centred,
+  // symmetric), fitted and removed in long double: the residual then carries the rounding of its
+  // own size, not that of the phase values (a 1e-3 ramp over 1e-12 noise keeps its noise).
+  using Wide = long double;
+  const Wide c = 0.5L * static_cast<Wide>(N - 1);
+  Wide t2 = 0, p22 = 0, mean = 0, dt = 0, dp = 0;
+  for (Index i = 0; i < N; ++i) t2 += (static_cast<Wide>(i) - c) * (static_cast<Wide>(i) - c);
+  const Wide mt2 = t2 / static_cast<Wide>(N);
+  for (Index i = 0; i < N; ++i) {
+    const Wide t = static_cast<Wide>(i) - c, p = t * t - mt2, d = static_cast<Wide>(x[i]) - x[0];
+    mean += d, dt += d * t, dp += d * p, p22 += p * p;
+  }
+  mean /= static_cast<Wide>(N);
+  const Wide a1 = dt / t2, a2 = p22 > 0 ? dp / p22 : 0.0L;
+  w.curvature = static_cast<double>(a2);
+  for (Index i = 0; i < N; ++i) {
+    const Wide t = static_cast<Wide>(i) - c;
+    w.r[i] = static_cast<double>(static_cast<Wide>(x[i]) - x[0] - mean - a1 * t - a2 * (t * t - mt2));
+  }
+  w.s1[0] = w.s2[0] = 0.0;
+  for (Index i = 0; i < N; ++i) {
+    w.s1[i + 1] = w.s1[i] + w.r[i];
+    w.s2[i + 1] = w.s2[i] + w.r[i] * w.r[i];
+  }
+  fft_twiddles(w.twiddle, w.P);
+  double* d = w.buffer.data();
+  load(d, w.P, w.r, {});
+  forward_bitreversed(d, w.P, w.twiddle.data());
+  for (Index k = 0; k < w.P; ++k) {  // |Z|^2 in any order
+    d[2 * k] = d[2 * k] * d[2 * k] + d[2 * k + 1] * d[2 * k + 1];
+    d[2 * k + 1] = 0.0;
+  }
+  inverse_from_bitreversed(d, w.P, w.twiddle.data());
+  for (Index lag = 0; lag < N; ++lag) w.ac[lag] = d[2 * lag] / as_double(w.P);
+  w.ready = true;
+  return w;
+}
+
+TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s) {
+  const Index N = w.r.size();
+  if (!w.ready || m < 2 || m % 2 != 0 || m > N - 1 || !(tau0_s > 0)) return {};
+  const Index M = static_cast<Index>(m), h = M / 2, L = N - M;
+  const std::span<const double> r = w.r, s1 = w.s1, s2 = w.s2, R = w.ac;
+  // The autocorrelations of the first and the last m residuals at lags below m: one FFT pair.
+  const Index n = fft_length(2 * M);
+  double* d = w.buffer.data();
+  load(d, n, r.first(M), {});
+  for (Index p = 0; p < M; ++p) d[2 * p + 1] = r[N - M + p];
+  forward_bitreversed(d, n, w.twiddle.data());
+  combine(d, n, false);
+  inverse_from_bitreversed(d, n, w.twiddle.data());
+  auto first = [&](Index lag) { return d[2 * lag] / as_double(n); };
+  auto last = [&](Index lag) { return d[2 * lag + 1] / as_double(n); };
+  // Sums of r and r^2 over the L start points shifted by s.
+  auto sum1 = [&](Index s) { return s1[s + L] - s1[s]; };
+  auto sum2 = [&](Index s) { return s2[s + L] - s2[s]; };
+  double sum = 0.0;
+  for (Index k = 1; k <= h; ++k) {
+    // sum_i (r[i] - r[i+k] - r[i+m-k] + r[i+m])^2 over i < L: squares, then the six products as
+    // lag sums over i in [s, s + L), each the whole record's less its ends (docs/total.md).
+    const double squares = sum2(0) + sum2(k) + sum2(M - k) + sum2(M);
+    const double products = -(R[k] - last(k)) - (R[M - k] - last(M - k)) + R[M] + R[M - 2 * k] -
+                            (R[M - k] - first(M - k)) - (R[k] - first(k));
+    const double gamma = 2.0 * w.curvature * as_double(k) * as_double(M - k);  // the quadratic's term
+    const double linear = sum1(0) - sum1(k) - sum1(M - k) + sum1(M);
+    sum += (squares + 2.0 * products + 2.0 * gamma * linear + as_double(L) * gamma * gamma) / as_double(k);
+  }
+  // The product r[i+k] r[i+m-k] over i in [k, k + L) is the whole record's lag sum less the pairs at
+  // either end (midpoint in the first or last m / 2 points), weighted 1 / k: two triangles.
+  // (The end autocorrelations above live in the buffer, which the triangles' FFTs now reuse.)
+  sum -= 2.0 * end_corrections(r, M, w);
+  const double tau = as_double(m) * tau0_s;
+  return {sum / (0.75 * as_double(L) * tau * tau), static_cast<std::uint64_t>(L) * h, 1};
+}
+
+TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s,
+                                   std::uint64_t ratio_taus) {
+  const std::uint64_t N = x.size();
+  if (N < 24 || ratio_taus < 2 || !(tau0_s > 0) || !w.ready || w.r.size() != N) return {};
+  const std::uint64_t last = theo_bias_last(N);
+  const std::uint64_t count = last + 1 <= ratio_taus ? last + 1 : ratio_taus;
+  TheoBiasRatio out;
+  out.defined = last + 1;
+  out.exact = count == last + 1;
+  double sum = 0.0;
+  for (std::uint64_t j = 0; j < count; ++j) {
+    const std::uint64_t i = theo_bias_index(j, count, last);
+    const TotalVariance t = theo1_fast(w, 12 + 4 * i, tau0_s);
+    const TotalVariance a = oavar(x, 9 + 3 * i, tau0_s, 1);
+    if (t.n == 0 || a.n == 0 || !(t.var > 0)) return {};
+    sum += a.var / t.var;
+  }
+  out.ratio = sum / as_double(count);
+  out.taus = count;
+  return out;
+}
+
+}  // namespace gyrochar

@@ -1,0 +1,189 @@
+// Exact Theo1 from lag sums (core/include/gyrochar/total_fast.hpp) against Theo1's definition summed
+// in long double at every even m of small records (and n against the direct theo1 of total.hpp);
+// TheoBR's bias ratio against theo_bias_ratio with every tau exact; the FFT against the DFT written
+// out. The Theo1 tolerance is the rounding bound of the lag-sum form (`tolerance` below). Records: white phase plus a random walk plus offset and drift, a
+// quadratic drift, and a 1e-3 ramp with 1e-12 noise (where expanding raw phase products fails).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <complex>
+#include <cstdint>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "gyrochar/total_fast.hpp"
+
+namespace gyrochar {
+namespace {
+
+std::vector<double> record(std::size_t n, std::uint64_t seed, double walk_step, double white, double drift,
+                           double curvature) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> z;
+  std::vector<double> x(n);
+  double walk = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i);
+    walk += walk_step * z(rng);
+    x[i] = 1e3 + drift * t + curvature * t * t + walk + white * z(rng);
+  }
+  return x;
+}
+
+// Theo1 by its definition (SP 1065 eq. 30, as total.hpp states it), summed in long double.
+long double theo1_oracle(const std::vector<double>& x, std::uint64_t m) {
+  using LD = long double;
+  const std::size_t N = x.size();
+  LD sum = 0;
+  for (std::size_t i = 0; i + m < N; ++i)
+    for (std::size_t k = 1; k <= m / 2; ++k) {
+      const LD t = (LD(x[i]) - x[i + k]) - (LD(x[i + m - k]) - x[i + m]);
+      sum += t * t / LD(k);
+    }
+  const LD md = LD(m);
+  return sum / (0.75L * LD(N - m) * md * md);
+}
+
+// The tolerance of theo1_fast at m (tau0 = 1; docs/total.md, "Rounding"), two parts:
+// - the lag sums: 64 units of rounding times log2 of the FFT length times H(m / 2) times 8 sum r^2,
+//   scaled like the estimate, plus 2^-48 of the estimate (r held in double, each value to 2^-53);
+// - the residual: r[i] = (x[i] - x[0]) - q(i) in long double carries up to e = 2^-61 (|x[i] - x[0]|
+//   + |q(i)|); Theo1 of an error sequence bounded by e is at most V_e = 16 e^2 H(m/2) / (0.75 m^2),
+//   and moves the estimate V by at most 2 sqrt(V V_e) + V_e.
+double tolerance(const std::vector<double>& x, const Theo1Workspace& w, std::uint64_t m, double estimate) {
+  double r2 = 0, e = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const long double d = static_cast<long double>(x[i]) - x[0];
+    r2 += w.r[i] * w.r[i];
+    e = std::max(e, 0x1p-61 * static_cast<double>(std::abs(d) + std::abs(d - w.r[i])));
+  }
+  double harmonic = 0;
+  for (std::uint64_t k = 1; k <= m / 2; ++k) harmonic += 1.0 / static_cast<double>(k);
+  const double L = static_cast<double>(w.r.size() - m), md = static_cast<double>(m);
+  const double lag_sums = 64.0 * 0x1p-53 * std::log2(static_cast<double>(w.P)) * harmonic * 8.0 * r2 / (0.75 * L * md * md);
+  const double ve = 16.0 * e * e * harmonic / (0.75 * md * md);
+  return lag_sums + 0x1p-48 * std::abs(estimate) + 2.0 * std::sqrt(std::abs(estimate) * ve) + ve;
+}
+
+void every_m(const std::vector<double>& x, const char* what) {
+  std::vector<double> work(theo1_workspace_size(x.size()));
+  Theo1Workspace w = theo1_prepare(x, work);
+  ASSERT_TRUE(w.ready);
+  double worst = 0;  // the largest error relative to the estimate, reported
+  for (std::uint64_t m = 2; m <= x.size() - 1; m += 2) {
+    const double oracle = static_cast<double>(theo1_oracle(x, m));
+    const TotalVariance direct = theo1(x, m, 1.0, 1), fast = theo1_fast(w, m, 1.0);
+    ASSERT_GT(direct.n, 0u);
+    EXPECT_EQ(fast.n, direct.n) << what << " m=" << m;
+    EXPECT_EQ(fast.stride, 1u);
+    EXPECT_NEAR(fast.var, oracle, tolerance(x, w, m, oracle)) << what << " N=" << x.size() << " m=" << m;
+    worst = std::max(worst, std::abs(fast.var / oracle - 1));
+  }
+  ::testing::Test::RecordProperty(std::string(what) + "_worst_relative", std::to_string(worst));
+  std::printf("%s N=%zu: worst relative error %.2e\n", what, x.size(), worst);
+}
+
+TEST(TotalFast, Theo1EqualsTheDirectSumAtEveryEvenM) {
+  for (const std::size_t n : {3u, 4u, 30u, 31u, 97u, 256u, 1000u, 2000u})
+    every_m(record(n, n, 0.3, 1.0, 2.5, 0.0), "walk+white+drift");
+}
+
+TEST(TotalFast, Theo1EqualsTheDirectSumUnderStrongDrift) {
+  // A 1e-3 ramp with 1e-12 white noise: products of raw phase values would lose all 16 digits.
+  every_m(record(1500, 7, 0.0, 1e-12, 1e-3, 0.0), "ramp");
+  // A frequency drift (quadratic phase) over random-walk FM: the quadratic comes back exactly.
+  std::vector<double> x = record(1200, 8, 0.0, 1e-9, 1e-3, 1e-6);
+  double y = 0;
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> z;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    y += 1e-9 * z(rng);
+    x[i] += y * static_cast<double>(i);
+  }
+  every_m(x, "quadratic+rwfm");
+}
+
+std::vector<double> values(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << path;
+  std::vector<double> v;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#') v.push_back(std::stod(line));
+  return v;
+}
+
+TEST(TotalFast, Theo1EqualsTheDefinitionOnTheReferenceRecords) {
+  const std::string ref = GYROCHAR_TEST_DATA;
+  every_m(values(ref + "/phasedat/PHASE.DAT"), "PHASE.DAT");
+  // The OCXO's frequencies (tests/data/ocxo) as phase, x[k+1] = x[k] + (f - 1e7) / 1e7: a drifting
+  // oscillator. Its first 1500 points (the oracle's cost grows as N^3 over every m).
+  std::vector<double> x{0.0};
+  for (const double f : values(ref + "/ocxo/ocxo_frequency.txt"))
+    if (x.size() < 1500) x.push_back(x.back() + (f - 1e7) / 1e7);
+  every_m(x, "ocxo");
+}
+
+TEST(TotalFast, TheoBiasRatioEqualsTheExactOne) {
+  // Oracle: theo_bias_ratio with S = 0 (every tau, each Theo1 and AVAR exact, direct sums).
+  for (const std::size_t n : {24u, 60u, 301u, 1000u}) {
+    const std::vector<double> x = record(n, 100 + n, 0.3, 1.0, 2.5, 0.0);
+    std::vector<double> work(theo1_workspace_size(n));
+    Theo1Workspace w = theo1_prepare(x, work);
+    const TheoBiasRatio direct = theo_bias_ratio(x, 1.0, 0, ~0ull), fast = theo_bias_ratio_fast(x, w, 1.0, ~0ull);
+    ASSERT_GT(direct.taus, 0u);
+    EXPECT_EQ(fast.taus, direct.taus);
+    EXPECT_EQ(fast.defined, direct.defined);
+    EXPECT_TRUE(fast.exact);
+    EXPECT_NEAR(fast.ratio, direct.ratio, 1e-9 * direct.ratio) << n;  // rounding of a mean of ratios
+    // A subset of taus: the same indices as the direct estimator's decimated call spreads.
+    const TheoBiasRatio few = theo_bias_ratio_fast(x, w, 1.0, 3);
+    EXPECT_EQ(few.taus, std::min<std::uint64_t>(3, direct.taus));
+  }
+}
+
+TEST(TotalFast, UndefinedInputGivesNoTerms) {
+  const std::vector<double> x = record(40, 1, 0.3, 1.0, 2.5, 0.0);
+  std::vector<double> work(theo1_workspace_size(x.size()));
+  Theo1Workspace w = theo1_prepare(x, work);
+  EXPECT_EQ(theo1_fast(w, 3, 1.0).n, 0u);   // odd m
+  EXPECT_EQ(theo1_fast(w, 0, 1.0).n, 0u);
+  EXPECT_EQ(theo1_fast(w, 40, 1.0).n, 0u);  // m > N - 1
+  EXPECT_EQ(theo1_fast(w, 10, 0.0).n, 0u);  // tau0 <= 0
+  std::vector<double> small(theo1_workspace_size(x.size()) - 1);
+  Theo1Workspace none = theo1_prepare(x, small);
+  EXPECT_FALSE(none.ready);
+  EXPECT_EQ(theo1_fast(none, 10, 1.0).n, 0u);
+  EXPECT_FALSE(theo1_prepare(std::vector<double>{1, 2}, work).ready);  // N < 3
+}
+
+TEST(TotalFast, FftEqualsTheDftWrittenOut) {
+  // Oracle: X_k = sum_p x_p exp(-+2 pi i k p / n) summed directly in long double.
+  const std::size_t P = 64;
+  std::vector<double> tw(2 * P);
+  fft_twiddles(tw, P);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> z;
+  for (const std::size_t n : {1u, 2u, 8u, 64u})
+    for (const bool inverse : {false, true}) {
+      std::vector<double> d(2 * n), in;
+      for (double& v : d) v = z(rng);
+      in = d;
+      fft(d, n, tw, inverse);
+      for (std::size_t k = 0; k < n; ++k) {
+        std::complex<long double> sum = 0;
+        for (std::size_t p = 0; p < n; ++p) {
+          const long double a = (inverse ? 2 : -2) * std::numbers::pi_v<long double> * static_cast<long double>(k * p) / n;
+          sum += std::complex<long double>(in[2 * p], in[2 * p + 1]) * std::polar(1.0L, a);
+        }
+        EXPECT_NEAR(d[2 * k], static_cast<double>(sum.real()), 1e-13) << n << " k=" << k;
+        EXPECT_NEAR(d[2 * k + 1], static_cast<double>(sum.imag()), 1e-13) << n << " k=" << k;
+      }
+    }
+}
+
+}  // namespace
+}  // namespace gyrochar
