@@ -100,7 +100,7 @@ Cell number(double v) {
 Cell verdict(Verdict v) { return {name(v), name(v), name(v)}; }
 
 std::string svg_log_plot(const LogPlot& plot) {
-  constexpr double width = 620, height = 400, left = 72, right = 170, top = 30, bottom = 48;
+  constexpr double width = 720, height = 400, left = 72, right = 250, top = 30, bottom = 48;
   const double pw = width - left - right, ph = height - top - bottom;
   double x_lo = std::numeric_limits<double>::infinity(), x_hi = 0, y_lo = x_lo, y_hi = 0;
   const auto take = [&](double x, double y) {

@@ -60,7 +60,11 @@ html::LogPlot node_plot(const NodePlot& p) {
   };
   plot.series.push_back({"ADEV", "#1f5fbf", false, points(p.adev)});
   plot.series.push_back({"MDEV", "#c0602a", true, points(p.mdev)});
-  for (const PlotLine& l : p.terms) plot.lines.push_back({l.label, l.term ? "#2a8a2a" : "#222222", false, l.tau_s, l.dev});
+  // Q N B K R, a Markov term, the model's sum.
+  static constexpr const char* term_colours[] = {"#8c564b", "#2a8a2a", "#9467bd", "#d62728", "#e377c2"};
+  for (const PlotLine& l : p.terms)
+    plot.lines.push_back({l.label, l.term ? term_colours[static_cast<int>(*l.term)] : l.markov ? "#17becf" : "#222222",
+                          false, l.tau_s, l.dev});
   if (p.truth) plot.lines.push_back({p.truth->label, "#7a3fa0", true, p.truth->tau_s, p.truth->dev});
   return plot;
 }
