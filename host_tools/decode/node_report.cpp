@@ -176,18 +176,19 @@ std::string decode_html(const Decoder& decoder, const InputCounters& input, cons
                             t.n ? Cell{fmt::format("{}", t.n), fmt::format("{}", t.n), {}} : Cell{}};
       for (const TauView::Dev* d : {&t.adev, &t.mdev}) {
         if (!d->received || !d->valid) {
-          row.insert(row.end(), {Cell{}, Cell{}, Cell{}, Cell{}});
+          row.insert(row.end(), {Cell{}, Cell{}, Cell{}, Cell{}, Cell{}});
           continue;
         }
         const double v = static_cast<double>(d->dev) * u.rate;
         const Interval ci = intervals(v, d->edf);
         row.insert(row.end(), {number(v), ci.valid ? number(ci.low) : Cell{}, ci.valid ? number(ci.high) : Cell{},
-                               d->edf > 0 ? number(d->edf) : Cell{}});
+                               d->edf > 0 ? number(d->edf) : Cell{}, {protocol::name(d->noise), {}, "text"}});
       }
       rows.push_back(std::move(row));
     }
     doc.table(id + "-taus", fmt::format("ADEV and MDEV [{}], intervals at {:g} %", u.rate_name, 100 * intervals.confidence()),
-              {"tau [s]", "m", "n", "adev", "ci low", "ci high", "edf", "mdev", "ci low", "ci high", "edf"}, rows);
+              {"tau [s]", "m", "n", "adev", "ci low", "ci high", "edf", "noise", "mdev", "ci low", "ci high", "edf", "noise"},
+              rows);
     // The fit.
     std::vector<std::vector<Cell>> terms;
     for (std::size_t k = 0; k < 5; ++k) {

@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -148,6 +149,82 @@ TEST(ReportBrowser, RenderedValuesEqualTheAnalyzersJson) {
   std::size_t plots = 0;
   for (auto at = dom.find("<svg class=\"plot\""); at != std::string::npos; at = dom.find("<svg class=\"plot\"", at + 1)) ++plots;
   EXPECT_EQ(plots, 2u) << "ADEV and MDEV";
+}
+
+}  // namespace
+
+namespace {
+
+// The fields of a CSV line without quotes (the decoder's rows have none).
+std::vector<std::string> fields(const std::string& line) {
+  std::vector<std::string> f;
+  std::string cur;
+  for (const char c : line) {
+    if (c == ',') f.push_back(cur), cur.clear();
+    else cur += c;
+  }
+  f.push_back(cur);
+  return f;
+}
+
+// The decoder's report of the demo's two nodes: each tau's ADEV and MDEV, interval and EDF in the
+// rendered DOM equal the decoder's CSV row of the last report (oracle: the CSV of the same run).
+TEST(ReportBrowser, DecoderReportEqualsItsCsv) {
+  const std::string browser = chromium();
+  if (browser.empty()) GTEST_SKIP() << "chromium is not installed (Debian package chromium; toolchain/build.sh test installs it)";
+  int code = 0;
+  const std::string log = temp("browser_demo.log"), csv = temp("browser_decode.csv"), report = temp("browser_decode.html");
+  run(std::string(GYROCHAR_BINARY_DIR) + "/host_tools/gyrochar-demo --hours 0.3 --window 0 --view-every 0 --csv '' --plot '' "
+      "--candump " + log + " > /dev/null", code);
+  ASSERT_EQ(code, 0);
+  run(std::string(GYROCHAR_BINARY_DIR) + "/host_tools/gyrochar-decode " + log + " --csv " + csv + " --report " + report, code);
+  ASSERT_EQ(code, 0);
+  const std::string flags = " --headless --no-sandbox --disable-gpu --no-first-run --disable-extensions"
+                            " --user-data-dir=" + temp("chromium_profile_decode") + " --proxy-server=127.0.0.1:9 ";
+  const std::string dom = run(browser + flags + "--dump-dom file://" + report + " 2>/dev/null", code);
+  ASSERT_EQ(code, 0);
+  mkdir(artifacts.c_str(), 0755);
+  run(browser + flags + "--window-size=1200,2400 --screenshot=" + artifacts + "/decode_report.png file://" + report +
+          " >/dev/null 2>&1", code);
+  // The last row of each node and tau.
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = fields(line);
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  std::map<std::pair<int, int>, std::vector<std::string>> last;
+  while (std::getline(in, line)) {
+    const auto f = fields(line);
+    if (f.size() == header.size() && f[col("type")] == "tau") last[{std::stoi(f[col("node")]), std::stoi(f[col("tau_index")])}] = f;
+  }
+  ASSERT_FALSE(last.empty());
+  std::size_t compared = 0;
+  for (const auto& [key, f] : last) {
+    char id[32];
+    std::snprintf(id, sizeof id, "node-%02x-taus", key.first);
+    const auto rows = table_rows(dom, id);
+    ASSERT_GT(rows.size(), static_cast<std::size_t>(key.second)) << id;
+    const auto& c = rows[static_cast<std::size_t>(key.second)];
+    ASSERT_EQ(c.size(), 13u) << id;
+    EXPECT_EQ(c[1], f[col("m")]) << id;
+    std::size_t at = 3;
+    for (const char* stat : {"adev", "mdev"}) {
+      const std::string s = stat;
+      if (f[col(s + "_status")] == "ok") {
+        for (const std::string suffix : {"", "_low", "_high", "_edf"}) {
+          const std::size_t k = at + (suffix == "" ? 0 : suffix == "_low" ? 1 : suffix == "_high" ? 2 : 3);
+          ASSERT_FALSE(c[k].empty()) << id << " " << s + suffix;
+          EXPECT_EQ(std::stod(c[k]), std::stod(f[col(s + suffix)])) << id << " tau " << key.second << " " << s + suffix;
+        }
+        EXPECT_EQ(c[at + 4], f[col(s + "_noise")]);
+        ++compared;
+      }
+      at += 5;
+    }
+  }
+  EXPECT_GE(compared, 2 * 10u) << "two nodes, ten taus or more each";
 }
 
 }  // namespace
