@@ -137,7 +137,7 @@ class Presenter {
     if (const int k = options_.kalibr.empty() ? exit_code::ok : kalibr(); code == exit_code::ok) code = k;
     if (!options_.report.empty() && !report() && code == exit_code::ok) code = exit_code::output_failed;
     if (view_ != View::none) show();
-    if (!options_.limits.empty() && code == exit_code::ok) code = verdicts();
+    if (const int v = options_.limits.empty() ? exit_code::ok : verdicts(); code == exit_code::ok) code = v;
     std::fputs(format_summary(session_.decoder(), session_.input(), session_.options().shown).c_str(), stderr);
     return code;
   }
