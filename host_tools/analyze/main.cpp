@@ -139,8 +139,9 @@ comments, e.g.
   bound one-sided 97.5 %): pass when the upper bound is within the limit, fail when the lower bound
   is beyond it, otherwise undecided (always for a term that is not resolved by an accepted fit),
   with the run length at which the interval is expected to decide (width ~ 1/sqrt(run length)).
-  Verdicts in the table, CSV (a second table after a blank line) and JSON ("acceptance"), and the
-  exit code: 5 when a limit is undecided and none failed, 6 when one failed.
+  Verdicts in the table, CSV (a second table after a blank line), JSON ("acceptance"; with
+  stable32, whose format has no place for them, on stderr), and the exit code: 5 when a limit is
+  undecided and none failed, 6 when one failed.
   --summary FILE.csv appends one row for the file (terms, uncertainties, status, verdicts; the
   header written once; a file with another header is refused).
 --report FILE.html: one self-contained page (inline SVG plots and CSS, no script, no external
