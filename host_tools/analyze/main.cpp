@@ -130,8 +130,8 @@ corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and 
 SP 1065's for the statistic. --fit-long-tau totdev or theoh lets the IEEE-952 fit take TOTDEV or
 TheoBR points in place of OADEV at long tau, where they have more degrees of freedom.
 
-Acceptance limits (--limits FILE, docs/metrology.md "Acceptance limits"): one limit a line, '#'
-comments, e.g.
+Acceptance limits (--limits FILE, docs/metrology.md "Acceptance limits and verdicts"): one limit
+a line, '#' comments, e.g.
   N <= 0.003 deg/sqrt(h)      B <= 0.01 deg/h      K <= 0.001 deg/h/sqrt(h)
   adev(100 s) <= 0.005 deg/h  mdev(10 s) <= 0.01 deg/h
   (Q N B K R need --fit ieee952; adev and mdev are read at that tau, added to the taus when it is a

@@ -1,6 +1,6 @@
 // The HTML report (gyrochar-analyze --report) in a real browser: Debian's chromium, headless, loads
-// the file with the network off, dumps the rendered DOM and takes a screenshot, kept as a test
-// artifact in the build folder (test-artifacts/report.png). Oracle: the analyzer's own JSON for the
+// the file with the network off, dumps the rendered DOM, takes a screenshot and prints it to PDF,
+// kept as test artifacts in the build folder (test-artifacts/report.png, report.pdf). Oracle: the analyzer's own JSON for the
 // same run: every statistic's tau, m, n, deviation, interval, EDF and alpha in the DOM equal the
 // JSON's (both shortest round trips of the same doubles: exact equality), and so do the fit's terms
 // and the verdicts. Skipped, saying so, where chromium is not installed (toolchain/build.sh installs
@@ -100,6 +100,13 @@ TEST(ReportBrowser, RenderedValuesEqualTheAnalyzersJson) {
   struct stat st {};
   EXPECT_EQ(stat((artifacts + "/report.png").c_str(), &st), 0);
   EXPECT_GT(st.st_size, 10000) << "a screenshot with something in it";
+  // Printed to PDF as a browser's print dialog would (the @media print style).
+  run(browser + flags + "--no-pdf-header-footer --print-to-pdf=" + artifacts + "/report.pdf file://" + report +
+          " >/dev/null 2>&1", code);
+  EXPECT_EQ(code, 0) << "chromium --print-to-pdf";
+  const std::string pdf = gyrochar::test_support::slurp(artifacts + "/report.pdf");
+  EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u) << "a PDF";
+  EXPECT_GT(pdf.size(), 20000u) << "with the tables and plots in it";
 
   // Every statistic: the DOM's rows are the JSON's results of that statistic, in order.
   std::map<std::string, std::vector<nlohmann::json>> results;
