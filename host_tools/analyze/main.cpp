@@ -23,11 +23,16 @@
 #include <tuple>
 #include <vector>
 
+#include "acceptance.hpp"
 #include "analysis.hpp"
+#include "analysis_html.hpp"
 #include "analysis_report.hpp"
 #include "datafile.hpp"
 #include "dynamic.hpp"
 #include "heat_map.hpp"
+#include "html_report.hpp"
+#include "limits.hpp"
+#include "verdict_output.hpp"
 #include "input_units.hpp"
 #include "output_paths.hpp"
 #include "plan.hpp"
@@ -128,6 +133,24 @@ tau and decimated beyond (blocks or sub-sequences every m/S samples, S from
 corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and the EDF is NIST
 SP 1065's for the statistic. --fit-long-tau totdev or theoh lets the IEEE-952 fit take TOTDEV or
 TheoBR points in place of OADEV at long tau, where they have more degrees of freedom.
+
+Acceptance limits (--limits FILE, docs/metrology.md "Acceptance limits and verdicts"): one limit
+a line, '#' comments, e.g.
+  N <= 0.003 deg/sqrt(h)      B <= 0.01 deg/h      K <= 0.001 deg/h/sqrt(h)
+  adev(100 s) <= 0.005 deg/h  mdev(10 s) <= 0.01 deg/h
+  (Q N B K R need --fit ieee952; adev and mdev are read at that tau, added to the taus when it is a
+  whole multiple of tau0.) Each verdict by a guard-banded rule on 95 % two-sided intervals (each
+  bound one-sided 97.5 %): pass when the upper bound is within the limit, fail when the lower bound
+  is beyond it, otherwise undecided (always for a term that is not resolved by an accepted fit),
+  with the run length at which the interval is expected to decide (width ~ 1/sqrt(run length)).
+  Verdicts in the table, CSV (a second table after a blank line), JSON ("acceptance"; with
+  stable32, whose format has no place for them, on stderr), and the exit code: 5 when a limit is
+  undecided and none failed, 6 when one failed.
+  --summary FILE.csv appends one row for the file (terms, uncertainties, status, verdicts; the
+  header written once; a file with another header is refused).
+--report FILE.html: one self-contained page (inline SVG plots and CSS, no script, no external
+reference; prints to PDF): provenance, ADEV and MDEV with intervals and the fitted model, every
+statistic with its intervals, the fit's terms, the read-off values and the verdicts.
 
 Dynamic Allan deviation (--dynamic WINDOW[,STEP], in seconds; STEP defaults to WINDOW): the
   statistics of every window of WINDOW/tau0 values, one starting every STEP/tau0 values, each as
@@ -382,7 +405,8 @@ int main(int argc, char** argv) {
                "MTOTDEV, TTOTDEV, HTOTDEV, Theo1, TheoH (held in memory) of a recorded file, with EDF,\n"
                "confidence intervals, noise identification and the IEEE-952 gyro fit.",
                "gyrochar-analyze"};
-  app.footer(std::string(footer) + exit_code::help);
+  app.footer(std::string(footer) + exit_code::help +
+             "\nWith --limits: 5 a limit is undecided (none failed); 6 a limit failed (the analysis is written).");
   std::string path, type_text, value_unit, pulse_weight_text, pulse_unit = "arcsec", rate_text = "deg/h";
   std::string taus_text = "octave", stats_text = "oadev,mdev", stride_text = "full", alpha_text = "auto";
   std::string format = "table", fit_text, kalibr_path, dynamic_text, plot_prefix;
@@ -438,12 +462,27 @@ int main(int argc, char** argv) {
   unsigned threads = 0;
   app.add_option("--threads", threads, "threads summing the taus of counts at --stride-factor full and of --taus all (default: one per core)")
       ->check(CLI::Range(1u, 1024u));
+  std::string limits_path, summary_path, report_path;
+  app.add_option("--limits", limits_path, "acceptance limits: a verdict per limit (see below)")->option_text("FILE");
+  app.add_option("--summary", summary_path, "with --limits: append the file's production summary row to FILE.csv")
+      ->option_text("FILE.csv");
+  app.add_option("--report", report_path, "write a self-contained HTML report (plots, tables, fit, verdicts)")
+      ->option_text("FILE.html");
   app.add_flag("--progress", progress, "show progress on stderr (default: when stderr is a terminal)");
   if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
   std::vector<NamedPath> outputs = plot_outputs("--plot", plot_prefix);
   outputs.insert(outputs.begin(), {"--kalibr", kalibr_path});
   outputs.insert(outputs.begin(), {"--psd", psd_path});
-  if (const auto conflict = output_conflict({{"file", path}}, outputs)) bad(conflict->what, conflict->why);
+  outputs.push_back({"--summary", summary_path});
+  outputs.push_back({"--report", report_path});
+  if (!report_path.empty()) outputs.push_back({"--report", report_path + ".part"});
+  if (const auto conflict = output_conflict({{"file", path}, {"--limits", limits_path}}, outputs))
+    bad(conflict->what, conflict->why);
+  std::string command;  // for the report's provenance
+  for (int i = 0; i < argc; ++i)
+    command += (i ? " " : "") + (std::string(argv[i]).find_first_of(" '\"") == std::string::npos
+                                     ? std::string(argv[i])
+                                     : "'" + std::string(argv[i]) + "'");
 
   try {
     // Options, checked before any data is read.
@@ -494,8 +533,31 @@ int main(int argc, char** argv) {
     else if (long_tau_text != "oadev") bad("--fit-long-tau", "must be oadev, totdev or theoh, not '" + long_tau_text + "'");
     if (long_tau != LongTau::oadev && fit_text.empty()) bad("--fit-long-tau", "only applies with --fit ieee952");
     o.keep_record = long_tau != LongTau::oadev;
+    // Acceptance limits: read and checked before any data.
+    std::vector<Limit> limits;
+    if (!limits_path.empty()) {
+      try {
+        limits = read_limits_file(limits_path);
+      } catch (const LimitsError& e) {
+        bad("--limits", limits_path + ": " + e.what());
+      }
+      for (const Limit& l : limits)
+        if (l.kind == Limit::Kind::term && fit_text.empty())
+          bad("--limits", fmt::format("{}: line {}: {} is a fitted term: add --fit ieee952", limits_path, l.line,
+                                      l.quantity()));
+    }
+    if (!summary_path.empty()) {
+      if (limits.empty()) bad("--summary", "needs --limits (the row holds the verdicts)");
+      std::string why;
+      if (!summary_compatible(summary_path, limits, why)) bad("--summary", summary_path + ": " + why);
+    }
     // The fit uses both curves, whatever the table shows: compute them, show what was asked.
     const std::vector<DevStat> shown = o.stats;
+    for (const Limit& l : limits) {  // limited deviations are computed, shown or not
+      const DevStat st = l.kind == Limit::Kind::adev ? DevStat::oadev : DevStat::mdev;
+      if (l.kind != Limit::Kind::term && std::find(o.stats.begin(), o.stats.end(), st) == o.stats.end())
+        o.stats.push_back(st);
+    }
     if (!fit_text.empty())
       for (const DevStat s : {DevStat::oadev, DevStat::mdev})
         if (std::find(o.stats.begin(), o.stats.end(), s) == o.stats.end()) o.stats.push_back(s);
@@ -518,6 +580,8 @@ int main(int argc, char** argv) {
     }
     if (!kalibr_path.empty() && !units.gyro)
       bad("--kalibr", "needs gyro data: counts, or --unit with an angle or a rate");
+    if (!limits.empty() && !units.gyro)
+      bad("--limits", "limits are in gyro units: needs gyro data (counts, or --unit with an angle or a rate)");
 
     const bool show_progress = progress || isatty(STDERR_FILENO);
     const std::string source = path == "-" ? "standard input" : path;
@@ -534,6 +598,8 @@ int main(int argc, char** argv) {
         if (std::find(o.stats.begin(), o.stats.end(), st) == o.stats.end()) o.stats.push_back(st);
     if (!dynamic_text.empty()) {
       if (!fit_text.empty()) bad("--fit", "fits the whole run's curves: not with --dynamic");
+      if (!limits.empty() || !report_path.empty())
+        bad(limits.empty() ? "--report" : "--limits", "is about the whole run: not with --dynamic");
       if (!psd_path.empty() || psd_segment != 0) bad("--psd", "the PSD is of the whole run: not with --dynamic");
       return analyze_dynamic(o, units, dynamic_text, taus_text, path, column, nominal_hz, format, plot_prefix,
                              show_progress);
@@ -582,6 +648,12 @@ int main(int argc, char** argv) {
     const std::uint64_t cut_above = plan.cut_above;
     const std::uint32_t s = o.stride_factor;
     if (o.m_list.empty()) bad(source, fmt::format("{} phase points are too few for any tau", n_phase));
+    for (const Limit& l : limits) {  // a limited tau joins the taus when the pyramid can form it
+      const std::uint64_t m = limit_m(l, o.tau0_s);
+      if (m == 0 || std::binary_search(o.m_list.begin(), o.m_list.end(), m)) continue;
+      if ((n_phase == 0 || m <= n_phase / 2) && (held || tau_representable(m, o.stride_factor)))
+        o.m_list.insert(std::upper_bound(o.m_list.begin(), o.m_list.end(), m), m);
+    }
     // More memory than the process may use, or an allocation that failed: a stride factor given is
     // the user's choice (bad input); under the default the cause is the memory limit (exit 1).
     const auto too_big = [&] {
@@ -695,8 +767,8 @@ int main(int argc, char** argv) {
       fits = fit_curves(a, units, o.tau0_s, o.type == DataType::counts ? units.phase_unit_si / std::sqrt(12.0) : 0.0,
                         long_tau, analyzer->record(), offered_hz);
     std::optional<Readoff> readoff = readoff_of(a, units);  // every OADEV row, shown or computed for the fit
-    std::vector<AnalysisRow> plotted;  // --plot draws OADEV and MDEV, shown or not
-    if (!plot_prefix.empty())
+    std::vector<AnalysisRow> plotted;  // --plot and --report draw OADEV and MDEV, shown or not; limits read them
+    if (!plot_prefix.empty() || !report_path.empty() || !limits.empty())
       std::copy_if(a.rows.begin(), a.rows.end(), std::back_inserter(plotted),
                    [](const AnalysisRow& r) { return r.stat == DevStat::oadev || r.stat == DevStat::mdev; });
     Analysis displayed = std::move(a);  // (a --taus all run has millions of rows: not copied)
@@ -729,6 +801,8 @@ int main(int argc, char** argv) {
                   std::move(readoff), std::nullopt};
     if (!report.fits.empty()) report.truth = truth_of(header, o.type, o.tau0_s, units.phase_unit_si);
     report.spectrum = std::move(spectrum);
+    const double run_s = static_cast<double>(report.analysis.n_values) * o.tau0_s;
+    const std::vector<Decision> decisions = decide_limits(limits, report, plotted, run_s);
     std::string yaml;  // made before anything is written: a refusal loses no output
     if (!kalibr_path.empty()) {
       std::string why;
@@ -740,10 +814,17 @@ int main(int argc, char** argv) {
         print_error(program, "note", "--kalibr: gyroscope_noise_density is the fitted white-rate N, gyroscope_random_walk the "
                                      "fitted rate random walk K; Kalibr's model has no place for the model's " + beyond);
     }
-    const std::string text = format == "json"       ? to_json(report).dump(2) + "\n"
-                             : format == "csv"      ? format_csv(report)
+    const auto json_text = [&] {
+      nlohmann::json j = to_json(report);
+      if (!limits.empty()) j["acceptance"] = acceptance_json(limits, decisions);
+      return j.dump(2) + "\n";
+    };
+    const std::string verdicts = limits.empty() ? std::string() : acceptance_table(limits, decisions);
+    const std::string text = format == "json"       ? json_text()
+                             : format == "csv"      ? format_csv(report) + (limits.empty() ? "" : acceptance_csv(limits, decisions))
                              : format == "stable32" ? format_stable32(report)
-                                                    : format_table(report);
+                                                    : format_table(report) + verdicts;
+    if (format == "stable32" && !limits.empty()) std::fputs(verdicts.c_str(), stderr);  // its format has no place
     std::fwrite(text.data(), 1, text.size(), stdout);
     if (!psd_path.empty()) {
       std::FILE* f = std::fopen(psd_path.c_str(), "w");
@@ -760,6 +841,30 @@ int main(int argc, char** argv) {
       if (f == nullptr) fail(exit_code::output_failed, kalibr_path, std::strerror(errno));
       std::fputs(yaml.c_str(), f);
       if (!close_output(f, program, kalibr_path)) return finish(program, exit_code::output_failed);
+    }
+    if (!report_path.empty()) {
+      std::string why;
+      const std::string page = analysis_html(report, plotted, {command, limits_path}, limits, decisions);
+      if (!html::write_file_atomically(report_path, page, why)) fail(exit_code::output_failed, "--report", why);
+    }
+    if (!summary_path.empty()) {
+      GyroSummary g{source, "", run_s, report.analysis.n_values, "", 0, {}, decisions};
+      if (!report.fits.empty()) {
+        const Ieee952Fit& fit = report.fits.front().fit;
+        g.fit_status = name(fit.status);
+        g.chi2_per_dof = fit.chi2_per_dof();
+        for (std::size_t k = 0; k < 5; ++k) {
+          const Ieee952Parameter& p = fit.p[k];
+          g.terms[k] = {p.fitted, p.value / units::ieee952[k].si, p.uncertainty / units::ieee952[k].si,
+                        !p.fitted ? "not in model" : p.resolved ? "resolved" : "not resolved"};
+        }
+      }
+      std::string why;
+      if (!append_summary(summary_path, limits, {g}, why)) fail(exit_code::output_failed, "--summary", summary_path + ": " + why);
+    }
+    if (!limits.empty()) {  // a lost output (4) comes before the verdict
+      const int code = finish(program, exit_code::ok);
+      return code != exit_code::ok ? code : exit_code_of(overall(decisions));
     }
   } catch (const std::bad_alloc&) {  // beyond the plan's own check (too_big): say what limits memory
     fail(exit_code::internal, "out of memory",

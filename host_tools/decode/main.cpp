@@ -20,6 +20,9 @@
 #include "hal/program/command_line.hpp"
 #include "hal/program/exit_codes.hpp"
 #include "hal/linux/socketcan.hpp"
+#include "html_report.hpp"
+#include "limits.hpp"
+#include "node_report.hpp"
 #include "output_paths.hpp"
 #include "plot.hpp"
 #include "session.hpp"
@@ -64,6 +67,9 @@ struct Options {
   double duration_s = 0.0;
   std::vector<std::string> nodes;
   double refresh_s = 1.0;
+  std::string limits_path, report, summary;  // --limits, --report, --summary
+  std::vector<Limit> limits;
+  std::string command;  // for the report's provenance
 };
 
 std::FILE* open_output(const std::string& path) {
@@ -110,9 +116,10 @@ class Presenter {
       last_view_s_ = now;
     }
     const InputCounters& in = session_.input();
-    if (!options_.plot.empty() && options_.plot_every_s > 0 && in.started &&
+    if ((!options_.plot.empty() || !options_.report.empty()) && options_.plot_every_s > 0 && in.started &&
         in.now_s - last_plot_s_ >= options_.plot_every_s) {
-      plot();
+      if (!options_.plot.empty()) plot();
+      if (!options_.report.empty()) report();
       last_plot_s_ = in.now_s;
     }
   }
@@ -128,7 +135,9 @@ class Presenter {
     int code = exit_code::ok;
     if (!options_.plot.empty() && !plot()) code = exit_code::output_failed;
     if (const int k = options_.kalibr.empty() ? exit_code::ok : kalibr(); code == exit_code::ok) code = k;
+    if (!options_.report.empty() && !report() && code == exit_code::ok) code = exit_code::output_failed;
     if (view_ != View::none) show();
+    if (const int v = options_.limits.empty() ? exit_code::ok : verdicts(); code == exit_code::ok) code = v;
     std::fputs(format_summary(session_.decoder(), session_.input(), session_.options().shown).c_str(), stderr);
     return code;
   }
@@ -170,6 +179,36 @@ class Presenter {
     }
     std::fputs(yaml->c_str(), f);
     return close_output(f, program, options_.kalibr) ? exit_code::ok : exit_code::output_failed;
+  }
+
+  bool report() {
+    std::string why;
+    const std::string page = decode_html(session_.decoder(), session_.input(), session_.options().shown, rate_unit_,
+                                         session_.intervals(), options_.limits, options_.command);
+    if (html::write_file_atomically(options_.report, page, why)) return true;
+    print_error(program, "--report", why);
+    return false;
+  }
+
+  // The verdicts at the end: after the view (stdout), as JSON lines records, in the summary file.
+  int verdicts() {
+    const Decoder& d = session_.decoder();
+    const NodeFilter& shown = session_.options().shown;
+    if (view_ != View::none) std::fputs(format_verdicts(d, shown, options_.limits).c_str(), stdout);
+    std::vector<GyroSummary> rows;
+    for (const auto& [address, node] : d.nodes()) {
+      if (!shown[address]) continue;
+      if (std::FILE* jsonl = session_.options().jsonl)
+        std::fputs((acceptance_record(session_.input().now_s, node, options_.limits,
+                                      node_decisions(node, options_.limits)).dump() + "\n").c_str(), jsonl);
+      rows.push_back(node_summary(node, session_.input().source, options_.limits));
+    }
+    std::string why;
+    if (!options_.summary.empty() && !append_summary(options_.summary, options_.limits, rows, why)) {
+      print_error(program, options_.summary, why);
+      return exit_code::output_failed;
+    }
+    return exit_code::ok;
   }
 
   bool plot() {
@@ -307,8 +346,14 @@ int main(int argc, char** argv) {
       " bytes among them), remote request (RTR) frames and\n"
       "rejected frames are counted and reported, not fatal. A log that is missing, unreadable, empty or\n"
       "without any candump line is bad input, and so is an output (--csv, --jsonl, --kalibr, --plot's\n"
-      "files) that is the same file as LOG or as another output, through links too: refused before\n"
-      "anything is written.\n" +
+      "files, --report, --summary) that is the same file as LOG or as another output, through links too:\n"
+      "refused before anything is written.\n"
+      "--limits FILE (the format of gyrochar-analyze --help): at the end, each shown node's verdicts\n"
+      "(pass, fail, undecided, with the run length at which an undecided one is expected to decide) after\n"
+      "the view, as a JSON lines record of type \"acceptance\" per node, in the report, and with\n"
+      "--summary FILE.csv as one row per node; the exit code does not depend on them.\n"
+      "--report FILE.html: a self-contained page (inline SVG and CSS, no script, no external reference):\n"
+      "provenance, each node's plot, taus with intervals, fit and verdicts.\n" +
       std::string(exit_code::help));
   Options o;
   app.add_option("log", o.log, "candump log file, or '-' for stdin")->option_text("LOG");
@@ -319,7 +364,13 @@ int main(int argc, char** argv) {
   app.add_option("--plot", o.plot, "write PREFIX.svg and PREFIX.png at the end")->option_text("PREFIX");
   app.add_option("--kalibr", o.kalibr, "write the node's N and K as a Kalibr imu.yaml at the end (one node: --node)")
       ->option_text("FILE");
-  app.add_option("--plot-every", o.plot_every_s, "also rewrite the plot every S seconds (decoder time)")
+  app.add_option("--limits", o.limits_path, "acceptance limits: a verdict per node and limit (gyrochar-analyze --help)")
+      ->option_text("FILE");
+  app.add_option("--report", o.report, "write a self-contained HTML report at the end (and every --plot-every)")
+      ->option_text("FILE.html");
+  app.add_option("--summary", o.summary, "with --limits: append one row per node to this production summary CSV")
+      ->option_text("FILE.csv");
+  app.add_option("--plot-every", o.plot_every_s, "also rewrite the plot and the report every S seconds (decoder time)")
       ->option_text("S");
   app.add_option("--view", o.view,
                  "live: refreshing table; final: the table once at the end; none. "
@@ -345,7 +396,21 @@ int main(int argc, char** argv) {
   if (!(o.confidence > 0 && o.confidence < 1)) fail(exit_code::bad_input, "--confidence", "must be in (0, 1)");
   if (!(o.duration_s >= 0)) fail(exit_code::bad_input, "--duration", "must be >= 0");
   if (!(o.plot_every_s >= 0)) fail(exit_code::bad_input, "--plot-every", "must be >= 0");
-  if (o.plot_every_s > 0 && o.plot.empty()) fail(exit_code::bad_input, "--plot-every", "needs --plot PREFIX");
+  if (o.plot_every_s > 0 && o.plot.empty() && o.report.empty())
+    fail(exit_code::bad_input, "--plot-every", "needs --plot PREFIX or --report FILE.html");
+  if (!o.limits_path.empty()) {
+    try {
+      o.limits = read_limits_file(o.limits_path);
+    } catch (const LimitsError& e) {
+      fail(exit_code::bad_input, "--limits", o.limits_path + ": " + e.what());
+    }
+  }
+  if (!o.summary.empty()) {
+    std::string why;
+    if (o.limits.empty()) fail(exit_code::bad_input, "--summary", "needs --limits (the rows hold the verdicts)");
+    if (!summary_compatible(o.summary, o.limits, why)) fail(exit_code::bad_input, "--summary", o.summary + ": " + why);
+  }
+  for (int i = 0; i < argc; ++i) o.command += (i ? " " : "") + std::string(argv[i]);
   if (!(o.refresh_s > 0)) fail(exit_code::bad_input, "--refresh", "must be > 0");
   View view = isatty(STDOUT_FILENO) ? View::live : View::none;
   if (o.view == "live")
@@ -358,7 +423,9 @@ int main(int argc, char** argv) {
     fail(exit_code::bad_input, "--view", "'" + o.view + "' is not live, final or none");
   std::vector<NamedPath> outputs = plot_outputs("--plot", o.plot);
   outputs.insert(outputs.begin(), {{"--csv", o.csv}, {"--jsonl", o.jsonl}, {"--kalibr", o.kalibr}});
-  if (const auto conflict = output_conflict({{"LOG", o.log}}, outputs))
+  outputs.insert(outputs.end(), {{"--report", o.report}, {"--report", o.report.empty() ? "" : o.report + ".part"},
+                                 {"--summary", o.summary}});
+  if (const auto conflict = output_conflict({{"LOG", o.log}, {"--limits", o.limits_path}}, outputs))
     fail(exit_code::bad_input, conflict->what, conflict->why);
   if (!o.plot.empty()) {
     if (const std::string missing = plot_devices_missing(); !missing.empty()) fail(exit_code::bad_input, "--plot", missing);

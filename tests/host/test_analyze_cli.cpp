@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "hal/program/exit_codes.hpp"
+#include "support/shell.hpp"
 #include "oracle/brute_force.hpp"
 #include "support/real_imu.hpp"
 
@@ -37,27 +38,11 @@ using namespace gyrochar;
 
 const std::string tool = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-analyze";
 
-struct Outcome {
-  int code = -1;
-  std::string out, err;
-};
+using Outcome = gyrochar::test_support::ShellOutcome;
 
-// Per-process names: CTest runs the tests of this file in parallel processes.
-std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_" + name; }
+std::string temp(const std::string& name) { return gyrochar::test_support::temp_path(name); }
 
-// A shell command line; its stderr is collected.
-Outcome run_shell(const std::string& command) {
-  const std::string err_file = temp("analyze_err.txt");
-  Outcome r;
-  FILE* p = popen(("(" + command + ") 2>" + err_file).c_str(), "r");
-  char buf[4096];
-  while (const std::size_t n = fread(buf, 1, sizeof buf, p)) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err_file);
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
-}
+Outcome run_shell(const std::string& command) { return gyrochar::test_support::run_shell(command, "analyze_err.txt"); }
 
 Outcome run(const std::string& args) { return run_shell(tool + " " + args); }
 

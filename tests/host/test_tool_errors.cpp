@@ -261,3 +261,19 @@ TEST(ToolErrors, PermissionDeniedIsNamedWithItsReason) {
 }
 
 }  // namespace
+
+// Acceptance limits, the production summary and the report: each rule names its option, before
+// anything is read or written (the limits file format itself: test_limits.cpp, test_acceptance_cli.cpp).
+TEST(ToolErrors, LimitsSummaryAndReportNameTheirRule) {
+  const int bad = exit_code::bad_input;
+  const std::string counts = " --type counts --tau0 1 --pulse-weight 1arcsec ";
+  expect("gyrochar-analyze", counts + "--limits /nonexistent-dir/limits.txt /dev/null", bad,
+         "--limits: /nonexistent-dir/limits.txt: cannot be read");
+  expect("gyrochar-analyze", counts + "--summary /tmp/s.csv /dev/null", bad, "--summary: needs --limits");
+  expect("gyrochar-analyze", counts + "--dynamic 100 --report /tmp/r.html /dev/null", bad,
+         "--report: is about the whole run: not with --dynamic");
+  expect("gyrochar-decode", "/dev/null --summary /tmp/s.csv", bad, "--summary: needs --limits");
+  expect("gyrochar-decode", "/dev/null --plot-every 5", bad, "--plot-every: needs --plot PREFIX or --report FILE.html");
+  expect("gyrochar-decode", "/dev/null --limits /nonexistent-dir/limits.txt", bad,
+         "--limits: /nonexistent-dir/limits.txt: cannot be read");
+}

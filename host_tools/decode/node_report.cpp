@@ -1,0 +1,213 @@
+#include "node_report.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "html_report.hpp"
+#include "plot_data.hpp"
+
+namespace gyrochar::decoding {
+namespace {
+
+using html::Cell;
+using html::number;
+
+double tau0_of(const NodeView& node) { return node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0; }
+double run_s_of(const NodeView& node) {
+  return node.have_status ? static_cast<double>(node.status.sample_count) * tau0_of(node) : 0.0;
+}
+bool fit_ok(const NodeView& node) {
+  return node.ieee952_summary && node.ieee952_summary->status == protocol::Ieee952Status::ok;
+}
+
+LimitEstimate node_estimate(const NodeView& node, const Limit& l) {
+  const auto wire_si = wire_per_si(node);  // wire value per SI value
+  if (!wire_si) return no_estimate("the node's angle unit is not known (or pulses)");
+  const double run_s = run_s_of(node);
+  if (l.kind == Limit::Kind::term) {
+    const char* letter = units::ieee952[l.term].letter;
+    if (!node.ieee952_summary) return no_estimate("no fit summary yet");
+    if (!fit_ok(node)) return no_estimate(fmt::format("fit {}", protocol::name(node.ieee952_summary->status)));
+    const Ieee952View& t = node.ieee952[l.term];
+    if (!t.in_model()) return no_estimate(fmt::format("{} not in the fitted model", letter));
+    if (!t.resolved) return no_estimate(fmt::format("{} not resolved", letter));
+    const double v = static_cast<double>(t.value) / *wire_si;
+    return normal_estimate(v, v * t.rel_uncertainty, run_s);
+  }
+  const double tau0 = tau0_of(node);
+  if (!(tau0 > 0)) return no_estimate("tau0 not known yet");
+  for (const TauView& t : node.taus) {
+    if (t.m == 0 || std::abs(static_cast<double>(t.m) * tau0 - l.tau_s) > 1e-6 * l.tau_s) continue;
+    const TauView::Dev& d = l.kind == Limit::Kind::adev ? t.adev : t.mdev;
+    if (!d.received || !d.valid) return no_estimate(fmt::format("no estimate at tau = {:g} s yet", l.tau_s));
+    return deviation_estimate(static_cast<double>(d.dev) / *wire_si, d.edf, 0, run_s);
+  }
+  return no_estimate(fmt::format("the node has no tau of {:g} s (its taus are tau0 2^k)", l.tau_s));
+}
+
+std::string node_name(const NodeView& node) { return fmt::format("node 0x{:02X}", node.address); }
+
+html::LogPlot node_plot(const NodePlot& p) {
+  html::LogPlot plot;
+  plot.title = p.title;
+  plot.x_label = "tau [s]";
+  plot.y_label = "ADEV, MDEV [" + p.rate_name + "]";
+  const auto points = [](const std::vector<PlotPoint>& in) {
+    std::vector<html::PlotPoint> out;
+    for (const PlotPoint& q : in) out.push_back({q.tau_s, q.dev, q.ci});
+    return out;
+  };
+  plot.series.push_back({"ADEV", "#1f5fbf", false, points(p.adev)});
+  plot.series.push_back({"MDEV", "#c0602a", true, points(p.mdev)});
+  // Q N B K R, a Markov term, the model's sum.
+  static constexpr const char* term_colours[] = {"#8c564b", "#2a8a2a", "#9467bd", "#d62728", "#e377c2"};
+  for (const PlotLine& l : p.terms)
+    plot.lines.push_back({l.label, l.term ? term_colours[static_cast<int>(*l.term)] : l.markov ? "#17becf" : "#222222",
+                          false, l.tau_s, l.dev});
+  if (p.truth) plot.lines.push_back({p.truth->label, "#7a3fa0", true, p.truth->tau_s, p.truth->dev});
+  return plot;
+}
+
+}  // namespace
+
+std::vector<Decision> node_decisions(const NodeView& node, const std::vector<Limit>& limits) {
+  std::vector<Decision> out;
+  for (const Limit& l : limits) out.push_back(decide(l, node_estimate(node, l)));
+  return out;
+}
+
+std::string format_verdicts(const Decoder& decoder, const NodeFilter& shown, const std::vector<Limit>& limits) {
+  std::string out;
+  for (const auto& [address, node] : decoder.nodes())
+    if (shown[address])
+      out += fmt::format("\n{} (run {}):", node_name(node), format_run_length(run_s_of(node))) +
+             acceptance_table(limits, node_decisions(node, limits));
+  return out;
+}
+
+nlohmann::json acceptance_record(double time_s, const NodeView& node, const std::vector<Limit>& limits,
+                                 const std::vector<Decision>& decisions) {
+  nlohmann::json j = acceptance_json(limits, decisions);
+  j["type"] = "acceptance";
+  j["time"] = time_s;
+  j["node"] = node.address;
+  j["session"] = node.session;
+  j["run_s"] = run_s_of(node);
+  return j;
+}
+
+GyroSummary node_summary(const NodeView& node, const std::string& source, const std::vector<Limit>& limits) {
+  GyroSummary g;
+  g.source = source;
+  g.node = fmt::format("0x{:02X}", node.address);
+  g.run_s = run_s_of(node);
+  g.samples = node.have_status ? node.status.sample_count : 0;
+  if (node.ieee952_summary) {
+    g.fit_status = protocol::name(node.ieee952_summary->status);
+    g.chi2_per_dof = node.ieee952_summary->chi2_per_dof;
+  }
+  if (const auto wire_si = wire_per_si(node))
+    for (std::size_t k = 0; k < 5; ++k) {
+      const Ieee952View& t = node.ieee952[k];
+      if (!t.received) continue;
+      const double v = static_cast<double>(t.value) / *wire_si / units::ieee952[k].si;
+      g.terms[k] = {t.in_model(), v, v * t.rel_uncertainty,
+                    !t.in_model() ? "not in model" : t.resolved ? "resolved" : "not resolved"};
+    }
+  g.decisions = node_decisions(node, limits);
+  return g;
+}
+
+std::string decode_html(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown,
+                        const DisplayRate& rate, ConfidenceIntervals& intervals, const std::vector<Limit>& limits,
+                        const std::string& command) {
+  html::Document doc("gyrochar report: " + input.source);
+  doc.heading("Provenance", 2, "provenance");
+  doc.facts({{"input", input.source},
+             {"frames", fmt::format("{}", input.frames)},
+             {"decoder time", fmt::format("{:g} s", input.started ? input.now_s - input.first_s : 0.0)},
+             {"bus", input.bus.empty() ? "a log" : input.bus},
+             {"command", command},
+             {"software", html::software_version()},
+             {"written", html::utc_now()}},
+            "provenance-facts");
+  for (const auto& [address, node] : decoder.nodes()) {
+    if (!shown[address]) continue;
+    const Units u = units_for(node, rate);
+    const std::string id = fmt::format("node-{:02x}", address);
+    doc.heading(node_name(node), 2, id);
+    const LinkHealth& h = node.health;
+    doc.facts({{"node", fmt::format("0x{:02X}, session {}", address, node.session)},
+               {"configuration",
+                node.config ? fmt::format("hash 0x{:08X}, report every {} ms", node.config->config_hash,
+                                          node.config->report_period_ms)
+                            : "not received"},
+               {"tau0", node.sampling ? fmt::format("{:g} s, stride factor {}", node.sampling->tau0_s,
+                                                    node.sampling->stride_factor)
+                                      : "not received"},
+               {"scale", node.scale ? fmt::format("{:g} {} a pulse, input {}", node.scale->angle_per_pulse,
+                                                  protocol::name(node.scale->angle_unit),
+                                                  protocol::name(node.scale->input_source))
+                                    : "not received"},
+               {"samples", node.have_status ? fmt::format("{} ({})", node.status.sample_count,
+                                                          format_run_length(run_s_of(node)))
+                                            : "no status yet"},
+               {"gaps", fmt::format("{} sample gaps, {} lost edges", node.faults.sample_gaps, node.faults.lost_edges)},
+               {"link", fmt::format("{} reports complete, {} incomplete, {} lost; {} frames missing; {} restarts",
+                                    h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing,
+                                    h.restarts)}},
+              id + "-provenance");
+    if (!limits.empty()) html::verdict_section(doc, limits, node_decisions(node, limits), id + "-verdicts", 3);
+    const NodePlot p = plot_data(node, rate, intervals);
+    html::LogPlot plot = node_plot(p);
+    for (const Limit& l : limits)
+      if (l.kind == Limit::Kind::adev && u.known && !u.pulses)
+        if (const auto wire_si = wire_per_si(node))
+          plot.limits.push_back({l.tau_s, l.value_si * *wire_si * u.rate, l.quantity() + " limit"});
+    doc.raw(html::svg_log_plot(plot) + "\n");
+    // The taus, in display units, with their intervals at the view's confidence.
+    std::vector<std::vector<Cell>> rows;
+    const double tau0 = tau0_of(node);
+    for (const TauView& t : node.taus) {
+      if (t.m == 0) continue;
+      std::vector<Cell> row{number(tau0 > 0 ? static_cast<double>(t.m) * tau0 : NAN),
+                            {fmt::format("{}", t.m), fmt::format("{}", t.m), {}},
+                            t.n ? Cell{fmt::format("{}", t.n), fmt::format("{}", t.n), {}} : Cell{}};
+      for (const TauView::Dev* d : {&t.adev, &t.mdev}) {
+        if (!d->received || !d->valid) {
+          row.insert(row.end(), {Cell{}, Cell{}, Cell{}, Cell{}, Cell{}});
+          continue;
+        }
+        const double v = static_cast<double>(d->dev) * u.rate;
+        const Interval ci = intervals(v, d->edf);
+        row.insert(row.end(), {number(v), ci.valid ? number(ci.low) : Cell{}, ci.valid ? number(ci.high) : Cell{},
+                               d->edf > 0 ? number(d->edf) : Cell{}, {protocol::name(d->noise), {}, "text"}});
+      }
+      rows.push_back(std::move(row));
+    }
+    doc.table(id + "-taus", fmt::format("ADEV and MDEV [{}], intervals at {:g} %", u.rate_name, 100 * intervals.confidence()),
+              {"tau [s]", "m", "n", "adev", "ci low", "ci high", "edf", "noise", "mdev", "ci low", "ci high", "edf", "noise"},
+              rows);
+    // The fit.
+    std::vector<std::vector<Cell>> terms;
+    for (std::size_t k = 0; k < 5; ++k) {
+      const Ieee952View& t = node.ieee952[k];
+      const double v = static_cast<double>(t.value) * u.ieee[k];
+      terms.push_back({{units::ieee952[k].letter, {}, "text"}, t.in_model() ? number(v) : Cell{},
+                       t.in_model() ? number(v * t.rel_uncertainty) : Cell{}, {u.ieee_name[k], {}, "text"},
+                       {!t.received ? "not received" : !t.in_model() ? "not in model" : t.resolved ? "resolved" : "not resolved",
+                        {}, "text"}});
+    }
+    const auto& s = node.ieee952_summary;
+    doc.table(id + "-fit",
+              s ? fmt::format("IEEE-952 fit: {}, chi2/dof {:.3g}, {} points, quantization {}", protocol::name(s->status),
+                              s->chi2_per_dof, s->points, s->quantization_white ? "white" : "periodic")
+                : std::string("IEEE-952 fit: no summary received"),
+              {"term", "value", "standard uncertainty", "unit", "status"}, terms);
+    for (const std::string& note : p.notes) doc.paragraph(note, "note");
+  }
+  return doc.finish();
+}
+
+}  // namespace gyrochar::decoding

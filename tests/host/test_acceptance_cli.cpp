@@ -1,0 +1,228 @@
+// gyrochar-analyze and gyrochar-decode with acceptance limits (--limits), the production summary
+// (--summary) and the HTML report (--report), as a user meets them. Oracles: the exit codes of
+// hal/program/exit_codes.hpp and of host_tools/analyze/acceptance.hpp (5 undecided, 6 fail); the
+// simulator's truth (N = 0.003 deg/sqrt(h), a white-angle residue of 1 arcsec): over an hour at
+// tau0 0.1 s the fit's N is within a few percent of it, so a limit of 0.006 (twice the truth) is
+// met and one of 0.0015 (half) is failed, with the guard band far from either; the decision rule of
+// common/limits.hpp recomputed from the JSON's own bounds.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <string>
+
+#include "hal/program/exit_codes.hpp"
+#include "support/shell.hpp"
+
+namespace {
+
+using namespace gyrochar;
+
+const std::string analyze = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-analyze";
+const std::string sim = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim";
+const std::string demo = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-demo";
+const std::string decode = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-decode";
+
+using test_support::run_shell;
+using test_support::slurp;
+using Outcome = test_support::ShellOutcome;
+std::string temp(const std::string& name) { return test_support::temp_path(name); }
+
+std::string file_with(const std::string& name, const std::string& content) {
+  const std::string path = temp(name);
+  std::ofstream(path) << content;
+  return path;
+}
+
+// An hour of a simulated gyro at 10 Hz: N = 0.003 deg/sqrt(h) and a white angle residue.
+const std::string& counts() {
+  static const std::string path = [] {
+    const std::string p = temp("gyro.txt");
+    const Outcome r = run_shell(sim + " --duration 3600 --tau0 0.1 --arw 0.003 --white-angle 1 --seed 5 > " + p);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return p;
+  }();
+  return path;
+}
+
+const std::string analyze_counts = " --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 ";
+
+TEST(AcceptanceCli, VerdictsSetTheExitCode) {
+  const std::string pass = file_with("pass.txt", "# twice the truth\nN <= 0.006 deg/sqrt(h)\n");
+  const std::string fail = file_with("fail.txt", "N <= 0.0015 deg/sqrt(h)  # half the truth\n");
+  const std::string open = file_with("open.txt", "N <= 0.006 deg/sqrt(h)\nK <= 1 deg/h/sqrt(h)\n");  // K: no such term
+  Outcome r = run_shell(analyze + analyze_counts + "--limits " + pass + " " + counts());
+  EXPECT_EQ(r.code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("Acceptance: pass"), std::string::npos) << r.out;
+  r = run_shell(analyze + analyze_counts + "--limits " + fail + " " + counts());
+  EXPECT_EQ(r.code, 6) << "a failed limit: 6\n" << r.err << r.out;
+  EXPECT_NE(r.out.find("Acceptance: fail"), std::string::npos) << r.out;
+  r = run_shell(analyze + analyze_counts + "--limits " + open + " --format json " + counts());
+  EXPECT_EQ(r.code, 5) << "an undecided limit: 5\n" << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& a = j.at("acceptance");
+  EXPECT_EQ(a.at("verdict"), "undecided");
+  ASSERT_EQ(a.at("limits").size(), 2u);
+  const auto& n = a.at("limits")[0];
+  EXPECT_EQ(n.at("quantity"), "N");
+  EXPECT_EQ(n.at("verdict"), "pass");
+  // The rule recomputed from the JSON's own numbers: the upper bound within the limit.
+  EXPECT_LE(n.at("upper").get<double>(), 0.006);
+  EXPECT_LE(n.at("lower").get<double>(), n.at("estimate").get<double>());
+  // The estimate is the fit's N (the same JSON, same unit).
+  EXPECT_DOUBLE_EQ(n.at("estimate").get<double>(), j.at("fit")[0].at("N").at("value").get<double>());
+  const auto& k = a.at("limits")[1];
+  EXPECT_EQ(k.at("verdict"), "undecided");
+  EXPECT_TRUE(k.at("estimate").is_null()) << "a term not resolved has no estimate to decide on";
+  EXPECT_NE(k.at("why").get<std::string>().find("K not"), std::string::npos) << k;
+}
+
+TEST(AcceptanceCli, DeviationLimitsAreReadAtTheirTauAndInCsv) {
+  // adev(50 s): m = 500 is no octave; the analyzer adds it to the taus.
+  const std::string lim = file_with("adev.txt", "adev(50 s) <= 1 deg/h\nmdev(1 min) <= 1e-9 deg/h\n");
+  const Outcome r = run_shell(analyze + analyze_counts + "--limits " + lim + " --format csv " + counts());
+  EXPECT_EQ(r.code, 6) << r.err;  // mdev below 1e-9 deg/h is impossible for this gyro: fail
+  const auto blank = r.out.find("\n\n");
+  ASSERT_NE(blank, std::string::npos) << r.out;
+  const std::string verdicts = r.out.substr(blank + 2);
+  EXPECT_EQ(verdicts.substr(0, verdicts.find('\n')), "limit,limit_value,unit,estimate,lower,upper,verdict,decides_at_s,why");
+  EXPECT_NE(verdicts.find("adev(50 s),1,deg/h,"), std::string::npos) << verdicts;
+  EXPECT_NE(verdicts.find(",pass,"), std::string::npos) << verdicts;
+  EXPECT_NE(verdicts.find("mdev(60 s),1e-09,deg/h,"), std::string::npos) << verdicts;
+  EXPECT_NE(verdicts.find(",fail,"), std::string::npos) << verdicts;
+  EXPECT_NE(r.out.find("\noadev,500,50,"), std::string::npos) << "the limited tau is a row of its own";
+}
+
+TEST(AcceptanceCli, BadLimitsFilesAreBadInput) {
+  const std::regex one_line("gyrochar-analyze: [^\n]+: [^\n]+\n");
+  const struct {
+    std::string content, why;
+  } cases[] = {
+      {"N <= 0.003 deg/h\n", "line 1: 'deg/h' is not a unit of N"},
+      {"# nothing\n", "no limit in the file"},
+      {"N <= 0.003 deg/sqrt(h)\nN >= 1 deg/sqrt(h)\n", "line 2: operator '>='"},
+      {"Z <= 1 deg/h\n", "line 1: 'Z' is not a limited quantity"},
+  };
+  for (const auto& c : cases) {
+    const std::string lim = file_with("bad_limits.txt", c.content);
+    const Outcome r = run_shell(analyze + analyze_counts + "--limits " + lim + " " + counts());
+    EXPECT_EQ(r.code, exit_code::bad_input) << c.content << r.err;
+    EXPECT_TRUE(std::regex_match(r.err, one_line)) << r.err;
+    EXPECT_NE(r.err.find(c.why), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty());
+  }
+  Outcome r = run_shell(analyze + analyze_counts + "--limits " + temp("absent_limits.txt") + " " + counts());
+  EXPECT_EQ(r.code, exit_code::bad_input) << r.err;
+  EXPECT_NE(r.err.find("cannot be read"), std::string::npos) << r.err;
+  // A fitted term without the fit.
+  const std::string n = file_with("n.txt", "N <= 0.003 deg/sqrt(h)\n");
+  r = run_shell(analyze + " --type counts --tau0 0.1 --pulse-weight 1arcsec --limits " + n + " " + counts());
+  EXPECT_EQ(r.code, exit_code::bad_input);
+  EXPECT_NE(r.err.find("add --fit ieee952"), std::string::npos) << r.err;
+  // Clock data have no gyro units.
+  const std::string phase = file_with("phase.txt", "0\n1e-9\n3e-9\n2e-9\n5e-9\n4e-9\n6e-9\n8e-9\n");
+  const std::string b = file_with("b.txt", "adev(1 s) <= 1 deg/h\n");
+  r = run_shell(analyze + " --type phase --tau0 1 --limits " + b + " " + phase);
+  EXPECT_EQ(r.code, exit_code::bad_input);
+  EXPECT_NE(r.err.find("needs gyro data"), std::string::npos) << r.err;
+  // The decoder reads the same format and refuses the same way.
+  const std::string bad = file_with("bad_for_decode.txt", "N <= 1\n");
+  r = run_shell(decode + " " + counts() + " --limits " + bad);
+  EXPECT_EQ(r.code, exit_code::bad_input);
+  EXPECT_NE(r.err.find("gyrochar-decode: --limits: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("line 1: the limit has no unit"), std::string::npos) << r.err;
+}
+
+TEST(AcceptanceCli, SummaryAppendsOneRowPerRunUnderOneHeader) {
+  const std::string lim = file_with("summary_limits.txt", "N <= 0.006 deg/sqrt(h)\n");
+  const std::string summary = temp("summary.csv");
+  std::remove(summary.c_str());
+  for (int i = 0; i < 2; ++i) {
+    const Outcome r = run_shell(analyze + analyze_counts + "--limits " + lim + " --summary " + summary + " " + counts());
+    EXPECT_EQ(r.code, 0) << r.err;
+  }
+  const std::string text = slurp(summary);
+  EXPECT_EQ(text.rfind("source,node,run_s,samples,fit_status,", 0), 0u) << text;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 3) << text;
+  EXPECT_NE(text.find(counts() + ",,3600,36000,ok,"), std::string::npos) << text;
+  // Other limits, the same summary file: refused before the analysis.
+  const std::string other = file_with("other_limits.txt", "B <= 1 deg/h\n");
+  const Outcome r = run_shell(analyze + analyze_counts + "--limits " + other + " --summary " + summary + " " + counts());
+  EXPECT_EQ(r.code, exit_code::bad_input);
+  EXPECT_NE(r.err.find("header differs"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(summary), text) << "nothing appended";
+  const Outcome no_limits = run_shell(analyze + analyze_counts + "--summary " + summary + " " + counts());
+  EXPECT_EQ(no_limits.code, exit_code::bad_input);
+}
+
+TEST(AcceptanceCli, ReportIsSelfContained) {
+  const std::string lim = file_with("report_limits.txt", "N <= 0.006 deg/sqrt(h)\nadev(100 s) <= 1 deg/h\n");
+  const std::string report = temp("report.html");
+  const Outcome r = run_shell(analyze + analyze_counts + "--stats oadev,mdev,tdev --limits " + lim + " --report " + report +
+                              " " + counts());
+  EXPECT_EQ(r.code, 0) << r.err;
+  const std::string html = slurp(report);
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_EQ(html.find("http://"), std::string::npos) << "no external reference";
+  EXPECT_EQ(html.find("https://"), std::string::npos) << "no external reference";
+  EXPECT_EQ(html.find("<script"), std::string::npos) << "no script needed";
+  EXPECT_EQ(html.find(" src="), std::string::npos) << "nothing loaded";
+  EXPECT_NE(html.find("@media print"), std::string::npos);
+  EXPECT_EQ(std::count(html.begin(), html.end(), '<') - std::count(html.begin(), html.end(), '>'), 0)
+      << "every tag closed on its line (no stray bracket)";
+  for (const char* id : {"id=\"provenance-facts\"", "id=\"verdicts\"", "id=\"fit\"", "id=\"readoff\"",
+                         "id=\"stat-oadev\"", "id=\"stat-mdev\"", "id=\"stat-tdev\"", "<svg class=\"plot\""})
+    EXPECT_NE(html.find(id), std::string::npos) << id;
+  EXPECT_LT(html.size(), 2u << 20) << "under 2 MB";
+  EXPECT_EQ(access((report + ".part").c_str(), F_OK), -1) << "the temporary file is renamed";
+}
+
+TEST(AcceptanceCli, ReportRefusesToOverwriteAnInput) {
+  const std::string lim = file_with("same_limits.txt", "N <= 0.006 deg/sqrt(h)\n");
+  Outcome r = run_shell(analyze + analyze_counts + "--report " + counts() + " " + counts());
+  EXPECT_EQ(r.code, exit_code::bad_input);
+  EXPECT_NE(r.err.find("--report"), std::string::npos) << r.err;
+  r = run_shell(analyze + analyze_counts + "--limits " + lim + " --report " + lim + " " + counts());
+  EXPECT_EQ(r.code, exit_code::bad_input) << "the limits file is an input too";
+  r = run_shell(analyze + analyze_counts + "--limits " + lim + " --summary " + lim + " " + counts());
+  EXPECT_EQ(r.code, exit_code::bad_input);
+  EXPECT_NE(slurp(counts()).find('\n'), std::string::npos) << "the input is whole";
+  r = run_shell(analyze + analyze_counts + "--report " + temp("no_such_dir") + "/r.html " + counts());
+  EXPECT_EQ(r.code, exit_code::output_failed) << r.err;
+}
+
+TEST(AcceptanceCli, DecoderGivesVerdictsAndReportPerNode) {
+  // The demo's two simulated gyros for 20 minutes, decoded from its candump log.
+  const std::string log = temp("demo.log");
+  Outcome r = run_shell(demo + " --hours 0.34 --window 0 --view-every 0 --csv '' --plot '' --candump " + log + " > /dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string lim = file_with("decode_limits.txt", "N <= 1 deg/sqrt(h)\nadev(10.24 s) <= 1e-9 deg/h\n");
+  const std::string report = temp("decode_report.html"), jsonl = temp("decode.jsonl"), summary = temp("decode_summary.csv");
+  std::remove(summary.c_str());
+  r = run_shell(decode + " " + log + " --view final --limits " + lim + " --report " + report + " --jsonl " + jsonl +
+                " --summary " + summary);
+  EXPECT_EQ(r.code, 0) << "the decoder's exit code does not depend on the verdicts\n" << r.err;
+  EXPECT_NE(r.out.find("Acceptance: "), std::string::npos) << r.out;
+  const std::string html = slurp(report);
+  EXPECT_EQ(html.find("http://"), std::string::npos);
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  EXPECT_NE(html.find("-verdicts\""), std::string::npos);
+  EXPECT_NE(html.find("<svg class=\"plot\""), std::string::npos);
+  std::ifstream in(jsonl);
+  std::size_t records = 0;
+  for (std::string line; std::getline(in, line);)
+    if (line.find("\"type\":\"acceptance\"") != std::string::npos) {
+      ++records;
+      const auto j = nlohmann::json::parse(line);
+      EXPECT_EQ(j.at("limits").size(), 2u);
+      EXPECT_EQ(j.at("limits")[1].at("verdict"), "fail") << "no gyro has an ADEV below 1e-9 deg/h: " << line;
+    }
+  EXPECT_GE(records, 1u);
+  const std::string rows = slurp(summary);
+  EXPECT_EQ(static_cast<std::size_t>(std::count(rows.begin(), rows.end(), '\n')), records + 1) << rows;
+}
+
+}  // namespace
