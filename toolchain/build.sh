@@ -35,6 +35,7 @@ if [ "$job" = test ]; then
   packages+=(python3-scipy)  # the allantools peer the Python tests compare with, when it is beside the checkout
   packages+=(python3-pandas python3-matplotlib)  # the Python package's to_pandas() and plot(), tested
   packages+=(python3-venv)  # python.install: the package installed by pip into a venv
+  packages+=(chromium)  # the live page in a real browser: tests labelled browser (headless, --dump-dom, --screenshot)
   # The QEMU bench (toolchain/bench/build.sh adds the kernel headers of the kernel it boots).
   packages+=(qemu-system-x86 busybox-static cpio can-utils)
 fi
