@@ -122,10 +122,11 @@ TEST(LivePage, DecoderServesTheRowsOfItsCsv) {
 // decoder receives every frame the bus carried and closes every report complete.
 TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
   const std::string csv = temp("eight.csv");
-  // GYROCHAR_LIVE_SPEED (gyro seconds per second, default 40) runs it slower, e.g. 1 for the latency
-  // of a real-time bus (docs/live.md).
+  // GYROCHAR_LIVE_SPEED (gyro seconds per second, default 40) and GYROCHAR_LIVE_HOURS (default 0.1)
+  // run it otherwise, e.g. 1 and 0.02 for the latency of a real-time bus (docs/live.md).
   const char* speed_env = std::getenv("GYROCHAR_LIVE_SPEED");
-  const std::string speed = speed_env != nullptr ? speed_env : "40", hours = "0.1";
+  const char* hours_env = std::getenv("GYROCHAR_LIVE_HOURS");
+  const std::string speed = speed_env != nullptr ? speed_env : "40", hours = hours_env != nullptr ? hours_env : "0.1";
   Background demo(bin + "gyrochar-demo --nodes 8 --hours " + hours + " --speed " + speed + " --view-every 0 --plot '' --csv " + csv +
                       " --http 127.0.0.1:0",
                   temp("eight.err"));
@@ -223,7 +224,8 @@ TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
   EXPECT_EQ(nodes_seen, 8u);
   EXPECT_GT(attacks, 0u);
   // The final snapshot is still served, with the rows of the CSV.
-  const Json last = Json::parse(body_of(get(port, "/data.json")));
+  const std::string last_text = body_of(get(port, "/data.json"));
+  const Json last = Json::parse(last_text);
   expect_rows_in_csv(last, csv_rows(csv), 8);
   EXPECT_EQ(demo.stop(), 0) << demo.err();
   ASSERT_FALSE(latency_ms.empty());
@@ -231,9 +233,9 @@ TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
   const auto at = [&](double q) { return latency_ms[static_cast<std::size_t>(q * static_cast<double>(latency_ms.size() - 1))]; };
   std::printf("live page latency (report closed -> event received), %zu reports of 8 nodes, speed %s, refresh 1 s, "
               "100 followers, %llu hostile requests: median %.0f ms, 95%% %.0f ms, max %.0f ms; frames %llu on the bus, "
-              "%llu received\n",
+              "%llu received; snapshot of 8 nodes %zu bytes\n",
               latency_ms.size(), speed.c_str(), static_cast<unsigned long long>(attacks), at(0.5), at(0.95), latency_ms.back(),
-              static_cast<unsigned long long>(on_bus), static_cast<unsigned long long>(received));
+              static_cast<unsigned long long>(on_bus), static_cast<unsigned long long>(received), last_text.size());
 }
 
 }  // namespace

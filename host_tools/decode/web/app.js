@@ -227,7 +227,7 @@ function nodeCard(node, snap, now) {
     `report seq ${first ? first.seq : "-"} at ${first ? first.time_s.toFixed(1) : "-"} s` +
     (meta.uptime_ms !== null ? `; uptime ${(meta.uptime_ms / 1000).toFixed(1)} s` : "") +
     (meta.protocol_version !== null ? `; protocol ${meta.protocol_version}` : "") +
-    (meta.tau0_s !== null ? `; tau0 ${meta.tau0_s} s` : "") +
+    (meta.tau0_s !== null ? `; tau0 ${short(meta.tau0_s)} s` : "") +
     `; rates [${rep.rate_unit}]` + (latency !== null ? `; shown ${(latency / 1000).toFixed(2)} s after the report closed` : "")));
   const figures = add(card, make("div", { class: "figures" }));
   const left = add(figures, make("div"));
@@ -262,6 +262,8 @@ function render(snap) {
 }
 
 let count = 0;  // snapshots received on the event stream
+// "?updates=N" stops following after N snapshots (a headless browser's test: the page then goes idle).
+const stopAfter = Number(new URLSearchParams(location.search).get("updates")) || Infinity;
 
 function connect() {
   const status = document.getElementById("status");
@@ -274,6 +276,10 @@ function connect() {
     status.setAttribute("data-updates", count);
     status.setAttribute("data-sent-ms", snap.sent_ms);
     status.textContent = `live: ${snap.program}, ${count} updates, every ${snap.refresh_s} s`;
+    if (count >= stopAfter) {
+      events.close();
+      status.textContent = `stopped after ${count} updates (?updates=${stopAfter}): reload to follow again`;
+    }
   };
   events.onerror = () => {
     status.setAttribute("data-state", "lost");
