@@ -6,6 +6,7 @@
 // contract (hal/program/exit_codes.hpp). The update latency is measured and printed, not asserted
 // (no timed tests: the figures are in docs/live.md).
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -63,6 +64,15 @@ std::map<Key, std::pair<std::string, std::string>> csv_rows(const std::string& p
   return rows;
 }
 
+bool send_all_to_fd(int fd, std::string_view bytes) {
+  while (!bytes.empty()) {
+    const ssize_t n = ::write(fd, bytes.data(), bytes.size());
+    if (n <= 0) return false;
+    bytes.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
 // The page's rows of every node equal the CSV's rows of the same report, value for value.
 void expect_rows_in_csv(const Json& snapshot, const std::map<Key, std::pair<std::string, std::string>>& csv,
                         std::size_t nodes) {
@@ -94,12 +104,16 @@ TEST(LivePage, DecoderServesTheRowsOfItsCsv) {
                      temp("decode.err"));
   const std::uint16_t port = decoder.port();
   ASSERT_NE(port, 0) << decoder.err();
-  std::FILE* bus = std::fopen(fifo.c_str(), "w");
-  ASSERT_NE(bus, nullptr);
+  int bus = -1;  // opened once the decoder reads the FIFO (bounded: it may have failed)
+  for (int k = 0; k < 200 && bus < 0; ++k) {
+    bus = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+    if (bus < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_GE(bus, 0) << decoder.err();
+  ::fcntl(bus, F_SETFL, 0);  // blocking writes: the decoder reads it all
   std::ifstream in(log);
-  std::string text{std::istreambuf_iterator<char>(in), {}};
-  std::fwrite(text.data(), 1, text.size(), bus);
-  std::fflush(bus);
+  const std::string text{std::istreambuf_iterator<char>(in), {}};
+  ASSERT_TRUE(send_all_to_fd(bus, text));
   Json snapshot;
   for (int k = 0; k < 100; ++k) {  // until a snapshot shows both nodes' rows (bounded)
     snapshot = Json::parse(body_of(get(port, "/data.json")));
@@ -109,7 +123,7 @@ TEST(LivePage, DecoderServesTheRowsOfItsCsv) {
   EXPECT_EQ(snapshot["program"], "gyrochar-decode");
   EXPECT_EQ(snapshot["source"], fifo);
   EXPECT_EQ(decoder.stop(), 0) << decoder.err();  // SIGTERM: ends cleanly, CSV closed
-  std::fclose(bus);
+  ::close(bus);
   std::remove(fifo.c_str());
   expect_rows_in_csv(snapshot, csv_rows(csv), 2);
   for (const Json& node : snapshot["nodes"]) {
