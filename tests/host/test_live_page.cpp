@@ -7,6 +7,7 @@
 // (no timed tests: the figures are in docs/live.md).
 #include <gtest/gtest.h>
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -132,9 +133,16 @@ TEST(LivePage, DecoderServesTheRowsOfItsCsv) {
   }
 }
 
-// 8 nodes, 100 browsers following the event stream and the hostile suite over the whole run: the
-// decoder receives every frame the bus carried and closes every report complete.
+// 8 nodes, 100 browsers following the event stream and the hostile suite over the whole run
+// (malformed and foreign requests, slowloris, 10 event streams never read, 1000 connections at
+// once): the decoder receives every frame the bus carried, and each node's link health is the
+// same as without the page.
 TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
+  rlimit files{};  // 100 followers, 100 slowloris, 1000 at once
+  ::getrlimit(RLIMIT_NOFILE, &files);
+  files.rlim_cur = std::max<rlim_t>(files.rlim_cur, std::min<rlim_t>(files.rlim_max, 1400));
+  ::setrlimit(RLIMIT_NOFILE, &files);
+  if (files.rlim_cur < 1400) GTEST_SKIP() << "needs 1400 open files (RLIMIT_NOFILE " << files.rlim_cur << ")";
   const std::string csv = temp("eight.csv");
   // GYROCHAR_LIVE_SPEED (gyro seconds per second, default 40) and GYROCHAR_LIVE_HOURS (default 0.1)
   // run it otherwise, e.g. 1 and 0.02 for the latency of a real-time bus (docs/live.md).
@@ -196,15 +204,30 @@ TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
         std::string("\x16\x03\x01\x00\xa5\x01\x00\x00\xa1\x03\x03garbage\r\n\r\n", 22),
         "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX: " + std::string(20000, 'x') + "\r\n\r\n",
         "GET /data.json HTTP/1.1\r\nHost: attacker.example\r\n\r\n"};
+    std::vector<int> deaf;  // event streams that are never read, on small receive buffers
+    for (int i = 0; i < 10; ++i) {
+      deaf.push_back(connect_local(port));
+      const int small = 4096;
+      ::setsockopt(deaf.back(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+      send_all(deaf.back(), "GET /events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
+    }
     for (int round = 0; round < 2000 && !done; ++round) {
       ask(port, hostile[static_cast<std::size_t>(round) % hostile.size()], 2.0);
       ++attacks;
+      if (round == 200) {  // 1000 connections at once, held for a second (those over the limit: 503)
+        std::vector<int> burst;
+        for (int i = 0; i < 1000; ++i) burst.push_back(connect_local(port));
+        std::this_thread::sleep_for(std::chrono::seconds(1));
+        for (const int fd : burst) ::close(fd);
+        attacks += 1000;
+      }
       if (round % 20 == 0 && slow.size() < 100) {  // slowloris: a request that never ends
         slow.push_back(connect_local(port));
         send_all(slow.back(), "GET / HTTP/1.1\r\nHost: 127.");
       }
     }
     for (const int fd : slow) ::close(fd);
+    for (const int fd : deaf) ::close(fd);
   });
   const bool finished = demo.wait_for("serves the finished run", 600);
   done = true;
