@@ -377,22 +377,25 @@ int main(int argc, char** argv) {
     std::remove((o.plot + ".svg.part").c_str());
   }
 
+  // The page is an output: an address that cannot be listened on is refused (4) before any file is
+  // opened for writing.
+  std::unique_ptr<LiveWeb> web;
+  if (http) {
+    try {
+      web = std::make_unique<LiveWeb>(*http, program, o.refresh_s, o.confidence);
+    } catch (const web::ListenError& e) {
+      fail(exit_code::output_failed, "--http", e.what());
+    }
+    print_error(program, "live page", web->url());
+  }
+
   SessionOptions s;
   s.rate_unit = rate_unit;
   s.confidence = o.confidence;
   s.shown = parse_nodes(o.nodes);
   s.csv = o.csv.empty() ? nullptr : open_output(o.csv);
   s.jsonl = o.jsonl.empty() ? nullptr : open_output(o.jsonl);
-  std::unique_ptr<LiveWeb> web;
-  if (http) {  // the page is an output: an address that cannot be listened on is refused now (4)
-    try {
-      web = std::make_unique<LiveWeb>(*http, program, o.refresh_s, o.confidence);
-    } catch (const web::ListenError& e) {
-      fail(exit_code::output_failed, "--http", e.what());
-    }
-    s.on_report = web->hook();
-    print_error(program, "live page", web->url());
-  }
+  if (web) s.on_report = web->hook();
   install_stop_handler();
   int code = exit_code::ok;
   {

@@ -121,6 +121,18 @@ int main(int argc, char** argv) {
   std::vector<NamedPath> outputs = plot_outputs("--plot", plot_prefix);
   outputs.insert(outputs.begin(), {{"--csv", csv_path}, {"--candump", candump_path}});
   if (const auto conflict = output_conflict({}, outputs)) bad(conflict->what, conflict->why);
+  // The live page is an output: an address that cannot be listened on is refused (4) before any
+  // file is opened for writing.
+  decoding::TrueTermsByNode truth;  // what the decoder cannot know: each simulated gyro's parameters
+  std::unique_ptr<decoding::LiveWeb> web;
+  if (http) {
+    try {
+      web = std::make_unique<decoding::LiveWeb>(*http, program, refresh_s, decoding::SessionOptions{}.confidence, &truth);
+    } catch (const web::ListenError& e) {
+      exit_with(exit_code::output_failed, program, "--http", e.what());
+    }
+    print_error(program, "live page", web->url());
+  }
   FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "w");
   if (!csv_path.empty() && csv == nullptr) exit_with(exit_code::output_failed, program, csv_path, std::strerror(errno));
   FILE* candump = nullptr;
@@ -132,7 +144,6 @@ int main(int argc, char** argv) {
   bus.set_loss(loss);
   auto host = bus.attach(1 << 16);
   std::vector<std::unique_ptr<Node>> gyros;
-  decoding::TrueTermsByNode truth;  // what the decoder cannot know: each simulated gyro's parameters
   for (unsigned i = 0; i < nodes; ++i) {
     firmware::Config c;
     c.node = static_cast<std::uint8_t>(0x10 + i);
@@ -169,16 +180,7 @@ int main(int argc, char** argv) {
   }
   decoding::SessionOptions so;
   so.csv = csv;
-  std::unique_ptr<decoding::LiveWeb> web;
-  if (http) {
-    try {
-      web = std::make_unique<decoding::LiveWeb>(*http, program, refresh_s, so.confidence, &truth);
-    } catch (const web::ListenError& e) {
-      exit_with(exit_code::output_failed, program, "--http", e.what());
-    }
-    so.on_report = web->hook();
-    print_error(program, "live page", web->url());
-  }
+  if (web) so.on_report = web->hook();
   struct sigaction action {};
   action.sa_handler = request_stop;
   sigemptyset(&action.sa_mask);

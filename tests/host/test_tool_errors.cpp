@@ -291,6 +291,12 @@ TEST(ToolErrors, LivePageAddressIsCheckedFirst) {
          "--http: 127.0.0.1:" + port + ": Address already in use");
   expect("gyrochar-demo", "--hours 0.01 --plot '' --csv '' --http 127.0.0.1:" + port, exit_code::output_failed,
          "--http: 127.0.0.1:" + port + ": Address already in use");
+  // Refused before any output is opened: a CSV from before is kept whole.
+  const std::string kept = temp("http_kept.csv");
+  std::ofstream(kept) << "an earlier run\n";
+  expect("gyrochar-decode", log + " --csv " + kept + " --http " + port, exit_code::output_failed, "--http: ");
+  expect("gyrochar-demo", "--hours 0.01 --plot '' --csv " + kept + " --http " + port, exit_code::output_failed, "--http: ");
+  EXPECT_EQ(slurp(kept), "an earlier run\n");
   expect("gyrochar-decode", log + " --http 192.0.2.1:0", exit_code::output_failed,
          "--http: 192.0.2.1:0: Cannot assign requested address");
   ::close(held);
