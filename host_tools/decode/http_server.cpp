@@ -239,10 +239,9 @@ void HttpServer::respond(Connection& c, int status, std::string_view type, std::
   if (status >= 400) ++counters_.errors;
 }
 
-bool HttpServer::serve(Connection& c, double now) {
+void HttpServer::serve(Connection& c, double now) {
   const auto error = [&](int status, std::string_view extra = {}) {
     respond(c, status, "text/plain; charset=utf-8", reason(status), false, extra);
-    return true;
   };
   const std::size_t line_end = c.in.find('\n');
   if (line_end == std::string::npos) {
@@ -251,7 +250,7 @@ bool HttpServer::serve(Connection& c, double now) {
       ++counters_.timed_out;
       return error(408);
     }
-    return true;  // wait for more
+    return;  // wait for more
   }
   std::string_view line(c.in.data(), line_end);
   if (line.ends_with('\r')) line.remove_suffix(1);
@@ -282,7 +281,7 @@ bool HttpServer::serve(Connection& c, double now) {
       ++counters_.timed_out;
       return error(408);
     }
-    return true;
+    return;
   }
   std::optional<std::string_view> host;
   for (std::size_t start = line_end + 1; start < head_end;) {
@@ -314,7 +313,7 @@ bool HttpServer::serve(Connection& c, double now) {
     c.event_s = now;
     ++counters_.requests;
     queue_snapshot(c);
-    return true;
+    return;
   }
   if (path == "/data.json") {
     std::string h = "HTTP/1.1 200 OK\r\n";
@@ -325,12 +324,12 @@ bool HttpServer::serve(Connection& c, double now) {
     if (!head) current_ ? c.push(current_, *current_) : c.push(nullptr, "null");
     c.answered = true;
     ++counters_.requests;
-    return true;
+    return;
   }
   for (const Asset& a : assets_)
     if (a.path == path) {
       respond(c, 200, a.content_type, a.body, head);
-      return true;
+      return;
     }
   return error(404);
 }
@@ -394,9 +393,8 @@ void HttpServer::run() {
       } else if (revents & (POLLERR | POLLNVAL)) {
         keep = false;
       }
-      if (keep && !c.answered) keep = serve(c, now);
+      if (keep && !c.answered) serve(c, now);
       if (c.peer_closed && (!c.answered || c.stream || c.draining)) keep = false;
-      if (keep && !c.answered) keep = serve(c, now);
       if (keep && c.stream) {
         queue_snapshot(c);
         if (!c.pending() && now - c.event_s > limits_.keepalive_s) c.push(nullptr, ": keep-alive\n\n");

@@ -91,7 +91,7 @@ class HttpServer {
   struct Connection;
   void run();
   void accept_all();
-  bool serve(Connection& c, double now);  // false: close it
+  void serve(Connection& c, double now);  // answers the request once its head is complete
   void respond(Connection& c, int status, std::string_view type, std::string_view body, bool head,
                std::string_view extra_headers = {});
   void queue_snapshot(Connection& c);
