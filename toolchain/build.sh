@@ -35,7 +35,7 @@ if [ "$job" = test ]; then
   packages+=(python3-scipy)  # the allantools peer the Python tests compare with, when it is beside the checkout
   packages+=(python3-pandas python3-matplotlib)  # the Python package's to_pandas() and plot(), tested
   packages+=(python3-venv)  # python.install: the package installed by pip into a venv
-  packages+=(chromium)  # host.ReportBrowser: the HTML report rendered headless (DOM and screenshot)
+  packages+=(chromium)  # tests labelled browser: the HTML reports and the live page rendered headless (DOM, screenshot)
   # The QEMU bench (toolchain/bench/build.sh adds the kernel headers of the kernel it boots).
   packages+=(qemu-system-x86 busybox-static cpio can-utils)
 fi

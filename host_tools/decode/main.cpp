@@ -22,6 +22,7 @@
 #include "hal/linux/socketcan.hpp"
 #include "html_report.hpp"
 #include "limits.hpp"
+#include "live_web.hpp"
 #include "node_report.hpp"
 #include "output_paths.hpp"
 #include "plot.hpp"
@@ -70,6 +71,7 @@ struct Options {
   std::string limits_path, report, summary;  // --limits, --report, --summary
   std::vector<Limit> limits;
   std::string command;  // for the report's provenance
+  std::string http;  // [ADDR:]PORT of the live web page; empty: none
 };
 
 std::FILE* open_output(const std::string& path) {
@@ -99,8 +101,8 @@ NodeFilter parse_nodes(const std::vector<std::string>& texts) {
 // Everything the main loop does besides decoding: the live view, the periodic plot, the end.
 class Presenter {
  public:
-  Presenter(const Options& o, View view, DisplayRate rate_unit, Session& session)
-      : options_(o), view_(view), rate_unit_(rate_unit), session_(session), tty_(isatty(STDOUT_FILENO) == 1) {}
+  Presenter(const Options& o, View view, DisplayRate rate_unit, Session& session, LiveWeb* web)
+      : options_(o), view_(view), rate_unit_(rate_unit), session_(session), web_(web), tty_(isatty(STDOUT_FILENO) == 1) {}
 
   void malformed(const std::string& where, std::uint64_t line, const std::string& why) {
     const std::uint64_t count = session_.input().malformed_lines;
@@ -115,6 +117,7 @@ class Presenter {
       show();
       last_view_s_ = now;
     }
+    if (web_ != nullptr) web_->update(session_);
     const InputCounters& in = session_.input();
     if ((!options_.plot.empty() || !options_.report.empty()) && options_.plot_every_s > 0 && in.started &&
         in.now_s - last_plot_s_ >= options_.plot_every_s) {
@@ -132,6 +135,7 @@ class Presenter {
 
   int finish() {
     session_.finish();
+    if (web_ != nullptr) web_->update(session_, true);
     int code = exit_code::ok;
     if (!options_.plot.empty() && !plot()) code = exit_code::output_failed;
     if (const int k = options_.kalibr.empty() ? exit_code::ok : kalibr(); code == exit_code::ok) code = k;
@@ -229,6 +233,7 @@ class Presenter {
   View view_;
   DisplayRate rate_unit_;
   Session& session_;
+  LiveWeb* web_;  // the live web page (--http), or null
   bool tty_;
   double last_view_s_ = -1e300;
   double last_plot_s_ = 0.0;
@@ -384,7 +389,13 @@ int main(int argc, char** argv) {
       ->option_text("S");
   app.add_option("--node", o.nodes, "show and record only this node address (repeatable; 16 or 0x10)")
       ->option_text("ADDRESS");
+  app.add_option("--http", o.http,
+                 "serve the live web page on [ADDR:]PORT (address 127.0.0.1 unless given; 0.0.0.0 for every "
+                 "interface), updated every --refresh seconds")
+      ->option_text("[ADDR:]PORT");
   if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
+  std::optional<web::ListenAddress> http;
+  if (std::string why; !o.http.empty() && !(http = web::parse_listen_address(o.http, why))) fail(exit_code::bad_input, "--http", why);
   if (o.log.empty() == o.interface.empty())
     fail(exit_code::bad_input, "options", "give either a LOG or --interface (see --help)");
   if (!o.interface.empty())  // a name no interface can have is bad input; a missing one is hardware
@@ -433,17 +444,30 @@ int main(int argc, char** argv) {
     std::remove((o.plot + ".svg.part").c_str());
   }
 
+  // The page is an output: an address that cannot be listened on is refused (4) before any file is
+  // opened for writing.
+  std::unique_ptr<LiveWeb> web;
+  if (http) {
+    try {
+      web = std::make_unique<LiveWeb>(*http, program, o.refresh_s, o.confidence);
+    } catch (const web::ListenError& e) {
+      fail(exit_code::output_failed, "--http", e.what());
+    }
+    print_error(program, "live page", web->url());
+  }
+
   SessionOptions s;
   s.rate_unit = rate_unit;
   s.confidence = o.confidence;
   s.shown = parse_nodes(o.nodes);
   s.csv = o.csv.empty() ? nullptr : open_output(o.csv);
   s.jsonl = o.jsonl.empty() ? nullptr : open_output(o.jsonl);
+  if (web) s.on_report = web->hook();
   install_stop_handler();
   int code = exit_code::ok;
   {
     Session session(s);
-    Presenter presenter(o, view, rate_unit, session);
+    Presenter presenter(o, view, rate_unit, session, web.get());
     code = o.interface.empty() ? decode_log(o, session, presenter) : decode_live(o, session, presenter);
   }
   for (const auto& [file, path] : {std::pair{s.csv, o.csv}, std::pair{s.jsonl, o.jsonl}})

@@ -105,7 +105,7 @@ void Session::finish() {
 
 void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
   const bool record = options_.shown[node.address];
-  if (e == DecoderEvent::report_closed && record && (csv_ || jsonl_)) {
+  if (e == DecoderEvent::report_closed && record && (csv_ || jsonl_ || options_.on_report)) {
     const Decoder::Report& report = *decoder_.report(node.address);  // the slot table of the report just closed
     const Units units = units_for(node, options_.rate_unit);
     rows_.clear();
@@ -115,6 +115,7 @@ void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
       if (jsonl_) jsonl_->row(row, units);
     }
     if (jsonl_) jsonl_->report(report.start_s, node, seq, units);
+    if (options_.on_report) options_.on_report(node, rows_, units);
   }
   if (e == DecoderEvent::window_complete && record && (csv_ || jsonl_) && node.current_window()) {
     const Units units = units_for(node, options_.rate_unit);

@@ -5,6 +5,7 @@
 // The program (host_tools/decode/main.cpp) adds the sources, the terminal view and the plot.
 #include <cstddef>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -46,6 +47,9 @@ struct SessionOptions {
   NodeFilter shown = NodeFilter{}.set();  // nodes recorded (the decoder follows all of them)
   std::FILE* csv = nullptr;               // not owned; null: no CSV
   std::FILE* jsonl = nullptr;             // not owned; null: no JSON lines
+  /// Given the rows of every closed report of a recorded node, the CSV's rows (the live web page
+  /// keeps them: live_feed.hpp). May be empty.
+  std::function<void(const NodeView&, const std::vector<TauRow>&, const Units&)> on_report;
 };
 
 /// Decodes one bus. Not copyable or movable (the decoder's listener points at it).

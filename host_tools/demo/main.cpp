@@ -12,6 +12,9 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <thread>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -21,6 +24,7 @@
 
 #include "board.hpp"
 #include "candump.hpp"
+#include "live_web.hpp"
 #include "output_paths.hpp"
 #include "plot.hpp"
 #include "session.hpp"
@@ -38,6 +42,9 @@ namespace {
 using namespace gyrochar;
 
 constexpr const char* program = "gyrochar-demo";
+
+volatile std::sig_atomic_t stop_requested = 0;
+extern "C" void request_stop(int) { stop_requested = 1; }
 
 [[noreturn]] void bad(const std::string& what, const std::string& why) {
   exit_with(exit_code::bad_input, program, what, why);
@@ -62,13 +69,18 @@ int main(int argc, char** argv) {
                "on a virtual clock.",
                "gyrochar-demo"};
   app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n"
-             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n\n"
+             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n"
+             "  gyrochar-demo --nodes 8 --http 8080 --speed 600   # then open http://127.0.0.1:8080/\n\n"
+             "With --http the live page is served during the run and, after it, until Ctrl-C (SIGINT or\n"
+             "SIGTERM, which also end the run early, its outputs written). An address that cannot be listened\n"
+             "on (port in use) is an output that cannot be opened (4).\n\n"
              "Two outputs (--csv, --candump, --plot's files) that are the same file, through links too, are\n"
              "refused (bad input) before anything is written.\n" +
              std::string(exit_code::help));
   double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30, window_min = 30;
   unsigned nodes = 2, octaves = 20;
-  std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo", candump_path;
+  std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo", candump_path, http_text;
+  double speed = 0, refresh_s = 1;
   app.add_option("--hours", hours, "gyro hours to simulate")->capture_default_str();
   app.add_option("--nodes", nodes, "gyro boards on the bus (1..8)")->capture_default_str();
   app.add_option("--tau0", tau0, "sample interval in seconds")->capture_default_str();
@@ -82,7 +94,16 @@ int main(int argc, char** argv) {
   app.add_option("--plot", plot_prefix, "ADEV/MDEV plot written to PREFIX.svg and PREFIX.png (empty: none)")
       ->capture_default_str();
   app.add_option("--candump", candump_path, "also record the bus as a candump log (canplayer replays it)");
+  app.add_option("--http", http_text, "serve the live web page on [ADDR:]PORT (address 127.0.0.1 unless given)")
+      ->option_text("[ADDR:]PORT");
+  app.add_option("--speed", speed, "gyro seconds per wall-clock second (0: as fast as it can)")->capture_default_str();
+  app.add_option("--refresh", refresh_s, "wall-clock seconds between updates of the live web page")
+      ->capture_default_str();
   if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
+  std::optional<web::ListenAddress> http;
+  if (std::string why; !http_text.empty() && !(http = web::parse_listen_address(http_text, why))) bad("--http", why);
+  if (!(speed >= 0) || !std::isfinite(speed)) bad("--speed", fmt::format("must be a number >= 0, not {}", speed));
+  if (!(refresh_s > 0) || !std::isfinite(refresh_s)) bad("--refresh", fmt::format("must be a number of seconds > 0, not {}", refresh_s));
   // Each rule its own message: the option, what it must be, and what was given.
   if (!(hours > 0) || !std::isfinite(hours)) bad("--hours", fmt::format("must be a positive number of hours, not {}", hours));
   if (!(tau0 > 0) || !std::isfinite(tau0)) bad("--tau0", fmt::format("must be a positive number of seconds, not {}", tau0));
@@ -100,6 +121,18 @@ int main(int argc, char** argv) {
   std::vector<NamedPath> outputs = plot_outputs("--plot", plot_prefix);
   outputs.insert(outputs.begin(), {{"--csv", csv_path}, {"--candump", candump_path}});
   if (const auto conflict = output_conflict({}, outputs)) bad(conflict->what, conflict->why);
+  // The live page is an output: an address that cannot be listened on is refused (4) before any
+  // file is opened for writing.
+  decoding::TrueTermsByNode truth;  // what the decoder cannot know: each simulated gyro's parameters
+  std::unique_ptr<decoding::LiveWeb> web;
+  if (http) {
+    try {
+      web = std::make_unique<decoding::LiveWeb>(*http, program, refresh_s, decoding::SessionOptions{}.confidence, &truth);
+    } catch (const web::ListenError& e) {
+      exit_with(exit_code::output_failed, program, "--http", e.what());
+    }
+    print_error(program, "live page", web->url());
+  }
   FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "w");
   if (!csv_path.empty() && csv == nullptr) exit_with(exit_code::output_failed, program, csv_path, std::strerror(errno));
   FILE* candump = nullptr;
@@ -111,7 +144,6 @@ int main(int argc, char** argv) {
   bus.set_loss(loss);
   auto host = bus.attach(1 << 16);
   std::vector<std::unique_ptr<Node>> gyros;
-  decoding::TrueTermsByNode truth;  // what the decoder cannot know: each simulated gyro's parameters
   for (unsigned i = 0; i < nodes; ++i) {
     firmware::Config c;
     c.node = static_cast<std::uint8_t>(0x10 + i);
@@ -148,6 +180,12 @@ int main(int argc, char** argv) {
   }
   decoding::SessionOptions so;
   so.csv = csv;
+  if (web) so.on_report = web->hook();
+  struct sigaction action {};
+  action.sa_handler = request_stop;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
   decoding::Session session(so);
   session.input().source = "in-process CAN bus";
 
@@ -170,7 +208,12 @@ int main(int argc, char** argv) {
                stdout);
     std::fflush(stdout);
   };
-  while (clock.now_ns() < end_ns) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  while (clock.now_ns() < end_ns && !stop_requested) {
+    if (speed > 0)  // hold the virtual clock to `speed` gyro seconds per wall-clock second
+      std::this_thread::sleep_until(wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                     std::chrono::duration<double>(
+                                                         static_cast<double>(clock.now_ns() - start_ns) * 1e-9 / speed)));
     clock.advance(step_ns);
     const std::uint64_t n = (clock.now_ns() - scripted_ns) / tau0_ns;
     for (auto& node : gyros) {
@@ -186,12 +229,14 @@ int main(int argc, char** argv) {
       session.feed(*frame, t_s);
       if (candump != nullptr) std::fprintf(candump, "%s\n", format_candump_line(t_s, "vcan0", *frame).c_str());
     }
+    if (web) web->update(session);
     if (view_every_ns != 0 && clock.now_ns() >= next_view_ns) {
       show();
       next_view_ns += view_every_ns;
     }
   }
   session.finish();
+  if (web) web->update(session, true);
   show();
   int code = exit_code::ok;
   if (!close_output(candump, program, candump_path)) code = exit_code::output_failed;
@@ -214,5 +259,9 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "gyrochar-demo: %.1f gyro hours, %u nodes, %llu frames on the bus%s%s%s%s\n", hours, nodes,
                static_cast<unsigned long long>(bus.frames_on_bus()), csv_path.empty() ? "" : "; CSV ", csv_path.c_str(),
                plot_prefix.empty() ? "" : ", plot ", plot_prefix.empty() ? "" : (plot_prefix + ".svg/.png").c_str());
+  if (web) {  // the final page stays served until Ctrl-C
+    print_error(program, "live page", web->url() + " serves the finished run until Ctrl-C");
+    while (!stop_requested) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
   return finish(program, code);
 }

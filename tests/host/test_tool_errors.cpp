@@ -6,6 +6,9 @@
 // (test_analyze_cli, test_decode_cli); gyrochard's start-up is in tests/firmware.
 // Oracle: the exit codes of hal/program/exit_codes.hpp.
 #include <gtest/gtest.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -258,6 +261,45 @@ TEST(ToolErrors, PermissionDeniedIsNamedWithItsReason) {
     EXPECT_NE(r.err.find("Permission denied"), std::string::npos) << r.err;
   }
   std::system(("chmod -R 755 " + dir + " && rm -rf " + dir).c_str());
+}
+
+// The live page's address: a value that is no address is bad usage (2), naming the rule; an
+// address that cannot be listened on is an output that cannot be opened (4), refused before any
+// input is read. The port in use is held by this test's own socket.
+TEST(ToolErrors, LivePageAddressIsCheckedFirst) {
+  const int bad = exit_code::bad_input;
+  expect("gyrochar-decode", "--interface vcan0 --http http", bad, "--http: port 'http' is not a number 0..65535");
+  expect("gyrochar-decode", "x.log --http 70000", bad, "--http: port '70000' is not a number 0..65535");
+  expect("gyrochar-decode", "x.log --http ::1:80", bad, "--http: '::1:80': an IPv6 address goes in brackets, e.g. [::1]:8080");
+  expect("gyrochar-decode", "x.log --http gyro.example:80", bad,
+         "--http: 'gyro.example' is not a numeric IPv4 or IPv6 address or localhost");
+  expect("gyrochar-demo", "--http :80", bad, "--http: ':80': no address before ':'");
+  expect("gyrochar-demo", "--speed -1", bad, "--speed: must be a number >= 0, not -1");
+  expect("gyrochar-demo", "--refresh 0", bad, "--refresh: must be a number of seconds > 0, not 0");
+  const int held = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(held, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  ASSERT_EQ(::listen(held, 1), 0);
+  socklen_t length = sizeof a;
+  ::getsockname(held, reinterpret_cast<sockaddr*>(&a), &length);
+  const std::string port = std::to_string(ntohs(a.sin_port));
+  const std::string log = temp("http_demo.log");
+  ASSERT_EQ(run(bin + "gyrochar-demo --hours 0.01 --plot '' --csv '' --candump " + log).code, exit_code::ok);
+  expect("gyrochar-decode", log + " --http " + port, exit_code::output_failed,
+         "--http: 127.0.0.1:" + port + ": Address already in use");
+  expect("gyrochar-demo", "--hours 0.01 --plot '' --csv '' --http 127.0.0.1:" + port, exit_code::output_failed,
+         "--http: 127.0.0.1:" + port + ": Address already in use");
+  // Refused before any output is opened: a CSV from before is kept whole.
+  const std::string kept = temp("http_kept.csv");
+  std::ofstream(kept) << "an earlier run\n";
+  expect("gyrochar-decode", log + " --csv " + kept + " --http " + port, exit_code::output_failed, "--http: ");
+  expect("gyrochar-demo", "--hours 0.01 --plot '' --csv " + kept + " --http " + port, exit_code::output_failed, "--http: ");
+  EXPECT_EQ(slurp(kept), "an earlier run\n");
+  expect("gyrochar-decode", log + " --http 192.0.2.1:0", exit_code::output_failed,
+         "--http: 192.0.2.1:0: Cannot assign requested address");
+  ::close(held);
 }
 
 }  // namespace
