@@ -91,6 +91,13 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
   const auto column = [&](const char* name) {
     return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
   };
+  // The next tau each card names (oracle: the CSV): the shortest tau of the card's report without
+  // an ADEV, its first estimate at most 2 tau of gyro time away (an ADEV at m needs 2m samples).
+  const std::regex next_re(R"re(class="meta next-tau" data-node="(\d+)" data-tau-s="([^"]+)" data-wait-s="([^"]+)")re");
+  std::map<int, std::pair<double, double>> next;  // node -> tau_s, wait_s
+  for (auto it = std::sregex_iterator(dom.begin(), dom.end(), next_re); it != std::sregex_iterator(); ++it)
+    next[std::stoi((*it)[1])] = {std::stod((*it)[2]), std::stod((*it)[3])};
+  std::map<int, double> first_without;  // node -> shortest tau of its shown report without an ADEV
   std::size_t compared = 0;
   while (std::getline(in, line)) {
     std::vector<std::string> f;
@@ -100,6 +107,9 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
     if (!report.contains(node) || report[node] != std::pair{std::stoi(f[column("seq")]), std::stod(f[column("time_s")])})
       continue;
     const int tau = std::stoi(f[column("tau_index")]);
+    const double tau_s = std::stod(f[column("tau_s")]);
+    if (f[column("adev")].empty() && tau_s > 0 && (!first_without.contains(node) || tau_s < first_without[node]))
+      first_without[node] = tau_s;
     for (const char* stat : {"adev", "mdev"}) {
       const std::string& text = f[column(stat)];
       const auto it = shown.find({node, tau, stat});
@@ -113,6 +123,14 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
     }
   }
   EXPECT_EQ(compared, shown.size()) << "every value the page shows is the CSV's of that report";
+  ASSERT_FALSE(first_without.empty()) << "a 15-minute run has taus its ADEV cannot reach yet";
+  ASSERT_EQ(next.size(), first_without.size()) << "a next tau on each card whose report has a tau without an ADEV";
+  for (const auto& [node, tau_s] : first_without) {
+    ASSERT_TRUE(next.contains(node)) << "node " << node;
+    EXPECT_NEAR(next[node].first, tau_s, 1e-6 * tau_s) << "node " << node;
+    EXPECT_GE(next[node].second, 0.0) << "node " << node;
+    EXPECT_LE(next[node].second, 2 * tau_s) << "node " << node;
+  }
 }
 
 }  // namespace

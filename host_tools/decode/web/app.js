@@ -211,6 +211,21 @@ function healthText(h) {
     `duplicates ${h.duplicates}; rejected ${rejected}`;
 }
 
+// The node's next tau to get its first estimate: the shortest whose ADEV is not yet valid. An
+// overlapping ADEV at m = tau / tau0 needs 2m samples, so at the node's sample rate it comes after
+// 2m less the samples so far (node time: the gyro's own clock). Null when every tau has one.
+function nextTau(node) {
+  const rep = node.report, tau0 = rep.metadata.tau0_s;
+  const next = node.rows.find((r) => r.adev.status === "invalid" && r.tau_s > 0);
+  if (!next || !(tau0 > 0) || typeof rep.sample_count !== "number") return null;
+  const m = Math.round(next.tau_s / tau0);
+  return { tau: next.tau_s, wait: Math.max(0, (2 * m - rep.sample_count) * tau0) };
+}
+
+function duration(s) {
+  return s >= 7200 ? `${short(s / 3600)} h` : s >= 120 ? `${short(s / 60)} min` : `${short(s)} s`;
+}
+
 // ---------------------------------------------------------------------------------------------
 // One node's card, redrawn at every snapshot.
 
@@ -229,6 +244,9 @@ function nodeCard(node, snap, now) {
     (meta.protocol_version !== null ? `; protocol ${meta.protocol_version}` : "") +
     (meta.tau0_s !== null ? `; tau0 ${short(meta.tau0_s)} s` : "") +
     `; rates [${rep.rate_unit}]` + (latency !== null ? `; shown ${(latency / 1000).toFixed(2)} s after the report closed` : "")));
+  const next = nextTau(node);
+  if (next) add(card, make("p", { class: "meta next-tau", "data-node": node.node, "data-tau-s": next.tau, "data-wait-s": next.wait },
+    `next tau ${short(next.tau)} s: its first estimate in about ${duration(next.wait)} of gyro time`));
   const figures = add(card, make("div", { class: "figures" }));
   const left = add(figures, make("div"));
   add(left, devPlot(node));
