@@ -119,6 +119,67 @@ GyroSummary node_summary(const NodeView& node, const std::string& source, const 
   return g;
 }
 
+namespace {
+
+// The model beyond the five terms (protocol version 4: Markov terms, the sensor's filter,
+// sinusoids) with each parameter's uncertainty and the runner-up, as the terminal view gives them.
+void model_table(html::Document& doc, const NodeView& node, const Units& u, const std::string& id) {
+  const std::optional<FitModelRow> m = fit_model_row(node, u);
+  if (!m || !node.ieee952_summary) return;
+  const protocol::Ieee952Status status = node.ieee952_summary->status;
+  if (status != protocol::Ieee952Status::ok && status != protocol::Ieee952Status::rejected) return;
+  if (m->state != Viewed::shown) {
+    doc.paragraph(fmt::format("Model beyond the five terms: {} (its pages {})", name(m->state),
+                              m->state == Viewed::pending ? "are still arriving" : "were lost"),
+                  "note");
+    return;
+  }
+  std::vector<std::vector<Cell>> rows;
+  const auto add_row = [&](const std::string& term, protocol::FitParameter kind, std::uint8_t j,
+                           const std::string& unit, bool with_status) {
+    const FitModelRow::Parameter& q = m->parameters[protocol::fit_parameter_position(kind, j)];
+    rows.push_back({{term, {}, "text"}, number(q.value),
+                    q.rel_uncertainty > 0 ? number(q.value * q.rel_uncertainty) : Cell{}, {unit, {}, "text"},
+                    {with_status ? (q.resolved ? "resolved" : "not resolved") : "", {}, "text"}});
+  };
+  using protocol::FitParameter;
+  for (std::uint8_t j = 0; j < m->markov; ++j) {
+    add_row(fmt::format("Markov {} sigma", j + 1), FitParameter::markov_sigma, j, u.rate_name, true);
+    add_row(fmt::format("Markov {} Tc", j + 1), FitParameter::markov_tc, j, "s", false);
+  }
+  if (m->bandwidth) add_row("sensor filter Tf", FitParameter::filter_tf, 0, "s", false);
+  for (std::uint8_t j = 0; j < m->sinusoids; ++j) {
+    add_row(fmt::format("sinusoid {} amplitude", j + 1), FitParameter::sinusoid_amplitude, j, u.rate_name, true);
+    add_row(fmt::format("sinusoid {} frequency", j + 1), FitParameter::sinusoid_frequency, j, "Hz", false);
+  }
+  std::string title = rows.empty() ? "Model: the five terms" : "Model beyond the five terms";
+  if (m->bandwidth_excluded_below_tau_s && *m->bandwidth_excluded_below_tau_s > 0)
+    title += fmt::format("; taus below {:.4g} s left out (sensor filter)", *m->bandwidth_excluded_below_tau_s);
+  if (const auto& r = m->runner_up)
+    title += fmt::format("; runner-up: {} Markov, {} sinusoids{}, criterion {:+.3g}", r->runner_up_markov,
+                         r->runner_up_sinusoids, r->runner_up_bandwidth ? ", filter" : "", r->criterion_margin);
+  if (rows.empty())
+    doc.paragraph(title, "model");
+  else
+    doc.table(id + "-model", title, {"term", "value", "standard uncertainty", "unit", "status"}, rows);
+}
+
+// The dynamic Allan deviation: the latest window's ADEV at each window tau, as the terminal view.
+void window_table(html::Document& doc, const NodeView& node, const Units& u, const std::string& id) {
+  if (node.window_taus == 0 || node.windows.empty()) return;
+  const WindowView& w = node.windows.rbegin()->second;
+  std::vector<std::vector<Cell>> rows;
+  for (std::size_t i = 0; i < w.adev.size(); ++i)  // window tau i is the node's tau i
+    rows.push_back({node.tau_s(i) > 0 ? number(node.tau_s(i)) : Cell{},
+                    w.received[i] && w.adev[i] > 0 ? number(w.adev[i] * u.rate) : Cell{}});
+  doc.table(id + "-window",
+            fmt::format("Dynamic ADEV [{}]: the latest window, {}{} ({} windows received)", u.rate_name, w.window,
+                        w.gaps ? fmt::format(", {} gaps", w.gaps) : "", node.windows.size()),
+            {"tau [s]", "adev"}, rows);
+}
+
+}  // namespace
+
 std::string decode_html(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown,
                         const DisplayRate& rate, ConfidenceIntervals& intervals, const std::vector<Limit>& limits,
                         const std::string& command) {
@@ -205,6 +266,8 @@ std::string decode_html(const Decoder& decoder, const InputCounters& input, cons
                               s->chi2_per_dof, s->points, s->quantization_white ? "white" : "periodic")
                 : std::string("IEEE-952 fit: no summary received"),
               {"term", "value", "standard uncertainty", "unit", "status"}, terms);
+    model_table(doc, node, u, id);
+    window_table(doc, node, u, id);
     for (const std::string& note : p.notes) doc.paragraph(note, "note");
   }
   return doc.finish();

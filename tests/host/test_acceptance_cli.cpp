@@ -8,11 +8,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
+#include <vector>
 
 #include "hal/program/exit_codes.hpp"
 #include "support/shell.hpp"
@@ -223,6 +225,66 @@ TEST(AcceptanceCli, DecoderGivesVerdictsAndReportPerNode) {
   EXPECT_GE(records, 1u);
   const std::string rows = slurp(summary);
   EXPECT_EQ(static_cast<std::size_t>(std::count(rows.begin(), rows.end(), '\n')), records + 1) << rows;
+}
+
+// The decoder's report shows what its final view shows beyond the tau table: the model's terms
+// beyond the five (the demo's second gyro gets a Markov term over an hour) and the latest window's
+// dynamic ADEV. Oracle: the final view of the same log, printed to 4 significant digits.
+TEST(AcceptanceCli, DecoderReportHasTheViewsModelAndWindow) {
+  const std::string log = temp("demo_window.log"), report = temp("decode_window.html");
+  Outcome r = run_shell(demo + " --hours 1 --window 10 --view-every 0 --csv '' --plot '' --candump " + log + " > /dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run_shell(decode + " " + log + " --view final --report " + report);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string html = slurp(report);
+  // The table with `id`: its cells' exact values, row by row (an empty cell: NaN).
+  const auto table = [&](const std::string& id) {
+    std::vector<std::vector<double>> rows;
+    const std::size_t from = html.find("<table id=\"" + id + "\">");
+    if (from == std::string::npos) return rows;
+    const std::string body = html.substr(from, html.find("</table>", from) - from);
+    const std::regex row_re("<tr><td.*?</tr>"), cell_re(R"re(<td( data-value="([^"]*)")?[^>]*>)re");
+    for (auto it = std::sregex_iterator(body.begin(), body.end(), row_re); it != std::sregex_iterator(); ++it) {
+      const std::string row = it->str();
+      std::vector<double> cells;
+      for (auto c = std::sregex_iterator(row.begin(), row.end(), cell_re); c != std::sregex_iterator(); ++c)
+        cells.push_back((*c)[2].matched ? std::stod((*c)[2]) : NAN);
+      rows.push_back(cells);
+    }
+    return rows;
+  };
+  // The view: per node, its "model:" line and its "dynamic ADEV" line.
+  std::vector<std::string> model_lines, window_lines;
+  for (std::size_t at = 0; (at = r.out.find('\n', at)) != std::string::npos; ++at) {
+    const std::string line = r.out.substr(at + 1, r.out.find('\n', at + 1) - at - 1);
+    if (line.rfind("  model:", 0) == 0) model_lines.push_back(line);
+    if (line.rfind("  dynamic ADEV:", 0) == 0) window_lines.push_back(line);
+  }
+  ASSERT_EQ(window_lines.size(), 2u) << r.out;
+  std::size_t markov_seen = 0;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const std::string id = k == 0 ? "node-10" : "node-11";
+    // The latest window's ADEVs, as the view prints them (%.3e).
+    std::vector<double> shown;
+    const std::regex value_re(R"re( ([0-9.]+e[-+][0-9]+))re");
+    const std::string tail = window_lines[k].substr(window_lines[k].rfind("]:"));
+    for (auto it = std::sregex_iterator(tail.begin(), tail.end(), value_re); it != std::sregex_iterator(); ++it)
+      shown.push_back(std::stod((*it)[1]));
+    const auto rows = table(id + "-window");
+    ASSERT_EQ(rows.size(), shown.size()) << id << ": " << window_lines[k];
+    for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_NEAR(rows[i][1], shown[i], 5e-4 * shown[i]) << id << " window tau " << i;
+    // Each Markov term's sigma and Tc, as the view prints them (%.4g).
+    std::smatch m;
+    const std::regex markov_re(R"re(Markov 1: sigma ([0-9.e+-]+) \S+ .*?Tc ([0-9.e+-]+) s)re");
+    if (k < model_lines.size() && std::regex_search(model_lines[k], m, markov_re)) {
+      const auto model = table(id + "-model");
+      ASSERT_GE(model.size(), 2u) << id << ": " << model_lines[k];
+      EXPECT_NEAR(model[0][1], std::stod(m[1]), 5e-4 * std::stod(m[1])) << id << " Markov sigma";
+      EXPECT_NEAR(model[1][1], std::stod(m[2]), 5e-4 * std::stod(m[2])) << id << " Markov Tc";
+      ++markov_seen;
+    }
+  }
+  EXPECT_GE(markov_seen, 1u) << "the demo's second gyro has a Markov term after an hour:\n" << r.out;
 }
 
 }  // namespace
