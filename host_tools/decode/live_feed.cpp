@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "display_units.hpp"
+#include "node_report.hpp"
 #include "plot_data.hpp"
 
 namespace gyrochar::decoding {
@@ -115,7 +116,10 @@ std::string LiveFeed::snapshot(Session& session) {
     const auto latest = latest_.find(address);
     Json extra{{"rows_received_ms", latest != latest_.end() ? Json(latest->second.received_ms) : Json(nullptr)},
                {"truth", truth_json(v, units, truth)},
-               {"plot", plot_json(plot_data(v, o.rate_unit, session.intervals(), truth))}};
+               {"plot", plot_json(plot_data(v, o.rate_unit, session.intervals(), truth))},
+               {"acceptance", limits_ != nullptr && !limits_->empty()
+                                  ? Json(acceptance_record(in.now_s, v, *limits_, node_decisions(v, *limits_)))
+                                  : Json(nullptr)}};
     std::string node = extra.dump();  // {"rows_received_ms":...}: the rows and the record go first
     node.erase(0, 1);
     nodes += nodes.empty() ? "{" : ",{";

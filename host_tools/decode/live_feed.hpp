@@ -7,7 +7,9 @@
 //   IEEE-952 terms and the fit's summary and model);
 // - "plot": the decoder plot's series (plot_data.hpp): the model's lines, the truth's line where a
 //   simulation knows it, the notes, the read-off points and the heat map of the dynamic Allan
-//   deviation; "truth": the true IEEE-952 terms in the display units, or null.
+//   deviation; "truth": the true IEEE-952 terms in the display units, or null;
+// - "acceptance": its verdicts under the decoder's --limits as of now (the JSON lines record of
+//   type "acceptance", node_report.hpp), or null without limits.
 // Top level: program, source, the input's counters, decoder time elapsed, "sent_ms" (wall clock
 // at the snapshot, ms since the Unix epoch), refresh_s, ci_level. The keys are the page's
 // contract (host_tools/decode/web/app.js reads them; docs/live.md lists them).
@@ -17,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "limits.hpp"
 #include "recording.hpp"
 #include "session.hpp"
 
@@ -33,6 +36,9 @@ class LiveFeed {
   LiveFeed(const LiveFeed&) = delete;
   LiveFeed& operator=(const LiveFeed&) = delete;
 
+  /// Judges every node against `limits` in each snapshot from now on (null: none); they must
+  /// outlive the feed.
+  void judge(const std::vector<Limit>* limits) { limits_ = limits; }
   /// Keeps the rows of `node`'s report just closed (SessionOptions::on_report). O(rows).
   void report_closed(const NodeView& node, const std::vector<TauRow>& rows, const Units& units);
   /// The snapshot of every recorded node: one line of JSON. O(nodes x (taus + windows x window
@@ -45,6 +51,7 @@ class LiveFeed {
   std::string program_;
   double refresh_s_;
   const TrueTermsByNode* truth_;
+  const std::vector<Limit>* limits_ = nullptr;
   char* buffer_ = nullptr;
   std::size_t size_ = 0;
   std::FILE* memory_;  // open_memstream: the JSON lines writer writes here

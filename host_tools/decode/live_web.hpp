@@ -18,6 +18,8 @@ class LiveWeb {
           const TrueTermsByNode* truth = nullptr, web::ServerLimits limits = {});
   /// The SessionOptions::on_report hook that keeps each report's rows for the page.
   std::function<void(const NodeView&, const std::vector<TauRow>&, const Units&)> hook();
+  /// Gives each node's verdicts under `limits` on the page (null: none); they must outlive this.
+  void judge(const std::vector<Limit>* limits) { feed_.judge(limits); }
   /// Publishes a snapshot of `session` once refresh_s of wall-clock time has passed since the
   /// last one (`force`: now). O(1) when not due; else the snapshot's cost (live_feed.hpp).
   void update(Session& session, bool force = false);

@@ -453,6 +453,7 @@ int main(int argc, char** argv) {
     } catch (const web::ListenError& e) {
       fail(exit_code::output_failed, "--http", e.what());
     }
+    web->judge(&o.limits);
     print_error(program, "live page", web->url());
   }
 

@@ -24,6 +24,7 @@
 
 #include "board.hpp"
 #include "candump.hpp"
+#include "limits.hpp"
 #include "live_web.hpp"
 #include "output_paths.hpp"
 #include "plot.hpp"
@@ -79,7 +80,7 @@ int main(int argc, char** argv) {
              std::string(exit_code::help));
   double hours = 6, tau0 = 0.01, loss = 0, view_every_min = 30, window_min = 30;
   unsigned nodes = 2, octaves = 20;
-  std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo", candump_path, http_text;
+  std::string csv_path = "gyrochar-demo.csv", plot_prefix = "gyrochar-demo", candump_path, http_text, limits_path;
   double speed = 0, refresh_s = 1;
   app.add_option("--hours", hours, "gyro hours to simulate")->capture_default_str();
   app.add_option("--nodes", nodes, "gyro boards on the bus (1..8)")->capture_default_str();
@@ -99,11 +100,21 @@ int main(int argc, char** argv) {
   app.add_option("--speed", speed, "gyro seconds per wall-clock second (0: as fast as it can)")->capture_default_str();
   app.add_option("--refresh", refresh_s, "wall-clock seconds between updates of the live web page")
       ->capture_default_str();
+  app.add_option("--limits", limits_path, "acceptance limits (gyrochar-analyze --help): each node's verdicts on the live page (--http)");
   if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
   std::optional<web::ListenAddress> http;
   if (std::string why; !http_text.empty() && !(http = web::parse_listen_address(http_text, why))) bad("--http", why);
   if (!(speed >= 0) || !std::isfinite(speed)) bad("--speed", fmt::format("must be a number >= 0, not {}", speed));
   if (!(refresh_s > 0) || !std::isfinite(refresh_s)) bad("--refresh", fmt::format("must be a number of seconds > 0, not {}", refresh_s));
+  std::vector<Limit> limits;
+  if (!limits_path.empty()) {
+    if (!http) bad("--limits", "the demo shows verdicts on its live page only: give --http too");
+    try {
+      limits = read_limits_file(limits_path);
+    } catch (const LimitsError& e) {
+      bad("--limits", limits_path + ": " + e.what());
+    }
+  }
   // Each rule its own message: the option, what it must be, and what was given.
   if (!(hours > 0) || !std::isfinite(hours)) bad("--hours", fmt::format("must be a positive number of hours, not {}", hours));
   if (!(tau0 > 0) || !std::isfinite(tau0)) bad("--tau0", fmt::format("must be a positive number of seconds, not {}", tau0));
@@ -131,6 +142,7 @@ int main(int argc, char** argv) {
     } catch (const web::ListenError& e) {
       exit_with(exit_code::output_failed, program, "--http", e.what());
     }
+    web->judge(&limits);
     print_error(program, "live page", web->url());
   }
   FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "w");

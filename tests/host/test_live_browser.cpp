@@ -47,9 +47,11 @@ std::string output_of(const std::string& command) {
 TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
   const std::string browser = chromium();
   if (browser.empty()) GTEST_SKIP() << "chromium is not installed (Debian package chromium; toolchain/build.sh test installs it)";
-  const std::string csv = temp("demo.csv");
+  const std::string csv = temp("demo.csv"), limits = temp("limits.txt");
+  // A limit no gyro meets (oracle: no gyro's ADEV is below 1e-9 deg/h): each card's verdict fails.
+  std::ofstream(limits) << "adev(10.24 s) <= 1e-9 deg/h\n";
   Background demo(bin + "gyrochar-demo --nodes 2 --hours 0.25 --speed 60 --view-every 0 --plot '' --csv " + csv +
-                      " --http 127.0.0.1:0",
+                      " --http 127.0.0.1:0 --limits " + limits,
                   temp("demo.err"));
   const std::uint16_t port = demo.port();
   ASSERT_NE(port, 0) << demo.err();
@@ -82,6 +84,11 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
   for (auto it = std::sregex_iterator(dom.begin(), dom.end(), cell_re); it != std::sregex_iterator(); ++it)
     shown[{std::stoi((*it)[1]), std::stoi((*it)[2]), (*it)[3]}] = std::stod((*it)[4]);
   ASSERT_GE(shown.size(), 20u);
+  const std::regex verdict_re(R"re(<tr data-limit="adev\(10.24 s\)" data-verdict="([a-z]+)")re");
+  std::vector<std::string> verdicts;
+  for (auto it = std::sregex_iterator(dom.begin(), dom.end(), verdict_re); it != std::sregex_iterator(); ++it)
+    verdicts.push_back((*it)[1]);
+  EXPECT_EQ(verdicts, (std::vector<std::string>{"fail", "fail"})) << "each card's verdict under --limits";
 
   std::ifstream in(csv);
   std::string line;

@@ -101,7 +101,12 @@ TEST(LivePage, DecoderServesTheRowsOfItsCsv) {
   // The log comes through a FIFO held open, so that the decoder keeps serving after its last line.
   std::remove(fifo.c_str());
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  Background decoder(bin + "gyrochar-decode " + fifo + " --view none --http 127.0.0.1:0 --refresh 0.2 --csv " + csv,
+  // A limit no gyro meets (oracle: no ADEV of a real or simulated gyro is below 1e-9 deg/h): each
+  // node's verdict on the page is "fail" as soon as its ADEV at 10.24 s exists.
+  const std::string limits = temp("live_limits.txt");
+  std::ofstream(limits) << "adev(10.24 s) <= 1e-9 deg/h\n";
+  Background decoder(bin + "gyrochar-decode " + fifo + " --view none --http 127.0.0.1:0 --refresh 0.2 --csv " + csv +
+                         " --limits " + limits,
                      temp("decode.err"));
   const std::uint16_t port = decoder.port();
   ASSERT_NE(port, 0) << decoder.err();
@@ -130,6 +135,12 @@ TEST(LivePage, DecoderServesTheRowsOfItsCsv) {
   for (const Json& node : snapshot["nodes"]) {
     EXPECT_TRUE(node["truth"].is_null()) << "the decoder knows no truth";
     EXPECT_EQ(node["report"]["type"], "report");
+    ASSERT_TRUE(node["acceptance"].is_object()) << node.dump().substr(0, 400);
+    EXPECT_EQ(node["acceptance"]["type"], "acceptance");
+    ASSERT_EQ(node["acceptance"]["limits"].size(), 1u);
+    EXPECT_EQ(node["acceptance"]["limits"][0]["quantity"], "adev(10.24 s)");
+    EXPECT_EQ(node["acceptance"]["limits"][0]["verdict"], "fail") << node["acceptance"].dump();
+    EXPECT_EQ(node["acceptance"]["verdict"], "fail");
   }
 }
 

@@ -204,6 +204,25 @@ function tauTable(node, level) {
   return table;
 }
 
+// The node's verdicts under the decoder's --limits (its JSON lines "acceptance" record as of now).
+function acceptanceTable(acc) {
+  const div = make("div", { class: "acceptance" });
+  add(div, make("p", { class: "model", "data-verdict": acc.verdict },
+    `acceptance (${short(100 * acc.confidence)} % intervals; ${acc.rule}): ${acc.verdict.toUpperCase()}`));
+  const table = add(div, make("table", { class: "fit" }));
+  const hr = add(table, make("tr"));
+  for (const h of ["limit", "estimate", "lower", "upper", "verdict", "decides at", "why"]) add(hr, make("th", {}, h));
+  for (const l of acc.limits) {
+    const tr = add(table, make("tr", { "data-limit": l.quantity, "data-verdict": l.verdict }));
+    add(tr, make("td", {}, `${l.quantity} <= ${short(l.limit)} ${l.unit}`));
+    for (const v of [l.estimate, l.lower, l.upper]) add(tr, make("td", { "data-value": v }, v === null ? "-" : short(v)));
+    add(tr, make("td", { class: l.verdict === "pass" ? "" : "not-resolved" }, l.verdict));
+    add(tr, make("td", {}, l.decides_at_s !== null ? `about ${duration(l.decides_at_s)}` : l.decides_never ? "never at this estimate" : "-"));
+    add(tr, make("td", {}, l.why));
+  }
+  return div;
+}
+
 function healthText(h) {
   const rejected = Object.values(h.rejected || {}).reduce((a, b) => a + b, 0);
   return `link: frames ${h.frames}; reports ${h.reports_complete} complete, ${h.reports_incomplete} incomplete, ` +
@@ -254,6 +273,7 @@ function nodeCard(node, snap, now) {
   if (node.plot.heat) add(figures, heatMap(node.plot.heat));
   for (const n of node.plot.notes) add(card, make("p", { class: "notes" }, n));
   add(card, fitTable(node));
+  if (node.acceptance) add(card, acceptanceTable(node.acceptance));
   add(card, make("p", { class: "link" }, healthText(rep.health)));
   const f = rep.faults;
   add(card, make("p", { class: "faults" }, `node faults: lost edges ${f.lost_edges}, sample gaps ${f.sample_gaps}, ` +
