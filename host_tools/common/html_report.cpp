@@ -122,8 +122,9 @@ std::string svg_log_plot(const LogPlot& plot) {
   }
   // Lines widen the window a little (the model beyond the points is clipped), limits too.
   for (const LogPlot::LimitMark& l : plot.limits) take(l.tau > 0 ? l.tau : x_lo, l.value);
-  const auto [xa, xb] = decades(x_lo, x_hi);
-  const auto [ya, yb] = decades(y_lo, y_hi);
+  // Plain names, not structured bindings: lambdas below capture them (clang before 16 refuses that).
+  const auto x_decades = decades(x_lo, x_hi), y_decades = decades(y_lo, y_hi);
+  const int xa = x_decades.first, xb = x_decades.second, ya = y_decades.first, yb = y_decades.second;
   const auto px = [&](double x) { return left + (std::log10(x) - xa) / (xb - xa) * pw; };
   const auto py = [&](double y) { return top + ph - (std::log10(y) - ya) / (yb - ya) * ph; };
   const auto inside = [&](double x, double y) {
