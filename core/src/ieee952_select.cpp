@@ -13,6 +13,30 @@ bool inside_search_range(double value, double lo, double hi) {
   return std::log(value) > std::log(lo) + edge && std::log(value) < std::log(hi) - edge;
 }
 
+// Golden-section minimum of profile_chi2 over ln(*value) in [a, b] (`iterations` steps); leaves
+// *value at it and returns chi2 there.
+double golden_min(Problem& pr, const Flags& free, const Terms& fixed, double* value, double a, double b, int iterations) {
+  constexpr double golden = 0.6180339887498949;
+  double x1 = b - golden * (b - a), x2 = a + golden * (b - a);
+  *value = std::exp(x1);
+  double f1 = profile_chi2(pr, free, fixed);
+  *value = std::exp(x2);
+  double f2 = profile_chi2(pr, free, fixed);
+  for (int k = 0; k < iterations; ++k) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - golden * (b - a);
+      *value = std::exp(x1);
+      f1 = profile_chi2(pr, free, fixed);
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + golden * (b - a);
+      *value = std::exp(x2);
+      f2 = profile_chi2(pr, free, fixed);
+    }
+  }
+  *value = std::exp(f1 < f2 ? x1 : x2);
+  return f1 < f2 ? f1 : f2;
+}
+
 // Minimizes profile_chi2 over *value in log space: a grid from lo to hi (`per_octave` a factor of
 // two), then golden section around the best node. Leaves *value at the minimum and returns whether
 // it lies inside the range (at an end, the data want the term where the search does not allow it).
@@ -24,26 +48,7 @@ bool search(Problem& pr, const Flags& free, const Terms& fixed, double* value, d
     const double chi2 = profile_chi2(pr, free, fixed);
     if (chi2 < best) best = chi2, best_log = l;
   }
-  double a = std::fmax(best_log - step, std::log(lo)), b = std::fmin(best_log + step, std::log(hi));
-  constexpr double golden = 0.6180339887498949;
-  double x1 = b - golden * (b - a), x2 = a + golden * (b - a);
-  *value = std::exp(x1);
-  double f1 = profile_chi2(pr, free, fixed);
-  *value = std::exp(x2);
-  double f2 = profile_chi2(pr, free, fixed);
-  for (int k = 0; k < 24; ++k) {
-    if (f1 < f2) {
-      b = x2, x2 = x1, f2 = f1, x1 = b - golden * (b - a);
-      *value = std::exp(x1);
-      f1 = profile_chi2(pr, free, fixed);
-    } else {
-      a = x1, x1 = x2, f1 = f2, x2 = a + golden * (b - a);
-      *value = std::exp(x2);
-      f2 = profile_chi2(pr, free, fixed);
-    }
-  }
-  const double at = f1 < f2 ? x1 : x2;
-  *value = std::exp(at);
+  golden_min(pr, free, fixed, value, std::fmax(best_log - step, std::log(lo)), std::fmin(best_log + step, std::log(hi)), 24);
   return inside_search_range(*value, lo, hi);
 }
 
@@ -64,21 +69,31 @@ double log_sd(Problem& pr, const Flags& free, const Terms& fixed, double* value)
   return curvature > 0 && std::isfinite(curvature) ? h * std::sqrt(2 / curvature) : 0.0;
 }
 
-// The standard deviation of ln(*value) from its profile: half the width of the interval where chi2
-// (the linear terms solved again at each step, on the fitted model's covariance) lies within 1 of
-// its minimum, walked out in steps of 0.1 to at most 3 either side. A Markov term's profile
-// flattens away from its minimum, so the curvature there (log_sd()) says too little: in the
-// recovery study its Tc lay within one such sigma of the truth in 38 % of the runs, not 68 %.
-double profile_log_sd(Problem& pr, const Flags& free, const Terms& fixed, double* value) {
-  constexpr double step = 0.1, reach = 3.0;
-  const double at = *value;
+// The standard deviation of ln(a_k), Markov term k's tau0 / Tc, from its profile: half the width
+// of the interval where chi2 (on the fitted model's covariance, the linear terms solved again at
+// each step, and every other Markov term's Tc placed again within an octave of where it was) lies
+// within 1 of its minimum, walked out in steps of 0.1 to at most 3 either side. A Markov term's
+// profile flattens away from its minimum, so the curvature there (log_sd()) says too little: in the
+// recovery study its Tc lay within one such sigma of the truth in 38 % of the runs, not 68 %; and
+// with the other terms held where they were, a second term's profile was too narrow again.
+double profile_log_sd(Problem& pr, const Flags& free, const Terms& fixed, std::size_t k) {
+  constexpr double step = 0.1, reach = 3.0, octave_ln = 0.6931471805599453;
+  const Model fitted = pr.model;
+  const double at = fitted.a[k];
   const double mid = profile_chi2(pr, free, fixed);
   double half[2] = {reach, reach};
   for (int side = 0; side < 2; ++side) {
     double before = 0;
+    pr.model = fitted;
     for (double l = step; l <= reach + 1e-9; l += step) {
-      *value = at * std::exp(side == 0 ? -l : l);
-      const double rise = profile_chi2(pr, free, fixed) - mid;
+      pr.model.a[k] = at * std::exp(side == 0 ? -l : l);
+      double chi2 = profile_chi2(pr, free, fixed);
+      for (std::size_t j = 0; j < fitted.markov; ++j)  // from where the last step left them
+        if (j != k) {
+          const double centre = std::log(fitted.a[j]);
+          chi2 = golden_min(pr, free, fixed, &pr.model.a[j], centre - octave_ln, centre + octave_ln, 12);
+        }
+      const double rise = chi2 - mid;
       if (rise >= 1) {
         half[side] = std::isfinite(rise) ? l - step + step * (1 - before) / (rise - before) : l - step / 2;
         break;
@@ -86,7 +101,7 @@ double profile_log_sd(Problem& pr, const Flags& free, const Terms& fixed, double
       before = std::fmax(rise, 0.0);
     }
   }
-  *value = at;
+  pr.model = fitted;
   set_rows(pr);
   return std::isfinite(mid) ? (half[0] + half[1]) / 2 : 0.0;
 }
@@ -256,7 +271,7 @@ bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const 
     return false;
   }
   chosen = exact;
-  for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = profile_log_sd(pr, free, fixed, &pr.model.a[k]);
+  for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = profile_log_sd(pr, free, fixed, k);
   if (runner_up.valid) {
     pr.model = runner_up.model;
     runner_up.sol.chi2 = profile_chi2(pr, free, fixed);
