@@ -33,8 +33,8 @@ std::string summary_header(const std::vector<Limit>& limits) {
   h += ",verdict";
   for (const Limit& l : limits) {
     const std::string q = l.quantity();
-    h += "," + csv_field(q + " verdict") + "," + csv_field(q + " estimate [" + l.unit + "]") + "," + csv_field(q + " lower") + "," +
-         csv_field(q + " upper");
+    h += fmt::format(",{},{},{},{}", csv_field(q + " verdict"), csv_field(q + " estimate [" + l.unit + "]"),
+                     csv_field(q + " lower"), csv_field(q + " upper"));
   }
   return h;
 }
