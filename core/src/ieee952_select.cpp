@@ -88,7 +88,7 @@ double profile_log_sd(Problem& pr, const Flags& free, const Terms& fixed, std::s
     for (double l = step; l <= reach + 1e-9; l += step) {
       pr.model.a[k] = at * std::exp(side == 0 ? -l : l);
       double chi2 = profile_chi2(pr, free, fixed);
-      for (std::size_t j = 0; j < fitted.markov; ++j)  // from where the last step left them
+      for (std::size_t j = 0; j < fitted.markov; ++j)  // within an octave of its fitted Tc
         if (j != k) {
           const double centre = std::log(fitted.a[j]);
           chi2 = golden_min(pr, free, fixed, &pr.model.a[j], centre - octave_ln, centre + octave_ln, 12);
