@@ -406,6 +406,8 @@ struct NoiseAtAnyLag {
   std::int64_t span_lo = 0, span_hi = 0, flicker_lo = 0, flicker_hi = 0;
   double center = 0;
   std::array<double, max_noises> p{}, tail_lo{}, tail_hi{};
+  ManyR flickers;  // the flicker noises of the set alone: beyond the span only they are evaluated
+  std::array<std::size_t, max_noises> flicker_of{};  // flickers' entry f is the set's noise flicker_of[f]
 
   NoiseAtAnyLag(const PairSetup& s, const TermGrid& a, const TermGrid& b)
       : span_lo(-s.k.u_max()), span_hi(-s.k.u_min()), center(-0.5 * static_cast<double>(s.k.u_min() + s.k.u_max())),
@@ -414,24 +416,41 @@ struct NoiseAtAnyLag {
     flicker_lo = span_lo - 3 * width;
     flicker_hi = span_hi + 3 * width;
     if (!s.many.flicker) return;
-    covariances(s.k, s.many, flicker_lo, tail_lo);
-    covariances(s.k, s.many, flicker_hi, tail_hi);
+    flickers.flicker = true;
+    for (std::size_t t = 0; t < s.many.count; ++t) {
+      if (s.many.twice_d[t] % 2 == 0) continue;
+      flicker_of[flickers.count] = t;
+      flickers.twice_d[flickers.count++] = s.many.twice_d[t];
+    }
+    flicker_covariances(s, flicker_lo, tail_lo);
+    flicker_covariances(s, flicker_hi, tail_hi);
   }
   bool inside(std::int64_t lag) const { return lag >= span_lo && lag <= span_hi; }
   void at(const PairSetup& s, std::int64_t lag, std::array<double, max_noises>& c) const {
-    c.fill(0.0);
-    const bool near = lag >= flicker_lo && lag <= flicker_hi;
-    if (inside(lag) || (s.many.flicker && near)) covariances(s.k, s.many, lag, c);
-    if (inside(lag)) return;
-    for (std::size_t t = 0; t < s.many.count; ++t) {
-      if (s.many.twice_d[t] % 2 == 0) {
-        c[t] = 0;  // beyond the span: zero but for rounding
-      } else if (!near) {
-        const bool left = lag < flicker_lo;
-        const double L = std::fabs(static_cast<double>(left ? flicker_lo : flicker_hi) - center);
-        c[t] = (left ? tail_lo[t] : tail_hi[t]) * std::pow(L / std::fabs(static_cast<double>(lag) - center), p[t]);
-      }
+    if (inside(lag)) {
+      covariances(s.k, s.many, lag, c);
+      return;
     }
+    c.fill(0.0);  // beyond the span the other noises' c is zero but for rounding
+    if (!s.many.flicker) return;
+    if (lag >= flicker_lo && lag <= flicker_hi) {
+      flicker_covariances(s, lag, c);
+      return;
+    }
+    const bool left = lag < flicker_lo;
+    const double L = std::fabs(static_cast<double>(left ? flicker_lo : flicker_hi) - center);
+    for (std::size_t f = 0; f < flickers.count; ++f) {
+      const std::size_t t = flicker_of[f];
+      c[t] = (left ? tail_lo[t] : tail_hi[t]) * std::pow(L / std::fabs(static_cast<double>(lag) - center), p[t]);
+    }
+  }
+
+ private:
+  // c of the flicker noises only (the same sums as covariances() gives them), at their places in c.
+  void flicker_covariances(const PairSetup& s, std::int64_t lag, std::array<double, max_noises>& c) const {
+    std::array<double, max_noises> own{};
+    covariances(s.k, flickers, lag, own);
+    for (std::size_t f = 0; f < flickers.count; ++f) c[flicker_of[f]] = own[f];
   }
 };
 

@@ -126,6 +126,7 @@ struct PowerPass {
 PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
   PowerPass pass;
   if (!pass.prepare(set, a, b)) return pass.out;
+  const NoiseAtAnyLag noise(pass.setup, a, b);
   NodeWalker walk = pass.walker();
   std::int64_t lag = 0;
   double weight = 0;
@@ -133,7 +134,7 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
     const double w = pass.weight_at(lag, weight);
     if (w == 0) continue;
     std::array<double, max_noises> c{};
-    covariances(pass.setup.k, pass.setup.many, lag, c);
+    noise.at(pass.setup, lag, c);
     pass.accumulate(w, c);
   }
   pass.finish(a, b);
@@ -152,6 +153,7 @@ void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b
     return;
   }
   // The two walks in step: a lag both visit has its covariances evaluated once.
+  const NoiseAtAnyLag noise(one.setup, a1, b1);
   NodeWalker walk1 = one.walker(), walk2 = two.walker();
   std::int64_t lag1 = 0, lag2 = 0;
   double weight1 = 0, weight2 = 0;
@@ -162,7 +164,7 @@ void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b
     const double w1 = take1 ? one.weight_at(lag, weight1) : 0.0, w2 = take2 ? two.weight_at(lag, weight2) : 0.0;
     if (w1 != 0 || w2 != 0) {
       std::array<double, max_noises> c{};
-      covariances(one.setup.k, one.setup.many, lag, c);
+      noise.at(one.setup, lag, c);
       if (w1 != 0) one.accumulate(w1, c);
       if (w2 != 0) two.accumulate(w2, c);
     }
