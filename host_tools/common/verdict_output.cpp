@@ -25,17 +25,25 @@ std::string csv_field(const std::string& s) {
   return q + "\"";
 }
 
+std::string decision_columns(const Limit& limit) {
+  const std::string q = limit.quantity();
+  return fmt::format(",{},{},{},{}", csv_field(q + " verdict"), csv_field(q + " estimate [" + limit.unit + "]"),
+                     csv_field(q + " lower"), csv_field(q + " upper"));
+}
+
+std::string decision_fields(const Limit& limit, const Decision* d) {
+  if (d == nullptr) return ",,,,";
+  const auto v = [&](double x) { return d->estimate.usable ? number(x / limit.unit_si) : std::string(); };
+  return fmt::format(",{},{},{},{}", name(d->verdict), v(d->estimate.value), v(d->estimate.low), v(d->estimate.high));
+}
+
 std::string summary_header(const std::vector<Limit>& limits) {
   std::string h = "source,node,run_s,samples,fit_status,chi2_per_dof";
   for (const auto& u : units::ieee952)
     h += fmt::format(",{}",
                      csv_field(fmt::format("{} [{}]", u.letter, u.name))) + fmt::format(",{} u,{} status", u.letter, u.letter);
   h += ",verdict";
-  for (const Limit& l : limits) {
-    const std::string q = l.quantity();
-    h += fmt::format(",{},{},{},{}", csv_field(q + " verdict"), csv_field(q + " estimate [" + l.unit + "]"),
-                     csv_field(q + " lower"), csv_field(q + " upper"));
-  }
+  for (const Limit& l : limits) h += decision_columns(l);
   return h;
 }
 
@@ -45,15 +53,8 @@ std::string summary_row(const GyroSummary& g, const std::vector<Limit>& limits) 
   for (const SummaryTerm& t : g.terms)
     r += fmt::format(",{},{},{}", t.known ? number(t.value) : "", t.known ? number(t.uncertainty) : "", csv_field(t.status));
   r += fmt::format(",{}", g.decisions.empty() ? "" : name(overall(g.decisions)));
-  for (std::size_t i = 0; i < limits.size(); ++i) {
-    if (i >= g.decisions.size()) {
-      r += ",,,,";
-      continue;
-    }
-    const Decision& d = g.decisions[i];
-    const auto v = [&](double x) { return d.estimate.usable ? number(x / limits[i].unit_si) : std::string(); };
-    r += fmt::format(",{},{},{},{}", name(d.verdict), v(d.estimate.value), v(d.estimate.low), v(d.estimate.high));
-  }
+  for (std::size_t i = 0; i < limits.size(); ++i)
+    r += decision_fields(limits[i], i < g.decisions.size() ? &g.decisions[i] : nullptr);
   return r;
 }
 

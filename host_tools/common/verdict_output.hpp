@@ -42,9 +42,16 @@ struct GyroSummary {
 /// `s` as a CSV field: quoted (quotes doubled) when it holds a separator, a quote or a line break.
 std::string csv_field(const std::string& s);
 
+/// One limit's decision as CSV columns, as the production summary and the decoder's per-tau CSV
+/// (--limits) give them: ",<quantity> verdict,<quantity> estimate [unit],<quantity> lower,
+/// <quantity> upper" (each with its leading comma), the bounds the decision bounds of limits.hpp in
+/// the limit's unit. The fields of `decision`, or empty ones for none (null). O(1).
+std::string decision_columns(const Limit& limit);
+std::string decision_fields(const Limit& limit, const Decision* decision);
+
 /// The header line (no newline): source,node,run_s,samples,fit_status,chi2_per_dof, then per term
-/// "N [deg/sqrt(h)]","N u","N status", then verdict, then per limit "<quantity> verdict",
-/// "<quantity> estimate", "<quantity> lower", "<quantity> upper" (in the limit's unit). O(limits).
+/// "N [deg/sqrt(h)]","N u","N status", then verdict, then per limit its decision_columns.
+/// O(limits).
 std::string summary_header(const std::vector<Limit>& limits);
 /// One row (no newline). O(limits).
 std::string summary_row(const GyroSummary& gyro, const std::vector<Limit>& limits);

@@ -194,7 +194,8 @@ class Presenter {
     return false;
   }
 
-  // The verdicts at the end: after the view (stdout), as JSON lines records, in the summary file.
+  // The verdicts at the end: after the view (stdout) and in the summary file (the session wrote
+  // the JSON lines records).
   int verdicts() {
     const Decoder& d = session_.decoder();
     const NodeFilter& shown = session_.options().shown;
@@ -202,9 +203,6 @@ class Presenter {
     std::vector<GyroSummary> rows;
     for (const auto& [address, node] : d.nodes()) {
       if (!shown[address]) continue;
-      if (std::FILE* jsonl = session_.options().jsonl)
-        std::fputs((acceptance_record(session_.input().now_s, node, options_.limits,
-                                      node_decisions(node, options_.limits)).dump() + "\n").c_str(), jsonl);
       rows.push_back(node_summary(node, session_.input().source, options_.limits));
     }
     std::string why;
@@ -353,10 +351,14 @@ int main(int argc, char** argv) {
       "without any candump line is bad input, and so is an output (--csv, --jsonl, --kalibr, --plot's\n"
       "files, --report, --summary) that is the same file as LOG or as another output, through links too:\n"
       "refused before anything is written.\n"
-      "--limits FILE (the format of gyrochar-analyze --help): at the end, each shown node's verdicts\n"
-      "(pass, fail, undecided, with the run length at which an undecided one is expected to decide) after\n"
-      "the view, as a JSON lines record of type \"acceptance\" per node, in the report, and with\n"
-      "--summary FILE.csv as one row per node; the exit code does not depend on them.\n"
+      "--limits FILE (the format of gyrochar-analyze --help): each shown node's verdicts (pass, fail,\n"
+      "undecided, with the run length at which an undecided one is expected to decide): in the CSV, columns\n"
+      "after the others on every tau row (verdict: the node's over all limits; per limit its limit, verdict,\n"
+      "estimate and the decision bounds lower and upper, filled where it applies: a term on every tau row,\n"
+      "a deviation on the row of its tau); in the JSON lines a record of type \"acceptance\" per node at each\n"
+      "closed report where a verdict changed (\"final\": false; the first report always) and at the end\n"
+      "(\"final\": true); at the end after the view, in the report, and with --summary FILE.csv as one row\n"
+      "per node. Without --limits the CSV has no verdict column. The exit code does not depend on them.\n"
       "--report FILE.html: a self-contained page (inline SVG and CSS, no script, no external reference):\n"
       "provenance, each node's plot, taus with intervals, fit and verdicts.\n" +
       std::string(exit_code::help));
@@ -369,7 +371,9 @@ int main(int argc, char** argv) {
   app.add_option("--plot", o.plot, "write PREFIX.svg and PREFIX.png at the end")->option_text("PREFIX");
   app.add_option("--kalibr", o.kalibr, "write the node's N and K as a Kalibr imu.yaml at the end (one node: --node)")
       ->option_text("FILE");
-  app.add_option("--limits", o.limits_path, "acceptance limits: a verdict per node and limit (gyrochar-analyze --help)")
+  app.add_option("--limits", o.limits_path,
+                 "acceptance limits: a verdict per node and limit, in the CSV, the JSON lines (when one changes), "
+                 "the view, the report (gyrochar-analyze --help)")
       ->option_text("FILE");
   app.add_option("--report", o.report, "write a self-contained HTML report at the end (and every --plot-every)")
       ->option_text("FILE.html");
@@ -463,6 +467,7 @@ int main(int argc, char** argv) {
   s.shown = parse_nodes(o.nodes);
   s.csv = o.csv.empty() ? nullptr : open_output(o.csv);
   s.jsonl = o.jsonl.empty() ? nullptr : open_output(o.jsonl);
+  s.limits = &o.limits;
   if (web) s.on_report = web->hook();
   install_stop_handler();
   int code = exit_code::ok;

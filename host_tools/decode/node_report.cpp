@@ -21,6 +21,13 @@ bool fit_ok(const NodeView& node) {
   return node.ieee952_summary && node.ieee952_summary->status == protocol::Ieee952Status::ok;
 }
 
+// Deviation limit `l` is at tau i of the node: m tau0 is its tau.
+bool at_limit_tau(const NodeView& node, const Limit& l, std::size_t i) {
+  const double tau0 = tau0_of(node);
+  const std::uint64_t m = i < node.taus.size() ? node.taus[i].m : 0;
+  return tau0 > 0 && m != 0 && std::abs(static_cast<double>(m) * tau0 - l.tau_s) <= 1e-6 * l.tau_s;
+}
+
 LimitEstimate node_estimate(const NodeView& node, const Limit& l) {
   const auto wire_si = wire_per_si(node);  // wire value per SI value
   if (!wire_si) return no_estimate("the node's angle unit is not known (or pulses)");
@@ -35,11 +42,10 @@ LimitEstimate node_estimate(const NodeView& node, const Limit& l) {
     const double v = static_cast<double>(t.value) / *wire_si;
     return normal_estimate(v, v * t.rel_uncertainty, run_s);
   }
-  const double tau0 = tau0_of(node);
-  if (!(tau0 > 0)) return no_estimate("tau0 not known yet");
-  for (const TauView& t : node.taus) {
-    if (t.m == 0 || std::abs(static_cast<double>(t.m) * tau0 - l.tau_s) > 1e-6 * l.tau_s) continue;
-    const TauView::Dev& d = l.kind == Limit::Kind::adev ? t.adev : t.mdev;
+  if (!(tau0_of(node) > 0)) return no_estimate("tau0 not known yet");
+  for (std::size_t i = 0; i < node.taus.size(); ++i) {
+    if (!at_limit_tau(node, l, i)) continue;
+    const TauView::Dev& d = l.kind == Limit::Kind::adev ? node.taus[i].adev : node.taus[i].mdev;
     if (!d.received || !d.valid) return no_estimate(fmt::format("no estimate at tau = {:g} s yet", l.tau_s));
     return deviation_estimate(static_cast<double>(d.dev) / *wire_si, d.edf, 0, run_s);
   }
@@ -75,6 +81,31 @@ std::vector<Decision> node_decisions(const NodeView& node, const std::vector<Lim
   std::vector<Decision> out;
   for (const Limit& l : limits) out.push_back(decide(l, node_estimate(node, l)));
   return out;
+}
+
+bool limit_applies(const Limit& limit, const NodeView& node, std::size_t tau_index) {
+  return limit.kind == Limit::Kind::term || at_limit_tau(node, limit, tau_index);
+}
+
+std::string verdict_csv_header(const std::vector<Limit>& limits) {
+  std::string h = ",verdict";
+  for (const Limit& l : limits) h += "," + csv_field(l.quantity() + " limit [" + l.unit + "]") + decision_columns(l);
+  return h;
+}
+
+std::size_t verdict_csv_columns(const std::vector<Limit>& limits) { return 1 + 5 * limits.size(); }
+
+std::string verdict_csv_fields(const std::vector<Limit>& limits, const std::vector<Decision>& decisions,
+                               const NodeView& node, std::size_t tau_index) {
+  std::string f = std::string(",") + name(overall(decisions));
+  for (std::size_t i = 0; i < limits.size(); ++i) {
+    const Limit& l = limits[i];
+    if (i < decisions.size() && limit_applies(l, node, tau_index))
+      f += fmt::format(",{}", l.value_si / l.unit_si) + decision_fields(l, &decisions[i]);
+    else
+      f += "," + decision_fields(l, nullptr);
+  }
+  return f;
 }
 
 std::string format_verdicts(const Decoder& decoder, const NodeFilter& shown, const std::vector<Limit>& limits) {

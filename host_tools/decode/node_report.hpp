@@ -23,6 +23,22 @@ namespace gyrochar::decoding {
 /// node's angle unit, tau0, fit or tau are unknown or the node reports pulses. O(limits x taus).
 std::vector<Decision> node_decisions(const NodeView& node, const std::vector<Limit>& limits);
 
+/// Whether `limit` applies to tau `tau_index` of `node` (a row of the per-tau CSV): a term limit to
+/// every tau (the report's fit, as the fit_ columns), a deviation limit to the tau whose m tau0 is
+/// its tau. O(1).
+bool limit_applies(const Limit& limit, const NodeView& node, std::size_t tau_index);
+
+/// The per-tau CSV's verdict columns with --limits (after its other columns, each with its leading
+/// comma): "verdict" (the node's over all limits, as the summary's), then per limit
+/// "<quantity> limit [unit]" and its decision_columns (verdict_output.hpp). O(limits).
+std::string verdict_csv_header(const std::vector<Limit>& limits);
+/// Their number. O(1).
+std::size_t verdict_csv_columns(const std::vector<Limit>& limits);
+/// A tau row's fields: `decisions` (node_decisions of the node as its report closed), a limit's
+/// fields empty where it does not apply to the row. O(limits).
+std::string verdict_csv_fields(const std::vector<Limit>& limits, const std::vector<Decision>& decisions,
+                               const NodeView& node, std::size_t tau_index);
+
 /// The verdicts of every shown node, for the end of the view: a block per node. O(nodes x limits).
 std::string format_verdicts(const Decoder& decoder, const NodeFilter& shown, const std::vector<Limit>& limits);
 

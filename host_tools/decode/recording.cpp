@@ -62,7 +62,8 @@ std::size_t model_columns() {
 // ---------------------------------------------------------------------------------------------
 // CSV
 
-CsvWriter::CsvWriter(std::FILE* out, double confidence) : out_(out), confidence_(confidence) {
+CsvWriter::CsvWriter(std::FILE* out, double confidence, const std::string& extra_header, std::size_t extra_columns)
+    : out_(out), confidence_(confidence), extra_columns_(extra_columns) {
   std::fputs(
       "time_s,node,seq,tau_index,m,tau_s,n,"
       "adev,adev_low,adev_high,adev_edf,adev_noise,adev_status,"
@@ -72,7 +73,7 @@ CsvWriter::CsvWriter(std::FILE* out, double confidence) : out_(out), confidence_
       "fit_avar_excluded_below_tau_s,fit_mvar_excluded_below_tau_s,"
       "type,window,window_start_s,window_end_s,window_gaps",
       out_);
-  std::fputs((model_header() + "\n").c_str(), out_);
+  std::fputs((model_header() + extra_header + "\n").c_str(), out_);
 }
 
 template <class T>
@@ -101,12 +102,12 @@ void CsvWriter::row(const WindowRow& r, const Units& units) {
   field(r.end_s > 0, r.start_s);
   field(r.end_s > 0, r.end_s);
   fmt::format_to(out, FMT_COMPILE("{}"), r.gaps);
-  line_.append(std::string(model_columns(), ','));  // a window row has no fit
+  line_.append(std::string(model_columns() + extra_columns_, ','));  // a window row has no fit, no verdict
   line_.push_back('\n');
   std::fwrite(line_.data(), 1, line_.size(), out_);
 }
 
-void CsvWriter::row(const TauRow& r, const Units& units) {
+void CsvWriter::row(const TauRow& r, const Units& units, std::string_view extra) {
   begin(r.time_s, r.node, r.seq, r.tau_index, r.m, r.tau_s);
   const auto out = fmt::appender(line_);
   field(r.n != 0, r.n);
@@ -128,7 +129,10 @@ void CsvWriter::row(const TauRow& r, const Units& units) {
   field(r.fit_excluded_below_tau_s[1].has_value(), r.fit_excluded_below_tau_s[1].value_or(0.0));
   fmt::format_to(out, FMT_COMPILE("tau,,,,,"));
   model_fields(r.fit_model);
-  line_.data()[line_.size() - 1] = '\n';  // the last field's comma ends the line
+  line_.resize(line_.size() - 1);  // the last field's comma
+  line_.append(extra);
+  for (std::size_t k = extra.empty() ? extra_columns_ : 0; k > 0; --k) line_.push_back(',');  // none given
+  line_.push_back('\n');
   std::fwrite(line_.data(), 1, line_.size(), out_);
 }
 

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <string>
+#include <string_view>
 
 #include "rows.hpp"
 
@@ -19,9 +20,12 @@ namespace gyrochar::decoding {
 class CsvWriter {
  public:
   /// Writes the header. `confidence` is the level of the intervals (column ci_level).
-  CsvWriter(std::FILE* out, double confidence);
-  void row(const TauRow& r, const Units& units);
-  void row(const WindowRow& r, const Units& units);
+  /// `extra_header` names `extra_columns` columns after the others, each with its leading comma
+  /// (--limits: the verdict columns, node_report.hpp); none by default.
+  CsvWriter(std::FILE* out, double confidence, const std::string& extra_header = {}, std::size_t extra_columns = 0);
+  /// `extra`: the row's extra fields, each with its leading comma (empty without extra columns).
+  void row(const TauRow& r, const Units& units, std::string_view extra = {});
+  void row(const WindowRow& r, const Units& units);  // the extra fields empty
 
  private:
   template <class T>
@@ -30,6 +34,7 @@ class CsvWriter {
   void begin(double time_s, std::uint8_t node, std::uint8_t seq, std::uint8_t tau_index, std::uint64_t m, double tau_s);
   std::FILE* out_;
   double confidence_;
+  std::size_t extra_columns_;
   fmt::memory_buffer line_;
 };
 
@@ -46,11 +51,12 @@ class JsonlWriter {
   void report(double time_s, const NodeView& node, std::uint8_t seq, const Units& units);
   void event(double time_s, DecoderEvent e, const NodeView& node);
   void summary(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown);
+  /// A record built elsewhere (one JSON object without '\n'), as one line: the acceptance records.
+  void line(const std::string& text);
 
  private:
   template <class T>
   void member(const char* key, bool known, T value);  // ,"key":value (or null) into line_
-  void line(const std::string& text);
   std::FILE* out_;
   double confidence_;
   fmt::memory_buffer line_;

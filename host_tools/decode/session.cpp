@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "node_report.hpp"
+
 namespace gyrochar::decoding {
 
 // ---------------------------------------------------------------------------------------------
@@ -57,10 +59,23 @@ LineReader::Result LineReader::next(std::string_view& line) {
 // ---------------------------------------------------------------------------------------------
 // Session
 
+namespace {
+
+std::vector<Verdict> verdicts_of(const std::vector<Decision>& decisions) {
+  std::vector<Verdict> v;
+  for (const Decision& d : decisions) v.push_back(d.verdict);
+  return v;
+}
+
+}  // namespace
+
 Session::Session(const SessionOptions& options)
     : options_(options),
       intervals_(options.confidence),
-      csv_(options.csv ? std::make_unique<CsvWriter>(options.csv, options.confidence) : nullptr),
+      csv_(!options.csv ? nullptr
+           : judging()  ? std::make_unique<CsvWriter>(options.csv, options.confidence, verdict_csv_header(*options.limits),
+                                                     verdict_csv_columns(*options.limits))
+                        : std::make_unique<CsvWriter>(options.csv, options.confidence)),
       jsonl_(options.jsonl ? std::make_unique<JsonlWriter>(options.jsonl, options.confidence) : nullptr),
       decoder_([this](DecoderEvent e, const NodeView& node, std::uint8_t seq) { on_event(e, node, seq); }) {}
 
@@ -100,7 +115,21 @@ void Session::tick(double t_s) {
 
 void Session::finish() {
   decoder_.flush();
-  if (jsonl_) jsonl_->summary(decoder_, input_, options_.shown);
+  if (!jsonl_) return;
+  if (judging())
+    for (const auto& [address, node] : decoder_.nodes()) {
+      if (!options_.shown[address]) continue;
+      decisions_ = node_decisions(node, *options_.limits);
+      write_acceptance(input_.now_s, node, true);
+    }
+  jsonl_->summary(decoder_, input_, options_.shown);
+}
+
+void Session::write_acceptance(double time_s, const NodeView& node, bool final) {
+  nlohmann::json j = acceptance_record(time_s, node, *options_.limits, decisions_);
+  j["final"] = final;
+  jsonl_->line(j.dump());
+  verdicts_written_[node.address] = verdicts_of(decisions_);
 }
 
 void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
@@ -110,11 +139,18 @@ void Session::on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq) {
     const Units units = units_for(node, options_.rate_unit);
     rows_.clear();
     tau_rows(node, report, units, intervals_, rows_);
+    const bool judged = judging() && (csv_ || jsonl_);
+    if (judged) decisions_ = node_decisions(node, *options_.limits);
     for (const TauRow& row : rows_) {
-      if (csv_) csv_->row(row, units);
+      if (csv_) csv_->row(row, units, judged ? verdict_csv_fields(*options_.limits, decisions_, node, row.tau_index) : "");
       if (jsonl_) jsonl_->row(row, units);
     }
     if (jsonl_) jsonl_->report(report.start_s, node, seq, units);
+    if (jsonl_ && judged) {  // a record when a verdict changed: a watcher sees pass or fail once decided
+      const auto written = verdicts_written_.find(node.address);
+      if (written == verdicts_written_.end() || written->second != verdicts_of(decisions_))
+        write_acceptance(report.start_s, node, false);
+    }
     if (options_.on_report) options_.on_report(node, rows_, units);
   }
   if (e == DecoderEvent::window_complete && record && (csv_ || jsonl_) && node.current_window()) {

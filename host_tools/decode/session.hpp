@@ -6,12 +6,14 @@
 #include <cstddef>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "candump.hpp"
+#include "limits.hpp"
 #include "recording.hpp"
 #include "decoder.hpp"
 
@@ -50,6 +52,12 @@ struct SessionOptions {
   /// Given the rows of every closed report of a recorded node, the CSV's rows (the live web page
   /// keeps them: live_feed.hpp). May be empty.
   std::function<void(const NodeView&, const std::vector<TauRow>&, const Units&)> on_report;
+  /// Acceptance limits (--limits; not owned, null or empty: none). With them the CSV gains the
+  /// verdict columns (node_report.hpp), and the JSON lines get a node's record of type
+  /// "acceptance" ("final": false) at each closed report where one of its verdicts differs from
+  /// the record written before (the first closed report always), and one per node at the end
+  /// ("final": true), before the summary.
+  const std::vector<Limit>* limits = nullptr;
 };
 
 /// Decodes one bus. Not copyable or movable (the decoder's listener points at it).
@@ -68,7 +76,8 @@ class Session {
   void feed(const CanFrame& frame, double t_s);
   /// Advances time without a frame (live input): silent nodes go offline.
   void tick(double t_s);
-  /// End of input: closes every open report and writes the JSON lines summary.
+  /// End of input: closes every open report and writes the final acceptance records and the JSON
+  /// lines summary.
   void finish();
 
   const Decoder& decoder() const { return decoder_; }
@@ -79,6 +88,8 @@ class Session {
 
  private:
   void on_event(DecoderEvent e, const NodeView& node, std::uint8_t seq);
+  bool judging() const { return options_.limits != nullptr && !options_.limits->empty(); }
+  void write_acceptance(double time_s, const NodeView& node, bool final);  // of decisions_
 
   SessionOptions options_;
   ConfidenceIntervals intervals_;
@@ -88,6 +99,8 @@ class Session {
   CandumpLine parsed_;
   std::vector<TauRow> rows_;
   std::vector<WindowRow> window_rows_;
+  std::vector<Decision> decisions_;                             // of the node whose report closed last
+  std::map<std::uint8_t, std::vector<Verdict>> verdicts_written_;  // per node, in its last acceptance record
   Decoder decoder_;  // last: its listener uses the members above
 };
 

@@ -8,11 +8,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <map>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -32,6 +35,13 @@ using test_support::run_shell;
 using test_support::slurp;
 using Outcome = test_support::ShellOutcome;
 std::string temp(const std::string& name) { return test_support::temp_path(name); }
+
+// "16" -> "0x10": a node as the summary names it.
+std::string fmt_node(const std::string& decimal) {
+  char b[8];
+  std::snprintf(b, sizeof b, "0x%02X", std::stoi(decimal) & 0xFF);
+  return b;
+}
 
 std::string file_with(const std::string& name, const std::string& content) {
   const std::string path = temp(name);
@@ -217,14 +227,162 @@ TEST(AcceptanceCli, DecoderGivesVerdictsAndReportPerNode) {
   std::size_t records = 0;
   for (std::string line; std::getline(in, line);)
     if (line.find("\"type\":\"acceptance\"") != std::string::npos) {
-      ++records;
       const auto j = nlohmann::json::parse(line);
       EXPECT_EQ(j.at("limits").size(), 2u);
+      if (!j.at("final").get<bool>()) continue;  // a record when a verdict changed (next test)
+      ++records;
       EXPECT_EQ(j.at("limits")[1].at("verdict"), "fail") << "no gyro has an ADEV below 1e-9 deg/h: " << line;
     }
   EXPECT_GE(records, 1u);
   const std::string rows = slurp(summary);
   EXPECT_EQ(static_cast<std::size_t>(std::count(rows.begin(), rows.end(), '\n')), records + 1) << rows;
+}
+
+// Fields of a CSV line (the decoder's names and values hold no comma or quote).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> f(1);
+  for (const char c : line) {
+    if (c == ',')
+      f.emplace_back();
+    else
+      f.back().push_back(c);
+  }
+  return f;
+}
+
+// The decoder with --limits judges every report: its per-tau CSV's verdict columns and its JSON
+// lines records against the decoder's own --summary of the same run (the oracle: each node's row,
+// written at the end from its final state), and the CSV without --limits, which must be the same
+// file with the verdict columns taken off. N <= 1 deg/sqrt(h) is far above the demo's gyros (N a
+// few 1e-3), adev(10.24 s) <= 1e-9 deg/h far below any gyro's: both are decided as soon as there
+// is an estimate, the ADEV at 10.24 s within the run's first minutes (its first EDF is there after
+// a few taus).
+TEST(AcceptanceCli, DecoderJudgesEveryReportInCsvAndJsonLines) {
+  const std::string log = temp("demo_judged.log");
+  Outcome r = run_shell(demo + " --hours 0.34 --window 0 --view-every 0 --csv '' --plot '' --candump " + log + " > /dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string lim = file_with("judged_limits.txt", "N <= 1 deg/sqrt(h)\nadev(10.24 s) <= 1e-9 deg/h\nB <= 1e3 deg/h\n");
+  const std::string csv = temp("judged.csv"), plain = temp("plain.csv"), jsonl = temp("judged.jsonl"),
+                    summary = temp("judged_summary.csv");
+  std::remove(summary.c_str());
+  r = run_shell(decode + " " + log + " --view none --limits " + lim + " --csv " + csv + " --jsonl " + jsonl +
+                " --summary " + summary);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run_shell(decode + " " + log + " --view none --csv " + plain);
+  ASSERT_EQ(r.code, 0) << r.err;
+
+  // Without --limits: the same bytes as with them, less the 16 verdict columns (1 + 5 a limit).
+  std::istringstream judged_lines(slurp(csv));
+  std::string stripped, line;
+  while (std::getline(judged_lines, line)) {
+    std::size_t cut = line.size();
+    for (int k = 0; k < 16; ++k) cut = line.rfind(',', cut - 1);
+    stripped += line.substr(0, cut) + "\n";
+  }
+  EXPECT_TRUE(stripped == slurp(plain)) << "the CSV without --limits is byte for byte the CSV less its verdict columns";
+
+  // The summary's row of each node, by column name.
+  std::istringstream summary_lines(slurp(summary));
+  std::getline(summary_lines, line);
+  const std::vector<std::string> summary_header = csv_fields(line);
+  std::map<std::string, std::map<std::string, std::string>> final_row;  // node "0x10" -> column -> field
+  while (std::getline(summary_lines, line)) {
+    const auto f = csv_fields(line);
+    ASSERT_EQ(f.size(), summary_header.size()) << line;
+    for (std::size_t k = 0; k < f.size(); ++k) final_row[f[1]][summary_header[k]] = f[k];
+  }
+  ASSERT_EQ(final_row.size(), 2u) << "the demo's two nodes";
+
+  // The CSV: the rows of each node's last report carry the summary's verdicts.
+  std::istringstream csv_lines(slurp(csv));
+  std::getline(csv_lines, line);
+  const std::vector<std::string> header = csv_fields(line);
+  const auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  std::map<std::string, std::vector<std::vector<std::string>>> last_report;  // node -> rows of its last report
+  while (std::getline(csv_lines, line)) {
+    const auto f = csv_fields(line);
+    ASSERT_EQ(f.size(), header.size()) << line;
+    if (f[column("type")] != "tau") continue;
+    auto& rows = last_report[fmt_node(f[column("node")])];
+    if (!rows.empty() && rows.back()[column("seq")] != f[column("seq")]) rows.clear();
+    rows.push_back(f);
+  }
+  ASSERT_EQ(last_report.size(), 2u);
+  for (const auto& [node, rows] : last_report) {
+    SCOPED_TRACE(node);
+    const auto& want = final_row.at(node);
+    std::size_t adev_rows = 0;
+    for (const auto& row : rows) {
+      EXPECT_EQ(row[column("verdict")], want.at("verdict"));
+      for (const std::string q : {"N", "B", "adev(10.24 s)"}) {
+        const bool term = q.size() == 1;
+        const std::string unit = q == "N" ? "deg/sqrt(h)" : "deg/h";
+        const bool applies = !row[column(q + " limit [" + unit + "]")].empty();
+        if (q == "B") {
+          ASSERT_TRUE(applies) << "a term limit applies to every tau row";
+        }
+        if (!applies) {
+          EXPECT_EQ(row[column(q + " verdict")], "");
+          continue;
+        }
+        if (!term) {
+          ++adev_rows;
+          EXPECT_NEAR(std::stod(row[column("tau_s")]), 10.24, 1e-5) << "a deviation limit on its tau's row only";
+        }
+        for (const std::string& c : {std::string(" verdict"), " estimate [" + unit + "]", std::string(" lower"),
+                                     std::string(" upper")})
+          EXPECT_EQ(row[column(q + c)], want.at(q + c)) << q + c;
+      }
+    }
+    EXPECT_EQ(adev_rows, 1u) << "the one row of tau 10.24 s";
+    EXPECT_EQ(want.at("adev(10.24 s) verdict"), "fail");
+  }
+
+  // The JSON lines: each node's verdicts when they change, the decided adev fail long before the
+  // end, and the final record equal to the summary.
+  std::map<int, std::vector<nlohmann::json>> records;
+  double end_s = 0;
+  std::ifstream in(jsonl);
+  while (std::getline(in, line)) {
+    const auto j = nlohmann::json::parse(line);
+    if (j.at("type") == "acceptance") records[j.at("node").get<int>()].push_back(j);
+    if (j.at("type") == "summary") end_s = j.at("last_s").get<double>();
+  }
+  ASSERT_EQ(records.size(), 2u);
+  for (const auto& [node, list] : records) {
+    SCOPED_TRACE(node);
+    ASSERT_GE(list.size(), 2u);
+    double decided_at = -1;
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      EXPECT_EQ(list[k].at("final").get<bool>(), k + 1 == list.size());
+      if (decided_at < 0 && list[k].at("limits")[1].at("verdict") == "fail") decided_at = list[k].at("time").get<double>();
+      if (k == 0 || k + 1 == list.size()) continue;
+      bool changed = false;  // a record only when a verdict changed
+      for (std::size_t i = 0; i < 3; ++i)
+        changed |= list[k].at("limits")[i].at("verdict") != list[k - 1].at("limits")[i].at("verdict");
+      EXPECT_TRUE(changed) << list[k - 1] << "\n" << list[k];
+    }
+    ASSERT_GE(decided_at, 0) << "the adev limit is failed";
+    EXPECT_LT(decided_at, end_s - 600) << "decided in the run's first half, not only at its end";
+    const auto& want = final_row.at(fmt_node(std::to_string(node)));
+    EXPECT_EQ(list.back().at("verdict"), want.at("verdict"));
+    EXPECT_EQ(list.back().at("limits")[0].at("verdict"), want.at("N verdict"));
+  }
+}
+
+// A bad limits file is refused before anything is written: the CSV given keeps its bytes.
+TEST(AcceptanceCli, DecoderRefusesABadLimitsFileAndWritesNothing) {
+  const std::string csv = file_with("kept.csv", "an earlier run's CSV\n");
+  const std::string bad = file_with("bad_for_csv.txt", "N <= 0.003 deg/sqrt(h)\nadev(0 s) <= 1 deg/h\n");
+  const Outcome r = run_shell(decode + " " + counts() + " --limits " + bad + " --csv " + csv + " --jsonl " + temp("none.jsonl"));
+  EXPECT_EQ(r.code, exit_code::bad_input) << r.err;
+  EXPECT_TRUE(std::regex_match(r.err, std::regex("gyrochar-decode: --limits: [^\n]+: line 2: [^\n]+\n"))) << r.err;
+  EXPECT_EQ(slurp(csv), "an earlier run's CSV\n");
+  EXPECT_EQ(access(temp("none.jsonl").c_str(), F_OK), -1) << "no output opened";
 }
 
 // The decoder's report shows what its final view shows beyond the tau table: the model's terms

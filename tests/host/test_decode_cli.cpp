@@ -321,12 +321,21 @@ void expect_row(const Csv& csv, const std::vector<std::string>& row, const LogWr
 
 // ---------------------------------------------------------------------------------------------
 
-TEST(DecodeCli, CsvAndJsonLinesCarryTheEncodedValuesOfEveryNode) {
-  const std::map<std::uint8_t, NodeSpec> nodes{{0x10, {0x10, 6, AngleUnit::arcsec, 0.01f}},
-                                               {0x2A, {0x2A, 4, AngleUnit::rad, 0.5f}}};
+// Two nodes of different units, tau0 and tau counts, and nine complete reports of each, node
+// 0x2A's 0.3 s after 0x10's.
+const std::map<std::uint8_t, NodeSpec> two_nodes{{0x10, {0x10, 6, AngleUnit::arcsec, 0.01f}},
+                                                 {0x2A, {0x2A, 4, AngleUnit::rad, 0.5f}}};
+LogWriter nine_reports() {
   LogWriter log;
   for (std::uint8_t seq = 0; seq < 9; ++seq)
-    for (const auto& [address, n] : nodes) log.report(n, seq, 1000.0 + seq + 0.3 * (address == 0x2A), 100u * (seq + 1));
+    for (const auto& [address, n] : two_nodes)
+      log.report(n, seq, 1000.0 + seq + 0.3 * (address == 0x2A), 100u * (seq + 1));
+  return log;
+}
+
+TEST(DecodeCli, CsvAndJsonLinesCarryTheEncodedValuesOfEveryNode) {
+  const std::map<std::uint8_t, NodeSpec>& nodes = two_nodes;
+  const LogWriter log = nine_reports();
   const std::string csv_path = temp("values.csv"), jsonl_path = temp("values.jsonl");
   const Outcome r =
       run(log.write("values.log") + " --view none --rate-unit native --csv " + csv_path + " --jsonl " + jsonl_path);
@@ -390,6 +399,97 @@ TEST(DecodeCli, CsvAndJsonLinesCarryTheEncodedValuesOfEveryNode) {
   EXPECT_EQ(taus, csv.rows.size());
   EXPECT_EQ(reports, 18u);
   EXPECT_EQ(summaries, 1u);
+}
+
+// --limits: the verdict columns of every tau row and the JSON lines acceptance records written when
+// a verdict changes. Oracles: the values encoded (N = 0.002 A/sqrt(s) with a relative uncertainty of
+// 12.5 %, A = arcsec for node 0x10 and rad for 0x2A; 1 arcsec/sqrt(s) = 1/60 deg/sqrt(h), 1 rad =
+// 180/pi deg, 1 arcsec/s = 1 deg/h), the decision rule of limits.hpp (value -+ 1.959964 u; a
+// deviation's two-sided 95 % chi-squared interval of confidence.hpp), and the node's fit summary,
+// which first arrives in report 3: before it N is undecided.
+TEST(DecodeCli, LimitsAddVerdictColumnsAndRecordsWhenAVerdictChanges) {
+  const std::map<std::uint8_t, NodeSpec>& nodes = two_nodes;
+  const LogWriter log = nine_reports();
+  const std::string limits = temp("limits.txt"), csv_path = temp("limits.csv"), jsonl_path = temp("limits.jsonl"),
+                    plain_path = temp("plain.csv");
+  // N: 3.3e-5 deg/sqrt(h) for 0x10 (pass), 6.9 deg/sqrt(h) for 0x2A (fail). adev(0.04 s): tau 2 of
+  // 0x10 (m = 4), 1.33 deg/h with EDF 8 (pass); 0x2A has no such tau (undecided).
+  std::ofstream(limits) << "N <= 1e-4 deg/sqrt(h)\nadev(0.04 s) <= 10 deg/h\n";
+  const std::string log_path = log.write("limits.log");
+  const Outcome r = run(log_path + " --view none --limits " + limits + " --csv " + csv_path + " --jsonl " + jsonl_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(run(log_path + " --view none --csv " + plain_path).code, 0);
+
+  const Csv csv = read_csv(csv_path);
+  const std::vector<std::string> added{"verdict",     "N limit [deg/sqrt(h)]",        "N verdict",          "N estimate [deg/sqrt(h)]",
+                                       "N lower",     "N upper",                      "adev(0.04 s) limit [deg/h]",
+                                       "adev(0.04 s) verdict", "adev(0.04 s) estimate [deg/h]", "adev(0.04 s) lower",
+                                       "adev(0.04 s) upper"};
+  const Csv plain = read_csv(plain_path);
+  ASSERT_EQ(csv.header.size(), plain.header.size() + added.size());
+  EXPECT_TRUE(std::equal(added.begin(), added.end(), csv.header.end() - static_cast<long>(added.size())));
+  ASSERT_EQ(csv.rows.size(), plain.rows.size());
+  // Per node, the verdict pairs (N, adev) of its reports in order: each change is a record.
+  std::map<int, std::vector<std::pair<std::string, std::string>>> changes;
+  for (std::size_t k = 0; k < csv.rows.size(); ++k) {
+    const auto& row = csv.rows[k];
+    EXPECT_TRUE(std::equal(plain.rows[k].begin(), plain.rows[k].end(), row.begin())) << "the same row, columns added";
+    const int node = std::stoi(csv.get(row, "node")), seq = std::stoi(csv.get(row, "seq"));
+    const bool arcsec = node == 0x10;
+    SCOPED_TRACE(testing::Message() << "node " << node << " seq " << seq << " tau " << csv.get(row, "tau_index"));
+    // N: on every tau row; decided once the summary (report 3) says the fit is ok.
+    EXPECT_EQ(csv.get(row, "N limit [deg/sqrt(h)]"), "0.0001");
+    const std::string n_verdict = seq < 3 ? "undecided" : arcsec ? "pass" : "fail";
+    EXPECT_EQ(csv.get(row, "N verdict"), n_verdict);
+    if (seq >= 3) {
+      const double n = static_cast<double>(ieee_of(1)) * (arcsec ? 1.0 / 60.0 : rad_to_deg * 60.0);
+      EXPECT_NEAR(std::stod(csv.get(row, "N estimate [deg/sqrt(h)]")), n, 1e-12 * n);
+      EXPECT_NEAR(std::stod(csv.get(row, "N lower")), n * (1 - 1.959963984540054 * 0.125), 1e-12 * n);
+      EXPECT_NEAR(std::stod(csv.get(row, "N upper")), n * (1 + 1.959963984540054 * 0.125), 1e-12 * n);
+    } else {
+      EXPECT_EQ(csv.get(row, "N estimate [deg/sqrt(h)]"), "");
+    }
+    // adev(0.04 s): only on the row of that tau, once its m is known.
+    const bool at_tau = arcsec && csv.get(row, "tau_index") == "2" && csv.get(row, "m") == "4";
+    EXPECT_EQ(csv.get(row, "adev(0.04 s) limit [deg/h]"), at_tau ? "10" : "");
+    EXPECT_EQ(csv.get(row, "adev(0.04 s) verdict"), at_tau ? "pass" : "");
+    if (at_tau) {
+      const double dev = static_cast<double>(adev_of(nodes.at(0x10), static_cast<std::uint8_t>(seq), 2));
+      const Interval ci = confidence_interval(dev, edf_of(2), 0.95);
+      EXPECT_NEAR(std::stod(csv.get(row, "adev(0.04 s) estimate [deg/h]")), dev, 1e-12 * dev);
+      EXPECT_NEAR(std::stod(csv.get(row, "adev(0.04 s) lower")), ci.low, 1e-12 * dev);
+      EXPECT_NEAR(std::stod(csv.get(row, "adev(0.04 s) upper")), ci.high, 1e-12 * dev);
+    }
+    // The node's verdict: 0x2A fails N; 0x10 passes both once the fit and tau 2's m are known.
+    const Expected* e = find_expected(log, static_cast<std::uint8_t>(node), static_cast<std::uint8_t>(seq), 0);
+    ASSERT_NE(e, nullptr);
+    const bool tau2_known = e->m.size() > 2 && e->m[2] != 0;
+    EXPECT_EQ(csv.get(row, "verdict"), seq < 3 ? "undecided" : !arcsec ? "fail" : tau2_known ? "pass" : "undecided");
+    if (csv.get(row, "tau_index") == "2") {
+      auto& c = changes[node];
+      const std::pair<std::string, std::string> now{n_verdict, csv.get(row, "adev(0.04 s) verdict")};
+      if (c.empty() || c.back() != now) c.push_back(now);
+    }
+  }
+  // The JSON lines: a record at each change (the first report too), then one final record a node.
+  std::map<int, std::vector<Json>> records;
+  for (const Json& j : read_jsonl(jsonl_path))
+    if (j.at("type") == "acceptance") records[j.at("node").get<int>()].push_back(j);
+  for (const auto& [node, list] : records) {
+    SCOPED_TRACE(node);
+    ASSERT_EQ(list.size(), changes[node].size() + 1);
+    for (std::size_t k = 0; k + 1 < list.size(); ++k) {
+      EXPECT_EQ(list[k].at("final"), false);
+      EXPECT_EQ(list[k].at("limits")[0].at("verdict"), changes[node][k].first);
+      if (!changes[node][k].second.empty()) {
+        EXPECT_EQ(list[k].at("limits")[1].at("verdict"), changes[node][k].second);
+      }
+    }
+    EXPECT_EQ(list.back().at("final"), true);
+    EXPECT_EQ(list.back().at("verdict"), node == 0x10 ? "pass" : "fail");
+    EXPECT_GE(list.size(), 3u) << "undecided at report 0, decided at report 3, final";
+  }
+  EXPECT_EQ(records.size(), 2u);
 }
 
 TEST(DecodeCli, RatesInDegreesPerHourAndPulsesNeverConverted) {
