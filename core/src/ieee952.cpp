@@ -162,6 +162,11 @@ Ieee952Parameter parameter(const Problem& pr, const Solution& sol, const Flags& 
   const double variance = p.fitted ? sol.cov[t][t] : free[t] ? sol.free_variance[t] : 0.0;
   const double sd = std::sqrt(std::fabs(variance)) * birge;
   p.uncertainty = p.value > 0 ? sd / (2 * p.value) : std::sqrt(sd);
+  if (free[t] && sol.free_variance[t] > 0) {
+    const double free_theta = sol.free_theta[t], free_sd = std::sqrt(sol.free_variance[t]) * birge;
+    p.unconstrained = free_theta > 0 ? std::sqrt(free_theta) : 0.0;
+    p.unconstrained_uncertainty = free_theta > 0 ? free_sd / (2 * p.unconstrained) : std::sqrt(free_sd);
+  }
   if (!p.fitted || !(theta > 2 * sd) || rejected_model) return p;
   for (std::size_t i = 0; i < pr.n && !p.resolved; ++i) {  // the largest contribution somewhere
     // The ramp's response is modeled exactly for Allan and modified Allan estimates only: a

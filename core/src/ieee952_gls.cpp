@@ -269,7 +269,7 @@ Solution solve(const Problem& pr, const Flags& free, const Terms& fixed) {
   }
   std::size_t n_free = 0;
   for (std::size_t t = 0; t < columns; ++t) n_free += free[t];
-  Terms free_variance{};
+  Terms free_theta{}, free_variance{};
   const unsigned extra = ((1u << columns) - 1) & ~((1u << power_terms) - 1);
   for (unsigned power_mask = 0; power_mask < (1u << power_terms); ++power_mask) {
     const unsigned mask = power_mask | extra;
@@ -295,8 +295,11 @@ Solution solve(const Problem& pr, const Flags& free, const Terms& fixed) {
     Terms x{};
     Matrix inv{};
     if (!solve_small(ata, atb, k, x, inv)) continue;
-    if (k == n_free)  // every free term: its variances
-      for (std::size_t a = 0; a < k; ++a) free_variance[idx[a]] = inv[a][a] * scale[idx[a]] * scale[idx[a]];
+    if (k == n_free)  // every free term: the unconstrained estimates and their variances
+      for (std::size_t a = 0; a < k; ++a) {
+        free_theta[idx[a]] = x[a] * scale[idx[a]];
+        free_variance[idx[a]] = inv[a][a] * scale[idx[a]] * scale[idx[a]];
+      }
     bool feasible = true;
     for (std::size_t a = 0; a < k; ++a) feasible &= x[a] >= 0;
     if (!feasible) continue;
@@ -318,6 +321,7 @@ Solution solve(const Problem& pr, const Flags& free, const Terms& fixed) {
       for (std::size_t b = 0; b < k; ++b) best.cov[idx[a]][idx[b]] = inv[a][b] * scale[idx[a]] * scale[idx[b]];
     }
   }
+  best.free_theta = free_theta;
   best.free_variance = free_variance;
   // With no free term (or none feasible) the held terms alone are the model.
   if (!best.ok) {

@@ -107,7 +107,7 @@ struct Solution {
   Terms theta{};
   Matrix cov{};
   Flags active{};
-  Terms free_variance{};  // of each free term in the model with every free term
+  Terms free_theta{}, free_variance{};  // each free term in the model with every free term, unconstrained
   double chi2 = 0;
   bool ok = false;
   bool feasible = false;  // a non-negative solution with every term beyond the five in it was found

@@ -17,7 +17,7 @@ LimitEstimate term_estimate(const Report& r, std::size_t k, double run_s) {
   const Ieee952Parameter& p = fit.p[k];
   if (!p.fitted) return no_estimate(fmt::format("{} not in the fitted model", letter));
   if (!p.resolved) return no_estimate(fmt::format("{} not resolved", letter));
-  return normal_estimate(p.value, p.uncertainty, run_s);
+  return fitted_term_estimate(p, run_s);
 }
 
 LimitEstimate deviation_row_estimate(const Limit& l, const Report& r, const std::vector<AnalysisRow>& rows,
@@ -39,6 +39,13 @@ LimitEstimate deviation_row_estimate(const Limit& l, const Report& r, const std:
 }
 
 }  // namespace
+
+// The non-negative fit's value leans low where it clips another term at zero (docs/metrology.md,
+// "Acceptance limits"): judged by it, a gyro at the limit would pass more often than the risk.
+LimitEstimate fitted_term_estimate(const Ieee952Parameter& p, double run_s) {
+  if (p.unconstrained_uncertainty > 0) return normal_estimate(p.unconstrained, p.unconstrained_uncertainty, run_s);
+  return normal_estimate(p.value, p.uncertainty, run_s);
+}
 
 int exit_code_of(Verdict v) {
   return v == Verdict::fail ? exit_limits_failed : v == Verdict::undecided ? exit_limits_undecided : 0;

@@ -23,6 +23,10 @@ int exit_code_of(Verdict overall);
 /// a whole multiple of tau0 within 1e-9 relative, or for a term. O(1).
 std::uint64_t limit_m(const Limit& limit, double tau0_s);
 
+/// A fitted term's estimate for a verdict: its unconstrained value and uncertainty where the fit
+/// gives them (Ieee952Parameter: unbiased where the model holds), else its own. O(1).
+LimitEstimate fitted_term_estimate(const Ieee952Parameter& p, double run_s);
+
 /// The decision of every limit for `r` over `rows` (every row computed, in engine units; the
 /// report's own rows may be a subset) and a run of run_s seconds. Limits need gyro data (the
 /// caller checks). O(limits x rows).

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "acceptance.hpp"
 #include "limits.hpp"
 #include "support/recovery.hpp"
 
@@ -62,7 +63,7 @@ TEST(VerdictMonteCarlo, WrongVerdictsStayWithinTheStatedRiskAndUndecidedShrinks)
         const Recovery rec = recover(o);
         const Ieee952Fit& fit = rec.fit();
         const Ieee952Parameter& n = fit.p[1];
-        const LimitEstimate e = fit.ok() && n.fitted && n.resolved ? normal_estimate(n.value, n.uncertainty, o.duration_s)
+        const LimitEstimate e = fit.ok() && n.fitted && n.resolved ? fitted_term_estimate(n, o.duration_s)
                                                                    : no_estimate("not resolved");
         const Decision v = decide(limit, e);
         Tally& t = tally[d][c];

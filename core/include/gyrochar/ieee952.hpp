@@ -132,6 +132,10 @@ struct Ieee952Parameter {
   double uncertainty = 0;  // standard uncertainty, same unit (scaled by the Birge ratio)
   bool fitted = false;     // part of the model the fit kept (false: left out, or held fixed)
   bool resolved = false;   // see the header
+  // The same term in the model with every free term, its square not held non-negative: unbiased
+  // where the model holds (the non-negative value above leans low or high where another term is
+  // clipped at zero); 0 and 0 where the term was not free. What acceptance verdicts judge.
+  double unconstrained = 0, unconstrained_uncertainty = 0;
 };
 
 /// A Markov term of the fit: sigma its stationary standard deviation [r/s], Tc its correlation time.
