@@ -89,6 +89,8 @@ std::optional<DevStat> parse_dev_stat(const std::string& text) {
   return std::nullopt;
 }
 
+bool valid_stride_factor(std::uint32_t s) { return s >= 2 && std::has_single_bit(s) && s <= (1u << 24); }
+
 std::uint32_t resolve_stride_factor(std::uint32_t requested, std::uint64_t m_max) {
   if (requested != 0) return requested;
   return static_cast<std::uint32_t>(std::bit_ceil(std::clamp<std::uint64_t>(m_max, 2, full_stride_cap)));
@@ -680,7 +682,7 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   for (std::size_t i = 0; i < o.m_list.size(); ++i)
     if (o.m_list[i] == 0 || (i > 0 && o.m_list[i] <= o.m_list[i - 1]))
       throw std::invalid_argument("averaging factors must be positive and strictly increasing");
-  if (o.stride_factor != 0 && (o.stride_factor < 2 || !std::has_single_bit(o.stride_factor) || o.stride_factor > (1u << 24)))
+  if (o.stride_factor != 0 && !valid_stride_factor(o.stride_factor))
     throw std::invalid_argument("the stride factor must be a power of two from 2 to 2^24");
   const std::uint32_t s = resolve_stride_factor(o.stride_factor, o.m_list.back());
   for (const std::uint64_t m : o.m_list)
