@@ -40,6 +40,10 @@ std::optional<DevStat> parse_dev_stat(const std::string& text);
 /// length; taus above it are strided (terms every m/S points) and their EDF says so.
 inline constexpr std::uint32_t full_stride_cap = 1u << 16;
 
+/// True for a stride factor the core's characterizer accepts: a power of two from 2 to 2^24
+/// (ConfigureStatus::bad_stride_factor otherwise). O(1).
+bool valid_stride_factor(std::uint32_t s);
+
 /// The stride factor used for a request: `requested` (a power of two >= 2) as is; 0 means "full":
 /// the smallest power of two >= m_max (so every tau is fully overlapped), at least 2 and at most
 /// full_stride_cap. O(1).

@@ -11,8 +11,6 @@
 #include <limits>
 #include <numbers>
 
-#include "gyrochar/greenhall_edf.hpp"
-#include "gyrochar/total.hpp"
 
 namespace gyrochar {
 
@@ -128,105 +126,6 @@ const char* name(LongTau l) {
     case LongTau::theoh: return "theoh";
   }
   return "?";
-}
-
-namespace {
-
-const AnalysisRow* oadev_row(const Analysis& a, std::uint64_t m) {  // the row at m, or the last before it
-  const AnalysisRow* found = nullptr;
-  for (const AnalysisRow& r : a.rows)
-    if (r.stat == DevStat::oadev && r.m <= m) found = &r;
-  return found;
-}
-
-// The Allan curve's long taus from the total family (LongTau; docs/metrology.md says why so). x:
-// the phase in engine units; unit: one of them in SI. Points keep the Allan geometry and carry
-// variance_scale = the Allan estimate's EDF over their own (Greenhall's and SP 1065's formulas for
-// the identified alpha).
-void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& a, std::span<const double> x,
-                  double tau0, double unit) {
-  const double N = static_cast<double>(x.size());
-  auto allan_edf = [&](int alpha, std::uint64_t m) {
-    const double md = static_cast<double>(m);
-    return edf_greenhall({alpha, 2, md, false, md, N});
-  };
-  if (input == LongTau::totdev) {
-    for (FitPoint& p : points) {
-      const AnalysisRow* r = p.stat == Stat::avar ? oadev_row(a, p.m) : nullptr;
-      if (r == nullptr || !r->alpha) continue;
-      const int alpha = *r->alpha;
-      const double md = static_cast<double>(p.m), edf = edf_totvar(alpha, N, md), edf_a = allan_edf(alpha, p.m);
-      if (!(edf > edf_a && edf_a > 0)) continue;
-      p.variance = totvar(x, p.m, tau0).var / totvar_bias(alpha, N, md) * unit * unit;
-      p.edf = edf;
-      p.variance_scale = edf_a / edf;
-    }
-    return;
-  }
-  const std::uint64_t k = theoh_switch(x.size());
-  std::erase_if(points, [&](const FitPoint& p) { return p.stat == Stat::avar && p.m >= k; });
-  constexpr std::uint32_t S = 16;
-  const double ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(x.size(), S)).ratio;
-  if (!(ratio > 0)) return;
-  for (std::uint64_t mt = 2 * k; 2 * (3 * mt / 4) + 1 <= x.size(); mt *= 2) {
-    const std::uint64_t m = 3 * mt / 4;  // tau = 0.75 mt tau0: the Allan geometry at m
-    const AnalysisRow* r = oadev_row(a, m);
-    if (r == nullptr || !r->alpha) continue;
-    const double edf = edf_theo1(*r->alpha, N, static_cast<double>(mt)), edf_a = allan_edf(*r->alpha, m);
-    if (!(edf > 0 && edf_a > 0)) continue;
-    const double var = theo1(x, mt, tau0, theo1_stride(mt, x.size(), S)).var * ratio * unit * unit;
-    points.push_back({Stat::avar, m, 1, x.size() - 2 * m, var, edf, edf_a / edf});
-  }
-}
-
-}  // namespace
-
-std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s, LongTau long_tau,
-                                 const PhaseRecord& record) {
-  std::vector<FitPoint> points;
-  for (const AnalysisRow& r : a.rows) {
-    if ((r.stat != DevStat::oadev && r.stat != DevStat::mdev) || !std::has_single_bit(r.m)) continue;
-    const double dev_si = r.dev * units.phase_unit_si;
-    points.push_back({r.stat == DevStat::oadev ? Stat::avar : Stat::mvar, r.m, r.stride, r.n, dev_si * dev_si, r.edf});
-  }
-  if (long_tau != LongTau::oadev && !record.phase.empty())
-    use_long_tau(points, long_tau, a, record.phase, tau0_s, units.phase_unit_si * record.phase_scale);
-  return points;
-}
-
-std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
-                                 double white_quantization_si, LongTau long_tau, const PhaseRecord& record,
-                                 const std::array<double, max_sinusoids>& sinusoid_hz) {
-  const std::vector<FitPoint> points = fit_points(a, units, tau0_s, long_tau, record);
-  std::vector<CurveFit> fits;
-  if (points.empty()) return fits;
-  std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
-  // The three fits share the covariance sums of their points (and the sinusoids' with them):
-  // computed once, in a cache with room for every pair.
-  std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
-  std::vector<PairSumCache::SinusoidEntry> sinusoid_entries(points.size() * points.size() + 16);
-  PairSumCache cache(entries, sinusoid_entries);
-  FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
-  setup.sinusoid_hz = sinusoid_hz;
-  const int used = long_tau != LongTau::oadev && !record.phase.empty() ? static_cast<int>(long_tau) : 0;
-  for (const FitCurve curve : {FitCurve::both, FitCurve::avar, FitCurve::mvar})
-    fits.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache), curve == FitCurve::mvar ? 0 : used});
-  return fits;
-}
-
-std::optional<Ieee952Truth> truth_of(const std::vector<std::string>& header, DataType type, double tau0_s,
-                                     double pulse_weight_rad) {
-  if (type != DataType::counts) return std::nullopt;
-  for (const std::string& line : header) {
-    const auto t = parse_sim_truth_line(line);
-    if (!t) continue;
-    const auto same = [](double a, double b) { return std::fabs(a - b) <= 1e-9 * std::fabs(b); };
-    if (!same(t->options.tau0_s, tau0_s) || !same(t->options.pulse_arcsec * units::arcsec, pulse_weight_rad))
-      return std::nullopt;
-    if (!t->options.segments.empty()) return std::nullopt;  // the gyro changed: no one truth for the run
-    return t->truth;
-  }
-  return std::nullopt;
 }
 
 namespace {

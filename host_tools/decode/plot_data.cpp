@@ -85,6 +85,93 @@ HeatMap window_heat_map(const NodeView& node, const Units& u) {
   return h;
 }
 
+// The simulated gyro's curve in display units over `grid` (its exact sampled curve from tau0 on
+// with Markov terms or sinusoids, as the fitted model's); nothing while the node's units are unknown.
+std::optional<PlotLine> truth_line(const NodeView& node, const TrueTerms& truth, const NodePlot& p,
+                                   const std::vector<double>& grid, const Units& u) {
+  const std::optional<double> to_wire = wire_per_si(node);
+  if (!to_wire) return std::nullopt;
+  // The truth as a fit in wire units; with Markov terms or sinusoids its exact sampled curve
+  // (from tau0 on), as the fitted model's below.
+  Ieee952Fit f;
+  std::array<double, 5> wire{};
+  for (std::size_t k = 0; k < 5; ++k) f.p[k].value = wire[k] = truth.qnbkr[k] * *to_wire;
+  for (const auto& [sigma, tc] : truth.markov)
+    if (f.n_markov < max_markov) f.markov[f.n_markov].sigma.value = sigma * *to_wire, f.markov[f.n_markov++].tc_s = tc;
+  for (const auto& [amplitude, hz] : truth.sinusoids)
+    if (f.n_sinusoids < max_sinusoids)
+      f.sinusoids[f.n_sinusoids].amplitude.value = amplitude * *to_wire, f.sinusoids[f.n_sinusoids++].frequency_hz = hz;
+  const bool beyond = (f.n_markov > 0 || f.n_sinusoids > 0) && node.sampling;
+  const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
+  PlotLine line{std::nullopt, false, "simulated gyro (truth)",
+                beyond ? log_grid(std::max(p.tau_min_s, tau0_s), p.tau_max_s) : grid, {}};
+  for (const double tau : line.tau_s)
+    line.dev.push_back(beyond ? fit_adev(f, tau, tau0_s, u.rate) : model_adev(wire, tau, u.rate));
+  return line;
+}
+
+// The notes on what the node's fit says, before any model line is drawn; false when no model
+// line is to be drawn (the fit rejected or not made).
+bool fit_notes(const NodeView& node, NodePlot& p) {
+  const auto& fit = node.ieee952_summary;
+  if (fit && fit->status == Ieee952Status::rejected) {
+    p.notes.push_back(fmt::format("IEEE-952 fit REJECTED (chi2/dof {:.3g}):", fit->chi2_per_dof));
+    p.notes.push_back("the model does not describe the curve");
+    return false;
+  }
+  if (fit && fit->status != Ieee952Status::ok) {
+    p.notes.push_back(fmt::format("no IEEE-952 fit: {}", fit->status == Ieee952Status::too_few_points
+                                                              ? "too few points"
+                                                              : "singular"));
+    return false;
+  }
+  if (fit && !fit->quantization_white) {
+    const auto below = [&](std::size_t k) {
+      const std::optional<double> tau = fit_excluded_below_tau_s(node, k);
+      return tau ? fmt::format("{:.3g} s", *tau) : std::string("?");
+    };
+    std::string note = "left out:";
+    const auto [avar, mvar] = fit->excluded_below_log2_m;
+    if (avar != 0) note += " ADEV < " + below(0);
+    if (mvar != 0) note += std::string(avar != 0 ? "," : "") + " MDEV < " + below(1);
+    p.notes.push_back("quantization not white, fit");
+    p.notes.push_back(note);
+  }
+  return true;
+}
+
+// Where each term's ADEV equals its parameter (s); B has its own rule (the floor of the sum).
+constexpr std::array<double, 5> read_tau_s{std::numbers::sqrt3, 1.0, 0.0, 3.0, std::numbers::sqrt2};
+constexpr std::array<const char*, 5> read_label{"Q at sqrt(3) s", "N at 1 s", "0.664 B", "K at 3 s", "R at sqrt(2) s"};
+constexpr auto b_index = static_cast<std::size_t>(Ieee952Term::bias_instability);
+
+// A line per resolved term of the five in the fitted model, with its read-off point within the
+// plot; `model` gets every term in the model (wire units). Returns how many are in it.
+std::size_t add_term_lines(const NodeView& node, const Units& u, const std::vector<double>& grid, NodePlot& p,
+                           std::array<double, 5>& model) {
+  const auto inside = [&](double tau) { return tau >= p.tau_min_s && tau <= p.tau_max_s; };
+  std::size_t fitted = 0;
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Ieee952View& t = node.ieee952[k];
+    if (!t.in_model()) continue;
+    ++fitted;
+    model[k] = t.value;
+    if (!t.resolved) continue;
+    std::array<double, 5> one{};
+    one[k] = t.value;
+    PlotLine line{static_cast<Ieee952Term>(k), false,
+                  fmt::format("{} {:.3g} {} (±{:.2g}%)", units::ieee952[k].letter, t.value * u.ieee[k], u.ieee_name[k],
+                              100.0 * t.rel_uncertainty),
+                  grid,
+                  {}};
+    for (const double tau : grid) line.dev.push_back(model_adev(one, tau, u.rate));
+    p.terms.push_back(std::move(line));
+    if (k != b_index && inside(read_tau_s[k]))
+      p.read_offs.push_back({read_tau_s[k], model_adev(one, read_tau_s[k], u.rate), read_label[k]});
+  }
+  return fitted;
+}
+
 }  // namespace
 
 NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceIntervals& intervals, const TrueTerms* truth) {
@@ -111,80 +198,14 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
   p.tau_min_s = lo / 2.0;
   p.tau_max_s = hi * 2.0;
   const std::vector<double> grid = log_grid(p.tau_min_s, p.tau_max_s);
-  if (truth != nullptr) {
-    if (const std::optional<double> to_wire = wire_per_si(node)) {
-      // The truth as a fit in wire units; with Markov terms or sinusoids its exact sampled curve
-      // (from tau0 on), as the fitted model's below.
-      Ieee952Fit f;
-      std::array<double, 5> wire{};
-      for (std::size_t k = 0; k < 5; ++k) f.p[k].value = wire[k] = truth->qnbkr[k] * *to_wire;
-      for (const auto& [sigma, tc] : truth->markov)
-        if (f.n_markov < max_markov) f.markov[f.n_markov].sigma.value = sigma * *to_wire, f.markov[f.n_markov++].tc_s = tc;
-      for (const auto& [amplitude, hz] : truth->sinusoids)
-        if (f.n_sinusoids < max_sinusoids)
-          f.sinusoids[f.n_sinusoids].amplitude.value = amplitude * *to_wire, f.sinusoids[f.n_sinusoids++].frequency_hz = hz;
-      const bool beyond = (f.n_markov > 0 || f.n_sinusoids > 0) && node.sampling;
-      const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
-      PlotLine line{std::nullopt, false, "simulated gyro (truth)",
-                    beyond ? log_grid(std::max(p.tau_min_s, tau0_s), p.tau_max_s) : grid, {}};
-      for (const double tau : line.tau_s)
-        line.dev.push_back(beyond ? fit_adev(f, tau, tau0_s, u.rate) : model_adev(wire, tau, u.rate));
-      p.truth = std::move(line);
-    }
-  }
+  if (truth != nullptr) p.truth = truth_line(node, *truth, p, grid, u);
 
   // What the node's fit says, before any model line is drawn.
   const auto& fit = node.ieee952_summary;
-  if (fit && fit->status == Ieee952Status::rejected) {
-    p.notes.push_back(fmt::format("IEEE-952 fit REJECTED (chi2/dof {:.3g}):", fit->chi2_per_dof));
-    p.notes.push_back("the model does not describe the curve");
-    return p;
-  }
-  if (fit && fit->status != Ieee952Status::ok) {
-    p.notes.push_back(fmt::format("no IEEE-952 fit: {}", fit->status == Ieee952Status::too_few_points
-                                                              ? "too few points"
-                                                              : "singular"));
-    return p;
-  }
-  if (fit && !fit->quantization_white) {
-    const auto below = [&](std::size_t k) {
-      const std::optional<double> tau = fit_excluded_below_tau_s(node, k);
-      return tau ? fmt::format("{:.3g} s", *tau) : std::string("?");
-    };
-    std::string note = "left out:";
-    const auto [avar, mvar] = fit->excluded_below_log2_m;
-    if (avar != 0) note += " ADEV < " + below(0);
-    if (mvar != 0) note += std::string(avar != 0 ? "," : "") + " MDEV < " + below(1);
-    p.notes.push_back("quantization not white, fit");
-    p.notes.push_back(note);
-  }
+  if (!fit_notes(node, p)) return p;
 
-  const auto inside = [&](double tau) { return tau >= p.tau_min_s && tau <= p.tau_max_s; };
-  // Where each term's ADEV equals its parameter (s); B has its own rule below.
-  static constexpr std::array<double, 5> read_tau_s{std::numbers::sqrt3, 1.0, 0.0, 3.0, std::numbers::sqrt2};
-  static constexpr std::array<const char*, 5> read_label{"Q at sqrt(3) s", "N at 1 s", "0.664 B", "K at 3 s",
-                                                         "R at sqrt(2) s"};
-  constexpr auto b_index = static_cast<std::size_t>(Ieee952Term::bias_instability);
   std::array<double, 5> model{};  // the fitted model, wire units
-  std::size_t fitted = 0;
-  for (std::size_t k = 0; k < 5; ++k) {
-    const Ieee952View& t = node.ieee952[k];
-    if (!t.in_model()) continue;
-    ++fitted;
-    model[k] = t.value;
-    if (!t.resolved) continue;
-    std::array<double, 5> one{};
-    one[k] = t.value;
-    PlotLine line{static_cast<Ieee952Term>(k), false,
-                  fmt::format("{} {:.3g} {} (±{:.2g}%)", units::ieee952[k].letter, t.value * u.ieee[k], u.ieee_name[k],
-                              100.0 * t.rel_uncertainty),
-                  grid,
-                  {}};
-    for (const double tau : grid) line.dev.push_back(model_adev(one, tau, u.rate));
-    p.terms.push_back(std::move(line));
-    if (k != b_index && inside(read_tau_s[k]))
-      p.read_offs.push_back({read_tau_s[k], model_adev(one, read_tau_s[k], u.rate), read_label[k]});
-  }
+  const std::size_t fitted = add_term_lines(node, u, grid, p, model);
   // Version 4: the model beyond the five terms, from the same fit (never another's).
   const std::optional<FitModelRow> beyond = fit_model_row(node, u);
   if (beyond && beyond->state != Viewed::shown) {

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <ctime>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -98,13 +99,7 @@ class CounterInputSender {
   std::uint64_t frames_ = 0, late_ = 0, queue_full_waits_ = 0, lost_down_ = 0, lost_queue_full_ = 0;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  using namespace gyrochar;
-  CLI::App app{"gyrochar-sim: pulse counts of a simulated ring laser gyro with known parameters.",
-               "gyrochar-sim"};
-  app.footer(R"(Parameters are in the units gyro data sheets use; the quantization noise follows from the pulse
+constexpr const char* footer = R"(Parameters are in the units gyro data sheets use; the quantization noise follows from the pulse
 weight (Q = pulse weight / sqrt(12), white only when the angle moves at random by a pulse or more
 per sample, or a dither moves it). Bias instability is flicker rate noise (ADEV floor 0.664 B)
 over the band from 1/(2 pi --bias-time) up to 0.34 / tau0. docs/metrology.md gives each term's
@@ -151,26 +146,36 @@ Examples:
   gyrochar-sim --duration 7200 --arw 0.002 --segment 3600:arw=0.004 > doubling.txt   # N doubles halfway
   gyrochar-sim --duration 36000 --tau0 0.1 --arw 0.002 --markov 0.05,300 --sinusoid 0.02,0.01 > bumps.txt
 
-)" + std::string(exit_code::help));
+)";
+
+// The command line's values.
+struct SimCli {
   SimOptions o;
   std::string out = "-";
-  app.add_option("--duration", o.duration_s, "simulated time in seconds")->capture_default_str();
-  app.add_option("--tau0", o.tau0_s, "sample interval in seconds")->capture_default_str();
-  app.add_option("--pulse-weight", o.pulse_arcsec, "angle per pulse in arcsec")->capture_default_str();
-  app.add_option("--rate", o.rate_deg_per_h, "input rate in deg/h (earth rate by default)")->capture_default_str();
-  app.add_option("--white-angle", o.white_angle_arcsec, "white angle noise beyond quantization, arcsec")
+  std::vector<std::string> segments, markov, sinusoids;
+  std::string can_interface;
+  unsigned can_node = 0x80;
+  double speed = 1.0;
+};
+
+void add_options(CLI::App& app, SimCli& c) {
+  app.add_option("--duration", c.o.duration_s, "simulated time in seconds")->capture_default_str();
+  app.add_option("--tau0", c.o.tau0_s, "sample interval in seconds")->capture_default_str();
+  app.add_option("--pulse-weight", c.o.pulse_arcsec, "angle per pulse in arcsec")->capture_default_str();
+  app.add_option("--rate", c.o.rate_deg_per_h, "input rate in deg/h (earth rate by default)")->capture_default_str();
+  app.add_option("--white-angle", c.o.white_angle_arcsec, "white angle noise beyond quantization, arcsec")
       ->capture_default_str();
-  app.add_option("--arw", o.arw_deg_per_sqrt_h, "angle random walk N in deg/sqrt(h)")->capture_default_str();
-  app.add_option("--rrw", o.rrw_deg_per_h_sqrt_h, "rate random walk K in deg/h/sqrt(h)")->capture_default_str();
-  app.add_option("--bias-instability", o.bias_deg_per_h, "bias instability B in deg/h (flicker rate noise)")
+  app.add_option("--arw", c.o.arw_deg_per_sqrt_h, "angle random walk N in deg/sqrt(h)")->capture_default_str();
+  app.add_option("--rrw", c.o.rrw_deg_per_h_sqrt_h, "rate random walk K in deg/h/sqrt(h)")->capture_default_str();
+  app.add_option("--bias-instability", c.o.bias_deg_per_h, "bias instability B in deg/h (flicker rate noise)")
       ->capture_default_str();
-  app.add_option("--bias-time", o.bias_time_s, "the flicker band reaches down to 1/(2 pi BIAS_TIME), seconds")
+  app.add_option("--bias-time", c.o.bias_time_s, "the flicker band reaches down to 1/(2 pi BIAS_TIME), seconds")
       ->capture_default_str();
-  app.add_option("--ramp", o.ramp_deg_per_h2, "rate ramp R in deg/h/h")->capture_default_str();
-  app.add_option("--dither", o.dither_arcsec, "dither amplitude in arcsec")->capture_default_str();
-  app.add_option("--dither-hz", o.dither_hz, "dither frequency in Hz")->capture_default_str();
+  app.add_option("--ramp", c.o.ramp_deg_per_h2, "rate ramp R in deg/h/h")->capture_default_str();
+  app.add_option("--dither", c.o.dither_arcsec, "dither amplitude in arcsec")->capture_default_str();
+  app.add_option("--dither-hz", c.o.dither_hz, "dither frequency in Hz")->capture_default_str();
   // CLI11 would wrap "-1" to 2^64 - 1: only plain decimal digits are a seed.
-  app.add_option("--seed", o.seed, "random seed 0..2^64-1 (runs are reproducible)")
+  app.add_option("--seed", c.o.seed, "random seed 0..2^64-1 (runs are reproducible)")
       ->capture_default_str()
       ->check(CLI::Validator(
           [](const std::string& text) {
@@ -180,23 +185,24 @@ Examples:
                        : "must be an integer 0..2^64-1, not '" + text + "'";
           },
           "SEED"));
-  std::vector<std::string> segments, markov, sinusoids;
-  app.add_option("--segment", segments, "from T seconds on, change parameters: T:NAME=VALUE[,NAME=VALUE...]")
+  app.add_option("--segment", c.segments, "from T seconds on, change parameters: T:NAME=VALUE[,NAME=VALUE...]")
       ->option_text("T:NAME=VALUE");
-  app.add_option("--markov", markov, "Gauss-Markov rate: stationary sigma in deg/h, correlation time in s (up to 4)")
+  app.add_option("--markov", c.markov, "Gauss-Markov rate: stationary sigma in deg/h, correlation time in s (up to 4)")
       ->option_text("SIGMA,TC");
-  app.add_option("--sinusoid", sinusoids, "sinusoidal rate: amplitude in deg/h, frequency in Hz below 1/(2 tau0) (up to 4)")
+  app.add_option("--sinusoid", c.sinusoids, "sinusoidal rate: amplitude in deg/h, frequency in Hz below 1/(2 tau0) (up to 4)")
       ->option_text("AMP,FREQ");
-  app.add_option("--out", out, "output file, '-' for standard output")->capture_default_str();
-  std::string can_interface;
-  unsigned can_node = 0x80;
-  double speed = 1.0;
-  app.add_option("--can", can_interface, "also send the counts as CounterInput frames on this SocketCAN interface")
+  app.add_option("--out", c.out, "output file, '-' for standard output")->capture_default_str();
+  app.add_option("--can", c.can_interface, "also send the counts as CounterInput frames on this SocketCAN interface")
       ->option_text("IF");
-  app.add_option("--can-node", can_node, "with --can: address of the simulated electronics, 0..253")
+  app.add_option("--can-node", c.can_node, "with --can: address of the simulated electronics, 0..253")
       ->capture_default_str();
-  app.add_option("--speed", speed, "with --can: frames every tau0 / SPEED seconds (1: real time)")->capture_default_str();
-  if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
+  app.add_option("--speed", c.speed, "with --can: frames every tau0 / SPEED seconds (1: real time)")->capture_default_str();
+}
+
+// The options CLI11 took, checked in this order; the exit code when one is refused (said on
+// stderr), nothing when the run goes on. Fills c.o's segments and terms; without --out, --can
+// writes no counts.
+std::optional<int> check_options(const CLI::App& app, SimCli& c) {
   auto bad = [](const char* what, const char* why) {
     print_error(program, what, why);
     return exit_code::bad_input;
@@ -211,32 +217,24 @@ Examples:
     return true;
   };
   std::string why;
-  if (!read_each(segments, parse_segment_option, o.segments, why)) return bad("--segment", why.c_str());
-  if (!read_each(markov, parse_markov_option, o.markov, why)) return bad("--markov", why.c_str());
-  if (!read_each(sinusoids, parse_sinusoid_option, o.sinusoids, why)) return bad("--sinusoid", why.c_str());
-  if (const auto problem = check_parameters(o)) return bad(problem->what, problem->why.c_str());
-  if (can_node > protocol::max_node_address) return bad("--can-node", "must be an address 0..253");
-  if (!(speed > 0) || !std::isfinite(speed)) return bad("--speed", "must be positive");
-  if (can_interface.empty() && (app.count("--can-node") || app.count("--speed")))
+  if (!read_each(c.segments, parse_segment_option, c.o.segments, why)) return bad("--segment", why.c_str());
+  if (!read_each(c.markov, parse_markov_option, c.o.markov, why)) return bad("--markov", why.c_str());
+  if (!read_each(c.sinusoids, parse_sinusoid_option, c.o.sinusoids, why)) return bad("--sinusoid", why.c_str());
+  if (const auto problem = check_parameters(c.o)) return bad(problem->what, problem->why.c_str());
+  if (c.can_node > protocol::max_node_address) return bad("--can-node", "must be an address 0..253");
+  if (!(c.speed > 0) || !std::isfinite(c.speed)) return bad("--speed", "must be positive");
+  if (c.can_interface.empty() && (app.count("--can-node") || app.count("--speed")))
     return bad("--can-node, --speed", "only apply with --can");
-  if (!can_interface.empty())  // a name no interface can have is bad input; a missing one is hardware
-    if (const std::string problem = interface_name_problem(can_interface); !problem.empty())
-      exit_with(exit_code::bad_input, program, "--can", "'" + can_interface + "': " + problem);
-  if (!can_interface.empty() && !app.count("--out")) out.clear();  // frames only
-  const GyroParameters p = gyro_parameters(o);
-  std::unique_ptr<CounterInputSender> sender;
-  if (!can_interface.empty()) {
-    try {
-      sender = std::make_unique<CounterInputSender>(can_interface, static_cast<std::uint8_t>(can_node), p.tau0_s / speed);
-    } catch (const std::exception& e) {
-      exit_with(exit_code::no_hardware, program, e.what());  // "vcan0: why": the interface first
-    }
-  }
-  FILE* f = out.empty() ? nullptr : out == "-" ? stdout : std::fopen(out.c_str(), "w");
-  if (!out.empty() && f == nullptr) exit_with(exit_code::output_failed, program, out, std::strerror(errno));
-  const std::string output_name = out == "-" ? "standard output" : out;
-  if (f != nullptr)  // the description, then the machine-readable truth (sim_truth.hpp)
-    std::fprintf(f, "%s\n%s\n", format_sim_description_line(o).c_str(), format_sim_truth_line(o).c_str());
+  if (!c.can_interface.empty())  // a name no interface can have is bad input; a missing one is hardware
+    if (const std::string problem = interface_name_problem(c.can_interface); !problem.empty())
+      exit_with(exit_code::bad_input, program, "--can", "'" + c.can_interface + "': " + problem);
+  if (!c.can_interface.empty() && !app.count("--out")) c.out.clear();  // frames only
+  return std::nullopt;
+}
+
+// The counts of the run to `f` (may be null) and `sender` (may be null); stops early when `f`
+// fails (its close says so).
+void simulate(const SimOptions& o, FILE* f, CounterInputSender* sender) {
   SimRun sim(o);
   if (sender) sender->send_next(0);  // the start: Count 0
   for (std::uint64_t k = 0; k < sim.samples(); ++k) {
@@ -253,7 +251,36 @@ Examples:
     }
     if (sender) sender->send_next(count);
   }
-  if (sender) std::fprintf(stderr, "gyrochar-sim: %s: %s\n", can_interface.c_str(), sender->summary().c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"gyrochar-sim: pulse counts of a simulated ring laser gyro with known parameters.",
+               "gyrochar-sim"};
+  app.footer(std::string(footer) + std::string(exit_code::help));
+  SimCli c;
+  add_options(app, c);
+  if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
+  if (const auto code = check_options(app, c)) return *code;
+  const SimOptions& o = c.o;
+  const std::string& out = c.out;
+  const GyroParameters p = gyro_parameters(o);
+  std::unique_ptr<CounterInputSender> sender;
+  if (!c.can_interface.empty()) {
+    try {
+      sender = std::make_unique<CounterInputSender>(c.can_interface, static_cast<std::uint8_t>(c.can_node), p.tau0_s / c.speed);
+    } catch (const std::exception& e) {
+      exit_with(exit_code::no_hardware, program, e.what());  // "vcan0: why": the interface first
+    }
+  }
+  FILE* f = out.empty() ? nullptr : out == "-" ? stdout : std::fopen(out.c_str(), "w");
+  if (!out.empty() && f == nullptr) exit_with(exit_code::output_failed, program, out, std::strerror(errno));
+  const std::string output_name = out == "-" ? "standard output" : out;
+  if (f != nullptr)  // the description, then the machine-readable truth (sim_truth.hpp)
+    std::fprintf(f, "%s\n%s\n", format_sim_description_line(o).c_str(), format_sim_truth_line(o).c_str());
+  simulate(o, f, sender.get());
+  if (sender) std::fprintf(stderr, "gyrochar-sim: %s: %s\n", c.can_interface.c_str(), sender->summary().c_str());
   if (f != nullptr && f != stdout && !close_output(f, program, output_name)) return exit_code::output_failed;
   return finish(program, exit_code::ok);
 }

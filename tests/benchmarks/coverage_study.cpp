@@ -12,9 +12,11 @@
 #include <cstring>
 #include <ctime>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "plan.hpp"
 #include "support/coverage.hpp"
 
 namespace {
@@ -181,16 +183,10 @@ Exit codes: 0 success, 1 the study failed otherwise, 2 bad options, 3 cannot wri
   for (const std::size_t n : s.lengths)
     if (n < 4 || n > (std::size_t{1} << 26)) return bad("--lengths", "each from 4 to 2^26 points");
   s.stride_factors.clear();
-  for (const std::string& t : strides) {
-    if (t == "full") {
-      s.stride_factors.push_back(0);
-      continue;
-    }
-    char* end = nullptr;
-    const unsigned long v = std::strtoul(t.c_str(), &end, 10);
-    if (*end != '\0' || v < 2 || v > (1ul << 24) || (v & (v - 1)) != 0)
-      return bad("--stride-factors", "'" + t + "' is neither 'full' nor a power of two from 2 to 2^24");
-    s.stride_factors.push_back(static_cast<std::uint32_t>(v));
+  for (const std::string& t : strides) {  // as gyrochar-analyze --stride-factor (plan.hpp), 0 for full
+    const std::optional<gyrochar::StrideFactor> factor = gyrochar::StrideFactor::parse(t);
+    if (!factor) return bad("--stride-factors", "'" + t + "' is neither 'full' nor a power of two from 2 to 2^24");
+    s.stride_factors.push_back(factor->requested());
   }
   s.stats.clear();
   for (const std::string& t : stats) {

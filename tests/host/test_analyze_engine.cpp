@@ -13,9 +13,59 @@
 
 #include "analysis.hpp"
 #include "datafile.hpp"
+#include "plan.hpp"
 
 namespace gyrochar {
 namespace {
+
+TEST(AnalyzeEngine, StrideFactorParsesFullAndWhatTheCharacterizerAccepts) {
+  // Oracle: the core characterizer's rule (characterizer.hpp, ConfigureStatus::bad_stride_factor):
+  // S a power of two with 2 <= S <= 2^24; "full" left for the planning step.
+  EXPECT_TRUE(StrideFactor::parse("full")->is_full());
+  EXPECT_EQ(StrideFactor::parse("full")->requested(), 0u);
+  EXPECT_EQ(StrideFactor::parse("2")->requested(), 2u);
+  EXPECT_EQ(StrideFactor::parse("16777216")->requested(), 1u << 24);
+  for (const char* text : {"", "0", "1", "3", "12", "33554432", "4294967296", "8x", " 8", "+8", "-8", "Full"})
+    EXPECT_FALSE(StrideFactor::parse(text).has_value()) << "'" << text << "'";
+  for (std::uint32_t s = 1; s != 0; s <<= 1) EXPECT_EQ(valid_stride_factor(s), s >= 2 && s <= (1u << 24)) << s;
+}
+
+TEST(AnalyzeEngine, TauRuleAndListParsedOnce) {
+  // Oracle: the --taus grammar of gyrochar-analyze --help: octave, decade, all, or positive
+  // averaging factors, strictly increasing, separated by commas.
+  EXPECT_EQ(tau_rule("octave"), TauRule::octave);
+  EXPECT_EQ(tau_rule("decade"), TauRule::decade);
+  EXPECT_EQ(tau_rule("all"), TauRule::all);
+  EXPECT_EQ(tau_rule("1,10"), TauRule::list);
+  std::string why;
+  EXPECT_EQ(parse_tau_list("1,10,100", why), (std::vector<std::uint64_t>{1, 10, 100}));
+  EXPECT_EQ(why, "");
+  EXPECT_TRUE(parse_tau_list("1,x", why).empty());
+  EXPECT_EQ(why, "'x' is not octave, decade, all or a positive averaging factor");
+  EXPECT_TRUE(parse_tau_list("4,2", why).empty());
+  EXPECT_EQ(why, "averaging factors must increase");
+  EXPECT_TRUE(parse_tau_list("", why).empty());
+  EXPECT_EQ(why, "empty list");
+  EXPECT_TRUE(parse_tau_list("0", why).empty());
+}
+
+TEST(AnalyzeEngine, FullIsResolvedInThePlanningStep) {
+  // Oracle: full_stride_factor() and resolve_stride_factor() (checked above) applied by hand.
+  AnalysisOptions o;
+  o.type = DataType::phase;
+  plan_taus(o, TauRule::octave, StrideFactor::full(), {}, 4000, std::uint64_t{1} << 40);
+  EXPECT_EQ(o.stride_factor, full_stride_factor(4000));  // 1024: every tau up to N/4 fully overlapped
+  EXPECT_EQ(o.m_list.back(), 1024u);  // octaves up to N/2 = 2000
+  plan_taus(o, TauRule::list, *StrideFactor::parse("8"), {1, 16}, 4000, std::uint64_t{1} << 40);
+  EXPECT_EQ(o.stride_factor, 8u);
+  EXPECT_EQ(o.m_list, (std::vector<std::uint64_t>{1, 16}));
+  // A dynamic window of 100 values (100 phase points): "all" keeps m with 4 m <= 100, and "full"
+  // is the smallest power of two >= the largest of them.
+  plan_window_taus(o, TauRule::all, StrideFactor::full(), {}, 100, 100);
+  EXPECT_EQ(o.m_list.size(), 25u);
+  EXPECT_EQ(o.m_list.back(), 25u);
+  EXPECT_EQ(o.stride_factor, 32u);
+}
 
 TEST(AnalyzeEngine, StrideFactorAndRepresentableTaus) {
   // "full": the smallest power of two >= m_max, within [2, 2^16] (the documented rule).

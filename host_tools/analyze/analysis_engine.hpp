@@ -1,0 +1,65 @@
+#pragma once
+// Inside the offline engine (analysis.hpp), not for its callers: what its engines share (the
+// interface, the read-out of the sums into rows, the record kept for the total family) and the
+// engines over a held record (held_engines.cpp): the batch kernels of counts and of phase or
+// frequency. The characterizer's engine is analysis.cpp's own.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "analysis.hpp"
+#include "gyrochar/estimates.hpp"
+
+namespace gyrochar {
+
+struct EngineBase {
+  virtual ~EngineBase() = default;
+  virtual void add(std::span<const double> values) = 0;
+  virtual Analysis result(const AnalysisOptions& o) const = 0;
+  virtual PhaseRecord record(const AnalysisOptions& o) const = 0;
+  virtual std::vector<std::byte> checkpoint() const { throw std::invalid_argument(no_checkpoint); }
+  virtual std::string restore(std::span<const std::byte>) { throw std::invalid_argument(no_checkpoint); }
+  static constexpr const char* no_checkpoint =
+      "a checkpoint holds the characterizer's state, not a held record: not with the total family or a "
+      "record of known length held in memory";
+};
+
+// The read-out every engine shares: the noise identification of every tau (Allan and Hadamard
+// curves), then each statistic's rows with their EDF and interval, and the total family from the
+// record. `a` has its counts filled in; the rows are appended.
+void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, const AnalysisOptions& o,
+              std::span<const double> record);
+
+// The record for the total family, in the characterizer's phase representation: phase relative
+// to the first point (the statistics ignore a constant), or the running sum of the increments.
+struct KeptRecord {
+  KeptRecord(DataType data_type, bool keep_it) : type(data_type), on(keep_it) {}
+  void keep(double value) {
+    if (!on) return;
+    if (type == DataType::phase) {
+      if (points.empty()) first = value;
+      points.push_back(value - first);
+    } else {
+      if (points.empty()) points.push_back(0.0);
+      points.push_back(points.back() + value);
+    }
+  }
+  DataType type;
+  bool on;
+  double first = 0.0;
+  std::vector<double> points;
+};
+
+/// Counts with the record held: every tau summed over it by the batch kernel (core batch.hpp).
+std::unique_ptr<EngineBase> make_count_batch_engine(std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list,
+                                                    bool keep_record, std::uint64_t values_hint);
+/// Phase or frequency with the record held: every tau summed by float_batch_taus() (float_batch.hpp).
+std::unique_ptr<EngineBase> make_float_batch_engine(DataType type, std::uint32_t stride_factor,
+                                                    const std::vector<std::uint64_t>& m_list, bool keep_record,
+                                                    std::uint64_t values_hint);
+
+}  // namespace gyrochar
