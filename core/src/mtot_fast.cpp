@@ -1,0 +1,239 @@
+// Exact MTOTVAR from lag sums; the derivation in docs/total.md ("MTOTVAR exactly, from lag sums"),
+// the interface in total_fast.hpp.
+//
+// Notation (docs/total.md): a window of len = 3m residuals starting at n; Sp the prefix sums of the
+// residual, zero before the record; U_n[t] = Sp[n + t] - Sp[n]. Every modified-Allan term of the
+// detrended, reflected window is z_k(n) = sum_j a_j Sp[n + p_j(k)]: four "moving" positions
+// p = s k + o (s = +-1, the reflected copies) with integer coefficients constant over each m-run of
+// k, and four fixed positions 0, h, len - h, len (the constant of the reflection and the slope's
+// half sums) whose coefficients phi depend on k.
+#include <cstdint>
+
+#include "gyrochar/total_fast.hpp"
+
+namespace gyrochar {
+namespace {
+
+using Index = std::size_t;
+using Pos = std::int64_t;    // positions relative to a window, may be negative
+using Wide = long double;
+
+struct Terms {
+  int a[4] = {}, s[4] = {};
+  Pos o[4] = {};
+  double phi[4] = {};  // at the fixed positions 0, h, len - h, len
+  Pos pos(int i, Pos k) const { return s[i] * k + o[i]; }
+};
+
+struct Geometry {
+  Pos m, len, h, run;
+  Pos fixed[4];
+  explicit Geometry(Pos m_) : m(m_), len(3 * m_), h(3 * m_ / 2), run(3 * m_ - 3 * m_ / 2), fixed{0, h, len - h, len} {}
+
+  static Wide sum_t(Pos tau) { return static_cast<Wide>(tau) * static_cast<Wide>(tau - 1) / 2; }  // sum_{t<tau} t
+  static Wide sum_t2(Pos tau) {  // sum_{t<tau} t^2
+    const Wide T = static_cast<Wide>(tau);
+    return (T - 1) * T * (2 * T - 1) / 6;
+  }
+
+  // z_k = E[k+3m] - 3 E[k+2m] + 3 E[k+m] - E[k] with E the prefix sums of the 9m-point extension:
+  // E[q] = U[len] - U[len - q] (first copy), U[len] + U[q - len] (the window), 3 U[len] - U[3 len - q]
+  // (last copy); then the slope's line, removed: z_k -= slope * (z_k of the ramp t), slope =
+  // (U[len] - U[len - h] - U[h]) / (h run).
+  Terms terms(Pos k) const {
+    static constexpr int w[4] = {-1, 3, -3, 1};
+    Terms t;
+    const Pos j = k / m;
+    int at_len = 0, moving = 0;  // the coefficient of U[len] and the moving coefficients' sum
+    for (int i = 0; i < 4; ++i) {
+      const Pos c = j + i;
+      if (c <= 2) t.a[i] = -w[i], t.s[i] = -1, t.o[i] = len - i * m, at_len += w[i];
+      else if (c <= 5) t.a[i] = w[i], t.s[i] = 1, t.o[i] = i * m - len, at_len += w[i];
+      else t.a[i] = -w[i], t.s[i] = -1, t.o[i] = 3 * len - i * m, at_len += 3 * w[i];
+      moving += t.a[i];
+    }
+    Wide ramp = at_len * sum_t(len);  // z_k of the ramp t (a constant changes no z)
+    for (int i = 0; i < 4; ++i) ramp += t.a[i] * sum_t(t.pos(i, k));
+    const double beta = -static_cast<double>(ramp / (static_cast<Wide>(h) * static_cast<Wide>(run)));
+    t.phi[0] = -(moving + at_len) + beta;  // U[t] = Sp[n + t] - Sp[n]: the coefficients sum to 0
+    t.phi[1] = -beta, t.phi[2] = -beta, t.phi[3] = at_len + beta;
+    return t;
+  }
+  // The same term's value on a window whose U is the function u.
+  template <class F>
+  Wide apply(const Terms& t, Pos k, F u) const {
+    Wide z = 0;
+    for (int i = 0; i < 4; ++i) z += t.a[i] * u(t.pos(i, k));
+    for (int f = 1; f < 4; ++f) z += t.phi[f] * u(fixed[f]);
+    return z + t.phi[0] * u(0);
+  }
+};
+
+// The sum over every k of the autocorrelation of z_k's kernel on the window (as a function of the
+// residual), A(d) for d in [0, len]: from the autocorrelation B of its first difference (eight
+// spikes a k), summed twice (A vanishes from d = len on).
+void kernel_autocorrelation(const Geometry& g, std::span<double> A, std::span<double> B) {
+  for (Pos d = 0; d <= g.len; ++d) B[static_cast<Index>(d)] = 0.0;
+  for (Pos k = 0; k < 6 * g.m; ++k) {
+    const Terms t = g.terms(k);
+    Pos p[8];
+    double v[8];
+    for (int i = 0; i < 4; ++i) p[i] = t.pos(i, k), v[i] = t.a[i], p[4 + i] = g.fixed[i], v[4 + i] = t.phi[i];
+    for (int u = 0; u < 8; ++u) {
+      B[0] += v[u] * v[u];
+      for (int x = u + 1; x < 8; ++x) {
+        const Pos d = p[u] > p[x] ? p[u] - p[x] : p[x] - p[u];
+        B[static_cast<Index>(d)] += (d == 0 ? 2.0 : 1.0) * v[u] * v[x];
+      }
+    }
+  }
+  // B(d) = 2 A(d) - A(d - 1) - A(d + 1)
+  Wide above = 0, here = 0;  // A(d + 1), A(d) from d = len
+  for (Pos d = g.len; d >= 1; --d) {
+    const Wide below = 2 * here - above - B[static_cast<Index>(d)];
+    above = here, here = below;
+    A[static_cast<Index>(d - 1)] = static_cast<double>(below);
+  }
+  A[static_cast<Index>(g.len)] = 0.0;
+}
+
+// The windows that stick out of one end: n in [-(len - 1), -1], the residual zero before the record.
+// Sp[i] for i in [0, len) the prefix sums of that end's residuals (read from the end inwards).
+struct EndWindows {
+  const Geometry& g;
+  std::span<const double> Sp;  // len values, Sp[0] = 0
+  std::span<double> T2;        // len + 2: sums of Sp over positions below i of i's parity
+  std::span<double> X[4];      // X[f][p] = sum_n Sp[n + fixed_f] Sp[n + p], p in [0, len] (f = 1..3)
+  Theo1Workspace& w;
+
+  double sp(Pos i) const { return i >= 1 && i < g.len ? Sp[static_cast<Index>(i)] : 0.0; }
+  double t2(Pos x) const {
+    if (x < 0) return 0.0;
+    if (x >= g.len) x = g.len + ((x - g.len) & 1);
+    return T2[static_cast<Index>(x)];
+  }
+
+  // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + s k + ou] Sp[n + s k + ou + delta]
+  Wide same(Pos s, Pos ou, Pos delta, Pos k0, Pos k1, Pos n0, Pos n1) const {
+    Pos lo = s > 0 ? n0 + k0 + ou : n0 - (k1 - 1) + ou, hi = s > 0 ? n1 + k1 - 2 + ou : n1 - 1 - k0 + ou;
+    lo = lo > 1 ? lo : 1, lo = lo + delta > 1 ? lo : 1 - delta;
+    hi = hi < g.len - 1 ? hi : g.len - 1, hi = hi + delta < g.len - 1 ? hi : g.len - 1 - delta;
+    Wide sum = 0;
+    for (Pos i = lo; i <= hi; ++i) {
+      Pos klo, khi;
+      if (s > 0) klo = i - ou - (n1 - 1), khi = i - ou - n0;
+      else klo = n0 - i + ou, khi = n1 - 1 - i + ou;
+      klo = klo > k0 ? klo : k0, khi = khi < k1 - 1 ? khi : k1 - 1;
+      if (khi >= klo) sum += static_cast<Wide>(khi - klo + 1) * (sp(i) * sp(i + delta));
+    }
+    return sum;
+  }
+  // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + k + op] Sp[n - k + om]: for each i = n - k + om, the
+  // other factor runs over every other position, a difference of T2.
+  Wide opposite(Pos op, Pos om, Pos k0, Pos k1, Pos n0, Pos n1) const {
+    Pos lo = n0 - (k1 - 1) + om, hi = n1 - 1 - k0 + om;
+    lo = lo > 1 ? lo : 1, hi = hi < g.len - 1 ? hi : g.len - 1;
+    Wide sum = 0;
+    for (Pos i = lo; i <= hi; ++i) {
+      Pos ka = n0 - i + om, kb = n1 - i + om;
+      ka = ka > k0 ? ka : k0, kb = kb < k1 ? kb : k1;
+      if (kb <= ka) continue;
+      const Pos c = i + op - om;
+      sum += static_cast<Wide>(sp(i)) * (t2(c + 2 * kb) - t2(c + 2 * ka));
+    }
+    return sum;
+  }
+
+  Wide total() {
+    const Pos len = g.len, n0 = -(len - 1), n1 = 0;
+    T2[0] = T2[1] = 0.0;
+    for (Pos x = 2; x <= len + 1; ++x) T2[static_cast<Index>(x)] = T2[static_cast<Index>(x - 2)] + sp(x - 2);
+    // X[f][p] = sum_{i=1}^{fixed_f - 1} Sp[i] Sp[i + p - fixed_f]: a correlation of Sp's first
+    // fixed_f values with Sp. (f = 0 gives nothing: Sp[n] = 0 for n < 0.)
+    for (int f = 1; f < 4; ++f) {
+      const Pos P = g.fixed[f];
+      const Index n = fft_length(static_cast<Index>(P + len));
+      cross_correlation(Sp.first(static_cast<Index>(P)), Sp, n, w);
+      for (Pos p = 0; p <= len; ++p) {
+        const Pos e = p - P;
+        X[f][static_cast<Index>(p)] = w.buffer[static_cast<Index>(e >= 0 ? e : e + static_cast<Pos>(n))];
+      }
+    }
+    Wide sum = 0;
+    // Moving with moving: per m-run of k the coefficients are constant.
+    for (Pos j = 0; j < 6; ++j) {
+      const Pos k0 = j * g.m, k1 = k0 + g.m;
+      const Terms t = g.terms(k0);
+      for (int u = 0; u < 4; ++u)
+        for (int v = u; v < 4; ++v) {
+          const Wide c = (u == v ? 1 : 2) * t.a[u] * t.a[v];
+          if (t.s[u] == t.s[v]) sum += c * same(t.s[u], t.o[u], t.o[v] - t.o[u], k0, k1, n0, n1);
+          else if (t.s[u] > 0) sum += c * opposite(t.o[u], t.o[v], k0, k1, n0, n1);
+          else sum += c * opposite(t.o[v], t.o[u], k0, k1, n0, n1);
+        }
+    }
+    // Fixed with moving, and fixed with fixed: X at the positions.
+    for (Pos k = 0; k < 6 * g.m; ++k) {
+      const Terms t = g.terms(k);
+      for (int f = 1; f < 4; ++f) {
+        Wide moving = 0;
+        for (int i = 0; i < 4; ++i) moving += t.a[i] * X[f][static_cast<Index>(t.pos(i, k))];
+        Wide fixed = 0;
+        for (int e = 1; e < 4; ++e) fixed += t.phi[e] * X[f][static_cast<Index>(g.fixed[e])];
+        sum += t.phi[f] * (2 * moving + fixed);
+      }
+    }
+    return sum;
+  }
+};
+
+}  // namespace
+
+std::size_t mtotvar_scratch_size(std::size_t n_phase) { return 8 * n_phase + 16; }
+
+TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+  const Index N = w.r.size();
+  if (!w.ready || m < 1 || 3 * m > N || !(tau0_s > 0) || scratch.size() < mtotvar_scratch_size(N)) return {};
+  const Geometry g(static_cast<Pos>(m));
+  const Index len = static_cast<Index>(g.len), windows = N - len + 1;
+  std::span<double> rest = scratch;
+  auto take = [&](Index count) {
+    const std::span<double> s = rest.first(count);
+    rest = rest.subspan(count);
+    return s;
+  };
+  const std::span<double> A = take(len + 1), B = take(len + 1), Sp = take(len), T2 = take(len + 2);
+  std::span<double> X[4] = {{}, take(len + 1), take(len + 1), take(len + 1)};
+  // Every window that meets the record, the residual zero outside: the autocorrelation weighted.
+  kernel_autocorrelation(g, A, B);
+  Wide sum = static_cast<Wide>(A[0]) * w.ac[0];
+  for (Index d = 1; d < len; ++d) sum += 2 * static_cast<Wide>(A[d]) * w.ac[d];
+  // Less the windows that stick out at the start, and at the end (the sum of a window's squares does
+  // not change when the window is reversed).
+  for (const bool tail : {false, true}) {
+    Sp[0] = 0.0;
+    for (Index i = 1; i < len; ++i) Sp[i] = Sp[i - 1] + (tail ? w.r[N - i] : w.r[i - 1]);
+    EndWindows end{g, Sp, T2, {X[0], X[1], X[2], X[3]}, w};
+    sum -= end.total();
+  }
+  // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
+  const Wide c = w.curvature;
+  if (c != 0) {
+    std::span<double> G = B;  // G[t] = sum over windows of U_n[t]
+    G[0] = 0.0;
+    for (Index t = 0; t < len; ++t) G[t + 1] = G[t] + (w.s1[windows + t] - w.s1[t]);
+    Wide cross = 0, square = 0;
+    for (Pos k = 0; k < 6 * g.m; ++k) {
+      const Terms t = g.terms(k);
+      const Wide q = g.apply(t, k, [](Pos tau) { return Geometry::sum_t2(tau); });
+      cross += q * g.apply(t, k, [&](Pos tau) { return static_cast<Wide>(G[static_cast<Index>(tau)]); });
+      square += q * q;
+    }
+    sum += 2 * c * cross + static_cast<Wide>(windows) * c * c * square;
+  }
+  const double tau = static_cast<double>(m) * tau0_s, md = static_cast<double>(m);
+  const double var = static_cast<double>(sum) / (6.0 * md * static_cast<double>(windows) * 2.0 * md * md * tau * tau);
+  return {var, windows, 1};
+}
+
+}  // namespace gyrochar
