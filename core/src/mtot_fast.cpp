@@ -69,24 +69,37 @@ struct Geometry {
   }
 };
 
+// Calls f(k, weight) over the 6m terms, each pair of mirror terms once with weight 2: the extension
+// is even about its reflection points and the modified Allan filter symmetric, so z_k = z_{len-k}
+// on [0, len] and z_k = z_{3 len - k} on (len, 2 len), for every window (the kernels are equal,
+// not their split into moving and fixed positions).
+template <class F>
+void for_each_term(const Geometry& g, F f) {
+  const Pos len = g.len;
+  for (Pos k = 0; 2 * k < len; ++k) f(k, 2.0);
+  if (len % 2 == 0) f(len / 2, 1.0);
+  for (Pos k = len + 1; 2 * k < 3 * len; ++k) f(k, 2.0);
+  if (len % 2 == 0) f(3 * len / 2, 1.0);
+}
+
 // The sum over every k of the autocorrelation of z_k's kernel on the window (as a function of the
 // residual), A(d) for d in [0, len]: from the autocorrelation B of its first difference (eight
 // spikes a k), summed twice (A vanishes from d = len on).
 void kernel_autocorrelation(const Geometry& g, std::span<double> A, std::span<double> B) {
   for (Pos d = 0; d <= g.len; ++d) B[static_cast<Index>(d)] = 0.0;
-  for (Pos k = 0; k < 6 * g.m; ++k) {
+  for_each_term(g, [&](Pos k, double weight) {
     const Terms t = g.terms(k);
     Pos p[8];
     double v[8];
     for (int i = 0; i < 4; ++i) p[i] = t.pos(i, k), v[i] = t.a[i], p[4 + i] = g.fixed[i], v[4 + i] = t.phi[i];
     for (int u = 0; u < 8; ++u) {
-      B[0] += v[u] * v[u];
+      B[0] += weight * v[u] * v[u];
       for (int x = u + 1; x < 8; ++x) {
         const Pos d = p[u] > p[x] ? p[u] - p[x] : p[x] - p[u];
-        B[static_cast<Index>(d)] += (d == 0 ? 2.0 : 1.0) * v[u] * v[x];
+        B[static_cast<Index>(d)] += (d == 0 ? 2.0 : 1.0) * weight * v[u] * v[x];
       }
     }
-  }
+  });
   // B(d) = 2 A(d) - A(d - 1) - A(d + 1)
   Wide above = 0, here = 0;  // A(d + 1), A(d) from d = len
   for (Pos d = g.len; d >= 1; --d) {
@@ -98,13 +111,12 @@ void kernel_autocorrelation(const Geometry& g, std::span<double> A, std::span<do
 }
 
 // The windows that stick out of one end: n in [-(len - 1), -1], the residual zero before the record.
-// Sp[i] for i in [0, len) the prefix sums of that end's residuals (read from the end inwards).
+// Sp[i] for i in [0, len) the prefix sums of that end's residuals (read from the end inwards). Here
+// the products of two moving positions; those with a fixed position in fixed_terms.
 struct EndWindows {
   const Geometry& g;
   std::span<const double> Sp;  // len values, Sp[0] = 0
   std::span<double> T2;        // len + 2: sums of Sp over positions below i of i's parity
-  std::span<double> X[4];      // X[f][p] = sum_n Sp[n + fixed_f] Sp[n + p], p in [0, len] (f = 1..3)
-  Theo1Workspace& w;
 
   double sp(Pos i) const { return i >= 1 && i < g.len ? Sp[static_cast<Index>(i)] : 0.0; }
   double t2(Pos x) const {
@@ -144,23 +156,11 @@ struct EndWindows {
     return sum;
   }
 
-  Wide total() {
+  Wide moving_terms() {
     const Pos len = g.len, n0 = -(len - 1), n1 = 0;
     T2[0] = T2[1] = 0.0;
     for (Pos x = 2; x <= len + 1; ++x) T2[static_cast<Index>(x)] = T2[static_cast<Index>(x - 2)] + sp(x - 2);
-    // X[f][p] = sum_{i=1}^{fixed_f - 1} Sp[i] Sp[i + p - fixed_f]: a correlation of Sp's first
-    // fixed_f values with Sp. (f = 0 gives nothing: Sp[n] = 0 for n < 0.)
-    for (int f = 1; f < 4; ++f) {
-      const Pos P = g.fixed[f];
-      const Index n = fft_length(static_cast<Index>(P + len));
-      cross_correlation(Sp.first(static_cast<Index>(P)), Sp, n, w);
-      for (Pos p = 0; p <= len; ++p) {
-        const Pos e = p - P;
-        X[f][static_cast<Index>(p)] = w.buffer[static_cast<Index>(e >= 0 ? e : e + static_cast<Pos>(n))];
-      }
-    }
-    Wide sum = 0;
-    // Moving with moving: per m-run of k the coefficients are constant.
+    Wide sum = 0;  // per m-run of k the coefficients are constant
     for (Pos j = 0; j < 6; ++j) {
       const Pos k0 = j * g.m, k1 = k0 + g.m;
       const Terms t = g.terms(k0);
@@ -172,20 +172,45 @@ struct EndWindows {
           else sum += c * opposite(t.o[v], t.o[u], k0, k1, n0, n1);
         }
     }
-    // Fixed with moving, and fixed with fixed: X at the positions.
-    for (Pos k = 0; k < 6 * g.m; ++k) {
-      const Terms t = g.terms(k);
-      for (int f = 1; f < 4; ++f) {
-        Wide moving = 0;
-        for (int i = 0; i < 4; ++i) moving += t.a[i] * X[f][static_cast<Index>(t.pos(i, k))];
-        Wide fixed = 0;
-        for (int e = 1; e < 4; ++e) fixed += t.phi[e] * X[f][static_cast<Index>(g.fixed[e])];
-        sum += t.phi[f] * (2 * moving + fixed);
-      }
-    }
     return sum;
   }
 };
+
+// The products with a fixed position in the windows past both ends, from X[f][p] = sum over both
+// ends and their windows of Sp[n + fixed_f] Sp[n + p] = sum_{i=1}^{fixed_f - 1} Sp[i] Sp[i + p -
+// fixed_f] (f = 0 gives nothing: Sp[n] = 0 for n < 0). X[3] is the ends' autocorrelation read
+// backwards; X[1] a correlation of each end's first h values with the end; X[2] the same as X[1]
+// when len is even (len - h = h), one point longer and one lag further when it is odd.
+Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail,
+                 std::span<double> (&X)[4], Theo1Workspace& w) {
+  const Pos len = g.len, h = g.h;
+  const Index L = static_cast<Index>(len);
+  autocorrelation_sum(head, tail, fft_length(2 * L), w);
+  for (Index p = 1; p <= L; ++p) X[3][p] = w.buffer[L - p];
+  X[3][0] = 0.0;
+  const Index n = fft_length(static_cast<Index>(h + len));
+  for (Index p = 0; p <= L; ++p) X[1][p] = 0.0;
+  for (const std::span<const double> Sp : {head, tail}) {
+    cross_correlation(Sp.first(static_cast<Index>(h)), Sp, n, w);
+    for (Pos p = 0; p <= len; ++p) X[1][static_cast<Index>(p)] += w.buffer[static_cast<Index>(p - h >= 0 ? p - h : p - h + static_cast<Pos>(n))];
+  }
+  const Index H = static_cast<Index>(h);
+  X[2][0] = 0.0;
+  for (Index p = 1; p <= L; ++p)
+    X[2][p] = len % 2 == 0 ? X[1][p] : X[1][p - 1] + (p >= 2 ? head[H] * head[p - 1] + tail[H] * tail[p - 1] : 0.0);
+  Wide sum = 0;  // every k: the split into moving and fixed positions is not mirror-symmetric
+  for (Pos k = 0; k < 2 * len; ++k) {
+    const Terms t = g.terms(k);
+    for (int f = 1; f < 4; ++f) {
+      Wide moving = 0;
+      for (int i = 0; i < 4; ++i) moving += t.a[i] * X[f][static_cast<Index>(t.pos(i, k))];
+      Wide fixed = 0;
+      for (int e = 1; e < 4; ++e) fixed += t.phi[e] * X[f][static_cast<Index>(g.fixed[e])];
+      sum += t.phi[f] * (2 * moving + fixed);
+    }
+  }
+  return sum;
+}
 
 }  // namespace
 
@@ -202,20 +227,18 @@ TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::ui
     rest = rest.subspan(count);
     return s;
   };
-  const std::span<double> A = take(len + 1), B = take(len + 1), Sp = take(len), T2 = take(len + 2);
+  const std::span<double> A = take(len + 1), B = take(len + 1), head = take(len), tail = take(len), T2 = take(len + 2);
   std::span<double> X[4] = {{}, take(len + 1), take(len + 1), take(len + 1)};
   // Every window that meets the record, the residual zero outside: the autocorrelation weighted.
   kernel_autocorrelation(g, A, B);
   Wide sum = static_cast<Wide>(A[0]) * w.ac[0];
   for (Index d = 1; d < len; ++d) sum += 2 * static_cast<Wide>(A[d]) * w.ac[d];
   // Less the windows that stick out at the start, and at the end (the sum of a window's squares does
-  // not change when the window is reversed).
-  for (const bool tail : {false, true}) {
-    Sp[0] = 0.0;
-    for (Index i = 1; i < len; ++i) Sp[i] = Sp[i - 1] + (tail ? w.r[N - i] : w.r[i - 1]);
-    EndWindows end{g, Sp, T2, {X[0], X[1], X[2], X[3]}, w};
-    sum -= end.total();
-  }
+  // not change when the window is reversed: the end's residuals are read backwards).
+  head[0] = tail[0] = 0.0;
+  for (Index i = 1; i < len; ++i) head[i] = head[i - 1] + w.r[i - 1], tail[i] = tail[i - 1] + w.r[N - i];
+  sum -= EndWindows{g, head, T2}.moving_terms() + EndWindows{g, tail, T2}.moving_terms();
+  sum -= fixed_terms(g, head, tail, X, w);
   // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
   const Wide c = w.curvature;
   if (c != 0) {
@@ -223,12 +246,12 @@ TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::ui
     G[0] = 0.0;
     for (Index t = 0; t < len; ++t) G[t + 1] = G[t] + (w.s1[windows + t] - w.s1[t]);
     Wide cross = 0, square = 0;
-    for (Pos k = 0; k < 6 * g.m; ++k) {
+    for_each_term(g, [&](Pos k, double weight) {
       const Terms t = g.terms(k);
       const Wide q = g.apply(t, k, [](Pos tau) { return Geometry::sum_t2(tau); });
-      cross += q * g.apply(t, k, [&](Pos tau) { return static_cast<Wide>(G[static_cast<Index>(tau)]); });
-      square += q * q;
-    }
+      cross += weight * q * g.apply(t, k, [&](Pos tau) { return static_cast<Wide>(G[static_cast<Index>(tau)]); });
+      square += weight * q * q;
+    });
     sum += 2 * c * cross + static_cast<Wide>(windows) * c * c * square;
   }
   const double tau = static_cast<double>(m) * tau0_s, md = static_cast<double>(m);

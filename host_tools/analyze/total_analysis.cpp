@@ -89,6 +89,27 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
     return rows;
   }
 
+  // MTOTVAR (and TTOTVAR) exact at every tau by lag sums (total_fast.hpp) unless the decimated plan
+  // is asked for or the workspace would pass the memory budget: the record prepared once as for
+  // Theo1, then O(m log m) a tau. The rows' stride says which estimator ran.
+  std::unique_ptr<double[]> mtot_work;  // not zero-filled: prepare writes before it reads
+  Theo1Workspace mtot_prepared;
+  const std::size_t mtot_size = theo1_workspace_size(N) + mtotvar_scratch_size(N);
+  const bool mtot_decimated = o.mtot_decimated || 8 * static_cast<std::uint64_t>(mtot_size) > memory_budget();
+  auto mtot_estimate = [&](std::uint64_t m) {
+    if (!mtot_decimated) {
+      if (!mtot_prepared.ready) {
+        mtot_work = std::make_unique_for_overwrite<double[]>(mtot_size);
+        mtot_prepared = theo1_prepare(x, {mtot_work.get(), theo1_workspace_size(N)});
+      }
+      return mtotvar_fast(mtot_prepared, {mtot_work.get() + theo1_workspace_size(N), mtotvar_scratch_size(N)}, m, tau0);
+    }
+    const std::uint64_t b = total_block(m, N, S);
+    scratch.resize(total_scratch_size(m, b));
+    if (b > 1 && blocks.empty()) blocks.resize(N / 2);
+    return b == 1 ? mtotvar(x, 1, m, tau0, scratch) : mtotvar(block_sums(x, b, blocks), b, m, tau0, scratch);
+  };
+
   for (const std::uint64_t m : o.m_list) {
     const double md = static_cast<double>(m);
     TotalVariance v;
@@ -105,10 +126,7 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
     }
     if (stat == DevStat::mtotdev || stat == DevStat::ttotdev) {
       if (3 * m > N) break;
-      const std::uint64_t b = total_block(m, N, S);
-      scratch.resize(total_scratch_size(m, b));
-      if (b > 1 && blocks.empty()) blocks.resize(N / 2);
-      v = b == 1 ? mtotvar(x, 1, m, tau0, scratch) : mtotvar(block_sums(x, b, blocks), b, m, tau0, scratch);
+      v = mtot_estimate(m);
       if (v.n == 0) continue;
       const AnalysisRow* a = allan_row(allan, DevStat::mdev, md);
       const double edf = known(a) ? edf_mtotvar(*a->alpha, n, md) : 0.0;

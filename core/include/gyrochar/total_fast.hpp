@@ -58,6 +58,11 @@ TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s);
 /// w.buffer[e mod n]. O(n log n).
 void cross_correlation(std::span<const double> a, std::span<const double> b, std::size_t n, Theo1Workspace& w);
 
+/// The sum of the autocorrelations of two real sequences, acf(a)(e) + acf(b)(e), acf(a)(e) = sum_p
+/// a[p] a[p+e], by one FFT pair of length n (as cross_correlation): left at w.buffer[e] for
+/// 0 <= e < n - max(a.size(), b.size()). O(n log n).
+void autocorrelation_sum(std::span<const double> a, std::span<const double> b, std::size_t n, Theo1Workspace& w);
+
 /// Doubles of scratch mtotvar_fast needs beside a prepared Theo1Workspace of N points: 8 N + 16.
 std::size_t mtotvar_scratch_size(std::size_t n_phase);
 
