@@ -78,9 +78,9 @@ double printed(std::uint64_t n) {
   return static_cast<double>((n + unit / 2) / unit * unit);
 }
 
-enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr, theo1_fast, theobr_fast };
+enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr, theo1_fast, theobr_fast, mtotdev_fast, ttotdev_fast };
 
-// PHASE.DAT prepared for the lag-sum Theo1 (total_fast.hpp).
+// PHASE.DAT prepared for the lag-sum Theo1 and MTOTVAR (total_fast.hpp).
 Theo1Workspace& phase_dat_prepared() {
   static std::vector<double> work(theo1_workspace_size(phase_dat().size()));
   static Theo1Workspace w = theo1_prepare(phase_dat(), work);
@@ -102,6 +102,13 @@ TotalVariance compute(Kind kind, const std::vector<double>& x, const Row& r, dou
       t = mtotvar(x, 1, r.m, 1.0, scratch);
       dev = std::sqrt(t.var) * (kind == Kind::ttotdev ? m / std::sqrt(3.0) : 1.0);
       break;
+    case Kind::mtotdev_fast:
+    case Kind::ttotdev_fast: {
+      static std::vector<double> fast_scratch(mtotvar_scratch_size(phase_dat().size()));
+      t = mtotvar_fast(phase_dat_prepared(), fast_scratch, r.m, 1.0);
+      dev = std::sqrt(t.var) * (kind == Kind::ttotdev_fast ? m / std::sqrt(3.0) : 1.0);
+      break;
+    }
     case Kind::htotdev:
       t = htotvar(x, 1, r.m, 1.0, scratch);
       dev = std::sqrt(t.var / htotvar_bias(r.alpha, r.m));
@@ -156,6 +163,13 @@ TEST(Stable32Total, MtotdevAndTtotdev) {
     compare(Kind::mtotdev, phase_dat(), ref + "/phasedat/phase_dat_" + f + ".txt", 1e-4);
   for (const char* f : {"ttotdev_octave", "ttotdev_decade"})
     compare(Kind::ttotdev, phase_dat(), ref + "/phasedat/phase_dat_" + f + ".txt", 1e-4);
+}
+
+TEST(Stable32Total, MtotdevAndTtotdevFromLagSums) {  // total_fast.hpp: mtotvar_fast, exact at every m
+  for (const char* f : {"mtotdev_octave", "mtotdev_octave_alpha0", "mtotdev_decade"})
+    compare(Kind::mtotdev_fast, phase_dat(), ref + "/phasedat/phase_dat_" + f + ".txt", 1e-4);
+  for (const char* f : {"ttotdev_octave", "ttotdev_decade"})
+    compare(Kind::ttotdev_fast, phase_dat(), ref + "/phasedat/phase_dat_" + f + ".txt", 1e-4);
 }
 
 TEST(Stable32Total, Stable32Version153ScaledMtotdevByOneOfTwoConstants) {
