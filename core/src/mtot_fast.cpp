@@ -30,7 +30,6 @@ struct Geometry {
   Pos fixed[4];
   explicit Geometry(Pos m_) : m(m_), len(3 * m_), h(3 * m_ / 2), run(3 * m_ - 3 * m_ / 2), fixed{0, h, len - h, len} {}
 
-  static Wide sum_t(Pos tau) { return static_cast<Wide>(tau) * static_cast<Wide>(tau - 1) / 2; }  // sum_{t<tau} t
   static Wide sum_t2(Pos tau) {  // sum_{t<tau} t^2
     const Wide T = static_cast<Wide>(tau);
     return (T - 1) * T * (2 * T - 1) / 6;
@@ -52,9 +51,11 @@ struct Geometry {
       else t.a[i] = -w[i], t.s[i] = -1, t.o[i] = 3 * len - i * m, at_len += 3 * w[i];
       moving += t.a[i];
     }
-    Wide ramp = at_len * sum_t(len);  // z_k of the ramp t (a constant changes no z)
-    for (int i = 0; i < 4; ++i) ramp += t.a[i] * sum_t(t.pos(i, k));
-    const double beta = -static_cast<double>(ramp / (static_cast<Wide>(h) * static_cast<Wide>(run)));
+    // z_k of the ramp t (a constant changes no z), in integers: exact (below 2^53 for len < 2^25).
+    auto sum_t_int = [](Pos tau) { return tau * (tau - 1) / 2; };
+    Pos ramp = at_len * sum_t_int(len);
+    for (int i = 0; i < 4; ++i) ramp += t.a[i] * sum_t_int(t.pos(i, k));
+    const double beta = -static_cast<double>(ramp) / (static_cast<double>(h) * static_cast<double>(run));
     t.phi[0] = -(moving + at_len) + beta;  // U[t] = Sp[n + t] - Sp[n]: the coefficients sum to 0
     t.phi[1] = -beta, t.phi[2] = -beta, t.phi[3] = at_len + beta;
     return t;
@@ -126,32 +127,32 @@ struct EndWindows {
   }
 
   // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + s k + ou] Sp[n + s k + ou + delta]
-  Wide same(Pos s, Pos ou, Pos delta, Pos k0, Pos k1, Pos n0, Pos n1) const {
+  double same(Pos s, Pos ou, Pos delta, Pos k0, Pos k1, Pos n0, Pos n1) const {
     Pos lo = s > 0 ? n0 + k0 + ou : n0 - (k1 - 1) + ou, hi = s > 0 ? n1 + k1 - 2 + ou : n1 - 1 - k0 + ou;
     lo = lo > 1 ? lo : 1, lo = lo + delta > 1 ? lo : 1 - delta;
     hi = hi < g.len - 1 ? hi : g.len - 1, hi = hi + delta < g.len - 1 ? hi : g.len - 1 - delta;
-    Wide sum = 0;
+    double sum = 0;  // double within a run (the FFT parts carry the same relative rounding)
     for (Pos i = lo; i <= hi; ++i) {
       Pos klo, khi;
       if (s > 0) klo = i - ou - (n1 - 1), khi = i - ou - n0;
       else klo = n0 - i + ou, khi = n1 - 1 - i + ou;
       klo = klo > k0 ? klo : k0, khi = khi < k1 - 1 ? khi : k1 - 1;
-      if (khi >= klo) sum += static_cast<Wide>(khi - klo + 1) * (sp(i) * sp(i + delta));
+      if (khi >= klo) sum += static_cast<double>(khi - klo + 1) * (sp(i) * sp(i + delta));
     }
     return sum;
   }
   // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + k + op] Sp[n - k + om]: for each i = n - k + om, the
   // other factor runs over every other position, a difference of T2.
-  Wide opposite(Pos op, Pos om, Pos k0, Pos k1, Pos n0, Pos n1) const {
+  double opposite(Pos op, Pos om, Pos k0, Pos k1, Pos n0, Pos n1) const {
     Pos lo = n0 - (k1 - 1) + om, hi = n1 - 1 - k0 + om;
     lo = lo > 1 ? lo : 1, hi = hi < g.len - 1 ? hi : g.len - 1;
-    Wide sum = 0;
+    double sum = 0;
     for (Pos i = lo; i <= hi; ++i) {
       Pos ka = n0 - i + om, kb = n1 - i + om;
       ka = ka > k0 ? ka : k0, kb = kb < k1 ? kb : k1;
       if (kb <= ka) continue;
       const Pos c = i + op - om;
-      sum += static_cast<Wide>(sp(i)) * (t2(c + 2 * kb) - t2(c + 2 * ka));
+      sum += sp(i) * (t2(c + 2 * kb) - t2(c + 2 * ka));
     }
     return sum;
   }
@@ -202,9 +203,9 @@ Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<cons
   for (Pos k = 0; k < 2 * len; ++k) {
     const Terms t = g.terms(k);
     for (int f = 1; f < 4; ++f) {
-      Wide moving = 0;
+      double moving = 0;
       for (int i = 0; i < 4; ++i) moving += t.a[i] * X[f][static_cast<Index>(t.pos(i, k))];
-      Wide fixed = 0;
+      double fixed = 0;
       for (int e = 1; e < 4; ++e) fixed += t.phi[e] * X[f][static_cast<Index>(g.fixed[e])];
       sum += t.phi[f] * (2 * moving + fixed);
     }

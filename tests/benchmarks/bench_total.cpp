@@ -38,6 +38,14 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// CPU seconds of the process so far (user + system): the figure that does not grow with the load
+// of the shared machine.
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 long peak_rss_kib() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
@@ -80,11 +88,12 @@ double lag_sum_octaves(Theo1Workspace& w) {
 // MTOTVAR by lag sums (mtotvar_fast) at every octave m of a prepared record: one line per tau,
 // their seconds returned.
 double mtot_lag_sum_octaves(Theo1Workspace& w) {
-  std::vector<double> scratch(mtotvar_scratch_size(w.r.size()));
+  const std::size_t size = mtotvar_scratch_size(w.r.size());
+  const auto scratch = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
   double total = 0;
   for (std::uint64_t m = 1; 3 * m <= w.r.size(); m *= 2) {
     const auto t0 = Clock::now();
-    const TotalVariance v = mtotvar_fast(w, scratch, m, 1.0);
+    const TotalVariance v = mtotvar_fast(w, {scratch.get(), size}, m, 1.0);
     const double s = seconds_since(t0);
     total += s;
     std::printf("mtotdev-lagsums,%llu,%.9f,%.6e,1\n", static_cast<unsigned long long>(m), s, std::sqrt(v.var));
@@ -173,14 +182,17 @@ int lag_sums(std::uint64_t n, std::uint32_t S) {
 int mtot_lag_sums(std::uint64_t n) {
   const std::vector<double> x = simulated(n);
   auto t0 = Clock::now();
+  double c0 = cpu_seconds();
   const std::size_t size = theo1_workspace_size(n);
   const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
-  const double prepare = seconds_since(t0);
-  std::printf("prepare: %.2f s (%.0f MB of workspace, %.0f MB of scratch)\n", prepare, 8e-6 * static_cast<double>(size),
-              8e-6 * static_cast<double>(mtotvar_scratch_size(n)));
-  const double taus = mtot_lag_sum_octaves(w);
-  std::printf("mtotdev exact: every octave m in %.2f s after prepare, %.2f s in all\n", taus, prepare + taus);
+  const double prepare = seconds_since(t0), prepare_cpu = cpu_seconds() - c0;
+  std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace, %.0f MB of scratch)\n", prepare, prepare_cpu,
+              8e-6 * static_cast<double>(size), 8e-6 * static_cast<double>(mtotvar_scratch_size(n)));
+  c0 = cpu_seconds();
+  const double taus = mtot_lag_sum_octaves(w), taus_cpu = cpu_seconds() - c0;
+  std::printf("mtotdev exact: every octave m in %.2f s (CPU %.2f s) after prepare; in all %.2f s, CPU %.2f s\n", taus,
+              taus_cpu, prepare + taus, prepare_cpu + taus_cpu);
   std::printf("peak RSS: %ld KiB\n", peak_rss_kib());
   return 0;
 }
