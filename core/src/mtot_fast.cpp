@@ -213,13 +213,10 @@ Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<cons
   return sum;
 }
 
-}  // namespace
-
-std::size_t mtotvar_scratch_size(std::size_t n_phase) { return 8 * n_phase + 16; }
-
-TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+// The sum over every window of 3m values of the prepared sequence of the 6m squared terms z_k
+// (MTOTVAR's kernel; HTOTVAR's on the frequencies). Valid input checked by the caller.
+Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
   const Index N = w.r.size();
-  if (!w.ready || m < 1 || 3 * m > N || !(tau0_s > 0) || scratch.size() < mtotvar_scratch_size(N)) return {};
   const Geometry g(static_cast<Pos>(m));
   const Index len = static_cast<Index>(g.len), windows = N - len + 1;
   std::span<double> rest = scratch;
@@ -255,9 +252,29 @@ TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::ui
     });
     sum += 2 * c * cross + static_cast<Wide>(windows) * c * c * square;
   }
-  const double tau = static_cast<double>(m) * tau0_s, md = static_cast<double>(m);
-  const double var = static_cast<double>(sum) / (6.0 * md * static_cast<double>(windows) * 2.0 * md * md * tau * tau);
-  return {var, windows, 1};
+  return sum;
+}
+
+}  // namespace
+
+std::size_t mtotvar_scratch_size(std::size_t n_phase) { return 8 * n_phase + 16; }
+
+TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+  const std::uint64_t N = w.r.size();
+  if (!w.ready || m < 1 || 3 * m > N || !(tau0_s > 0) || scratch.size() < mtotvar_scratch_size(w.r.size())) return {};
+  // The mean over windows of the mean of the 6m squares, / (2 m^2 tau^2).
+  const double windows = static_cast<double>(N - 3 * m + 1), md = static_cast<double>(m), tau = md * tau0_s;
+  const double var = static_cast<double>(window_sum(w, scratch, m)) / (6.0 * md * windows * 2.0 * md * md * tau * tau);
+  return {var, N - 3 * m + 1, 1};
+}
+
+TotalVariance htotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+  const std::uint64_t N = w.r.size();  // frequencies
+  if (!w.ready || m < 2 || 3 * m > N || !(tau0_s > 0) || scratch.size() < mtotvar_scratch_size(w.r.size())) return {};
+  // z sums m frequencies: H = z / (m tau0); the mean over windows of the mean of the 6m squares / 6.
+  const double windows = static_cast<double>(N - 3 * m + 1), md = static_cast<double>(m), scale = md * tau0_s;
+  const double var = static_cast<double>(window_sum(w, scratch, m)) / (6.0 * md * windows * 6.0 * scale * scale);
+  return {var, N - 3 * m + 1, 1};
 }
 
 }  // namespace gyrochar

@@ -126,9 +126,9 @@ largest octave at or below 10 % of the record) and TheoBR from there on. Theo1 a
 are exact at every tau (lag sums, O(N log N) once and about O(m log^2 m) per tau; it holds about
 6 N + 4 fft_length(2 N) doubles, 1.6 GB at 10^7 points, or the decimated estimator below when
 that passes the memory budget); --theo-decimated takes the decimated estimator instead where the
-direct one costs over 2^26 operations. Mtotdev and ttotdev rows are exact at every tau the same
-way (lag sums, same memory; --mtot-decimated takes the plan below instead). TheoBR's bias ratio,
-and totdev, htotdev (and mtotdev, ttotdev under --mtot-decimated), are exact where that costs at most 2^26 operations at their
+direct one costs over 2^26 operations. Mtotdev, ttotdev and htotdev rows are exact at every tau
+the same way (lag sums, same memory; --total-decimated takes the plan below instead). TheoBR's
+bias ratio, and totdev (and mtotdev, ttotdev, htotdev under --total-decimated), are exact where that costs at most 2^26 operations at their
 tau and decimated beyond (blocks or sub-sequences every m/S samples, S from
 --total-stride-factor, 16 by default; 'exact' never decimates): the stride column says which. Where the noise is identified the deviations carry Stable32's bias
 corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and the EDF is NIST
@@ -413,7 +413,7 @@ int main(int argc, char** argv) {
   std::string format = "table", fit_text, kalibr_path, dynamic_text, plot_prefix;
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
   unsigned column = 0;  // 0: the reader chooses
-  bool progress = false, theo_decimated = false, mtot_decimated = false;
+  bool progress = false, theo_decimated = false, total_decimated = false;
   app.add_option("file", path, "data file (plain or gzip), '-' for standard input")->required();
   app.add_option("--type", type_text, "phase, freq or counts")->required();
   app.add_option("--tau0", tau0_s, "sample interval in seconds")->required();
@@ -433,8 +433,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--theo-decimated", theo_decimated,
               "Theo1/TheoBR rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
-  app.add_flag("--mtot-decimated", mtot_decimated,
-               "MTOTDEV/TTOTDEV rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
+  app.add_flag("--total-decimated", total_decimated,
+               "MTOTDEV/TTOTDEV/HTOTDEV rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
   app.add_option("--confidence", confidence, "confidence level of the intervals")->capture_default_str();
   app.add_option("--alpha", alpha_text, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
   app.add_option("--fit", fit_text, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
@@ -491,7 +491,7 @@ int main(int argc, char** argv) {
     // Options, checked before any data is read.
     AnalysisOptions o;
     o.theo_decimated = theo_decimated;
-    o.mtot_decimated = mtot_decimated;
+    o.total_decimated = total_decimated;
     if (type_text == "phase") o.type = DataType::phase;
     else if (type_text == "freq") o.type = DataType::freq;
     else if (type_text == "counts") o.type = DataType::counts;

@@ -284,6 +284,39 @@ TEST(MtotFast, EqualsTheDefinitionOnPhaseDat) {
   mtot_every_m(values(std::string(GYROCHAR_TEST_DATA) + "/phasedat/PHASE.DAT"), "PHASE.DAT");
 }
 
+// HTOTVAR by lag sums (htotvar_fast on the prepared frequencies) at every m >= 2. Oracle: MTOTVAR's
+// definition in long double on the frequencies y (HTOTVAR's sub-sequences and terms are MTOTVAR's on
+// y; the scales differ by m^2 / 3 at tau0 = 1: z^2 / (6 m^2) against z^2 / (2 m^4)), with
+// mtot_tolerance's bound on y scaled the same; n against the direct htotvar of total.hpp.
+void htot_every_m(const std::vector<double>& x, const char* what) {
+  std::vector<double> y(x.size() - 1);
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) y[i] = x[i + 1] - x[i];
+  std::vector<double> work(theo1_workspace_size(y.size())), scratch(mtotvar_scratch_size(y.size()));
+  std::vector<double> direct_scratch(total_scratch_size(y.size() / 3, 1));
+  Theo1Workspace w = theo1_prepare(y, work);
+  ASSERT_TRUE(w.ready);
+  double worst = 0;
+  for (std::size_t m = 2; 3 * m <= y.size(); ++m) {
+    const double scale = static_cast<double>(m * m) / 3.0;
+    const double oracle = static_cast<double>(mtotvar_oracle(y, m)) * scale;
+    const TotalVariance direct = htotvar(x, 1, m, 1.0, direct_scratch), fast = htotvar_fast(w, scratch, m, 1.0);
+    EXPECT_GT(direct.n, 0u);
+    EXPECT_EQ(fast.n, direct.n) << what << " m=" << m;
+    EXPECT_EQ(fast.stride, 1u);
+    EXPECT_NEAR(fast.var, oracle, scale * mtot_tolerance(y, w, m, oracle / scale)) << what << " N=" << x.size() << " m=" << m;
+    worst = std::max(worst, std::abs(fast.var / oracle - 1));
+  }
+  EXPECT_EQ(htotvar_fast(w, scratch, 1, 1.0).n, 0u);  // m = 1: the overlapping Hadamard variance, not this kernel
+  std::printf("%s N=%zu: HTOTVAR worst relative error %.2e\n", what, x.size(), worst);
+}
+
+TEST(HtotFast, EqualsTheDefinitionAtEveryM) {
+  for (const std::size_t n : {7u, 8u, 12u, 31u, 97u, 400u, 1500u})
+    htot_every_m(record(n, 50 + n, 0.3, 1.0, 2.5, 0.0), "walk+white+drift");
+  htot_every_m(record(1200, 8, 1e-6, 0.0, 1e-3, 1e-6), "quadratic+walk");
+  htot_every_m(values(std::string(GYROCHAR_TEST_DATA) + "/phasedat/PHASE.DAT"), "PHASE.DAT");
+}
+
 TEST(MtotFast, UndefinedInputGivesNoTerms) {
   const std::vector<double> x = record(40, 1, 0.3, 1.0, 2.5, 0.0);
   std::vector<double> work(theo1_workspace_size(x.size())), scratch(mtotvar_scratch_size(x.size()));

@@ -73,6 +73,13 @@ std::size_t mtotvar_scratch_size(std::size_t n_phase);
 /// Undefined input (or scratch smaller than mtotvar_scratch_size(N)) gives n = 0.
 TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s);
 
+/// HTOTVAR at averaging factor m (2 <= m <= (N - 1) / 3), exactly the estimator htotvar(x, 1, m,
+/// tau0_s, .) computes (same n, stride 1), to rounding: MTOTVAR's kernel on the N - 1 frequencies,
+/// so `w` is theo1_prepare of y[k] = x[k+1] - x[k] (the frequencies times tau0), not of x; scratch
+/// of mtotvar_scratch_size(N - 1). m = 1 is the overlapping Hadamard variance (htotvar, O(N)), not
+/// this kernel: n = 0 here. O(m log m) a tau on a prepared record.
+TotalVariance htotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s);
+
 /// theo_bias_ratio with every Theo1 and AVAR exact, Theo1 by theo1_fast: at most `ratio_taus` of the
 /// definition's taus, evenly spread (all when ratio_taus >= n + 1). O(taus (N + m log^2 m)).
 TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s,
