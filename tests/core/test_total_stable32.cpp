@@ -78,7 +78,7 @@ double printed(std::uint64_t n) {
   return static_cast<double>((n + unit / 2) / unit * unit);
 }
 
-enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr, theo1_fast, theobr_fast, mtotdev_fast, ttotdev_fast };
+enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr, theo1_fast, theobr_fast, mtotdev_fast, ttotdev_fast, htotdev_fast };
 
 // PHASE.DAT prepared for the lag-sum Theo1 and MTOTVAR (total_fast.hpp).
 Theo1Workspace& phase_dat_prepared() {
@@ -109,6 +109,22 @@ TotalVariance compute(Kind kind, const std::vector<double>& x, const Row& r, dou
       dev = std::sqrt(t.var) * (kind == Kind::ttotdev_fast ? m / std::sqrt(3.0) : 1.0);
       break;
     }
+    case Kind::htotdev_fast:
+      if (r.m > 1) {  // m = 1 is the overlapping Hadamard variance: the direct htotvar below. x is
+                      // PHASE.DAT (its frequencies prepared once, as phase_dat_prepared)
+        static std::vector<double> y, work, fast_scratch;
+        static Theo1Workspace w;
+        if (!w.ready) {
+          for (std::size_t i = 0; i + 1 < x.size(); ++i) y.push_back(x[i + 1] - x[i]);
+          work.resize(theo1_workspace_size(y.size()));
+          fast_scratch.resize(mtotvar_scratch_size(y.size()));
+          w = theo1_prepare(y, work);
+        }
+        t = htotvar_fast(w, fast_scratch, r.m, 1.0);
+        dev = std::sqrt(t.var / htotvar_bias(r.alpha, r.m));
+        break;
+      }
+      [[fallthrough]];
     case Kind::htotdev:
       t = htotvar(x, 1, r.m, 1.0, scratch);
       dev = std::sqrt(t.var / htotvar_bias(r.alpha, r.m));
@@ -188,6 +204,11 @@ TEST(Stable32Total, Stable32Version153ScaledMtotdevByOneOfTwoConstants) {
 TEST(Stable32Total, Htotdev) {
   compare(Kind::htotdev, phase_dat(), ref + "/phasedat/phase_dat_htotdev_octave.txt", 1e-4);
   compare(Kind::htotdev, phase_dat(), ref + "/phasedat/phase_dat_htotdev_octave_nobias.txt", 1e-4);
+}
+
+TEST(Stable32Total, HtotdevFromLagSums) {  // total_fast.hpp: htotvar_fast from m = 2, exact
+  compare(Kind::htotdev_fast, phase_dat(), ref + "/phasedat/phase_dat_htotdev_octave.txt", 1e-4);
+  compare(Kind::htotdev_fast, phase_dat(), ref + "/phasedat/phase_dat_htotdev_octave_nobias.txt", 1e-4);
 }
 
 TEST(Stable32Total, Theo1AndTheoBR) {
