@@ -193,7 +193,16 @@ int mtot_lag_sums(std::uint64_t n) {
   const double taus = mtot_lag_sum_octaves(w), taus_cpu = cpu_seconds() - c0;
   std::printf("mtotdev exact: every octave m in %.2f s (CPU %.2f s) after prepare; in all %.2f s, CPU %.2f s\n", taus,
               taus_cpu, prepare + taus, prepare_cpu + taus_cpu);
-  std::printf("peak RSS: %ld KiB\n", peak_rss_kib());
+  // The direct exact estimator where it is cheap (at most 2^28 operations): the lag sums' rounding at
+  // this N, as a relative difference of the deviations.
+  std::vector<double> direct_scratch, scratch(mtotvar_scratch_size(n));
+  for (std::uint64_t m = 1; 3 * m <= n && total_exact_cost(false, m, n) <= 4 * total_exact_budget; m *= 2) {
+    direct_scratch.resize(total_scratch_size(m, 1));
+    const double direct = mtotvar(x, 1, m, 1.0, direct_scratch).var;
+    const double fast = mtotvar_fast(w, scratch, m, 1.0).var;
+    std::printf("m = %llu: direct %.9e, lag sums %.9e, deviations differ by %.1e\n", static_cast<unsigned long long>(m),
+                std::sqrt(direct), std::sqrt(fast), std::sqrt(fast / direct) - 1);
+  }
   return 0;
 }
 
