@@ -127,8 +127,9 @@ are exact at every tau (lag sums, O(N log N) once and about O(m log^2 m) per tau
 6 N + 4 fft_length(2 N) doubles, 1.6 GB at 10^7 points, or the decimated estimator below when
 that passes the memory budget); --theo-decimated takes the decimated estimator instead where the
 direct one costs over 2^26 operations. Mtotdev, ttotdev and htotdev rows are exact at every tau
-the same way (lag sums, same memory; --total-decimated takes the plan below instead). TheoBR's
-bias ratio, and totdev (and mtotdev, ttotdev, htotdev under --total-decimated), are exact where that costs at most 2^26 operations at their
+the same way (lag sums, about O(m log m) per tau, holding 8 N doubles more than Theo1;
+--total-decimated takes the plan below instead). TheoBR's bias ratio, and totdev (and mtotdev,
+ttotdev, htotdev under --total-decimated), are exact where that costs at most 2^26 operations at their
 tau and decimated beyond (blocks or sub-sequences every m/S samples, S from
 --total-stride-factor, 16 by default; 'exact' never decimates): the stride column says which. Where the noise is identified the deviations carry Stable32's bias
 corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and the EDF is NIST
