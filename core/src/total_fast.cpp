@@ -244,6 +244,28 @@ void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle,
   }
 }
 
+void cross_correlation(std::span<const double> a, std::span<const double> b, std::size_t n, Theo1Workspace& w) {
+  double* d = w.buffer.data();
+  load(d, n, a, b);
+  forward_bitreversed(d, n, w.twiddle.data());
+  combine(d, n, true);
+  inverse_from_bitreversed(d, n, w.twiddle.data());
+  for (Index e = 0; e < n; ++e) d[e] = d[2 * e] / as_double(n);  // the real parts, scaled
+}
+
+void autocorrelation_sum(std::span<const double> a, std::span<const double> b, std::size_t n, Theo1Workspace& w) {
+  // a + i b: the inverse of |Z|^2 is acf(a) + acf(b) plus i times an odd cross term.
+  double* d = w.buffer.data();
+  load(d, n, a, b);
+  forward_bitreversed(d, n, w.twiddle.data());
+  for (Index k = 0; k < n; ++k) {
+    d[2 * k] = d[2 * k] * d[2 * k] + d[2 * k + 1] * d[2 * k + 1];
+    d[2 * k + 1] = 0.0;
+  }
+  inverse_from_bitreversed(d, n, w.twiddle.data());
+  for (Index e = 0; e < n; ++e) d[e] = d[2 * e] / as_double(n);
+}
+
 std::size_t theo1_workspace_size(std::size_t n_phase) {
   return 6 * n_phase + 2 + 4 * fft_length(2 * n_phase);
 }

@@ -91,6 +91,8 @@ struct AnalysisOptions {
   std::uint32_t total_stride_factor = 16;  // S of their decimated estimators; 0: always exact
   bool theo_decimated = false;             // Theo1/TheoBR rows by the decimated estimator (S above)
                                            // where the direct one is costly; false: exact, lag sums
+  bool total_decimated = false;            // MTOTDEV/TTOTDEV/HTOTDEV rows by the exact-or-decimated
+                                           // plan (S above) instead of the exact lag-sum estimator
   bool keep_record = false;                // hold the record without a total statistic (fits)
   // Counts only: hold the phase (4 bytes a point while it strays less than 2^31 pulses from the
   // line of the first count, else 8) and sum every tau over it by the batch kernel

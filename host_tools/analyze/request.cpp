@@ -99,8 +99,10 @@ largest octave at or below 10 % of the record) and TheoBR from there on. Theo1 a
 are exact at every tau (lag sums, O(N log N) once and about O(m log^2 m) per tau; it holds about
 6 N + 4 fft_length(2 N) doubles, 1.6 GB at 10^7 points, or the decimated estimator below when
 that passes the memory budget); --theo-decimated takes the decimated estimator instead where the
-direct one costs over 2^26 operations. TheoBR's bias ratio, and
-totdev, mtotdev, ttotdev and htotdev, are exact where that costs at most 2^26 operations at their
+direct one costs over 2^26 operations. Mtotdev, ttotdev and htotdev rows are exact at every tau
+the same way (lag sums, about O(m log m) per tau, holding 8 N doubles more than Theo1;
+--total-decimated takes the plan below instead). TheoBR's bias ratio, and totdev (and mtotdev,
+ttotdev, htotdev under --total-decimated), are exact where that costs at most 2^26 operations at their
 tau and decimated beyond (blocks or sub-sequences every m/S samples, S from
 --total-stride-factor, 16 by default; 'exact' never decimates): the stride column says which. Where the noise is identified the deviations carry Stable32's bias
 corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and the EDF is NIST
@@ -154,7 +156,7 @@ struct OptionText {
   std::string taus = "octave", stats = "oadev,mdev", stride = "full", alpha = "auto";
   std::string format = "table", fit, dynamic, total_stride = "16", long_tau = "oadev";
   double tau0_s = 0, nominal_hz = 0, confidence = 0.683;
-  bool progress = false, theo_decimated = false, no_sinusoid_search = false;
+  bool progress = false, theo_decimated = false, total_decimated = false, no_sinusoid_search = false;
   unsigned threads = 0;
 };
 
@@ -177,6 +179,8 @@ void add_options(CLI::App& app, OptionText& t, Request& r) {
       ->capture_default_str();
   app.add_flag("--theo-decimated", t.theo_decimated,
               "Theo1/TheoBR rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
+  app.add_flag("--total-decimated", t.total_decimated,
+               "MTOTDEV/TTOTDEV/HTOTDEV rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
   app.add_option("--confidence", t.confidence, "confidence level of the intervals")->capture_default_str();
   app.add_option("--alpha", t.alpha, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
   app.add_option("--fit", t.fit, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
@@ -261,6 +265,7 @@ std::uint32_t parse_power_of_two(const std::string& text, const char* word, std:
 void check_engine_options(const OptionText& t, const CLI::App& app, Request& r) {
   AnalysisOptions& o = r.options;
   o.theo_decimated = t.theo_decimated;
+  o.total_decimated = t.total_decimated;
   if (t.type == "phase") o.type = DataType::phase;
   else if (t.type == "freq") o.type = DataType::freq;
   else if (t.type == "counts") o.type = DataType::counts;

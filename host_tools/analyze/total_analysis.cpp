@@ -89,6 +89,42 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
     return rows;
   }
 
+  // MTOTVAR (and TTOTVAR) and HTOTVAR exact at every tau by lag sums (total_fast.hpp) unless the
+  // decimated plan is asked for or the workspace would pass the memory budget: the record (for
+  // HTOTVAR its frequencies) prepared once as for Theo1, then O(m log m) a tau. The rows' stride
+  // says which estimator ran.
+  const bool hadamard = stat == DevStat::htotdev;
+  std::vector<double> y;                // HTOTVAR: the frequencies times tau0
+  std::unique_ptr<double[]> fast_work;  // not zero-filled: prepare writes before it reads
+  Theo1Workspace prepared;
+  const std::size_t n_fast = hadamard ? N - 1 : N, fast_size = theo1_workspace_size(n_fast) + mtotvar_scratch_size(n_fast);
+  const bool total_decimated = o.total_decimated || N < 2 || 8 * (static_cast<std::uint64_t>(fast_size) + N) > memory_budget();
+  auto exact = [&](std::uint64_t m) {
+    if (!prepared.ready) {
+      if (hadamard) {
+        y.resize(n_fast);
+        for (std::size_t i = 0; i < n_fast; ++i) y[i] = x[i + 1] - x[i];
+      }
+      fast_work = std::make_unique_for_overwrite<double[]>(fast_size);
+      prepared = theo1_prepare(hadamard ? std::span<const double>(y) : x, {fast_work.get(), theo1_workspace_size(n_fast)});
+    }
+    const std::span<double> fast_scratch{fast_work.get() + theo1_workspace_size(n_fast), mtotvar_scratch_size(n_fast)};
+    return hadamard ? htotvar_fast(prepared, fast_scratch, m, tau0) : mtotvar_fast(prepared, fast_scratch, m, tau0);
+  };
+  auto mtot_estimate = [&](std::uint64_t m) {
+    if (!total_decimated) return exact(m);
+    const std::uint64_t b = total_block(m, N, S);
+    scratch.resize(total_scratch_size(m, b));
+    if (b > 1 && blocks.empty()) blocks.resize(N / 2);
+    return b == 1 ? mtotvar(x, 1, m, tau0, scratch) : mtotvar(block_sums(x, b, blocks), b, m, tau0, scratch);
+  };
+  auto htot_estimate = [&](std::uint64_t m) {  // m = 1: the overlapping Hadamard variance, O(N)
+    if (!total_decimated && m > 1) return exact(m);
+    const std::uint64_t b = total_block(m, N, S);
+    scratch.resize(total_scratch_size(m, b));
+    return htotvar(x, b, m, tau0, scratch);
+  };
+
   for (const std::uint64_t m : o.m_list) {
     const double md = static_cast<double>(m);
     TotalVariance v;
@@ -105,10 +141,7 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
     }
     if (stat == DevStat::mtotdev || stat == DevStat::ttotdev) {
       if (3 * m > N) break;
-      const std::uint64_t b = total_block(m, N, S);
-      scratch.resize(total_scratch_size(m, b));
-      if (b > 1 && blocks.empty()) blocks.resize(N / 2);
-      v = b == 1 ? mtotvar(x, 1, m, tau0, scratch) : mtotvar(block_sums(x, b, blocks), b, m, tau0, scratch);
+      v = mtot_estimate(m);
       if (v.n == 0) continue;
       const AnalysisRow* a = allan_row(allan, DevStat::mdev, md);
       const double edf = known(a) ? edf_mtotvar(*a->alpha, n, md) : 0.0;
@@ -118,9 +151,7 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
     }
     if (stat == DevStat::htotdev) {
       if (3 * m > N - 1) break;
-      const std::uint64_t b = total_block(m, N, S);
-      scratch.resize(total_scratch_size(m, b));
-      v = htotvar(x, b, m, tau0, scratch);
+      v = htot_estimate(m);
       if (v.n == 0) continue;
       const AnalysisRow* a = allan_row(allan, DevStat::ohdev, md);
       const double bias = known(a) ? htotvar_bias(*a->alpha, m) : 1.0;

@@ -22,7 +22,8 @@ namespace gyrochar {
 /// TheoH's ADEV part) or o.theo_m_list (Theo1, TheoH's TheoBR part), the exact estimator where it
 /// costs at most 2^26 operations per tau and the decimated one with o.total_stride_factor beyond;
 /// Theo1 (and TheoBR's Theo1 factor) exact at every tau by lag sums (total_fast.hpp) unless
-/// o.theo_decimated.
+/// o.theo_decimated, and MTOTDEV/TTOTDEV/HTOTDEV the same unless o.total_decimated (each also falls
+/// back to the plan when its lag-sum workspace would pass the memory budget).
 /// `allan`: the run's oadev, mdev and ohdev rows at its taus. Allocates the block-sum buffer and the
 /// rows; O(N) per tau for TOTDEV, O(N S) to O(N S^2 / m) for the others (docs/total.md).
 std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> phase, double phase_scale,

@@ -6,12 +6,14 @@
 //
 //   bench_total octave FILE S   MTOTDEV and Theo1 at octave taus of the phase values in FILE (one
 //                               per line), exact (S = 0) or with the plan for S; one line per tau;
-//                               then Theo1 by lag sums (exact) at the same taus
+//                               then Theo1 and MTOTDEV by lag sums (exact) at the same taus
 //   bench_total long N S        N points of random-walk plus white phase: TOTDEV, MTOTDEV and
 //                               TheoH at octave taus; time per statistic and peak RSS
 //   bench_total lagsums N S     N points as for `long`: exact Theo1 by lag sums (total_fast.hpp) at
 //                               every octave m, then TheoH with exact Theo1 rows (its bias ratio
 //                               with the plan for S); time of each part and peak RSS
+//   bench_total mtotlagsums N   N points as for `long`: exact MTOTDEV by lag sums (mtotvar_fast) at
+//                               every octave m; the preparation, the taus and peak RSS
 //   bench_total decimation FILE S [freq]
 //                               the decimated estimators against the exact ones at octave taus
 //                               (a markdown table; freq: FILE holds frequencies in Hz of 10 MHz)
@@ -35,6 +37,14 @@ using namespace gyrochar;
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// CPU seconds of the process so far (user + system): the figure that does not grow with the load
+// of the shared machine.
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 long peak_rss_kib() {
   rusage u{};
@@ -75,6 +85,22 @@ double lag_sum_octaves(Theo1Workspace& w) {
   return total;
 }
 
+// MTOTVAR by lag sums (mtotvar_fast) at every octave m of a prepared record: one line per tau,
+// their seconds returned.
+double mtot_lag_sum_octaves(Theo1Workspace& w) {
+  const std::size_t size = mtotvar_scratch_size(w.r.size());
+  const auto scratch = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  double total = 0;
+  for (std::uint64_t m = 1; 3 * m <= w.r.size(); m *= 2) {
+    const auto t0 = Clock::now();
+    const TotalVariance v = mtotvar_fast(w, {scratch.get(), size}, m, 1.0);
+    const double s = seconds_since(t0);
+    total += s;
+    std::printf("mtotdev-lagsums,%llu,%.9f,%.6e,1\n", static_cast<unsigned long long>(m), s, std::sqrt(v.var));
+  }
+  return total;
+}
+
 int octave(const char* file, std::uint32_t S) {
   const std::vector<double> x = read_phase(file, false);
   if (x.size() < 10) {
@@ -108,8 +134,11 @@ int octave(const char* file, std::uint32_t S) {
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   total = seconds_since(t0);
   std::printf("theo1-lagsums,prepare,%.9f\n", total);
+  const double prepare = total;
   total += lag_sum_octaves(w);
   std::printf("theo1-lagsums,total,%.9f\n", total);
+  total = prepare + mtot_lag_sum_octaves(w);  // the same prepared record
+  std::printf("mtotdev-lagsums,total,%.9f\n", total);
   return 0;
 }
 
@@ -147,6 +176,33 @@ int lag_sums(std::uint64_t n, std::uint32_t S) {
               t_avar, ratio.ratio, static_cast<unsigned long long>(ratio.taus), ratio.exact ? "exact" : "plan", t_ratio,
               seconds_since(t0));
   std::printf("peak RSS: %ld KiB\n", peak_rss_kib());
+  return 0;
+}
+
+int mtot_lag_sums(std::uint64_t n) {
+  const std::vector<double> x = simulated(n);
+  auto t0 = Clock::now();
+  double c0 = cpu_seconds();
+  const std::size_t size = theo1_workspace_size(n);
+  const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  Theo1Workspace w = theo1_prepare(x, {work.get(), size});
+  const double prepare = seconds_since(t0), prepare_cpu = cpu_seconds() - c0;
+  std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace, %.0f MB of scratch)\n", prepare, prepare_cpu,
+              8e-6 * static_cast<double>(size), 8e-6 * static_cast<double>(mtotvar_scratch_size(n)));
+  c0 = cpu_seconds();
+  const double taus = mtot_lag_sum_octaves(w), taus_cpu = cpu_seconds() - c0;
+  std::printf("mtotdev exact: every octave m in %.2f s (CPU %.2f s) after prepare; in all %.2f s, CPU %.2f s\n", taus,
+              taus_cpu, prepare + taus, prepare_cpu + taus_cpu);
+  // The direct exact estimator where it is cheap (at most 2^28 operations): the lag sums' rounding at
+  // this N, as a relative difference of the deviations.
+  std::vector<double> direct_scratch, scratch(mtotvar_scratch_size(n));
+  for (std::uint64_t m = 1; 3 * m <= n && total_exact_cost(false, m, n) <= 4 * total_exact_budget; m *= 2) {
+    direct_scratch.resize(total_scratch_size(m, 1));
+    const double direct = mtotvar(x, 1, m, 1.0, direct_scratch).var;
+    const double fast = mtotvar_fast(w, scratch, m, 1.0).var;
+    std::printf("m = %llu: direct %.9e, lag sums %.9e, deviations differ by %.1e\n", static_cast<unsigned long long>(m),
+                std::sqrt(direct), std::sqrt(fast), std::sqrt(fast / direct) - 1);
+  }
   return 0;
 }
 
@@ -230,9 +286,10 @@ int main(int argc, char** argv) {
   if (argc == 4 && mode == "octave") return octave(argv[2], static_cast<std::uint32_t>(std::stoul(argv[3])));
   if (argc == 4 && mode == "long") return long_record(std::stoull(argv[2]), static_cast<std::uint32_t>(std::stoul(argv[3])));
   if (argc == 4 && mode == "lagsums") return lag_sums(std::stoull(argv[2]), static_cast<std::uint32_t>(std::stoul(argv[3])));
+  if (argc == 3 && mode == "mtotlagsums") return mtot_lag_sums(std::stoull(argv[2]));
   if ((argc == 4 || argc == 5) && mode == "decimation")
     return decimation(argv[2], static_cast<std::uint32_t>(std::stoul(argv[3])), argc == 5 && std::string(argv[4]) == "freq");
-  std::fprintf(stderr, "usage: bench_total octave FILE S | bench_total long N S | bench_total lagsums N S | "
+  std::fprintf(stderr, "usage: bench_total octave FILE S | bench_total long N S | bench_total lagsums N S | bench_total mtotlagsums N | "
                        "bench_total decimation FILE S [freq]\n");
   return 2;
 }

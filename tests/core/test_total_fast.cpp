@@ -1,8 +1,10 @@
-// Exact Theo1 from lag sums (core/include/gyrochar/total_fast.hpp) against Theo1's definition summed
-// in long double at every even m of small records (and n against the direct theo1 of total.hpp);
-// TheoBR's bias ratio against theo_bias_ratio with every tau exact; the FFT against the DFT written
-// out. The Theo1 tolerance is the rounding bound of the lag-sum form (`tolerance` below). Records: white phase plus a random walk plus offset and drift, a
-// quadratic drift, and a 1e-3 ramp with 1e-12 noise (where expanding raw phase products fails).
+// Exact Theo1 and MTOTVAR from lag sums (core/include/gyrochar/total_fast.hpp). Theo1 against its
+// definition summed in long double at every even m of small records (and n against the direct theo1
+// of total.hpp); TheoBR's bias ratio against theo_bias_ratio with every tau exact; the FFT against
+// the DFT written out; MTOTVAR against its definition in long double at every m (below). Each
+// tolerance is the rounding bound of the lag-sum form (`tolerance`, `mtot_tolerance`). Records:
+// white phase plus a random walk plus offset and drift, a quadratic drift, and a 1e-3 ramp with
+// 1e-12 noise (where expanding raw phase products fails).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,6 +17,7 @@
 #include <random>
 #include <vector>
 
+#include "gyrochar/total.hpp"
 #include "gyrochar/total_fast.hpp"
 
 namespace gyrochar {
@@ -183,6 +186,149 @@ TEST(TotalFast, FftEqualsTheDftWrittenOut) {
         EXPECT_NEAR(d[2 * k + 1], static_cast<double>(sum.imag()), 1e-13) << n << " k=" << k;
       }
     }
+}
+
+// ---- Exact MTOTVAR from lag sums (mtotvar_fast) against MTOTVAR's definition summed in long double
+// at every m of small records (and n against the direct mtotvar of total.hpp). Records as above, plus
+// pure white phase and a pure random walk.
+
+// MTOTVAR by its definition (SP 1065 eq. 27 with Stable32's half-average slope, as total.hpp states
+// it), in long double: each 3m-point window detrended, reflected to 9m points, every one of the 6m
+// modified-Allan terms summed out.
+long double mtotvar_oracle(const std::vector<double>& x, std::size_t m) {
+  using LD = long double;
+  const std::size_t N = x.size(), len = 3 * m, half = len / 2;
+  std::vector<LD> e(9 * m), E(9 * m + 1);
+  LD total = 0;
+  for (std::size_t n = 0; n + len <= N; ++n) {
+    LD first = 0, second = 0;
+    for (std::size_t t = 0; t < half; ++t) first += x[n + t], second += x[n + len - half + t];
+    const LD slope = (second - first) / LD(half) / LD(len - half);
+    for (std::size_t t = 0; t < len; ++t) {
+      const LD u = LD(x[n + t]) - x[n] - slope * LD(t);
+      e[len - 1 - t] = u, e[len + t] = u, e[3 * len - 1 - t] = u;
+    }
+    E[0] = 0;
+    for (std::size_t i = 0; i < 9 * m; ++i) E[i + 1] = E[i] + e[i];
+    LD window = 0;
+    for (std::size_t k = 0; k < 6 * m; ++k) {
+      const LD z = (E[k + 3 * m] - E[k + 2 * m]) - 2 * (E[k + 2 * m] - E[k + m]) + (E[k + m] - E[k]);
+      window += z * z;
+    }
+    total += window / LD(6 * m);
+  }
+  const LD md = LD(m);
+  return total / (LD(N - len + 1) * 2 * md * md * md * md);
+}
+
+// The tolerance of mtotvar_fast at m (tau0 = 1; docs/total.md, "Rounding"), two parts:
+// - the lag sums: the estimate is the sum over lags of the residual's autocorrelation (each lag's
+//   FFT error below a few units of 2^-53 log2(P) sum r^2) times the kernel's autocorrelation A(d),
+//   whose absolute sum is at most 2 len A(0), A(0) = sum_k |g_k|^2 <= 6m len 16 (no coefficient of a
+//   term above 4 in size), less the end windows (of the same order); scaled like the estimate, a
+//   factor 64 for the constants not counted, and 2^-44 of the estimate for the sums;
+// - the residual: r[i] = (x[i] - x[0]) - q(i) in long double carries up to e = 2^-61 (|x[i] - x[0]|
+//   + |q(i)|); each z_k of an error sequence bounded by e is at most 48 m e (sum_t |g_k[t]| <= 48 m),
+//   so its MTOTVAR is at most V_e = (48 m e)^2 / (2 m^4), and it moves the estimate V by at most
+//   2 sqrt(V V_e) + V_e.
+double mtot_tolerance(const std::vector<double>& x, const Theo1Workspace& w, std::size_t m, double estimate) {
+  double r2 = 0, e = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const long double d = static_cast<long double>(x[i]) - x[0];
+    r2 += w.r[i] * w.r[i];
+    e = std::max(e, 0x1p-61 * static_cast<double>(std::abs(d) + std::abs(d - w.r[i])));
+  }
+  const double md = static_cast<double>(m), len = 3 * md, windows = static_cast<double>(w.r.size()) - len + 1;
+  const double a0 = 6 * md * len * 16;
+  const double lag_sums = 64.0 * 0x1p-53 * std::log2(static_cast<double>(w.P)) * 2 * len * a0 * r2;
+  const double ve = (48 * md * e) * (48 * md * e) / (2 * md * md * md * md);
+  return lag_sums / (6 * md * windows * 2 * md * md * md * md) + 0x1p-44 * std::abs(estimate) +
+         2.0 * std::sqrt(std::abs(estimate) * ve) + ve;
+}
+
+double mtot_every_m(const std::vector<double>& x, const char* what) {
+  std::vector<double> work(theo1_workspace_size(x.size())), scratch(mtotvar_scratch_size(x.size()));
+  std::vector<double> direct_scratch(total_scratch_size(x.size() / 3, 1));
+  Theo1Workspace w = theo1_prepare(x, work);
+  EXPECT_TRUE(w.ready);
+  double worst = 0;  // the largest error relative to the estimate, reported
+  for (std::size_t m = 1; 3 * m <= x.size(); ++m) {
+    const double oracle = static_cast<double>(mtotvar_oracle(x, m));
+    const TotalVariance direct = mtotvar(x, 1, m, 1.0, direct_scratch), fast = mtotvar_fast(w, scratch, m, 1.0);
+    EXPECT_GT(direct.n, 0u);
+    EXPECT_EQ(fast.n, direct.n) << what << " m=" << m;
+    EXPECT_EQ(fast.stride, 1u);
+    EXPECT_NEAR(fast.var, oracle, mtot_tolerance(x, w, m, oracle)) << what << " N=" << x.size() << " m=" << m;
+    worst = std::max(worst, std::abs(fast.var / oracle - 1));
+  }
+  std::printf("%s N=%zu: worst relative error %.2e\n", what, x.size(), worst);
+  return worst;
+}
+
+TEST(MtotFast, EqualsTheDefinitionAtEveryM) {
+  for (const std::size_t n : {3u, 4u, 5u, 6u, 7u, 8u, 12u, 31u, 97u, 256u, 1000u})
+    mtot_every_m(record(n, n, 0.3, 1.0, 2.5, 0.0), "walk+white+drift");
+  mtot_every_m(record(2000, 11, 0.0, 1.0, 0.0, 0.0), "white");
+  mtot_every_m(record(2000, 12, 1.0, 0.0, 0.0, 0.0), "walk");
+}
+
+TEST(MtotFast, EqualsTheDefinitionUnderStrongDrift) {
+  // A 1e-3 ramp with 1e-12 white noise: products of raw phase values would lose all 16 digits (the
+  // direct double-precision mtotvar loses most of them too; the oracle is in long double).
+  mtot_every_m(record(1500, 7, 0.0, 1e-12, 1e-3, 0.0), "ramp");
+  // A frequency drift (quadratic phase) over a random walk: the quadratic comes back exactly.
+  mtot_every_m(record(1200, 8, 1e-6, 0.0, 1e-3, 1e-6), "quadratic+walk");
+}
+
+TEST(MtotFast, EqualsTheDefinitionOnPhaseDat) {
+  mtot_every_m(values(std::string(GYROCHAR_TEST_DATA) + "/phasedat/PHASE.DAT"), "PHASE.DAT");
+}
+
+// HTOTVAR by lag sums (htotvar_fast on the prepared frequencies) at every m >= 2. Oracle: MTOTVAR's
+// definition in long double on the frequencies y (HTOTVAR's sub-sequences and terms are MTOTVAR's on
+// y; the scales differ by m^2 / 3 at tau0 = 1: z^2 / (6 m^2) against z^2 / (2 m^4)), with
+// mtot_tolerance's bound on y scaled the same; n against the direct htotvar of total.hpp.
+void htot_every_m(const std::vector<double>& x, const char* what) {
+  std::vector<double> y(x.size() - 1);
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) y[i] = x[i + 1] - x[i];
+  std::vector<double> work(theo1_workspace_size(y.size())), scratch(mtotvar_scratch_size(y.size()));
+  std::vector<double> direct_scratch(total_scratch_size(y.size() / 3, 1));
+  Theo1Workspace w = theo1_prepare(y, work);
+  ASSERT_TRUE(w.ready);
+  double worst = 0;
+  for (std::size_t m = 2; 3 * m <= y.size(); ++m) {
+    const double scale = static_cast<double>(m * m) / 3.0;
+    const double oracle = static_cast<double>(mtotvar_oracle(y, m)) * scale;
+    const TotalVariance direct = htotvar(x, 1, m, 1.0, direct_scratch), fast = htotvar_fast(w, scratch, m, 1.0);
+    EXPECT_GT(direct.n, 0u);
+    EXPECT_EQ(fast.n, direct.n) << what << " m=" << m;
+    EXPECT_EQ(fast.stride, 1u);
+    EXPECT_NEAR(fast.var, oracle, scale * mtot_tolerance(y, w, m, oracle / scale)) << what << " N=" << x.size() << " m=" << m;
+    worst = std::max(worst, std::abs(fast.var / oracle - 1));
+  }
+  EXPECT_EQ(htotvar_fast(w, scratch, 1, 1.0).n, 0u);  // m = 1: the overlapping Hadamard variance, not this kernel
+  std::printf("%s N=%zu: HTOTVAR worst relative error %.2e\n", what, x.size(), worst);
+}
+
+TEST(HtotFast, EqualsTheDefinitionAtEveryM) {
+  for (const std::size_t n : {7u, 8u, 12u, 31u, 97u, 400u, 1500u})
+    htot_every_m(record(n, 50 + n, 0.3, 1.0, 2.5, 0.0), "walk+white+drift");
+  htot_every_m(record(1200, 8, 1e-6, 0.0, 1e-3, 1e-6), "quadratic+walk");
+  htot_every_m(values(std::string(GYROCHAR_TEST_DATA) + "/phasedat/PHASE.DAT"), "PHASE.DAT");
+}
+
+TEST(MtotFast, UndefinedInputGivesNoTerms) {
+  const std::vector<double> x = record(40, 1, 0.3, 1.0, 2.5, 0.0);
+  std::vector<double> work(theo1_workspace_size(x.size())), scratch(mtotvar_scratch_size(x.size()));
+  Theo1Workspace w = theo1_prepare(x, work);
+  EXPECT_GT(mtotvar_fast(w, scratch, 13, 1.0).n, 0u);  // 3m = 39 <= N
+  EXPECT_EQ(mtotvar_fast(w, scratch, 14, 1.0).n, 0u);  // 3m > N
+  EXPECT_EQ(mtotvar_fast(w, scratch, 0, 1.0).n, 0u);
+  EXPECT_EQ(mtotvar_fast(w, scratch, 4, 0.0).n, 0u);   // tau0 <= 0
+  EXPECT_EQ(mtotvar_fast(w, std::span<double>(scratch).first(scratch.size() - 1), 4, 1.0).n, 0u);
+  std::vector<double> small(theo1_workspace_size(x.size()) - 1);
+  Theo1Workspace none = theo1_prepare(x, small);
+  EXPECT_EQ(mtotvar_fast(none, scratch, 4, 1.0).n, 0u);
 }
 
 }  // namespace

@@ -78,9 +78,9 @@ double printed(std::uint64_t n) {
   return static_cast<double>((n + unit / 2) / unit * unit);
 }
 
-enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr, theo1_fast, theobr_fast };
+enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr, theo1_fast, theobr_fast, mtotdev_fast, ttotdev_fast, htotdev_fast };
 
-// PHASE.DAT prepared for the lag-sum Theo1 (total_fast.hpp).
+// PHASE.DAT prepared for the lag-sum Theo1 and MTOTVAR (total_fast.hpp).
 Theo1Workspace& phase_dat_prepared() {
   static std::vector<double> work(theo1_workspace_size(phase_dat().size()));
   static Theo1Workspace w = theo1_prepare(phase_dat(), work);
@@ -102,6 +102,29 @@ TotalVariance compute(Kind kind, const std::vector<double>& x, const Row& r, dou
       t = mtotvar(x, 1, r.m, 1.0, scratch);
       dev = std::sqrt(t.var) * (kind == Kind::ttotdev ? m / std::sqrt(3.0) : 1.0);
       break;
+    case Kind::mtotdev_fast:
+    case Kind::ttotdev_fast: {
+      static std::vector<double> fast_scratch(mtotvar_scratch_size(phase_dat().size()));
+      t = mtotvar_fast(phase_dat_prepared(), fast_scratch, r.m, 1.0);
+      dev = std::sqrt(t.var) * (kind == Kind::ttotdev_fast ? m / std::sqrt(3.0) : 1.0);
+      break;
+    }
+    case Kind::htotdev_fast:
+      if (r.m > 1) {  // m = 1 is the overlapping Hadamard variance: the direct htotvar below. x is
+                      // PHASE.DAT (its frequencies prepared once, as phase_dat_prepared)
+        static std::vector<double> y, work, fast_scratch;
+        static Theo1Workspace w;
+        if (!w.ready) {
+          for (std::size_t i = 0; i + 1 < x.size(); ++i) y.push_back(x[i + 1] - x[i]);
+          work.resize(theo1_workspace_size(y.size()));
+          fast_scratch.resize(mtotvar_scratch_size(y.size()));
+          w = theo1_prepare(y, work);
+        }
+        t = htotvar_fast(w, fast_scratch, r.m, 1.0);
+        dev = std::sqrt(t.var / htotvar_bias(r.alpha, r.m));
+        break;
+      }
+      [[fallthrough]];
     case Kind::htotdev:
       t = htotvar(x, 1, r.m, 1.0, scratch);
       dev = std::sqrt(t.var / htotvar_bias(r.alpha, r.m));
@@ -158,6 +181,13 @@ TEST(Stable32Total, MtotdevAndTtotdev) {
     compare(Kind::ttotdev, phase_dat(), ref + "/phasedat/phase_dat_" + f + ".txt", 1e-4);
 }
 
+TEST(Stable32Total, MtotdevAndTtotdevFromLagSums) {  // total_fast.hpp: mtotvar_fast, exact at every m
+  for (const char* f : {"mtotdev_octave", "mtotdev_octave_alpha0", "mtotdev_decade"})
+    compare(Kind::mtotdev_fast, phase_dat(), ref + "/phasedat/phase_dat_" + f + ".txt", 1e-4);
+  for (const char* f : {"ttotdev_octave", "ttotdev_decade"})
+    compare(Kind::ttotdev_fast, phase_dat(), ref + "/phasedat/phase_dat_" + f + ".txt", 1e-4);
+}
+
 TEST(Stable32Total, Stable32Version153ScaledMtotdevByOneOfTwoConstants) {
   for (const auto& [file, kind] : {std::pair{"mtotdev", Kind::mtotdev}, std::pair{"ttotdev_all", Kind::ttotdev}}) {
     const auto rows = stable32_rows(ref + "/phasedat/phase_dat_" + file + ".txt");
@@ -174,6 +204,11 @@ TEST(Stable32Total, Stable32Version153ScaledMtotdevByOneOfTwoConstants) {
 TEST(Stable32Total, Htotdev) {
   compare(Kind::htotdev, phase_dat(), ref + "/phasedat/phase_dat_htotdev_octave.txt", 1e-4);
   compare(Kind::htotdev, phase_dat(), ref + "/phasedat/phase_dat_htotdev_octave_nobias.txt", 1e-4);
+}
+
+TEST(Stable32Total, HtotdevFromLagSums) {  // total_fast.hpp: htotvar_fast from m = 2, exact
+  compare(Kind::htotdev_fast, phase_dat(), ref + "/phasedat/phase_dat_htotdev_octave.txt", 1e-4);
+  compare(Kind::htotdev_fast, phase_dat(), ref + "/phasedat/phase_dat_htotdev_octave_nobias.txt", 1e-4);
 }
 
 TEST(Stable32Total, Theo1AndTheoBR) {

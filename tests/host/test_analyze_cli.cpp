@@ -439,16 +439,12 @@ TEST(AnalyzeCli, TotalFamilyInEveryFormat) {
     }
     EXPECT_DOUBLE_EQ(row["tau"].get<double>(), 0.75 * row["m"].get<double>() * 0.001);
   }
-  // Each row says which estimator made it: the plan of core/total.hpp (its own test), exact below
-  // 2^26 operations (mtotdev and htotdev to m = 128 here), blocks of m/16 beyond; theo1 and theoh
-  // exact at every m (lag sums, total_fast.hpp).
+  // Each row says which estimator made it: every one exact here (stride 1), mtotdev, ttotdev,
+  // htotdev, theo1 and theoh by lag sums (total_fast.hpp); the decimated plan under
+  // --total-decimated is MtotRowsAreExactUnlessTheDecimatedEstimatorIsAsked's.
   for (const auto& [stat, rows] : by_stat)
-    for (const auto& row : rows) {
-      const std::uint64_t m = row["m"];
-      const std::uint64_t want = stat == "mtotdev" || stat == "ttotdev" || stat == "htotdev" ? gyrochar::total_block(m, 20001, 16) : 1;
-      EXPECT_EQ(row["stride"].get<std::uint64_t>(), want) << stat << " m=" << m;
-    }
-  EXPECT_EQ(by_stat["mtotdev"].back()["stride"], 256) << "m = 4096: blocks of 256";
+    for (const auto& row : rows) EXPECT_EQ(row["stride"].get<std::uint64_t>(), 1u) << stat << " m=" << row["m"];
+  EXPECT_EQ(by_stat["htotdev"].back()["m"], 4096) << "m = 4096: exact";
 }
 
 TEST(AnalyzeCli, TheoRowsAreExactUnlessTheDecimatedEstimatorIsAsked) {
@@ -485,6 +481,47 @@ TEST(AnalyzeCli, TheoRowsAreExactUnlessTheDecimatedEstimatorIsAsked) {
       }
     }
     EXPECT_EQ(strided, decimated ? 4 : 0);  // m = 4096 to 32768
+  }
+}
+
+TEST(AnalyzeCli, MtotRowsAreExactUnlessTheDecimatedEstimatorIsAsked) {
+  // 12000 phase points of a random walk plus white noise: MTOTDEV and HTOTDEV at m = 512 to 2048
+  // cost over 2^26 operations directly. Oracles: the direct exact mtotvar and htotvar (total.hpp)
+  // for the default rows (mtotdev, ttotdev, htotdev), the plan's block total_block(m, N, 16) for
+  // --total-decimated rows.
+  std::mt19937_64 rng(6);
+  std::normal_distribution<double> z;
+  std::string s;
+  double walk = 0;
+  for (int i = 0; i < 12000; ++i) s += std::to_string((walk += 0.1 * z(rng)) + z(rng)) + "\n";
+  std::vector<double> x, scratch;
+  std::istringstream back(s);  // the values as the file holds them
+  for (double v; back >> v;) x.push_back(v);
+  const std::string path = file_with("walk_mtot.txt", s);
+  const std::string args = "--type phase --tau0 1 --stats mdev,ohdev,mtotdev,ttotdev,htotdev --alpha 0 --format json ";
+  for (const bool decimated : {false, true}) {
+    const Outcome r = run(args + (decimated ? "--total-decimated " : "") + path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    int strided = 0, rows = 0;
+    const auto j = nlohmann::json::parse(r.out);
+    for (const auto& row : j["results"]) {
+      const std::string stat = row["stat"];
+      if (stat != "mtotdev" && stat != "ttotdev" && stat != "htotdev") continue;
+      const std::uint64_t m = row["m"];
+      const std::uint64_t want = decimated ? gyrochar::total_block(m, x.size(), 16) : 1;
+      EXPECT_EQ(row["stride"].get<std::uint64_t>(), want) << stat << " m=" << m;
+      strided += want > 1, ++rows;
+      if (!decimated) {
+        scratch.resize(gyrochar::total_scratch_size(m, 1));
+        const double md = static_cast<double>(m);
+        // HTOTDEV carries Stable32's white-FM bias correction (alpha 0) from m = 2 on.
+        const double exact = stat == "htotdev" ? gyrochar::htotvar(x, 1, m, 1.0, scratch).var / gyrochar::htotvar_bias(0, m)
+                                               : gyrochar::mtotvar(x, 1, m, 1.0, scratch).var * (stat == "ttotdev" ? md * md / 3 : 1.0);
+        EXPECT_NEAR(row["dev"].get<double>() / std::sqrt(exact), 1.0, 1e-9) << stat << " m=" << m;  // two summation orders
+      }
+    }
+    EXPECT_EQ(rows, 3 * 12);                     // m = 1 .. 2048 for each
+    EXPECT_EQ(strided, decimated ? 3 * 3 : 0);  // m = 512, 1024 and 2048
   }
 }
 

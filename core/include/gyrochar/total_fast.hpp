@@ -53,6 +53,33 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work);
 /// a few passes over the lags below m). Undefined input gives n = 0.
 TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s);
 
+/// The cross-correlation c(e) = sum_p a[p] b[p+e] of two real sequences by FFT of length n (a power
+/// of two, at most w.P, n >= a.size() + b.size() for no wrap-around): c(e) for e in (-n, n) left at
+/// w.buffer[e mod n]. O(n log n).
+void cross_correlation(std::span<const double> a, std::span<const double> b, std::size_t n, Theo1Workspace& w);
+
+/// The sum of the autocorrelations of two real sequences, acf(a)(e) + acf(b)(e), acf(a)(e) = sum_p
+/// a[p] a[p+e], by one FFT pair of length n (as cross_correlation): left at w.buffer[e] for
+/// 0 <= e < n - max(a.size(), b.size()). O(n log n).
+void autocorrelation_sum(std::span<const double> a, std::span<const double> b, std::size_t n, Theo1Workspace& w);
+
+/// Doubles of scratch mtotvar_fast needs beside a prepared Theo1Workspace of N points: 8 N + 16.
+std::size_t mtotvar_scratch_size(std::size_t n_phase);
+
+/// MTOTVAR at averaging factor m (1 <= m <= N / 3), exactly the estimator mtotvar(x, 1, m, tau0_s, .)
+/// computes (same n, stride 1), to rounding, from the record prepared by theo1_prepare: the
+/// whole record's autocorrelation weighted per lag, less the windows that stick out of either end
+/// (docs/total.md, "MTOTVAR exactly, from lag sums"). O(m log m) a tau on a prepared record.
+/// Undefined input (or scratch smaller than mtotvar_scratch_size(N)) gives n = 0.
+TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s);
+
+/// HTOTVAR at averaging factor m (2 <= m <= (N - 1) / 3), exactly the estimator htotvar(x, 1, m,
+/// tau0_s, .) computes (same n, stride 1), to rounding: MTOTVAR's kernel on the N - 1 frequencies,
+/// so `w` is theo1_prepare of y[k] = x[k+1] - x[k] (the frequencies times tau0), not of x; scratch
+/// of mtotvar_scratch_size(N - 1). m = 1 is the overlapping Hadamard variance (htotvar, O(N)), not
+/// this kernel: n = 0 here. O(m log m) a tau on a prepared record.
+TotalVariance htotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s);
+
 /// theo_bias_ratio with every Theo1 and AVAR exact, Theo1 by theo1_fast: at most `ratio_taus` of the
 /// definition's taus, evenly spread (all when ratio_taus >= n + 1). O(taus (N + m log^2 m)).
 TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s,

@@ -1,0 +1,280 @@
+// Exact MTOTVAR from lag sums; the derivation in docs/total.md ("MTOTVAR exactly, from lag sums"),
+// the interface in total_fast.hpp.
+//
+// Notation (docs/total.md): a window of len = 3m residuals starting at n; Sp the prefix sums of the
+// residual, zero before the record; U_n[t] = Sp[n + t] - Sp[n]. Every modified-Allan term of the
+// detrended, reflected window is z_k(n) = sum_j a_j Sp[n + p_j(k)]: four "moving" positions
+// p = s k + o (s = +-1, the reflected copies) with integer coefficients constant over each m-run of
+// k, and four fixed positions 0, h, len - h, len (the constant of the reflection and the slope's
+// half sums) whose coefficients phi depend on k.
+#include <cstdint>
+
+#include "gyrochar/total_fast.hpp"
+
+namespace gyrochar {
+namespace {
+
+using Index = std::size_t;
+using Pos = std::int64_t;    // positions relative to a window, may be negative
+using Wide = long double;
+
+struct Terms {
+  int a[4] = {}, s[4] = {};
+  Pos o[4] = {};
+  double phi[4] = {};  // at the fixed positions 0, h, len - h, len
+  Pos pos(int i, Pos k) const { return s[i] * k + o[i]; }
+};
+
+struct Geometry {
+  Pos m, len, h, run;
+  Pos fixed[4];
+  explicit Geometry(Pos m_) : m(m_), len(3 * m_), h(3 * m_ / 2), run(3 * m_ - 3 * m_ / 2), fixed{0, h, len - h, len} {}
+
+  static Wide sum_t2(Pos tau) {  // sum_{t<tau} t^2
+    const Wide T = static_cast<Wide>(tau);
+    return (T - 1) * T * (2 * T - 1) / 6;
+  }
+
+  // z_k = E[k+3m] - 3 E[k+2m] + 3 E[k+m] - E[k] with E the prefix sums of the 9m-point extension:
+  // E[q] = U[len] - U[len - q] (first copy), U[len] + U[q - len] (the window), 3 U[len] - U[3 len - q]
+  // (last copy); then the slope's line, removed: z_k -= slope * (z_k of the ramp t), slope =
+  // (U[len] - U[len - h] - U[h]) / (h run).
+  Terms terms(Pos k) const {
+    static constexpr int w[4] = {-1, 3, -3, 1};
+    Terms t;
+    const Pos j = k / m;
+    int at_len = 0, moving = 0;  // the coefficient of U[len] and the moving coefficients' sum
+    for (int i = 0; i < 4; ++i) {
+      const Pos c = j + i;
+      if (c <= 2) t.a[i] = -w[i], t.s[i] = -1, t.o[i] = len - i * m, at_len += w[i];
+      else if (c <= 5) t.a[i] = w[i], t.s[i] = 1, t.o[i] = i * m - len, at_len += w[i];
+      else t.a[i] = -w[i], t.s[i] = -1, t.o[i] = 3 * len - i * m, at_len += 3 * w[i];
+      moving += t.a[i];
+    }
+    // z_k of the ramp t (a constant changes no z), in integers: exact (below 2^53 for len < 2^25).
+    auto sum_t_int = [](Pos tau) { return tau * (tau - 1) / 2; };
+    Pos ramp = at_len * sum_t_int(len);
+    for (int i = 0; i < 4; ++i) ramp += t.a[i] * sum_t_int(t.pos(i, k));
+    const double beta = -static_cast<double>(ramp) / (static_cast<double>(h) * static_cast<double>(run));
+    t.phi[0] = -(moving + at_len) + beta;  // U[t] = Sp[n + t] - Sp[n]: the coefficients sum to 0
+    t.phi[1] = -beta, t.phi[2] = -beta, t.phi[3] = at_len + beta;
+    return t;
+  }
+  // The same term's value on a window whose U is the function u.
+  template <class F>
+  Wide apply(const Terms& t, Pos k, F u) const {
+    Wide z = 0;
+    for (int i = 0; i < 4; ++i) z += t.a[i] * u(t.pos(i, k));
+    for (int f = 1; f < 4; ++f) z += t.phi[f] * u(fixed[f]);
+    return z + t.phi[0] * u(0);
+  }
+};
+
+// Calls f(k, weight) over the 6m terms, each pair of mirror terms once with weight 2: the extension
+// is even about its reflection points and the modified Allan filter symmetric, so z_k = z_{len-k}
+// on [0, len] and z_k = z_{3 len - k} on (len, 2 len), for every window (the kernels are equal,
+// not their split into moving and fixed positions).
+template <class F>
+void for_each_term(const Geometry& g, F f) {
+  const Pos len = g.len;
+  for (Pos k = 0; 2 * k < len; ++k) f(k, 2.0);
+  if (len % 2 == 0) f(len / 2, 1.0);
+  for (Pos k = len + 1; 2 * k < 3 * len; ++k) f(k, 2.0);
+  if (len % 2 == 0) f(3 * len / 2, 1.0);
+}
+
+// The sum over every k of the autocorrelation of z_k's kernel on the window (as a function of the
+// residual), A(d) for d in [0, len]: from the autocorrelation B of its first difference (eight
+// spikes a k), summed twice (A vanishes from d = len on).
+void kernel_autocorrelation(const Geometry& g, std::span<double> A, std::span<double> B) {
+  for (Pos d = 0; d <= g.len; ++d) B[static_cast<Index>(d)] = 0.0;
+  for_each_term(g, [&](Pos k, double weight) {
+    const Terms t = g.terms(k);
+    Pos p[8];
+    double v[8];
+    for (int i = 0; i < 4; ++i) p[i] = t.pos(i, k), v[i] = t.a[i], p[4 + i] = g.fixed[i], v[4 + i] = t.phi[i];
+    for (int u = 0; u < 8; ++u) {
+      B[0] += weight * v[u] * v[u];
+      for (int x = u + 1; x < 8; ++x) {
+        const Pos d = p[u] > p[x] ? p[u] - p[x] : p[x] - p[u];
+        B[static_cast<Index>(d)] += (d == 0 ? 2.0 : 1.0) * weight * v[u] * v[x];
+      }
+    }
+  });
+  // B(d) = 2 A(d) - A(d - 1) - A(d + 1)
+  Wide above = 0, here = 0;  // A(d + 1), A(d) from d = len
+  for (Pos d = g.len; d >= 1; --d) {
+    const Wide below = 2 * here - above - B[static_cast<Index>(d)];
+    above = here, here = below;
+    A[static_cast<Index>(d - 1)] = static_cast<double>(below);
+  }
+  A[static_cast<Index>(g.len)] = 0.0;
+}
+
+// The windows that stick out of one end: n in [-(len - 1), -1], the residual zero before the record.
+// Sp[i] for i in [0, len) the prefix sums of that end's residuals (read from the end inwards). Here
+// the products of two moving positions; those with a fixed position in fixed_terms.
+struct EndWindows {
+  const Geometry& g;
+  std::span<const double> Sp;  // len values, Sp[0] = 0
+  std::span<double> T2;        // len + 2: sums of Sp over positions below i of i's parity
+
+  double sp(Pos i) const { return i >= 1 && i < g.len ? Sp[static_cast<Index>(i)] : 0.0; }
+  double t2(Pos x) const {
+    if (x < 0) return 0.0;
+    if (x >= g.len) x = g.len + ((x - g.len) & 1);
+    return T2[static_cast<Index>(x)];
+  }
+
+  // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + s k + ou] Sp[n + s k + ou + delta]
+  double same(Pos s, Pos ou, Pos delta, Pos k0, Pos k1, Pos n0, Pos n1) const {
+    Pos lo = s > 0 ? n0 + k0 + ou : n0 - (k1 - 1) + ou, hi = s > 0 ? n1 + k1 - 2 + ou : n1 - 1 - k0 + ou;
+    lo = lo > 1 ? lo : 1, lo = lo + delta > 1 ? lo : 1 - delta;
+    hi = hi < g.len - 1 ? hi : g.len - 1, hi = hi + delta < g.len - 1 ? hi : g.len - 1 - delta;
+    double sum = 0;  // double within a run (the FFT parts carry the same relative rounding)
+    for (Pos i = lo; i <= hi; ++i) {
+      Pos klo, khi;
+      if (s > 0) klo = i - ou - (n1 - 1), khi = i - ou - n0;
+      else klo = n0 - i + ou, khi = n1 - 1 - i + ou;
+      klo = klo > k0 ? klo : k0, khi = khi < k1 - 1 ? khi : k1 - 1;
+      if (khi >= klo) sum += static_cast<double>(khi - klo + 1) * (sp(i) * sp(i + delta));
+    }
+    return sum;
+  }
+  // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + k + op] Sp[n - k + om]: for each i = n - k + om, the
+  // other factor runs over every other position, a difference of T2.
+  double opposite(Pos op, Pos om, Pos k0, Pos k1, Pos n0, Pos n1) const {
+    Pos lo = n0 - (k1 - 1) + om, hi = n1 - 1 - k0 + om;
+    lo = lo > 1 ? lo : 1, hi = hi < g.len - 1 ? hi : g.len - 1;
+    double sum = 0;
+    for (Pos i = lo; i <= hi; ++i) {
+      Pos ka = n0 - i + om, kb = n1 - i + om;
+      ka = ka > k0 ? ka : k0, kb = kb < k1 ? kb : k1;
+      if (kb <= ka) continue;
+      const Pos c = i + op - om;
+      sum += sp(i) * (t2(c + 2 * kb) - t2(c + 2 * ka));
+    }
+    return sum;
+  }
+
+  Wide moving_terms() {
+    const Pos len = g.len, n0 = -(len - 1), n1 = 0;
+    T2[0] = T2[1] = 0.0;
+    for (Pos x = 2; x <= len + 1; ++x) T2[static_cast<Index>(x)] = T2[static_cast<Index>(x - 2)] + sp(x - 2);
+    Wide sum = 0;  // per m-run of k the coefficients are constant
+    for (Pos j = 0; j < 6; ++j) {
+      const Pos k0 = j * g.m, k1 = k0 + g.m;
+      const Terms t = g.terms(k0);
+      for (int u = 0; u < 4; ++u)
+        for (int v = u; v < 4; ++v) {
+          const Wide c = (u == v ? 1 : 2) * t.a[u] * t.a[v];
+          if (t.s[u] == t.s[v]) sum += c * same(t.s[u], t.o[u], t.o[v] - t.o[u], k0, k1, n0, n1);
+          else if (t.s[u] > 0) sum += c * opposite(t.o[u], t.o[v], k0, k1, n0, n1);
+          else sum += c * opposite(t.o[v], t.o[u], k0, k1, n0, n1);
+        }
+    }
+    return sum;
+  }
+};
+
+// The products with a fixed position in the windows past both ends, from X[f][p] = sum over both
+// ends and their windows of Sp[n + fixed_f] Sp[n + p] = sum_{i=1}^{fixed_f - 1} Sp[i] Sp[i + p -
+// fixed_f] (f = 0 gives nothing: Sp[n] = 0 for n < 0). X[3] is the ends' autocorrelation read
+// backwards; X[1] a correlation of each end's first h values with the end; X[2] the same as X[1]
+// when len is even (len - h = h), one point longer and one lag further when it is odd.
+Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail,
+                 std::span<double> (&X)[4], Theo1Workspace& w) {
+  const Pos len = g.len, h = g.h;
+  const Index L = static_cast<Index>(len);
+  autocorrelation_sum(head, tail, fft_length(2 * L), w);
+  for (Index p = 1; p <= L; ++p) X[3][p] = w.buffer[L - p];
+  X[3][0] = 0.0;
+  const Index n = fft_length(static_cast<Index>(h + len));
+  for (Index p = 0; p <= L; ++p) X[1][p] = 0.0;
+  for (const std::span<const double> Sp : {head, tail}) {
+    cross_correlation(Sp.first(static_cast<Index>(h)), Sp, n, w);
+    for (Pos p = 0; p <= len; ++p) X[1][static_cast<Index>(p)] += w.buffer[static_cast<Index>(p - h >= 0 ? p - h : p - h + static_cast<Pos>(n))];
+  }
+  const Index H = static_cast<Index>(h);
+  X[2][0] = 0.0;
+  for (Index p = 1; p <= L; ++p)
+    X[2][p] = len % 2 == 0 ? X[1][p] : X[1][p - 1] + (p >= 2 ? head[H] * head[p - 1] + tail[H] * tail[p - 1] : 0.0);
+  Wide sum = 0;  // every k: the split into moving and fixed positions is not mirror-symmetric
+  for (Pos k = 0; k < 2 * len; ++k) {
+    const Terms t = g.terms(k);
+    for (int f = 1; f < 4; ++f) {
+      double moving = 0;
+      for (int i = 0; i < 4; ++i) moving += t.a[i] * X[f][static_cast<Index>(t.pos(i, k))];
+      double fixed = 0;
+      for (int e = 1; e < 4; ++e) fixed += t.phi[e] * X[f][static_cast<Index>(g.fixed[e])];
+      sum += t.phi[f] * (2 * moving + fixed);
+    }
+  }
+  return sum;
+}
+
+// The sum over every window of 3m values of the prepared sequence of the 6m squared terms z_k
+// (MTOTVAR's kernel; HTOTVAR's on the frequencies). Valid input checked by the caller.
+Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
+  const Index N = w.r.size();
+  const Geometry g(static_cast<Pos>(m));
+  const Index len = static_cast<Index>(g.len), windows = N - len + 1;
+  std::span<double> rest = scratch;
+  auto take = [&](Index count) {
+    const std::span<double> s = rest.first(count);
+    rest = rest.subspan(count);
+    return s;
+  };
+  const std::span<double> A = take(len + 1), B = take(len + 1), head = take(len), tail = take(len), T2 = take(len + 2);
+  std::span<double> X[4] = {{}, take(len + 1), take(len + 1), take(len + 1)};
+  // Every window that meets the record, the residual zero outside: the autocorrelation weighted.
+  kernel_autocorrelation(g, A, B);
+  Wide sum = static_cast<Wide>(A[0]) * w.ac[0];
+  for (Index d = 1; d < len; ++d) sum += 2 * static_cast<Wide>(A[d]) * w.ac[d];
+  // Less the windows that stick out at the start, and at the end (the sum of a window's squares does
+  // not change when the window is reversed: the end's residuals are read backwards).
+  head[0] = tail[0] = 0.0;
+  for (Index i = 1; i < len; ++i) head[i] = head[i - 1] + w.r[i - 1], tail[i] = tail[i - 1] + w.r[N - i];
+  sum -= EndWindows{g, head, T2}.moving_terms() + EndWindows{g, tail, T2}.moving_terms();
+  sum -= fixed_terms(g, head, tail, X, w);
+  // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
+  const Wide c = w.curvature;
+  if (c != 0) {
+    std::span<double> G = B;  // G[t] = sum over windows of U_n[t]
+    G[0] = 0.0;
+    for (Index t = 0; t < len; ++t) G[t + 1] = G[t] + (w.s1[windows + t] - w.s1[t]);
+    Wide cross = 0, square = 0;
+    for_each_term(g, [&](Pos k, double weight) {
+      const Terms t = g.terms(k);
+      const Wide q = g.apply(t, k, [](Pos tau) { return Geometry::sum_t2(tau); });
+      cross += weight * q * g.apply(t, k, [&](Pos tau) { return static_cast<Wide>(G[static_cast<Index>(tau)]); });
+      square += weight * q * q;
+    });
+    sum += 2 * c * cross + static_cast<Wide>(windows) * c * c * square;
+  }
+  return sum;
+}
+
+}  // namespace
+
+std::size_t mtotvar_scratch_size(std::size_t n_phase) { return 8 * n_phase + 16; }
+
+TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+  const std::uint64_t N = w.r.size();
+  if (!w.ready || m < 1 || 3 * m > N || !(tau0_s > 0) || scratch.size() < mtotvar_scratch_size(w.r.size())) return {};
+  // The mean over windows of the mean of the 6m squares, / (2 m^2 tau^2).
+  const double windows = static_cast<double>(N - 3 * m + 1), md = static_cast<double>(m), tau = md * tau0_s;
+  const double var = static_cast<double>(window_sum(w, scratch, m)) / (6.0 * md * windows * 2.0 * md * md * tau * tau);
+  return {var, N - 3 * m + 1, 1};
+}
+
+TotalVariance htotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+  const std::uint64_t N = w.r.size();  // frequencies
+  if (!w.ready || m < 2 || 3 * m > N || !(tau0_s > 0) || scratch.size() < mtotvar_scratch_size(w.r.size())) return {};
+  // z sums m frequencies: H = z / (m tau0); the mean over windows of the mean of the 6m squares / 6.
+  const double windows = static_cast<double>(N - 3 * m + 1), md = static_cast<double>(m), scale = md * tau0_s;
+  const double var = static_cast<double>(window_sum(w, scratch, m)) / (6.0 * md * windows * 6.0 * scale * scale);
+  return {var, N - 3 * m + 1, 1};
+}
+
+}  // namespace gyrochar
