@@ -61,7 +61,7 @@ std::vector<std::uint64_t> parse_tau_list(std::string_view text, std::string& wh
     std::uint64_t v = 0;
     const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
     if (ec != std::errc() || end != item.data() + item.size() || v == 0) {
-      why = "'" + std::string(item) + "' is not octave, decade, all or a positive averaging factor";
+      why.assign(1, '\'').append(item).append("' is not octave, decade, all or a positive averaging factor");
       return {};
     }
     if (!m.empty() && v <= m.back()) {

@@ -3,6 +3,8 @@
 // simulation's truth read back from the file's header.
 #include <bit>
 #include <cmath>
+#include <future>
+#include <initializer_list>
 
 #include "analysis_report.hpp"
 #include "gyrochar/greenhall_edf.hpp"
@@ -80,17 +82,26 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   const std::vector<FitPoint> points = fit_points(a, units, tau0_s, long_tau, record);
   std::vector<CurveFit> fits;
   if (points.empty()) return fits;
-  std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
-  // The three fits share the covariance sums of their points (and the sinusoids' with them):
-  // computed once, in a cache with room for every pair.
-  std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
-  std::vector<PairSumCache::SinusoidEntry> sinusoid_entries(points.size() * points.size() + 16);
-  PairSumCache cache(entries, sinusoid_entries);
   FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
   setup.sinusoid_hz = sinusoid_hz;
   const int used = long_tau != LongTau::oadev && !record.phase.empty() ? static_cast<int>(long_tau) : 0;
-  for (const FitCurve curve : {FitCurve::both, FitCurve::avar, FitCurve::mvar})
-    fits.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache), curve == FitCurve::mvar ? 0 : used});
+  // Fits in turn that share the covariance sums of their points (and the sinusoids' with them),
+  // computed once in a cache with room for every pair.
+  const auto fit_in_turn = [&](std::initializer_list<FitCurve> curves) {
+    std::vector<CurveFit> out;
+    std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
+    std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
+    std::vector<PairSumCache::SinusoidEntry> sinusoid_entries(points.size() * points.size() + 16);
+    PairSumCache cache(entries, sinusoid_entries);
+    for (const FitCurve curve : curves)
+      out.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache), curve == FitCurve::mvar ? 0 : used});
+    return out;
+  };
+  // Each curve alone on a second thread while this one fits both: the alone fits make the sums of
+  // their points again (the same to the last bit as the shared cache gave them), in the meantime.
+  auto alone = std::async(std::launch::async, [&] { return fit_in_turn({FitCurve::avar, FitCurve::mvar}); });
+  fits = fit_in_turn({FitCurve::both});
+  for (CurveFit& f : alone.get()) fits.push_back(std::move(f));
   return fits;
 }
 

@@ -227,10 +227,14 @@ void check_output_paths(const Request& r) {
 
 std::string quoted_command(int argc, const char* const* argv) {
   std::string command;
-  for (int i = 0; i < argc; ++i)
-    command += (i ? " " : "") + (std::string(argv[i]).find_first_of(" '\"") == std::string::npos
-                                     ? std::string(argv[i])
-                                     : "'" + std::string(argv[i]) + "'");
+  for (int i = 0; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (i) command += ' ';
+    const bool quote = arg.find_first_of(" '\"") != std::string_view::npos;
+    if (quote) command += '\'';
+    command += arg;
+    if (quote) command += '\'';
+  }
   return command;
 }
 
