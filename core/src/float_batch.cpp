@@ -328,57 +328,95 @@ void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) 
   }
 }
 
-// Points [from, to) of up to four fully overlapped taus in the steady state (from >= 3m of each),
-// one lane a tau (lanes past `count` repeat the first tau and are dropped): the terms formed as
-// run_points() forms them, each lane's sums in e's order.
-GYROCHAR_FLOAT_CLONES void run_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
-                                     std::size_t to) {
+// Points [from, to) of up to four fully overlapped taus, one lane a tau (lanes past `count` repeat
+// the first tau and are dropped): the terms formed as run_points() forms them, each lane's sums in
+// e's order. Steady (from >= 3m of each): the three terms at every point. Otherwise (Ramp) each
+// lane from its own start: no term below 2m, the AVAR term alone below 3m, the MVAR term from
+// 3m - 1; a lane adds 0 (0 * 0 to a sum of squares, which leaves it as it is) where it has none,
+// and reads its points below an age's start at e itself (the value unused).
+template <bool Ramp>
+[[gnu::always_inline]] inline void lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
+                                         std::size_t to) {
   std::size_t k1[4], k2[4], k3[4];  // the ages m, 2m, 3m of each lane
-  alignas(32) double init[5][4];    // AVAR, MVAR, HVAR sums, t_hi, t_c of each lane
+  alignas(32) double init[8][4];    // AVAR, MVAR, HVAR sums, t_hi, t_c of each lane; 2m, 3m, 3m - 1
   for (std::size_t j = 0; j < 4; ++j) {
     const PhaseRun& r = runs[j < count ? j : 0];
     k1[j] = r.m, k2[j] = 2 * r.m, k3[j] = 3 * r.m;
     init[0][j] = r.sum[0], init[1][j] = r.sum[1], init[2][j] = r.sum[2], init[3][j] = r.t_hi, init[4][j] = r.t_c;
+    init[5][j] = static_cast<double>(2 * r.m), init[6][j] = static_cast<double>(3 * r.m);
+    init[7][j] = static_cast<double>(3 * r.m - 1);
   }
-  Lanes sa, st, sh, t_hi, t_c;
+  Lanes sa, st, sh, t_hi, t_c, two_m, three_m, first_t;
   load(sa, init[0]), load(st, init[1]), load(sh, init[2]), load(t_hi, init[3]), load(t_c, init[4]);
-  // The points of each lane at the four ages, four loads a lane.
-  const auto ages = [&](std::size_t e, Lanes& x0, Lanes& x1, Lanes& x2, Lanes& x3) {
-    x0 = Lanes{x[e], x[e], x[e], x[e]};
-    x1 = Lanes{x[e - k1[0]], x[e - k1[1]], x[e - k1[2]], x[e - k1[3]]};
-    x2 = Lanes{x[e - k2[0]], x[e - k2[1]], x[e - k2[2]], x[e - k2[3]]};
-    x3 = Lanes{x[e - k3[0]], x[e - k3[1]], x[e - k3[2]], x[e - k3[3]]};
-  };
+  load(two_m, init[5]), load(three_m, init[6]), load(first_t, init[7]);
+  const Lanes zero{0, 0, 0, 0};
+  const auto age = [&](std::size_t e, std::size_t k) { return Ramp && e < k ? e : e - k; };
   for (std::size_t e = from; e < to; ++e) {
-    Lanes x0, x1, x2, x3, hi, lo;
-    ages(e, x0, x1, x2, x3);
+    const Lanes x0{x[e], x[e], x[e], x[e]};
+    const Lanes x1{x[age(e, k1[0])], x[age(e, k1[1])], x[age(e, k1[2])], x[age(e, k1[3])]};
+    const Lanes x2{x[age(e, k2[0])], x[age(e, k2[1])], x[age(e, k2[2])], x[age(e, k2[3])]};
+    const Lanes x3{x[age(e, k3[0])], x[age(e, k3[1])], x[age(e, k3[2])], x[age(e, k3[3])]};
     const Lanes d2 = x1 - x2;
-    const Lanes a = (x0 - x1) - d2;
-    const Lanes h = a - (d2 - (x2 - x3));
+    Lanes a = (x0 - x1) - d2;
+    Lanes h = a - (d2 - (x2 - x3));
+    Lanes hi, lo;
     exact_third(x0, x1, x2, x3, hi, lo);
-    add_term(t_hi, t_c, hi, lo);
-    const Lanes t = t_hi + t_c;
-    sa += a * a;
-    st += t * t;
-    sh += h * h;
+    if constexpr (Ramp) {
+      const Lanes ev = zero + static_cast<double>(e);
+      const auto has_a = ev >= two_m, has_h = ev >= three_m, has_t = ev >= first_t;
+      Lanes a_hi, a_lo;
+      exact_second(x0, x1, x2, a_hi, a_lo);
+      hi = has_h ? hi : (has_a ? a_hi : zero);
+      lo = has_h ? lo : (has_a ? a_lo : zero);
+      a = has_a ? a : zero;
+      h = has_h ? h : zero;
+      add_term(t_hi, t_c, hi, lo);
+      const Lanes t = has_t ? t_hi + t_c : zero;
+      sa += a * a;
+      st += t * t;
+      sh += h * h;
+    } else {
+      add_term(t_hi, t_c, hi, lo);
+      const Lanes t = t_hi + t_c;
+      sa += a * a;
+      st += t * t;
+      sh += h * h;
+    }
   }
   std::memcpy(init[0], &sa, sizeof sa), std::memcpy(init[1], &st, sizeof st), std::memcpy(init[2], &sh, sizeof sh);
   std::memcpy(init[3], &t_hi, sizeof t_hi), std::memcpy(init[4], &t_c, sizeof t_c);
   for (std::size_t j = 0; j < count; ++j) {
     PhaseRun& r = runs[j];
     r.sum[0] = init[0][j], r.sum[1] = init[1][j], r.sum[2] = init[2][j], r.t_hi = init[3][j], r.t_c = init[4][j];
-    for (std::uint64_t& n : r.n) n += to - from;
   }
 }
+GYROCHAR_FLOAT_CLONES void steady_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
+                                        std::size_t to) {
+  lanes<false>(x, runs, count, from, to);
+}
+GYROCHAR_FLOAT_CLONES void ramp_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
+                                      std::size_t to) {
+  lanes<true>(x, runs, count, from, to);
+}
 
-// The taus of runs[0 .. count) (fully overlapped, 3m < size for each) over the record: each alone
-// up to 3m of the largest, then side by side.
+// The taus of runs[0 .. count) (fully overlapped, 3m < size for each) over the record, side by
+// side: each from its own start up to 3m of the largest, then all in the steady state.
 void run_group(std::span<const double> x, PhaseRun* runs, std::size_t count) {
-  std::size_t steady = 0;
-  for (std::size_t j = 0; j < count; ++j) steady = 3 * runs[j].m > steady ? 3 * runs[j].m : steady;
-  steady = steady < x.size() ? steady : x.size();
-  for (std::size_t j = 0; j < count; ++j) run_points(x.data(), runs[j], 2 * runs[j].m, steady);
-  if (steady < x.size()) run_lanes(x.data(), runs, count, steady, x.size());
+  const std::size_t size = x.size();
+  std::size_t least = size, most = 0;
+  for (std::size_t j = 0; j < count; ++j) {
+    least = runs[j].m < least ? runs[j].m : least;
+    most = runs[j].m > most ? runs[j].m : most;
+  }
+  const std::size_t steady = 3 * most < size ? 3 * most : size;
+  ramp_lanes(x.data(), runs, count, 2 * least, steady);
+  if (steady < size) steady_lanes(x.data(), runs, count, steady, size);
+  for (std::size_t j = 0; j < count; ++j) {
+    PhaseRun& r = runs[j];
+    r.n[0] = size - 2 * r.m;
+    r.n[1] = size - 3 * r.m + 1;
+    r.n[2] = size - 3 * r.m;
+  }
 }
 
 void store(const PhaseRun& r, TauResult<double>& out) {

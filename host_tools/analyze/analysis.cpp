@@ -595,14 +595,19 @@ class CountBatchEngine final : public EngineBase {
 
 // Phase or frequency with the record held: the points as the characterizer stages them (relative
 // to the line through the first two phase points, or to the first frequency value), 8 bytes a
-// point, every tau summed over them by phase_batch_taus() (float_batch.hpp): the characterizer's
-// AVAR and HVAR sums to the last bit, MVAR within its stated rounding bound, O(N) per tau.
+// point, every tau summed over them by phase_batch_taus() (float_batch.hpp), four side by side:
+// the characterizer's AVAR and HVAR sums to the last bit, MVAR within its stated rounding bound.
+// With prefix sums (dense tau lists) also their double-double prefix sums (24 bytes a point in
+// all), every tau summed by float_batch_taus(), 64 consecutive ones at a time from the cache.
 class FloatBatchEngine final : public EngineBase {
  public:
   FloatBatchEngine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list,
-                   bool keep_record, std::uint64_t values_hint)
-      : type_(type), stride_factor_(stride_factor), m_list_(m_list), record_(type, keep_record) {
+                   bool keep_record, std::uint64_t values_hint, bool prefix_sums)
+      : type_(type), stride_factor_(stride_factor), m_list_(m_list), record_(type, keep_record),
+        prefix_sums_(prefix_sums) {
     x_.reserve(values_hint + 1);
+    if (prefix_sums_)
+      for (Held<double>* v : {&p_hi_, &p_lo_}) v->reserve(values_hint + 1);
   }
 
   void add(std::span<const double> values) override {
@@ -610,13 +615,13 @@ class FloatBatchEngine final : public EngineBase {
       const double v = values[i];
       if (!std::isfinite(v)) throw BadValue(i, "not a finite number");
       if (type_ == DataType::phase) {
-        x_.push_back(line_residual(v, x_.size(), line_x0_, line_slope_));
+        stage(line_residual(v, x_.size(), line_x0_, line_slope_));
       } else {  // as the characterizer's add_increment(): x_0 = 0, then the sum of y - y_1
         if (increments_++ == 0) {
           first_increment_ = v;
-          x_.push_back(0.0);
+          stage(0.0);
         }
-        x_.push_back(x_.back() + (v - first_increment_));
+        stage(x_.back() + (v - first_increment_));
       }
       record_.keep(v);
     }
@@ -627,15 +632,18 @@ class FloatBatchEngine final : public EngineBase {
     a.n_phase = x_.size();
     a.n_values = type_ == DataType::phase ? a.n_phase : increments_;
     a.stride_factor = stride_factor_;
-    // phase_batch_lanes consecutive taus at a time (phase_batch_taus() sums them side by side).
-    const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), phase_batch_lanes, o,
+    const FloatRecord held{x_, p_hi_, p_lo_};
+    const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), prefix_sums_ ? float_batch_group : phase_batch_lanes, o,
                                                     [&](std::size_t first, std::span<TauSums> out) {
       const std::span<const std::uint64_t> m(m_list_.data() + first, out.size());
-      std::uint64_t stride[phase_batch_lanes];
-      TauResult<double> r[phase_batch_lanes];
-      NoiseIdAccumulator noise[phase_batch_lanes];
+      std::vector<std::uint64_t> stride(out.size());
       for (std::size_t j = 0; j < out.size(); ++j) stride[j] = stride_of(m[j], stride_factor_);
-      phase_batch_taus(x_, m, std::span(stride, out.size()), std::span(r, out.size()), std::span(noise, out.size()));
+      std::vector<TauResult<double>> r(out.size());
+      std::vector<NoiseIdAccumulator> noise(out.size());
+      if (prefix_sums_)
+        float_batch_taus(held, m, stride, r, noise);
+      else
+        phase_batch_taus(x_, m, stride, r, noise);
       for (std::size_t j = 0; j < out.size(); ++j) out[j] = tau_sums(r[j], noise[j]);
     });
     read_out(a, sums, type_, o, record_.points);
@@ -647,11 +655,21 @@ class FloatBatchEngine final : public EngineBase {
   }
 
  private:
+  void stage(double x) {
+    x_.push_back(x);
+    if (!prefix_sums_) return;
+    prefix_ = FloatArith::add_prefix(prefix_, x);
+    p_hi_.push_back(prefix_.hi);
+    p_lo_.push_back(prefix_.lo);
+  }
+
   DataType type_;
   std::uint32_t stride_factor_;
   std::vector<std::uint64_t> m_list_;
   KeptRecord record_;
-  Held<double> x_;  // the staged points
+  bool prefix_sums_;
+  Held<double> x_, p_hi_, p_lo_;  // the staged points; with prefix sums P_{e+1} = x_0 + ... + x_e
+  FloatArith::Prefix prefix_;
   double line_x0_ = 0, line_slope_ = 0, first_increment_ = 0;
   std::uint64_t increments_ = 0;
 };
@@ -686,7 +704,8 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   if (o.type == DataType::counts && o.hold_counts)
     impl_->engine = std::make_unique<CountBatchEngine>(s, o.m_list, keep_record, o.values_hint);
   else if (o.type != DataType::counts && o.hold_phase)
-    impl_->engine = std::make_unique<FloatBatchEngine>(o.type, s, o.m_list, keep_record, o.values_hint);
+    impl_->engine = std::make_unique<FloatBatchEngine>(o.type, s, o.m_list, keep_record, o.values_hint,
+                                                       o.hold_prefix_sums);
   else if (o.type == DataType::counts)
     impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record, o.checkpoint_tag);
   else

@@ -101,6 +101,11 @@ struct AnalysisOptions {
   // bit, the MVAR terms as exact running sums (within u relative and a second-order bound), O(N)
   // per tau where the characterizer visits every tau at every point.
   bool hold_phase = false;
+  // With hold_phase, for dense tau lists (--taus all): hold the double-double prefix sums too (24
+  // bytes a point) and sum 64 consecutive taus at a time from the cache (float_batch_taus(): the
+  // characterizer's terms to the last bit, the overlapping sums in another order, within 2 n u
+  // relative), two to three times faster there than four taus side by side.
+  bool hold_prefix_sums = false;
   // Threads summing the held record's taus (each tau on one; they are independent); 0: one per
   // core the system offers.
   unsigned threads = 0;

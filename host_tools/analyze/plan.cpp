@@ -39,11 +39,14 @@ TauPlan plan_taus(AnalysisOptions& o, const std::string& taus, const std::vector
   // sums as the characterizer's, at 4 bytes a point instead of its history near N/4) while the
   // record fits in memory at its worst (12 bytes a point while it widens to int64).
   o.hold_counts = o.type == DataType::counts && o.stride_factor == 0 && n_phase > 0 && o.values_hint < budget / 12;
-  // Phase and frequency of a known length under full (any tau rule) hold the staged points and
-  // their prefix sums (24 bytes a point) and sum the taus over them (float_batch.hpp): O(N) per
-  // tau where the characterizer visits every tau at every point.
-  o.hold_phase = o.type != DataType::counts && o.stride_factor == 0 && (taus == "all" || n_phase > 0) &&
-                 o.values_hint < budget / 24;
+  // Phase and frequency of a known length (any tau rule) hold the staged points (8 bytes a point)
+  // and sum the taus over them (phase_batch_taus(), float_batch.hpp): O(N) per tau where the
+  // characterizer visits every tau at every point. Under full, or under a stride factor of at
+  // least N/8, whose pyramid would hold more than the record (3S points of 24 bytes and more);
+  // a smaller one keeps the characterizer's few MiB.
+  const bool wide = o.stride_factor == 0 || (n_phase > 0 && o.stride_factor >= n_phase / 8);
+  o.hold_phase = o.type != DataType::counts && wide && (taus == "all" || n_phase > 0) && o.values_hint < budget / 24;
+  o.hold_prefix_sums = o.hold_phase && taus == "all";
   plan.held = o.hold_counts || o.hold_phase;
   // full: every tau up to N/4 fully overlapped; for "all" every m up to N/2 (all of them).
   if (o.stride_factor == 0) o.stride_factor = full_stride_factor(taus == "all" ? 2 * n_phase : n_phase);
