@@ -98,13 +98,13 @@ GYROCHAR_FLOAT_CLONES void steady_terms(const double* x, const double* ph, const
 }
 
 // The decimated series x_0, x_m, x_2m, ...: the characterizer's decimate(), point by point.
-void decimate(const FloatRecord& r, std::size_t m, TauResult<double>& result, NoiseIdAccumulator& noise) {
+void decimate(std::span<const double> xs, std::size_t m, TauResult<double>& result, NoiseIdAccumulator& noise) {
   constexpr auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
   constexpr auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
   double d[3] = {0, 0, 0};  // the last three decimated points, newest first
   std::size_t have = 0;
-  for (std::size_t e = 0; e < r.x.size(); e += m) {
-    const double x = r.x[e];
+  for (std::size_t e = 0; e < xs.size(); e += m) {
+    const double x = xs[e];
     double a = 0, h = 0;
     if (have >= 2 && FloatArith::x_term2(x, d[0], d[1], a)) {
       result.sum[avar_d] += a * a;
@@ -118,8 +118,8 @@ void decimate(const FloatRecord& r, std::size_t m, TauResult<double>& result, No
     d[1] = d[0];
     d[0] = x;
     if (have < 3) ++have;
-    noise.add(x);
   }
+  noise.add(xs.data(), (xs.size() + m - 1) / m, m);
 }
 
 // Several taus at once (float_batch_taus()). A group's taus go through the record together, a
@@ -246,6 +246,186 @@ void run_group(const FloatRecord& record, Run* runs, const std::size_t* index, s
   }
 }
 
+// phase_batch_taus(): the MVAR term as a running sum of exact second and third differences.
+
+// a + b = s + err exactly (Knuth's two-sum), for a double or a vector of them.
+template <class V>
+[[gnu::always_inline]] inline void two_sum(V a, V b, V& s, V& err) {
+  s = a + b;
+  const V bb = s - a;
+  err = (a - (s - bb)) + (b - bb);
+}
+
+// x0 - 2 x1 + x2 = hi + lo, exact but for the rounding of lo (x1 + x1 is exact).
+template <class V>
+[[gnu::always_inline]] inline void exact_second(V x0, V x1, V x2, V& hi, V& lo) {
+  V s, e1, e2;
+  two_sum(x0, x2, s, e1);
+  two_sum(s, -(x1 + x1), hi, e2);
+  lo = e1 + e2;
+}
+
+// (x0 - x3) - 3 (x1 - x2) = hi + lo, exact but for the rounding of lo: 3 q as q + q (exact) plus q,
+// whose error Dekker's fast two-sum gives (|2q| >= |q|).
+template <class V>
+[[gnu::always_inline]] inline void exact_third(V x0, V x1, V x2, V x3, V& hi, V& lo) {
+  V s, e1, q, e2, e4;
+  two_sum(x0, -x3, s, e1);
+  two_sum(x1, -x2, q, e2);
+  const V q2 = q + q;
+  const V p = q2 + q;
+  const V e3 = q - (p - q2);
+  two_sum(s, -p, hi, e4);
+  lo = ((e1 + e4) - e3) - e2 * 3.0;
+}
+
+// The running MVAR term hi + c: hi the rounded sum of the exact terms' high parts, c what it lost
+// and their low parts.
+template <class V>
+[[gnu::always_inline]] inline void add_term(V& hi, V& c, V term_hi, V term_lo) {
+  V s, err;
+  two_sum(hi, term_hi, s, err);
+  hi = s;
+  c += err + term_lo;
+}
+
+// One tau while its points pass: the sums of squares (SumKind's order) and the running MVAR term.
+struct PhaseRun {
+  std::size_t m = 0, stride = 1;
+  double sum[3] = {0, 0, 0};
+  std::uint64_t n[3] = {0, 0, 0};
+  double t_hi = 0, t_c = 0;
+};
+
+// Points [from, to) of one tau (2m <= from), one by one, every case: the AVAR term alone below 3m,
+// the squares of the terms at multiples of its stride only (the running term takes every point).
+void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) {
+  const std::size_t m = r.m, step = r.stride;
+  std::size_t counted = (from + step - 1) / step * step;  // the next point whose terms are summed
+  for (std::size_t e = from; e < to; ++e) {
+    double a = 0, h = 0, hi = 0, lo = 0;
+    const bool steady = e >= 3 * m;
+    if (steady) {
+      FloatArith::x_terms(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h);
+      exact_third(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], hi, lo);
+    } else {
+      FloatArith::x_term2(x[e], x[e - m], x[e - 2 * m], a);
+      exact_second(x[e], x[e - m], x[e - 2 * m], hi, lo);
+    }
+    add_term(r.t_hi, r.t_c, hi, lo);
+    if (e != counted) continue;
+    counted += step;
+    r.sum[0] += a * a;
+    ++r.n[0];
+    if (steady) {
+      r.sum[2] += h * h;
+      ++r.n[2];
+    }
+    if (e + 1 < 3 * m) continue;
+    const double t = r.t_hi + r.t_c;
+    r.sum[1] += t * t;
+    ++r.n[1];
+  }
+}
+
+// Points [from, to) of up to four fully overlapped taus, one lane a tau (lanes past `count` repeat
+// the first tau and are dropped): the terms formed as run_points() forms them, each lane's sums in
+// e's order. Steady (from >= 3m of each): the three terms at every point. Otherwise (Ramp) each
+// lane from its own start: no term below 2m, the AVAR term alone below 3m, the MVAR term from
+// 3m - 1; a lane adds 0 (0 * 0 to a sum of squares, which leaves it as it is) where it has none,
+// and reads its points below an age's start at e itself (the value unused).
+template <bool Ramp>
+[[gnu::always_inline]] inline void lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
+                                         std::size_t to) {
+  std::size_t k1[4], k2[4], k3[4];  // the ages m, 2m, 3m of each lane
+  alignas(32) double init[8][4];    // AVAR, MVAR, HVAR sums, t_hi, t_c of each lane; 2m, 3m, 3m - 1
+  for (std::size_t j = 0; j < 4; ++j) {
+    const PhaseRun& r = runs[j < count ? j : 0];
+    k1[j] = r.m, k2[j] = 2 * r.m, k3[j] = 3 * r.m;
+    init[0][j] = r.sum[0], init[1][j] = r.sum[1], init[2][j] = r.sum[2], init[3][j] = r.t_hi, init[4][j] = r.t_c;
+    init[5][j] = static_cast<double>(2 * r.m), init[6][j] = static_cast<double>(3 * r.m);
+    init[7][j] = static_cast<double>(3 * r.m - 1);
+  }
+  Lanes sa, st, sh, t_hi, t_c, two_m, three_m, first_t;
+  load(sa, init[0]), load(st, init[1]), load(sh, init[2]), load(t_hi, init[3]), load(t_c, init[4]);
+  load(two_m, init[5]), load(three_m, init[6]), load(first_t, init[7]);
+  const Lanes zero{0, 0, 0, 0};
+  const auto age = [&](std::size_t e, std::size_t k) { return Ramp && e < k ? e : e - k; };
+  for (std::size_t e = from; e < to; ++e) {
+    const Lanes x0{x[e], x[e], x[e], x[e]};
+    const Lanes x1{x[age(e, k1[0])], x[age(e, k1[1])], x[age(e, k1[2])], x[age(e, k1[3])]};
+    const Lanes x2{x[age(e, k2[0])], x[age(e, k2[1])], x[age(e, k2[2])], x[age(e, k2[3])]};
+    const Lanes x3{x[age(e, k3[0])], x[age(e, k3[1])], x[age(e, k3[2])], x[age(e, k3[3])]};
+    const Lanes d2 = x1 - x2;
+    Lanes a = (x0 - x1) - d2;
+    Lanes h = a - (d2 - (x2 - x3));
+    Lanes hi, lo;
+    exact_third(x0, x1, x2, x3, hi, lo);
+    if constexpr (Ramp) {
+      const Lanes ev = zero + static_cast<double>(e);
+      const auto has_a = ev >= two_m, has_h = ev >= three_m, has_t = ev >= first_t;
+      Lanes a_hi, a_lo;
+      exact_second(x0, x1, x2, a_hi, a_lo);
+      hi = has_h ? hi : (has_a ? a_hi : zero);
+      lo = has_h ? lo : (has_a ? a_lo : zero);
+      a = has_a ? a : zero;
+      h = has_h ? h : zero;
+      add_term(t_hi, t_c, hi, lo);
+      const Lanes t = has_t ? t_hi + t_c : zero;
+      sa += a * a;
+      st += t * t;
+      sh += h * h;
+    } else {
+      add_term(t_hi, t_c, hi, lo);
+      const Lanes t = t_hi + t_c;
+      sa += a * a;
+      st += t * t;
+      sh += h * h;
+    }
+  }
+  std::memcpy(init[0], &sa, sizeof sa), std::memcpy(init[1], &st, sizeof st), std::memcpy(init[2], &sh, sizeof sh);
+  std::memcpy(init[3], &t_hi, sizeof t_hi), std::memcpy(init[4], &t_c, sizeof t_c);
+  for (std::size_t j = 0; j < count; ++j) {
+    PhaseRun& r = runs[j];
+    r.sum[0] = init[0][j], r.sum[1] = init[1][j], r.sum[2] = init[2][j], r.t_hi = init[3][j], r.t_c = init[4][j];
+  }
+}
+GYROCHAR_FLOAT_CLONES void steady_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
+                                        std::size_t to) {
+  lanes<false>(x, runs, count, from, to);
+}
+GYROCHAR_FLOAT_CLONES void ramp_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
+                                      std::size_t to) {
+  lanes<true>(x, runs, count, from, to);
+}
+
+// The taus of runs[0 .. count) (fully overlapped, 3m < size for each) over the record, side by
+// side: each from its own start up to 3m of the largest, then all in the steady state.
+void run_group(std::span<const double> x, PhaseRun* runs, std::size_t count) {
+  const std::size_t size = x.size();
+  std::size_t least = size, most = 0;
+  for (std::size_t j = 0; j < count; ++j) {
+    least = runs[j].m < least ? runs[j].m : least;
+    most = runs[j].m > most ? runs[j].m : most;
+  }
+  const std::size_t steady = 3 * most < size ? 3 * most : size;
+  ramp_lanes(x.data(), runs, count, 2 * least, steady);
+  if (steady < size) steady_lanes(x.data(), runs, count, steady, size);
+  for (std::size_t j = 0; j < count; ++j) {
+    PhaseRun& r = runs[j];
+    r.n[0] = size - 2 * r.m;
+    r.n[1] = size - 3 * r.m + 1;
+    r.n[2] = size - 3 * r.m;
+  }
+}
+
+void store(const PhaseRun& r, TauResult<double>& out) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    out.sum[k] = r.sum[k];
+    out.n[k] = r.n[k];
+  }
+}
+
 }  // namespace
 
 TauResult<double> float_batch_sums(const FloatRecord& record, std::uint64_t m, std::uint64_t stride,
@@ -260,7 +440,7 @@ TauResult<double> float_batch_sums(const FloatRecord& record, std::uint64_t m, s
     return result;
   }
   const auto lag = static_cast<std::size_t>(m);
-  decimate(record, lag, result, noise);
+  decimate(record.x, lag, result, noise);
   Sums s;
   if (stride == 1 && size > 3 * lag) {
     for (std::size_t e = 2 * lag; e < 3 * lag; ++e) point_terms(record, e, lag, s);
@@ -297,7 +477,7 @@ void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> 
     out[i] = TauResult<double>{};
     out[i].m = m[i];
     out[i].stride = 1;
-    decimate(record, lag, out[i], noise[i]);
+    decimate(record.x, lag, out[i], noise[i]);
     Run& r = runs[count];
     r = Run{};
     r.m = lag;
@@ -310,6 +490,44 @@ void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> 
     }
   }
   if (count > 0) run_group(record, runs, index, count, out);
+}
+
+void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
+                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise) {
+  const std::size_t size = x.size();
+  PhaseRun runs[phase_batch_lanes];
+  std::size_t index[phase_batch_lanes];  // runs[j] is tau index[j]
+  std::size_t count = 0;
+  const auto flush = [&] {
+    run_group(x, runs, count);
+    for (std::size_t j = 0; j < count; ++j) store(runs[j], out[index[j]]);
+    count = 0;
+  };
+  for (std::size_t i = 0; i < m.size() && i < stride.size() && i < out.size() && i < noise.size(); ++i) {
+    out[i] = TauResult<double>{};
+    out[i].m = m[i];
+    out[i].stride = stride[i];
+    if (m[i] == 0) continue;
+    if (m[i] >= size) {  // no term; the decimated series is x_0 alone (when there is one)
+      if (size > 0) noise[i].add(x[0]);
+      continue;
+    }
+    const auto lag = static_cast<std::size_t>(m[i]);
+    decimate(x, lag, out[i], noise[i]);
+    if (size <= 2 * lag) continue;  // no overlapping term
+    PhaseRun r;
+    r.m = lag;
+    r.stride = stride[i] > 1 ? static_cast<std::size_t>(stride[i]) : 1;
+    if (r.stride != 1 || size <= 3 * lag) {
+      run_points(x.data(), r, 2 * lag, size);
+      store(r, out[i]);
+      continue;
+    }
+    runs[count] = r;
+    index[count++] = i;
+    if (count == phase_batch_lanes) flush();
+  }
+  if (count > 0) flush();
 }
 
 }  // namespace gyrochar

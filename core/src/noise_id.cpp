@@ -61,6 +61,13 @@ void NoiseIdAccumulator::add_run(const std::int64_t* z, std::size_t count, std::
   add_steady(z, count, step);
 }
 
+#if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void NoiseIdAccumulator::add_run(const double* z, std::size_t count, std::size_t step) {
+  add_steady(z, count, step);
+}
+
 Lag1Estimate lag1_estimate(const Lag1Summary& series, int dmin, int dmax) {
   Lag1Estimate out;
   for (int d = dmin; d <= dmax; ++d) {

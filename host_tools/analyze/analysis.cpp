@@ -405,7 +405,7 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   if (o.type == DataType::counts && o.hold_counts)
     impl_->engine = make_count_batch_engine(s, o.m_list, keep_record, o.values_hint);
   else if (o.type != DataType::counts && o.hold_phase)
-    impl_->engine = make_float_batch_engine(o.type, s, o.m_list, keep_record, o.values_hint);
+    impl_->engine = make_float_batch_engine(o.type, s, o.m_list, keep_record, o.values_hint, o.hold_prefix_sums);
   else if (o.type == DataType::counts)
     impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record, o.checkpoint_tag);
   else

@@ -57,9 +57,10 @@ struct KeptRecord {
 /// Counts with the record held: every tau summed over it by the batch kernel (core batch.hpp).
 std::unique_ptr<EngineBase> make_count_batch_engine(std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list,
                                                     bool keep_record, std::uint64_t values_hint);
-/// Phase or frequency with the record held: every tau summed by float_batch_taus() (float_batch.hpp).
+/// Phase or frequency with the record held: every tau summed by phase_batch_taus() over the points,
+/// or with prefix_sums by float_batch_taus() (float_batch.hpp; dense tau lists).
 std::unique_ptr<EngineBase> make_float_batch_engine(DataType type, std::uint32_t stride_factor,
                                                     const std::vector<std::uint64_t>& m_list, bool keep_record,
-                                                    std::uint64_t values_hint);
+                                                    std::uint64_t values_hint, bool prefix_sums);
 
 }  // namespace gyrochar

@@ -214,14 +214,20 @@ class CountBatchEngine final : public EngineBase {
 };
 
 // Phase or frequency with the record held: the points as the characterizer stages them (relative
-// to the line through the first two phase points, or to the first frequency value) and their
-// double-double prefix sums, every tau summed over them by float_batch_taus() (float_batch.hpp).
+// to the line through the first two phase points, or to the first frequency value), 8 bytes a
+// point, every tau summed over them by phase_batch_taus() (float_batch.hpp), four side by side:
+// the characterizer's AVAR and HVAR sums to the last bit, MVAR within its stated rounding bound.
+// With prefix sums (dense tau lists) also their double-double prefix sums (24 bytes a point in
+// all), every tau summed by float_batch_taus(), 64 consecutive ones at a time from the cache.
 class FloatBatchEngine final : public EngineBase {
  public:
   FloatBatchEngine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list,
-                   bool keep_record, std::uint64_t values_hint)
-      : type_(type), stride_factor_(stride_factor), m_list_(m_list), record_(type, keep_record) {
-    for (Held<double>* v : {&x_, &p_hi_, &p_lo_}) v->reserve(values_hint + 1);
+                   bool keep_record, std::uint64_t values_hint, bool prefix_sums)
+      : type_(type), stride_factor_(stride_factor), m_list_(m_list), record_(type, keep_record),
+        prefix_sums_(prefix_sums) {
+    x_.reserve(values_hint + 1);
+    if (prefix_sums_)
+      for (Held<double>* v : {&p_hi_, &p_lo_}) v->reserve(values_hint + 1);
   }
 
   void add(std::span<const double> values) override {
@@ -247,15 +253,17 @@ class FloatBatchEngine final : public EngineBase {
     a.n_values = type_ == DataType::phase ? a.n_phase : increments_;
     a.stride_factor = stride_factor_;
     const FloatRecord held{x_, p_hi_, p_lo_};
-    // A group of consecutive taus at a time (float_batch_taus(): the record streams once a group).
-    const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), float_batch_group, o,
+    const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), prefix_sums_ ? float_batch_group : phase_batch_lanes, o,
                                                     [&](std::size_t first, std::span<TauSums> out) {
       const std::span<const std::uint64_t> m(m_list_.data() + first, out.size());
       std::vector<std::uint64_t> stride(out.size());
       for (std::size_t j = 0; j < out.size(); ++j) stride[j] = stride_of(m[j], stride_factor_);
       std::vector<TauResult<double>> r(out.size());
       std::vector<NoiseIdAccumulator> noise(out.size());
-      float_batch_taus(held, m, stride, r, noise);
+      if (prefix_sums_)
+        float_batch_taus(held, m, stride, r, noise);
+      else
+        phase_batch_taus(x_, m, stride, r, noise);
       for (std::size_t j = 0; j < out.size(); ++j) out[j] = tau_sums(r[j], noise[j]);
     });
     read_out(a, sums, type_, o, record_.points);
@@ -268,8 +276,9 @@ class FloatBatchEngine final : public EngineBase {
 
  private:
   void stage(double x) {
-    prefix_ = FloatArith::add_prefix(prefix_, x);
     x_.push_back(x);
+    if (!prefix_sums_) return;
+    prefix_ = FloatArith::add_prefix(prefix_, x);
     p_hi_.push_back(prefix_.hi);
     p_lo_.push_back(prefix_.lo);
   }
@@ -278,7 +287,8 @@ class FloatBatchEngine final : public EngineBase {
   std::uint32_t stride_factor_;
   std::vector<std::uint64_t> m_list_;
   KeptRecord record_;
-  Held<double> x_, p_hi_, p_lo_;  // the staged points and P_{e+1} = x_0 + ... + x_e
+  bool prefix_sums_;
+  Held<double> x_, p_hi_, p_lo_;  // the staged points; with prefix sums P_{e+1} = x_0 + ... + x_e
   FloatArith::Prefix prefix_;
   double line_x0_ = 0, line_slope_ = 0, first_increment_ = 0;
   std::uint64_t increments_ = 0;
@@ -293,8 +303,8 @@ std::unique_ptr<EngineBase> make_count_batch_engine(std::uint32_t stride_factor,
 
 std::unique_ptr<EngineBase> make_float_batch_engine(DataType type, std::uint32_t stride_factor,
                                                     const std::vector<std::uint64_t>& m_list, bool keep_record,
-                                                    std::uint64_t values_hint) {
-  return std::make_unique<FloatBatchEngine>(type, stride_factor, m_list, keep_record, values_hint);
+                                                    std::uint64_t values_hint, bool prefix_sums) {
+  return std::make_unique<FloatBatchEngine>(type, stride_factor, m_list, keep_record, values_hint, prefix_sums);
 }
 
 }  // namespace gyrochar

@@ -90,10 +90,14 @@ TauPlan plan_taus(AnalysisOptions& o, TauRule rule, StrideFactor stride, const s
   // sums as the characterizer's, at 4 bytes a point instead of its history near N/4) while the
   // record fits in memory at its worst (12 bytes a point while it widens to int64).
   o.hold_counts = o.type == DataType::counts && stride.is_full() && n_phase > 0 && o.values_hint < budget / 12;
-  // Phase and frequency under --taus all hold the staged points and their prefix sums (24 bytes
-  // a point) and sum 64 consecutive taus at a time (the characterizer would visit every tau at
-  // every point).
-  o.hold_phase = o.type != DataType::counts && rule == TauRule::all && stride.is_full() && o.values_hint < budget / 24;
+  // Phase and frequency of a known length (any tau rule) hold the staged points (8 bytes a point)
+  // and sum the taus over them (phase_batch_taus(), float_batch.hpp): O(N) per tau where the
+  // characterizer visits every tau at every point. Under full, or under a stride factor of at
+  // least N/8, whose pyramid would hold more than the record (3S points of 24 bytes and more);
+  // a smaller one keeps the characterizer's few MiB.
+  const bool wide = stride.is_full() || (n_phase > 0 && stride.requested() >= n_phase / 8);
+  o.hold_phase = o.type != DataType::counts && wide && (rule == TauRule::all || n_phase > 0) && o.values_hint < budget / 24;
+  o.hold_prefix_sums = o.hold_phase && rule == TauRule::all;
   plan.held = o.hold_counts || o.hold_phase;
   // "full" resolved, here only: every tau up to N/4 fully overlapped; for "all" every m up to N/2
   // (all of them).

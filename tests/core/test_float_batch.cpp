@@ -4,9 +4,11 @@
 // sums to the last bit (the same terms summed in the same order), and the overlapping sums within
 // the bound of summing the same n non-negative terms in another order, 2 (n - 1) u relative
 // (u = 2^-53: each order is within (n - 1) u of the exact sum). Phase (relative to its line) and
-// frequency (relative to its first value), fully overlapped and strided taus.
+// frequency (relative to its first value), fully overlapped and strided taus. phase_batch_taus()
+// below: against the characterizer and against the definitions in long double.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -57,10 +59,9 @@ std::vector<double> clock(bool phase, std::size_t n) {
   return v;
 }
 
-void expect_same_sums(bool phase, std::uint32_t s, const std::vector<std::uint64_t>& m_list) {
-  const std::vector<double> values = clock(phase, 2500);
-  FloatHeap heap(s, m_list);
-  Record record;
+// The values into the characterizer (phase points or frequency values) and, staged as it stages
+// them, into the record.
+void feed_both(bool phase, const std::vector<double>& values, FloatHeap& heap, Record& record) {
   double x0 = 0, slope = 0, first = 0;
   for (std::size_t k = 0; k < values.size(); ++k) {
     if (phase) {
@@ -75,6 +76,13 @@ void expect_same_sums(bool phase, std::uint32_t s, const std::vector<std::uint64
       record.stage(record.x.back() + (values[k] - first));
     }
   }
+}
+
+void expect_same_sums(bool phase, std::uint32_t s, const std::vector<std::uint64_t>& m_list) {
+  const std::vector<double> values = clock(phase, 2500);
+  FloatHeap heap(s, m_list);
+  Record record;
+  feed_both(phase, values, heap, record);
   ASSERT_EQ(heap.c.phase_points(), record.x.size());
   for (std::size_t i = 0; i < m_list.size(); ++i) {
     const std::uint64_t m = m_list[i];
@@ -177,6 +185,159 @@ TEST(FloatBatch, TausTogetherGiveTheSumsOfEachAlone) {
     m = {n + 5, 3, 0, 24, 5, 8, 2, n, 1};
     stride = {1, 1, 1, 8, 1, 4, 1, 1, 1};
     expect_taus_match_one_by_one(record, m, stride);
+  }
+}
+
+// phase_batch_taus() (the held record of the analyzer: x alone) against the characterizer fed the
+// same values (oracle: the characterizer, checked against the definitions in
+// test_characterizer.cpp): the same counts; AVAR, HVAR, the non-overlapped and the noise sums to
+// the last bit (the same terms, each sum in e's order). Its MVAR sums are held to the definition
+// below.
+void expect_phase_batch_as_characterizer(bool phase, std::uint32_t s, const std::vector<std::uint64_t>& m_list) {
+  const std::vector<double> values = clock(phase, 2500);
+  FloatHeap heap(s, m_list);
+  Record record;
+  feed_both(phase, values, heap, record);
+  std::vector<std::uint64_t> stride;
+  for (std::size_t i = 0; i < m_list.size(); ++i) stride.push_back(heap.c.result(i).stride);
+  std::vector<TauResult<double>> got(m_list.size());
+  std::vector<NoiseIdAccumulator> noise(m_list.size());
+  phase_batch_taus(record.x, m_list, stride, got, noise);
+  for (std::size_t i = 0; i < m_list.size(); ++i) {
+    const auto want = heap.c.result(i);
+    const std::string where = std::string(phase ? "phase" : "freq") + " m=" + std::to_string(m_list[i]);
+    EXPECT_EQ(got[i].m, m_list[i]);
+    EXPECT_EQ(got[i].stride, want.stride) << where;
+    EXPECT_EQ(got[i].n, want.n) << where;
+    ASSERT_GT(want.n[0], 0u) << where;
+    for (const SumKind k : {SumKind::avar, SumKind::hvar, SumKind::avar_nonoverlapped, SumKind::hvar_nonoverlapped}) {
+      const auto j = static_cast<std::size_t>(k);
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].sum[j]), std::bit_cast<std::uint64_t>(want.sum[j]))
+          << where << " kind " << j << ": " << got[i].sum[j] << " vs " << want.sum[j];
+    }
+    for (int d = 0; d < 4; ++d) {
+      const Lag1Sums a = noise[i].order(d), b = heap.c.noise(i).order(d);
+      EXPECT_TRUE(a.n == b.n && a.pairs == b.pairs && a.shift == b.shift && a.sum == b.sum && a.sum_sq == b.sum_sq &&
+                  a.sum_lag == b.sum_lag && a.sum_left == b.sum_left && a.sum_right == b.sum_right)
+          << where << " order " << d;
+    }
+  }
+}
+
+TEST(PhaseBatch, GivesTheCharacterizersAvarHvarAndNoiseSumsToTheLastBit) {
+  // S = 1024: every tau fully overlapped (four side by side from 3m of the largest of four);
+  // S = 8: the taus above 8 strided (one by one).
+  for (const bool phase : {true, false}) {
+    expect_phase_batch_as_characterizer(phase, 1024, {1, 2, 3, 4, 5, 6, 7, 10, 33, 100, 255, 500, 624});
+    expect_phase_batch_as_characterizer(phase, 8, {1, 3, 8, 10, 12, 20, 64, 96, 256});
+  }
+}
+
+// The definitions in long double (oracle: each term formed from the points directly, MVAR's as
+// the sum of its m second differences, O(m) a term; 64-bit significands), with the tolerance each
+// sum is owed: a term of the kernel differs from the exact one by the roundings of its double
+// differences (first order: 2 u times the magnitudes it is formed from, doubled for the second
+// order), the MVAR term by the bound of float_batch.hpp (u |t| + (n^2 T + 8 n X) u^2, doubled),
+// and a sum of n squares by n u of itself for its own roundings, u = 2^-53. Every difference is
+// also within the long double's own rounding (2^-64 relative), far below these.
+struct Definition {
+  long double sum[3] = {0, 0, 0}, tolerance[3] = {0, 0, 0};
+  std::uint64_t n[3] = {0, 0, 0};
+};
+
+Definition definition(const std::vector<double>& x, std::size_t m, std::size_t stride) {
+  using L = long double;
+  const L u = 0x1p-53L;
+  const std::size_t size = x.size();
+  L big_x = 0, big_t = 0;
+  for (const double v : x) big_x = std::max(big_x, std::fabs(static_cast<L>(v)));
+  const auto second = [&](std::size_t e) { return static_cast<L>(x[e]) - 2 * static_cast<L>(x[e - m]) + static_cast<L>(x[e - 2 * m]); };
+  std::vector<L> t_of(size, 0);
+  for (std::size_t e = 3 * m - 1; e < size; ++e) {
+    for (std::size_t j = 0; j < m; ++j) t_of[e] += second(e - j);
+    big_t = std::max(big_t, std::fabs(t_of[e]));
+  }
+  const L n_l = static_cast<L>(size);
+  Definition d;
+  for (std::size_t e = (2 * m + stride - 1) / stride * stride; e < size; e += stride) {
+    const L x0 = x[e], x1 = x[e - m], x2 = x[e - 2 * m];
+    const L d1 = x0 - x1, d2 = x1 - x2, a = d1 - d2;
+    const L da = 4 * u * (std::fabs(d1) + std::fabs(d2) + std::fabs(a));
+    d.sum[0] += a * a;
+    d.tolerance[0] += 2 * std::fabs(a) * da + da * da;
+    ++d.n[0];
+    if (e >= 3 * m) {
+      const L d3 = x2 - static_cast<L>(x[e - 3 * m]), a1 = d2 - d3, h = a - a1;
+      const L dh = 4 * u * (std::fabs(d1) + 2 * std::fabs(d2) + std::fabs(d3) + std::fabs(a) + std::fabs(a1) + std::fabs(h));
+      d.sum[2] += h * h;
+      d.tolerance[2] += 2 * std::fabs(h) * dh + dh * dh;
+      ++d.n[2];
+    }
+    if (e + 1 >= 3 * m) {
+      const L t = t_of[e];
+      const L dt = 2 * (u * std::fabs(t) + (n_l * n_l * big_t + 8 * n_l * big_x) * u * u);
+      d.sum[1] += t * t;
+      d.tolerance[1] += 2 * std::fabs(t) * dt + dt * dt;
+      ++d.n[1];
+    }
+  }
+  for (std::size_t k = 0; k < 3; ++k) d.tolerance[k] += static_cast<L>(d.n[k] + 1) * u * d.sum[k];
+  return d;
+}
+
+TEST(PhaseBatch, SumsAreTheDefinitionsWithinTheirRoundingBounds) {
+  std::mt19937_64 rng(23);
+  std::normal_distribution<double> g;
+  const std::size_t n = 1500;
+  std::vector<std::vector<double>> records(3);
+  double walk = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    records[0].push_back(1e-9 * g(rng));                              // random (white phase)
+    walk += g(rng);
+    records[1].push_back(3.0e4 + walk);                              // random walk far from 0
+    records[2].push_back(0.125 + 0.37 * static_cast<double>(k) + 1e-12 * g(rng));  // ramp: terms ~ 0
+  }
+  const std::vector<std::uint64_t> m{1, 2, 3, 5, 8, 13, 64, 100, 250, 333, 400, 499, 500, 700, 750};
+  const std::vector<std::uint64_t> stride{1, 1, 1, 1, 1, 1, 1, 4, 2, 1, 16, 1, 1, 1, 1};
+  for (std::size_t r = 0; r < records.size(); ++r) {
+    std::vector<TauResult<double>> got(m.size());
+    std::vector<NoiseIdAccumulator> noise(m.size());
+    phase_batch_taus(records[r], m, stride, got, noise);
+    for (std::size_t i = 0; i < m.size(); ++i) {
+      const Definition want = definition(records[r], m[i], stride[i]);
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::string where = "record " + std::to_string(r) + " m=" + std::to_string(m[i]) + " kind " + std::to_string(k);
+        EXPECT_EQ(got[i].n[k], want.n[k]) << where;
+        EXPECT_LE(std::fabs(static_cast<long double>(got[i].sum[k]) - want.sum[k]), want.tolerance[k])
+            << where << ": " << got[i].sum[k] << " vs " << static_cast<double>(want.sum[k]);
+      }
+    }
+  }
+}
+
+TEST(PhaseBatch, TausSideBySideGiveTheSumsOfEachAlone) {
+  // Oracle: phase_batch_taus() of one tau at a time (the lanes and the one-by-one path form the
+  // same terms in the same order): every sum to the last bit, lists of several lengths.
+  std::mt19937_64 rng(31);
+  std::normal_distribution<double> g;
+  for (const std::size_t n : {3, 8, 13, 100, 513, 2051}) {
+    std::vector<double> x;
+    double walk = 0;
+    for (std::size_t k = 0; k < n; ++k) x.push_back(walk += g(rng));
+    std::vector<std::uint64_t> m{n + 5, 3, 0, 24, 5, 8, 2, n, 1}, stride{1, 1, 1, 8, 1, 4, 1, 1, 1};
+    for (std::uint64_t tau = 1; 3 * tau < n; tau = tau * 3 / 2 + 1) m.push_back(tau), stride.push_back(1);
+    std::vector<TauResult<double>> got(m.size());
+    std::vector<NoiseIdAccumulator> noise(m.size());
+    phase_batch_taus(x, m, stride, got, noise);
+    for (std::size_t i = 0; i < m.size(); ++i) {
+      TauResult<double> one[1];
+      NoiseIdAccumulator one_noise[1];
+      phase_batch_taus(x, std::span(&m[i], 1), std::span(&stride[i], 1), one, one_noise);
+      EXPECT_EQ(got[i].n, one[0].n) << "N=" << n << " m=" << m[i];
+      for (std::size_t k = 0; k < sum_kinds; ++k)
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].sum[k]), std::bit_cast<std::uint64_t>(one[0].sum[k]))
+            << "N=" << n << " m=" << m[i] << " kind " << k;
+    }
   }
 }
 

@@ -300,10 +300,13 @@ TEST(AnalyzeEngine, HeldCountsGiveTheCharacterizersRowsBitForBit) {
 TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
   // --taus all on phase and frequency data: the batch path (hold_phase: core/float_batch.hpp over
   // the held record) against the characterizer (oracle: itself checked against brute force in
-  // tests/core) at the stride factor "full" gives --taus all, every tau of 3000 values. The terms
-  // are the characterizer's to the last bit and their sums of squares are summed in another
-  // order: a deviation within n DBL_EPSILON relative (twice the bound (n - 1) u of two orders of
-  // n non-negative terms, halved by the square root); counts, noise and EDF the same.
+  // tests/core) at the stride factor "full" gives --taus all, every tau of 3000 values. With the
+  // prefix sums (float_batch_taus()) the terms are the characterizer's to the last bit and their
+  // sums of squares are summed in another order: a deviation within n DBL_EPSILON relative (twice
+  // the bound (n - 1) u of two orders of n non-negative terms, halved by the square root). Without
+  // (phase_batch_taus()) AVAR and HVAR are its sums to the bit and the MVAR terms are within u of
+  // the exact ones where the characterizer's are within a few u: the same bound holds. Counts,
+  // noise and EDF the same.
   std::mt19937_64 rng(5);
   std::normal_distribution<double> g;
   std::vector<double> clock;  // phase: offset, frequency, random-walk FM, white PM
@@ -313,6 +316,7 @@ TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
     x += y;
     clock.push_back(x + 3e-10 * g(rng));
   }
+  for (const bool prefix_sums : {true, false})  // float_batch_taus() (--taus all), phase_batch_taus()
   for (const DataType type : {DataType::phase, DataType::freq}) {
     const std::size_t n_phase = type == DataType::phase ? clock.size() : clock.size() + 1;
     AnalysisOptions o;
@@ -324,6 +328,7 @@ TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
     ASSERT_EQ(o.m_list.size(), n_phase / 2);
     Analyzer pyramid(o);
     o.hold_phase = true;
+    o.hold_prefix_sums = prefix_sums;
     o.values_hint = clock.size();
     o.threads = 3;
     std::size_t told = 0, total = 0;
@@ -348,7 +353,8 @@ TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
       const double tolerance = static_cast<double>(p.n) * DBL_EPSILON * p.dev;
       EXPECT_TRUE(p.stat == q.stat && p.m == q.m && p.n == q.n && p.alpha == q.alpha && p.edf == q.edf &&
                   std::fabs(p.dev - q.dev) <= tolerance)
-          << name(type) << " " << name(p.stat) << " m=" << p.m << ": " << p.dev << " vs " << q.dev;
+          << name(type) << (prefix_sums ? " prefix sums " : " ") << name(p.stat) << " m=" << p.m << ": " << p.dev
+          << " vs " << q.dev;
     }
   }
 }

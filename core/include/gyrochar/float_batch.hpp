@@ -75,4 +75,33 @@ inline constexpr std::size_t float_batch_group = 64;
 void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
                       std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise);
 
+// The same sums from the staged points x alone (8 bytes a point instead of 24), for the offline
+// analyzer's held record (phase and frequency data of a known length, every tau rule):
+//   - the AVAR and HVAR terms are float_batch_sums()' (the same operations) and each sum of their
+//     squares runs in e's order, as the characterizer's: its sums to the last bit;
+//   - the MVAR term t_e = sum_{j<m} a_{e-j} (a the exact second difference) runs as t_{3m-1} =
+//     a_{2m} + ... + a_{3m-1}, then t_e = t_{e-1} + h_e (h_e = a_e - a_{e-m}, the exact third
+//     difference). Each a and h is formed as a double-double by two-sums (exact but for the
+//     rounding of its low part, within 8 u^2 X, X the largest |x|) and added by a two-sum to a
+//     running sum hi + c whose rounding errors c collects (c rounds too, within n u^2 T a step, T
+//     the largest |t|). Over a record of n points the term comes out (hi + c, rounded) within
+//     u |t_e| + (n^2 T + 8 n X) u^2 of the exact one (u = 2^-53): for n = 10^7 the second part
+//     is below 1.3e-18 T + 1e-24 X. No cancellation grows with n, as a running sum in doubles
+//     would (n u T); the prefix-sum form of float_batch_sums() is within a few u of its sums'
+//     differences.
+// The terms of several fully overlapped taus run side by side in vector lanes, phase_batch_lanes
+// taus at a time, each lane's sums in e's order (the same bits as that tau alone). O(N) per tau,
+// no allocation.
+
+/// Taus phase_batch_taus() sums side by side.
+inline constexpr std::size_t phase_batch_lanes = 4;
+
+/// The sums of the taus m[i] with strides stride[i] over the staged points x (as
+/// Characterizer<FloatArith> stages them: FloatRecord::x), into out[i], and the noise sums of each
+/// added to noise[i] (fresh accumulators). AVAR, HVAR, the non-overlapped and noise sums: the
+/// characterizer's to the last bit; MVAR within the bound above. O(N) per tau. The four spans
+/// (m, stride, out, noise) have the same size.
+void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
+                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise);
+
 }  // namespace gyrochar

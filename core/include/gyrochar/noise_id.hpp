@@ -46,6 +46,13 @@ class NoiseIdAccumulator {
     for (; k < count && !(have_ == 3 && linked_[3]); ++k) add_ramp(static_cast<double>(z[k * step]));
     if (k < count) add_run(z + k * step, count - k, step);
   }
+  /// Adds z[0], z[step], ..., z[(count-1) step], as add() would one by one. O(count), no
+  /// allocation.
+  void add(const double* z, std::size_t count, std::size_t step) {
+    std::size_t k = 0;
+    for (; k < count && !(have_ == 3 && linked_[3]); ++k) add_ramp(z[k * step]);
+    if (k < count) add_run(z + k * step, count - k, step);
+  }
   /// A gap: the next value starts a new segment; no difference or pair spans it.
   void reset_segment() {
     have_ = 0;
@@ -72,6 +79,7 @@ class NoiseIdAccumulator {
   using Lanes = double __attribute__((vector_size(4 * sizeof(double)), aligned(4 * sizeof(double))));
   void add_ramp(double z);  // the first values of a segment, order by order
   void add_run(const std::int64_t* z, std::size_t count, std::size_t step);  // add_steady(), SIMD-compiled
+  void add_run(const double* z, std::size_t count, std::size_t step);
   // Every order has a previous value in this segment: the four advance together.
   template <class T>
   void add_steady(const T* z, std::size_t count, std::size_t step) {
