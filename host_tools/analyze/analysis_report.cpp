@@ -463,6 +463,9 @@ nlohmann::json to_json(const Report& r) {
         const Ieee952Parameter& p = fit.p[i];
         one[fu.letter] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"fitted", p.fitted},
                         {"resolved", p.resolved}, {"unit", fu.name}};
+        if (p.unconstrained_uncertainty > 0)  // what a verdict judges (docs/metrology.md, "Acceptance limits")
+          one[fu.letter]["unconstrained"] = {{"value", p.unconstrained / fu.si},
+                                             {"uncertainty", p.unconstrained_uncertainty / fu.si}};
       }
       add_model_json(one, fit, u);
       fits.push_back(std::move(one));
