@@ -39,55 +39,62 @@ AnalysisRow make_row(DevStat stat, std::uint64_t m, double tau_s, const TotalVar
   return row;
 }
 
-}  // namespace
+// Whether the Allan row has an identified (or given) alpha: else no bias correction, no EDF.
+bool known(const AnalysisRow* r) { return r != nullptr && r->alpha.has_value(); }
 
-std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, double phase_scale,
-                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan) {
+// Theo1, or TheoH (the overlapping ADEV rows below its switch point, TheoBR above): k2 is
+// phase_scale squared.
+std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, double k2, const AnalysisOptions& o,
+                                   const std::vector<AnalysisRow>& allan) {
   std::vector<AnalysisRow> rows;
   const std::uint64_t N = x.size();
-  const double n = static_cast<double>(N), tau0 = o.tau0_s, k2 = phase_scale * phase_scale;
+  const double n = static_cast<double>(N), tau0 = o.tau0_s;
+  const std::uint32_t S = o.total_stride_factor;
+  const std::uint64_t k = theoh_switch(N);
+  double ratio = 1.0;
+  if (stat == DevStat::theoh) {
+    for (const AnalysisRow& r : allan)
+      if (r.stat == DevStat::oadev && r.m < k) {
+        AnalysisRow a = r;
+        a.stat = DevStat::theoh;
+        rows.push_back(a);
+      }
+    ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S)).ratio;
+    if (!(ratio > 0)) return rows;
+  }
+  // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for or its
+  // workspace would pass the memory budget (plan.hpp): the record prepared once (O(N log N),
+  // 6 N + 4 fft_length(2 N) doubles), then each tau. The rows' stride says which estimator ran.
+  std::unique_ptr<double[]> work;  // not zero-filled: prepare writes before it reads (1.6 GB at 10^7)
+  Theo1Workspace prepared;
+  const bool decimated = o.theo_decimated || 8 * static_cast<std::uint64_t>(theo1_workspace_size(N)) > memory_budget();
+  auto estimate = [&](std::uint64_t m) {
+    if (decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));
+    if (!prepared.ready) {
+      work = std::make_unique_for_overwrite<double[]>(theo1_workspace_size(N));
+      prepared = theo1_prepare(x, {work.get(), theo1_workspace_size(N)});
+    }
+    return theo1_fast(prepared, m, tau0);
+  };
+  for (const std::uint64_t m : o.theo_m_list) {
+    if (stat == DevStat::theoh && 3 * m < 4 * k) continue;  // 0.75 m < k: ADEV's part
+    const TotalVariance v = estimate(m);
+    if (v.n == 0) continue;
+    const AnalysisRow* a = allan_row(allan, DevStat::oadev, 0.75 * static_cast<double>(m));
+    const double edf = known(a) ? edf_theo1(*a->alpha, n, static_cast<double>(m)) : 0.0;
+    rows.push_back(make_row(stat, m, 0.75 * static_cast<double>(m) * tau0, v, v.var * ratio * k2, a, edf, o));
+  }
+  return rows;
+}
+
+// TOTDEV, MTOTDEV, TTOTDEV or HTOTDEV at o.m_list: k2 is phase_scale squared.
+std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double> x, double k2,
+                                           const AnalysisOptions& o, const std::vector<AnalysisRow>& allan) {
+  std::vector<AnalysisRow> rows;
+  const std::uint64_t N = x.size();
+  const double n = static_cast<double>(N), tau0 = o.tau0_s;
   const std::uint32_t S = o.total_stride_factor;
   std::vector<double> blocks, scratch;
-  // Whether the Allan row has an identified (or given) alpha: else no bias correction, no EDF.
-  auto known = [](const AnalysisRow* r) { return r != nullptr && r->alpha.has_value(); };
-
-  if (stat == DevStat::theo1 || stat == DevStat::theoh) {
-    const std::uint64_t k = theoh_switch(N);
-    double ratio = 1.0;
-    if (stat == DevStat::theoh) {
-      for (const AnalysisRow& r : allan)
-        if (r.stat == DevStat::oadev && r.m < k) {
-          AnalysisRow a = r;
-          a.stat = DevStat::theoh;
-          rows.push_back(a);
-        }
-      ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S)).ratio;
-      if (!(ratio > 0)) return rows;
-    }
-    // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for or its
-    // workspace would pass the memory budget (plan.hpp): the record prepared once (O(N log N),
-    // 6 N + 4 fft_length(2 N) doubles), then each tau. The rows' stride says which estimator ran.
-    std::unique_ptr<double[]> work;  // not zero-filled: prepare writes before it reads (1.6 GB at 10^7)
-    Theo1Workspace prepared;
-    const bool decimated = o.theo_decimated || 8 * static_cast<std::uint64_t>(theo1_workspace_size(N)) > memory_budget();
-    auto estimate = [&](std::uint64_t m) {
-      if (decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));
-      if (!prepared.ready) {
-        work = std::make_unique_for_overwrite<double[]>(theo1_workspace_size(N));
-        prepared = theo1_prepare(x, {work.get(), theo1_workspace_size(N)});
-      }
-      return theo1_fast(prepared, m, tau0);
-    };
-    for (const std::uint64_t m : o.theo_m_list) {
-      if (stat == DevStat::theoh && 3 * m < 4 * k) continue;  // 0.75 m < k: ADEV's part
-      const TotalVariance v = estimate(m);
-      if (v.n == 0) continue;
-      const AnalysisRow* a = allan_row(allan, DevStat::oadev, 0.75 * static_cast<double>(m));
-      const double edf = known(a) ? edf_theo1(*a->alpha, n, static_cast<double>(m)) : 0.0;
-      rows.push_back(make_row(stat, m, 0.75 * static_cast<double>(m) * tau0, v, v.var * ratio * k2, a, edf, o));
-    }
-    return rows;
-  }
 
   // MTOTVAR (and TTOTVAR) and HTOTVAR exact at every tau by lag sums (total_fast.hpp) unless the
   // decimated plan is asked for or the workspace would pass the memory budget: the record (for
@@ -161,6 +168,15 @@ std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, dou
     }
   }
   return rows;
+}
+
+}  // namespace
+
+std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, double phase_scale,
+                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan) {
+  const double k2 = phase_scale * phase_scale;
+  if (stat == DevStat::theo1 || stat == DevStat::theoh) return theo_rows(stat, x, k2, o, allan);
+  return total_family_rows(stat, x, k2, o, allan);
 }
 
 }  // namespace gyrochar

@@ -307,62 +307,58 @@ int decode_live(const Options& o, Session& session, Presenter& presenter) {
   return presenter.finish();
 }
 
-}  // namespace
+// The help's footer: the input, what is shown and recorded, examples, the outputs, the exit codes.
+std::string help_footer() {
+  return "Input: exactly one of LOG (a `candump -l` log; '-' reads stdin, e.g. `candump -L can0 | gyrochar-decode -`)\n"
+         "and --interface. A log is decoded at its own timestamps; a live interface at the system clock.\n"
+         "Rates are shown in --rate-unit, IEEE-952 terms as Q arcsec, N deg/sqrt(h), B deg/h, K deg/h/sqrt(h),\n"
+         "R deg/h/h; a node that reports pulses is shown in pulse units, never converted.\n"
+         "The node's IEEE-952 fit (protocol version 2) comes with its summary: status (ok, too_few_points,\n"
+         "rejected = the model does not describe the curve, singular), chi2/dof, points used, whether the\n"
+         "quantization is white, and the taus below which short-tau points were left out. A term in the\n"
+         "model but not resolved is shown with its value and uncertainty and \"not resolved\"; a rejected\n"
+         "fit is said so and draws no model line. Version-1 nodes send no summary.\n"
+         "CSV: one row per node, report and tau; after session, the fit summary: fit_status,\n"
+         "fit_chi2_per_dof, fit_points, fit_quantization_white (true/false), fit_avar_excluded_below_tau_s,\n"
+         "fit_mvar_excluded_below_tau_s (s; 0 = none left out); empty without a summary. JSON lines: the\n"
+         "report records carry it as \"ieee952_fit\" (null without), each term \"fitted\" and \"resolved\".\n"
+         "A version-4 node's fit also carries its selected model: Markov terms (sigma, Tc), the sensor's\n"
+         "filter (Tf), sinusoids, the runner-up; shown only with the summary of the same slow cycle\n"
+         "(fit_model = shown, else pending or missing): the CSV's fit_model, fit_markov_terms, markov1_sigma,\n"
+         "... columns, \"markov\", \"sinusoids\", \"bandwidth\" in \"ieee952_fit\", a 'model:' line in the\n"
+         "table, and the Markov terms and the whole model in the plot.\n"
+         "A node with a window (protocol version 3, gyrochard --window) adds its dynamic Allan deviation: window\n"
+         "rows (column type = window) in the CSV and JSON lines, and a heat map beside its plot.\n"
+         "All columns: host_tools/decode/README.md.\n\n"
+         "Examples:\n"
+         "  gyrochar-decode --interface can0\n"
+         "  gyrochar-decode --interface can0 --csv run.csv --jsonl run.jsonl --plot run --plot-every 60\n"
+         "  gyrochar-decode capture.log --view none --csv capture.csv --plot capture\n"
+         "  gyrochar-decode capture.log --node 0x10 --rate-unit deg/s --view final\n"
+         "  gyrochar-decode --interface can0 --node 0x10 --duration 86400 --kalibr imu.yaml\n"
+         "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
+         "The table shows one report per row: a value whose frame that report lost reads 'missing', as in\n"
+         "the CSV (one still awaited 'pending'), never the report before's.\n"
+         "Malformed lines (lines longer than " + std::to_string(max_candump_line_bytes) +
+         " bytes among them), remote request (RTR) frames and\n"
+         "rejected frames are counted and reported, not fatal. A log that is missing, unreadable, empty or\n"
+         "without any candump line is bad input, and so is an output (--csv, --jsonl, --kalibr, --plot's\n"
+         "files, --report, --summary) that is the same file as LOG or as another output, through links too:\n"
+         "refused before anything is written.\n"
+         "--limits FILE (the format of gyrochar-analyze --help): each shown node's verdicts (pass, fail,\n"
+         "undecided, with the run length at which an undecided one is expected to decide): in the CSV, columns\n"
+         "after the others on every tau row (verdict: the node's over all limits; per limit its limit, verdict,\n"
+         "estimate and the decision bounds lower and upper, filled where it applies: a term on every tau row,\n"
+         "a deviation on the row of its tau); in the JSON lines a record of type \"acceptance\" per node at each\n"
+         "closed report where a verdict changed (\"final\": false; the first report always) and at the end\n"
+         "(\"final\": true); at the end after the view, in the report, and with --summary FILE.csv as one row\n"
+         "per node. Without --limits the CSV has no verdict column. The exit code does not depend on them.\n"
+         "--report FILE.html: a self-contained page (inline SVG and CSS, no script, no external reference):\n"
+         "provenance, each node's plot, taus with intervals, fit and verdicts.\n" +
+         std::string(exit_code::help);
+}
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "gyrochar-decode: follows the gyrochar nodes on a CAN bus; shows, records and plots their "
-      "ADEV, MDEV, IEEE-952 terms and link health.",
-      "gyrochar-decode"};
-  app.footer(
-      "Input: exactly one of LOG (a `candump -l` log; '-' reads stdin, e.g. `candump -L can0 | gyrochar-decode -`)\n"
-      "and --interface. A log is decoded at its own timestamps; a live interface at the system clock.\n"
-      "Rates are shown in --rate-unit, IEEE-952 terms as Q arcsec, N deg/sqrt(h), B deg/h, K deg/h/sqrt(h),\n"
-      "R deg/h/h; a node that reports pulses is shown in pulse units, never converted.\n"
-      "The node's IEEE-952 fit (protocol version 2) comes with its summary: status (ok, too_few_points,\n"
-      "rejected = the model does not describe the curve, singular), chi2/dof, points used, whether the\n"
-      "quantization is white, and the taus below which short-tau points were left out. A term in the\n"
-      "model but not resolved is shown with its value and uncertainty and \"not resolved\"; a rejected\n"
-      "fit is said so and draws no model line. Version-1 nodes send no summary.\n"
-      "CSV: one row per node, report and tau; after session, the fit summary: fit_status,\n"
-      "fit_chi2_per_dof, fit_points, fit_quantization_white (true/false), fit_avar_excluded_below_tau_s,\n"
-      "fit_mvar_excluded_below_tau_s (s; 0 = none left out); empty without a summary. JSON lines: the\n"
-      "report records carry it as \"ieee952_fit\" (null without), each term \"fitted\" and \"resolved\".\n"
-      "A version-4 node's fit also carries its selected model: Markov terms (sigma, Tc), the sensor's\n"
-      "filter (Tf), sinusoids, the runner-up; shown only with the summary of the same slow cycle\n"
-      "(fit_model = shown, else pending or missing): the CSV's fit_model, fit_markov_terms, markov1_sigma,\n"
-      "... columns, \"markov\", \"sinusoids\", \"bandwidth\" in \"ieee952_fit\", a 'model:' line in the\n"
-      "table, and the Markov terms and the whole model in the plot.\n"
-      "A node with a window (protocol version 3, gyrochard --window) adds its dynamic Allan deviation: window\n"
-      "rows (column type = window) in the CSV and JSON lines, and a heat map beside its plot.\n"
-      "All columns: host_tools/decode/README.md.\n\n"
-      "Examples:\n"
-      "  gyrochar-decode --interface can0\n"
-      "  gyrochar-decode --interface can0 --csv run.csv --jsonl run.jsonl --plot run --plot-every 60\n"
-      "  gyrochar-decode capture.log --view none --csv capture.csv --plot capture\n"
-      "  gyrochar-decode capture.log --node 0x10 --rate-unit deg/s --view final\n"
-      "  gyrochar-decode --interface can0 --node 0x10 --duration 86400 --kalibr imu.yaml\n"
-      "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
-      "The table shows one report per row: a value whose frame that report lost reads 'missing', as in\n"
-      "the CSV (one still awaited 'pending'), never the report before's.\n"
-      "Malformed lines (lines longer than " + std::to_string(max_candump_line_bytes) +
-      " bytes among them), remote request (RTR) frames and\n"
-      "rejected frames are counted and reported, not fatal. A log that is missing, unreadable, empty or\n"
-      "without any candump line is bad input, and so is an output (--csv, --jsonl, --kalibr, --plot's\n"
-      "files, --report, --summary) that is the same file as LOG or as another output, through links too:\n"
-      "refused before anything is written.\n"
-      "--limits FILE (the format of gyrochar-analyze --help): each shown node's verdicts (pass, fail,\n"
-      "undecided, with the run length at which an undecided one is expected to decide): in the CSV, columns\n"
-      "after the others on every tau row (verdict: the node's over all limits; per limit its limit, verdict,\n"
-      "estimate and the decision bounds lower and upper, filled where it applies: a term on every tau row,\n"
-      "a deviation on the row of its tau); in the JSON lines a record of type \"acceptance\" per node at each\n"
-      "closed report where a verdict changed (\"final\": false; the first report always) and at the end\n"
-      "(\"final\": true); at the end after the view, in the report, and with --summary FILE.csv as one row\n"
-      "per node. Without --limits the CSV has no verdict column. The exit code does not depend on them.\n"
-      "--report FILE.html: a self-contained page (inline SVG and CSS, no script, no external reference):\n"
-      "provenance, each node's plot, taus with intervals, fit and verdicts.\n" +
-      std::string(exit_code::help));
-  Options o;
+void add_options(CLI::App& app, Options& o) {
   app.add_option("log", o.log, "candump log file, or '-' for stdin")->option_text("LOG");
   app.add_option("-i,--interface", o.interface, "live SocketCAN interface, e.g. can0, vcan0")->option_text("IF");
   app.add_option("--csv", o.csv, "write one row per node, closed report and tau to this CSV file")->option_text("FILE");
@@ -397,22 +393,41 @@ int main(int argc, char** argv) {
                  "serve the live web page on [ADDR:]PORT (address 127.0.0.1 unless given; 0.0.0.0 for every "
                  "interface), updated every --refresh seconds")
       ->option_text("[ADDR:]PORT");
-  if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
+}
+
+// The checks below run in the order main calls them: the first bad option is the one reported.
+
+std::optional<web::ListenAddress> check_http(const Options& o) {
   std::optional<web::ListenAddress> http;
   if (std::string why; !o.http.empty() && !(http = web::parse_listen_address(o.http, why))) fail(exit_code::bad_input, "--http", why);
+  return http;
+}
+
+void check_input(const Options& o) {
   if (o.log.empty() == o.interface.empty())
     fail(exit_code::bad_input, "options", "give either a LOG or --interface (see --help)");
   if (!o.interface.empty())  // a name no interface can have is bad input; a missing one is hardware
     if (const std::string problem = interface_name_problem(o.interface); !problem.empty())
       fail(exit_code::bad_input, "--interface", "'" + o.interface + "': " + problem);
+}
+
+DisplayRate check_rate_unit(const Options& o) {
   const DisplayRate rate_unit = gyrochar::rate_unit(o.rate_unit);
   if (!rate_unit && o.rate_unit != "native")
     fail(exit_code::bad_input, "--rate-unit", "'" + o.rate_unit + "' is not deg/h, deg/s, rad/s or native");
+  return rate_unit;
+}
+
+void check_numbers(const Options& o) {
   if (!(o.confidence > 0 && o.confidence < 1)) fail(exit_code::bad_input, "--confidence", "must be in (0, 1)");
   if (!(o.duration_s >= 0)) fail(exit_code::bad_input, "--duration", "must be >= 0");
   if (!(o.plot_every_s >= 0)) fail(exit_code::bad_input, "--plot-every", "must be >= 0");
   if (o.plot_every_s > 0 && o.plot.empty() && o.report.empty())
     fail(exit_code::bad_input, "--plot-every", "needs --plot PREFIX or --report FILE.html");
+}
+
+// --limits read into o.limits; --summary checked against them.
+void read_limits(Options& o) {
   if (!o.limits_path.empty()) {
     try {
       o.limits = read_limits_file(o.limits_path);
@@ -425,7 +440,10 @@ int main(int argc, char** argv) {
     if (o.limits.empty()) fail(exit_code::bad_input, "--summary", "needs --limits (the rows hold the verdicts)");
     if (!summary_compatible(o.summary, o.limits, why)) fail(exit_code::bad_input, "--summary", o.summary + ": " + why);
   }
-  for (int i = 0; i < argc; ++i) o.command += (i ? " " : "") + std::string(argv[i]);
+}
+
+// --refresh and --view.
+View choose_view(const Options& o) {
   if (!(o.refresh_s > 0)) fail(exit_code::bad_input, "--refresh", "must be > 0");
   View view = isatty(STDOUT_FILENO) ? View::live : View::none;
   if (o.view == "live")
@@ -436,6 +454,12 @@ int main(int argc, char** argv) {
     view = View::none;
   else if (!o.view.empty())
     fail(exit_code::bad_input, "--view", "'" + o.view + "' is not live, final or none");
+  return view;
+}
+
+// No output is an input or another output; the plot can be written (checked now, not after hours of
+// decoding).
+void check_outputs(const Options& o) {
   std::vector<NamedPath> outputs = plot_outputs("--plot", o.plot);
   outputs.insert(outputs.begin(), {{"--csv", o.csv}, {"--jsonl", o.jsonl}, {"--kalibr", o.kalibr}});
   outputs.insert(outputs.end(), {{"--report", o.report}, {"--report", o.report.empty() ? "" : o.report + ".part"},
@@ -447,9 +471,11 @@ int main(int argc, char** argv) {
     std::fclose(open_output(o.plot + ".svg.part"));  // fail now, not after hours of decoding
     std::remove((o.plot + ".svg.part").c_str());
   }
+}
 
-  // The page is an output: an address that cannot be listened on is refused (4) before any file is
-  // opened for writing.
+// The page is an output: an address that cannot be listened on is refused (4) before any file is
+// opened for writing. Null without --http.
+std::unique_ptr<LiveWeb> open_live_page(const std::optional<web::ListenAddress>& http, const Options& o) {
   std::unique_ptr<LiveWeb> web;
   if (http) {
     try {
@@ -460,7 +486,11 @@ int main(int argc, char** argv) {
     web->judge(&o.limits);
     print_error(program, "live page", web->url());
   }
+  return web;
+}
 
+// Opens the CSV and JSON lines, decodes the log or the interface to its end, closes them: exit code.
+int decode(const Options& o, View view, const DisplayRate& rate_unit, LiveWeb* web) {
   SessionOptions s;
   s.rate_unit = rate_unit;
   s.confidence = o.confidence;
@@ -468,15 +498,38 @@ int main(int argc, char** argv) {
   s.csv = o.csv.empty() ? nullptr : open_output(o.csv);
   s.jsonl = o.jsonl.empty() ? nullptr : open_output(o.jsonl);
   s.limits = &o.limits;
-  if (web) s.on_report = web->hook();
+  if (web != nullptr) s.on_report = web->hook();
   install_stop_handler();
   int code = exit_code::ok;
   {
     Session session(s);
-    Presenter presenter(o, view, rate_unit, session, web.get());
+    Presenter presenter(o, view, rate_unit, session, web);
     code = o.interface.empty() ? decode_log(o, session, presenter) : decode_live(o, session, presenter);
   }
   for (const auto& [file, path] : {std::pair{s.csv, o.csv}, std::pair{s.jsonl, o.jsonl}})
     if (!close_output(file, program, path)) code = exit_code::output_failed;
-  return finish(program, code);
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "gyrochar-decode: follows the gyrochar nodes on a CAN bus; shows, records and plots their "
+      "ADEV, MDEV, IEEE-952 terms and link health.",
+      "gyrochar-decode"};
+  app.footer(help_footer());
+  Options o;
+  add_options(app, o);
+  if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);
+  for (int i = 0; i < argc; ++i) o.command += (i ? " " : "") + std::string(argv[i]);
+  const std::optional<web::ListenAddress> http = check_http(o);
+  check_input(o);
+  const DisplayRate rate_unit = check_rate_unit(o);
+  check_numbers(o);
+  read_limits(o);
+  const View view = choose_view(o);
+  check_outputs(o);
+  const std::unique_ptr<LiveWeb> web = open_live_page(http, o);
+  return finish(program, decode(o, view, rate_unit, web.get()));
 }
