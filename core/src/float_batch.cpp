@@ -248,9 +248,10 @@ void run_group(const FloatRecord& record, Run* runs, const std::size_t* index, s
 
 // phase_batch_taus(): the MVAR term as a running sum of exact second and third differences.
 
-// a + b = s + err exactly (Knuth's two-sum), for a double or a vector of them.
+// a + b = s + err exactly (Knuth's two-sum), for a double or a vector of them. Vectors by reference:
+// by value they would change the ABI of the clone without AVX (clang's -Wpsabi).
 template <class V>
-[[gnu::always_inline]] inline void two_sum(V a, V b, V& s, V& err) {
+[[gnu::always_inline]] inline void two_sum(const V& a, const V& b, V& s, V& err) {
   s = a + b;
   const V bb = s - a;
   err = (a - (s - bb)) + (b - bb);
@@ -258,7 +259,7 @@ template <class V>
 
 // x0 - 2 x1 + x2 = hi + lo, exact but for the rounding of lo (x1 + x1 is exact).
 template <class V>
-[[gnu::always_inline]] inline void exact_second(V x0, V x1, V x2, V& hi, V& lo) {
+[[gnu::always_inline]] inline void exact_second(const V& x0, const V& x1, const V& x2, V& hi, V& lo) {
   V s, e1, e2;
   two_sum(x0, x2, s, e1);
   two_sum(s, -(x1 + x1), hi, e2);
@@ -268,7 +269,7 @@ template <class V>
 // (x0 - x3) - 3 (x1 - x2) = hi + lo, exact but for the rounding of lo: 3 q as q + q (exact) plus q,
 // whose error Dekker's fast two-sum gives (|2q| >= |q|).
 template <class V>
-[[gnu::always_inline]] inline void exact_third(V x0, V x1, V x2, V x3, V& hi, V& lo) {
+[[gnu::always_inline]] inline void exact_third(const V& x0, const V& x1, const V& x2, const V& x3, V& hi, V& lo) {
   V s, e1, q, e2, e4;
   two_sum(x0, -x3, s, e1);
   two_sum(x1, -x2, q, e2);
@@ -282,7 +283,7 @@ template <class V>
 // The running MVAR term hi + c: hi the rounded sum of the exact terms' high parts, c what it lost
 // and their low parts.
 template <class V>
-[[gnu::always_inline]] inline void add_term(V& hi, V& c, V term_hi, V term_lo) {
+[[gnu::always_inline]] inline void add_term(V& hi, V& c, const V& term_hi, const V& term_lo) {
   V s, err;
   two_sum(hi, term_hi, s, err);
   hi = s;
