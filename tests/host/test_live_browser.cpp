@@ -1,6 +1,8 @@
 // The live page in a real browser: headless Chromium (Debian's chromium) loads the demo's page
 // while the demo runs, and the numbers the page shows (each ADEV and MDEV cell's exact value, in
-// its data-value) equal the decoder's CSV for the same report (node, seq, time). A screenshot is
+// its data-value) equal the decoder's CSV for the same report (node, seq, time), each card's plot
+// is drawn by the page's plotting library (Chart.js, served by the demo), and the browser logs no
+// script error and no Content-Security-Policy refusal. A screenshot is
 // kept in the build folder (tests/live_page.png) for a person to look at. Oracle: the CSV the same
 // program wrote. Skipped, saying so, where chromium is not installed (toolchain/build.sh test
 // installs it).

@@ -119,13 +119,13 @@ function heatChart(node) {
   const cells = heat.columns.flatMap((c) => c.value.map((v, i) => ({ y: labels[i], x: [c.start_s / 3600, c.end_s / 3600], v })))
     .filter((p) => p.v > 0);
   const key = [0, 1, 2, 3, 4].map((k) => ({ text: exp(10 ** (hi - ((hi - lo) * k) / 4), 1), fillStyle: viridis(1 - k / 4), lineWidth: 0 }));
-  return chart(`${node.node}/heat`, 460, 380, heat.title, { type: "bar", data: { labels, datasets: [{ label: heat.title, data: cells,
+  return chart(`${node.node}/heat`, 420, 460, heat.title, { type: "bar", data: { labels, datasets: [{ label: heat.title, data: cells,
     backgroundColor: (ctx) => (ctx.raw ? colour(ctx.raw.v) : "#888"), barPercentage: 1, categoryPercentage: 1 }] }, options: {
     indexAxis: "y",
     scales: {
       y: { reverse: true, grid: { display: false }, title: { display: true, text: "tau [s]" }, ticks: { callback: (i) => short(heat.tau_s[i]) } },
       x: { type: "linear", min: heat.columns[0].start_s / 3600, max: heat.columns[heat.columns.length - 1].end_s / 3600,
-        title: { display: true, text: "time in the run [h]" } },
+        title: { display: true, text: "time in the run [h]" }, ticks: { callback: short } },
     },
     plugins: {
       title: { display: true, text: heat.title },
