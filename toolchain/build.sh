@@ -15,12 +15,13 @@ esac
 # Debian packages: the host build, then what only the tests need (cross compilers for the
 # microcontroller build of the core). The host preset configures the tests too, so their own
 # libraries are here (libfftw3-dev: the analyzer's PSD and the power-law noise of tests/support;
-# pybind11 and pytest: the Python package host_tools/python and its tests).
+# pybind11 and pytest: the Python package host_tools/python and its tests; libjs-chart.js: the live
+# page's plotting library, compiled into the decoder and the demo at build time).
 packages=(
   g++ cmake ninja-build pkg-config
   libgtest-dev libgmock-dev libbenchmark-dev libfftw3-dev
   libboost-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libplplot-dev plplot-driver-cairo
-  libgpiod-dev
+  libgpiod-dev libjs-chart.js
   python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest
 )
 if [ "$job" = test ]; then

@@ -50,7 +50,13 @@ TEST_F(Server, ServesItsPageItsDataAndNothingElse) {
   EXPECT_NE(page.find("Content-Type: text/html; charset=utf-8\r\n"), std::string::npos);
   EXPECT_NE(page.find("<script src=\"app.js\""), std::string::npos);
   EXPECT_NE(page.find("Content-Security-Policy: default-src 'none'"), std::string::npos);
-  for (const char* path : {"/app.js", "/style.css"}) EXPECT_EQ(status_of(get(server.port(), path)), 200) << path;
+  for (const char* path : {"/app.js", "/style.css", "/chart.js"}) EXPECT_EQ(status_of(get(server.port(), path)), 200) << path;
+  // The plotting library is served from the page's own origin, before the page's script: Chart.js
+  // as Debian's libjs-chart.js installs it (oracle: the banner that file begins with).
+  EXPECT_LT(page.find("<script src=\"chart.js\""), page.find("<script src=\"app.js\""));
+  const std::string library = get(server.port(), "/chart.js");
+  EXPECT_NE(library.find("Content-Type: text/javascript; charset=utf-8\r\n"), std::string::npos);
+  EXPECT_NE(body_of(library).find(" * Chart.js v"), std::string::npos);
   expect_responsive();
   const std::string head = ask(server.port(), "HEAD /app.js HTTP/1.1\r\nHost: localhost\r\n\r\n");
   EXPECT_EQ(status_of(head), 200);

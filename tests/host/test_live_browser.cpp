@@ -1,6 +1,8 @@
 // The live page in a real browser: headless Chromium (Debian's chromium) loads the demo's page
 // while the demo runs, and the numbers the page shows (each ADEV and MDEV cell's exact value, in
-// its data-value) equal the decoder's CSV for the same report (node, seq, time). A screenshot is
+// its data-value) equal the decoder's CSV for the same report (node, seq, time), each card's plot
+// is drawn by the page's plotting library (Chart.js, served by the demo), and the browser logs no
+// script error and no Content-Security-Policy refusal. A screenshot is
 // kept in the build folder (tests/live_page.png) for a person to look at. Oracle: the CSV the same
 // program wrote. Skipped, saying so, where chromium is not installed (toolchain/build.sh test
 // installs it).
@@ -10,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -63,7 +66,10 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
   // Bounded: `timeout` ends a browser that hangs. The profile goes to a temporary folder.
   const std::string flags = " --headless --no-sandbox --disable-gpu --no-first-run --user-data-dir=" + temp("profile") +
                             " --virtual-time-budget=10000 ";
-  const std::string dom = output_of("timeout 120 " + browser + flags + "--dump-dom " + url + " 2>/dev/null");
+  // The browser's log (its console among it) goes to a file: the page's scripts must run clean.
+  const std::string log = temp("chromium.log");
+  const std::string dom = output_of("timeout 120 " + browser + flags + "--enable-logging=stderr --v=0 --dump-dom " + url +
+                                    " 2>" + log);
   const std::string shot = GYROCHAR_BINARY_DIR "/tests/live_page.png";
   std::remove(shot.c_str());
   std::system(("timeout 120 " + browser + flags + "--window-size=1400,1700 --screenshot=" + shot + " " + url +
@@ -80,6 +86,16 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
   for (auto it = std::sregex_iterator(dom.begin(), dom.end(), report_re); it != std::sregex_iterator(); ++it)
     report[std::stoi((*it)[1])] = {std::stoi((*it)[2]), std::stod((*it)[3])};
   ASSERT_EQ(report.size(), 2u) << "both nodes' cards: " << dom.substr(0, 2000);
+  // Each card's ADEV/MDEV plot is a canvas that Chart.js (served by the demo as /chart.js) took
+  // over: it gives the canvas its display style. No script error and no request refused by the
+  // Content-Security-Policy (the library needs no inline style and no eval).
+  const std::regex chart_re(R"re(<canvas (?=[^>]*style="display: block;)(?=[^>]*aria-label="[^"]*: ADEV and MDEV")[^>]*>)re");
+  EXPECT_EQ(std::distance(std::sregex_iterator(dom.begin(), dom.end(), chart_re), std::sregex_iterator()), 2)
+      << "a plot drawn by Chart.js on each card";
+  std::stringstream console;
+  console << std::ifstream(log).rdbuf();
+  for (const char* error : {"Uncaught", "Refused to", "Content Security Policy"})
+    EXPECT_EQ(console.str().find(error), std::string::npos) << error << " in the browser's log: " << console.str();
   std::map<std::tuple<int, int, std::string>, double> shown;  // node, tau index, stat -> value
   for (auto it = std::sregex_iterator(dom.begin(), dom.end(), cell_re); it != std::sregex_iterator(); ++it)
     shown[{std::stoi((*it)[1]), std::stoi((*it)[2]), (*it)[3]}] = std::stod((*it)[4]);

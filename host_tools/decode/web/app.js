@@ -1,96 +1,105 @@
 // gyrochar live page: draws what the decoder pushes on /events (one JSON snapshot per refresh:
-// host_tools/decode/live_feed.hpp). Hand-written SVG, no library, nothing fetched from elsewhere.
+// host_tools/decode/live_feed.hpp). The plots are Chart.js (/chart.js: Debian's libjs-chart.js,
+// compiled into the decoder at build time); nothing is fetched from elsewhere.
 // Every value shown comes from the snapshot; the tau table's cells carry the exact number in
 // data-value, so a test can compare the page with the decoder's CSV.
 "use strict";
 
-const SVG = "http://www.w3.org/2000/svg";
 const TERM_COLOURS = { Q: "#9467bd", N: "#2ca02c", B: "#d62728", K: "#17becf", R: "#bcbd22" };
+// The model's lines as the PNG/SVG plot draws them: the fit solid, each term dashed in its colour,
+// Markov terms dotted, the simulated gyro's true model in long dashes.
+const LINE_STYLES = {
+  model: { borderColor: "#000", borderWidth: 2 },
+  truth: { borderColor: "#777", borderWidth: 2, borderDash: [10, 4] },
+  markov: { borderColor: "#8c564b", borderWidth: 2, borderDash: [1, 3] },
+};
+Chart.defaults.font.family = "system-ui, sans-serif";
+Chart.defaults.font.size = 11;
+Chart.defaults.color = "#222";
 
-function make(tag, attrs, text, ns) {
-  const e = ns ? document.createElementNS(ns, tag) : document.createElement(tag);
+function make(tag, attrs, text) {
+  const e = document.createElement(tag);
   for (const [k, v] of Object.entries(attrs || {})) if (v !== undefined && v !== null) e.setAttribute(k, v);
   if (text !== undefined && text !== null) e.textContent = String(text);
   return e;
 }
-const svg = (tag, attrs, text) => make(tag, attrs, text, SVG);
 const add = (parent, child) => (parent.appendChild(child), child);
 const exp = (v, digits = 4) => (typeof v === "number" && isFinite(v) ? v.toExponential(digits) : "-");
 const short = (v) => (typeof v === "number" && isFinite(v) ? Number(v.toPrecision(4)).toString() : "-");
 
+// The charts live from one snapshot to the next (key: node and plot), updated in place; render()
+// destroys those it did not use (a node gone, a heat map with no window yet).
+const charts = new Map();
+let chartsUsed = new Set();
+function chart(key, width, height, label, config) {
+  chartsUsed.add(key);
+  config.options = Object.assign({ responsive: false, animation: false }, config.options);
+  let c = charts.get(key);
+  if (c) {
+    c.data = config.data;
+    c.options = config.options;
+    c.update();
+  } else {
+    c = new Chart(make("canvas", { width, height, role: "img" }), config);
+    charts.set(key, c);
+  }
+  c.canvas.setAttribute("aria-label", label);
+  return c.canvas;
+}
+
+// A log axis labelled at each decade (1eN), and at 2 and 5 between them when it spans under two.
+function logTicks(title) {
+  return { type: "logarithmic", title: { display: true, text: title }, ticks: { autoSkip: false, maxRotation: 0, callback(value) {
+    const d = Math.floor(Math.log10(value) + 1e-9), m = value / 10 ** d;
+    if (Math.abs(m - Math.round(m)) > 1e-6) return "";
+    return m < 1.5 || ((Math.round(m) === 2 || Math.round(m) === 5) && this.max / this.min < 100) ? `${Math.round(m)}e${d}` : "";
+  } } };
+}
+
 // ---------------------------------------------------------------------------------------------
 // Log-log plot of ADEV and MDEV with their intervals, the model's lines and the truth's.
 
-function logRange(values) {
-  const ok = values.filter((v) => typeof v === "number" && isFinite(v) && v > 0);
-  if (ok.length === 0) return null;
-  let lo = Math.floor(Math.log10(Math.min(...ok)) * 2) / 2, hi = Math.ceil(Math.log10(Math.max(...ok)) * 2) / 2;
-  if (hi - lo < 1) { lo -= 0.5; hi += 0.5; }
-  return [lo, hi];
-}
+// Each point's confidence interval as a bar with caps: one line dataset running from the point's
+// low to its high, broken (null) before the next point's.
+const intervalBars = (points) => points.filter((p) => p.low > 0 && p.high > 0)
+  .flatMap((p) => [{ x: p.tau, y: p.low }, { x: p.tau, y: p.high }, { x: p.tau, y: null }]);
 
-function devPlot(node) {
-  const W = 600, H = 380, L = 64, R = 12, T = 10, B = 40;
-  const plot = node.plot, rows = node.rows;
-  const points = (key) => rows.filter((r) => r[key].status === "ok" && r.tau_s > 0)
+function devChart(node, level) {
+  const plot = node.plot;
+  const points = (key) => node.rows.filter((r) => r[key].status === "ok" && r.tau_s > 0)
     .map((r) => ({ tau: r.tau_s, dev: r[key].value, low: r[key].low, high: r[key].high }));
-  const adev = points("adev"), mdev = points("mdev");
-  const taus = adev.concat(mdev).map((p) => p.tau);
-  const xr = plot.tau_max_s > 0 ? [Math.log10(plot.tau_min_s), Math.log10(plot.tau_max_s)] : logRange(taus);
-  const ys = [];
-  for (const p of adev.concat(mdev)) ys.push(p.dev, p.low, p.high);
-  for (const l of plot.lines) l.dev.forEach((d, i) => { if (l.tau_s[i] > 0) ys.push(d); });
-  const yr = logRange(ys);
-  const root = svg("svg", { width: W, height: H, viewBox: `0 0 ${W} ${H}`, class: "deviation", role: "img",
-    "aria-label": `${plot.title}: ADEV and MDEV` });
-  if (!xr || !yr) { add(root, svg("text", { x: W / 2, y: H / 2, "text-anchor": "middle" }, "no values yet")); return root; }
-  const x = (tau) => L + ((Math.log10(tau) - xr[0]) / (xr[1] - xr[0])) * (W - L - R);
-  const y = (dev) => T + ((yr[1] - Math.log10(dev)) / (yr[1] - yr[0])) * (H - T - B);
-  const clip = `clip-${node.node}`;
-  const defs = add(root, svg("defs"));
-  add(add(defs, svg("clipPath", { id: clip })), svg("rect", { x: L, y: T, width: W - L - R, height: H - T - B }));
-  for (let d = Math.ceil(xr[0]); d <= Math.floor(xr[1]); ++d) {
-    add(root, svg("line", { class: "grid", x1: x(10 ** d), x2: x(10 ** d), y1: T, y2: H - B }));
-    add(root, svg("text", { x: x(10 ** d), y: H - B + 14, "text-anchor": "middle" }, `1e${d}`));
+  const datasets = [];  // drawn last to first: the points on top
+  for (const [key, label, colour, style] of [["adev", "ADEV", "#1f77b4", "circle"], ["mdev", "MDEV", "#ff7f0e", "rect"]]) {
+    const pts = points(key);
+    datasets.push({ label, data: pts.map((p) => ({ x: p.tau, y: p.dev })), pointStyle: style, pointRadius: 3,
+      borderColor: colour, backgroundColor: colour });
+    datasets.push({ label: `${label} ${short(100 * level)} % interval`, interval: true, data: intervalBars(pts),
+      showLine: true, borderColor: colour, borderWidth: 1.2, pointStyle: "line", pointRadius: 3 });
   }
-  for (let d = Math.ceil(yr[0]); d <= Math.floor(yr[1]); ++d) {
-    add(root, svg("line", { class: "grid", x1: L, x2: W - R, y1: y(10 ** d), y2: y(10 ** d) }));
-    add(root, svg("text", { x: L - 4, y: y(10 ** d) + 4, "text-anchor": "end" }, `1e${d}`));
-  }
-  add(root, svg("rect", { class: "frame", x: L, y: T, width: W - L - R, height: H - T - B }));
-  add(root, svg("text", { x: (L + W - R) / 2, y: H - 6, "text-anchor": "middle" }, "averaging time tau [s]"));
-  add(root, svg("text", { x: 12, y: (T + H - B) / 2, "text-anchor": "middle",
-    transform: `rotate(-90 12 ${(T + H - B) / 2})` }, `deviation [${plot.rate_unit}]`));
-  const inside = add(root, svg("g", { "clip-path": `url(#${clip})` }));
+  datasets.push({ label: "read-off points", data: plot.read_offs.filter((r) => r.dev > 0).map((r) => ({ x: r.tau_s, y: r.dev })),
+    pointRadius: 5, borderColor: "#000", backgroundColor: "transparent" });
   for (const l of plot.lines) {
-    const pts = l.tau_s.map((t, i) => [t, l.dev[i]]).filter(([t, d]) => t > 0 && d > 0);
-    if (pts.length < 2) continue;
-    const kind = l.kind === "model" || l.kind === "truth" || l.kind === "markov" ? l.kind : "term";
-    add(inside, svg("polyline", { class: `line ${kind}`, stroke: kind === "term" ? TERM_COLOURS[l.kind] : null,
-      points: pts.map(([t, d]) => `${x(t).toFixed(1)},${y(d).toFixed(1)}`).join(" ") }));
+    const data = l.tau_s.map((t, i) => ({ x: t, y: l.dev[i] })).filter((p) => p.x > 0 && p.y > 0);
+    if (data.length < 2) continue;
+    const style = LINE_STYLES[l.kind] || { borderColor: TERM_COLOURS[l.kind], borderWidth: 1.5, borderDash: [4, 3] };
+    datasets.push(Object.assign({ label: l.label, data, showLine: true, pointRadius: 0, pointStyle: "line" }, style));
   }
-  for (const r of plot.read_offs) if (r.dev > 0) add(inside, svg("circle", { class: "readoff", cx: x(r.tau_s), cy: y(r.dev), r: 5 }));
-  for (const [key, pts] of [["adev", adev], ["mdev", mdev]]) {
-    for (const p of pts) {
-      if (p.low > 0 && p.high > 0)
-        add(inside, svg("line", { class: `${key} bar`, x1: x(p.tau), x2: x(p.tau), y1: y(p.low), y2: y(p.high) }));
-      if (key === "adev") add(inside, svg("circle", { class: key, cx: x(p.tau), cy: y(p.dev), r: 3 }));
-      else add(inside, svg("rect", { class: key, x: x(p.tau) - 3, y: y(p.dev) - 3, width: 6, height: 6 }));
-    }
-  }
-  return root;
-}
-
-function legend(node) {
-  const ul = make("ul", { class: "legend" });
-  add(ul, make("li", { class: "adev" }, "ADEV (bars: confidence interval)"));
-  add(ul, make("li", { class: "mdev" }, "MDEV"));
-  for (const l of node.plot.lines) add(ul, make("li", { class: l.kind }, l.label));
-  return ul;
+  if (!datasets.some((d) => d.data.length)) return make("p", { class: "empty" }, `${plot.title}: no values yet`);
+  const x = logTicks("averaging time tau [s]");
+  if (plot.tau_max_s > 0) Object.assign(x, { min: plot.tau_min_s, max: plot.tau_max_s });
+  return chart(`${node.node}/dev`, 600, 460, `${plot.title}: ADEV and MDEV`, { type: "scatter", data: { datasets }, options: {
+    scales: { x, y: logTicks(`deviation [${plot.rate_unit}]`) },
+    // The legend: each point's symbol, each line's dash (Chart.js's own legend takes the points').
+    plugins: { legend: { position: "bottom", labels: { usePointStyle: true, filter: (item) => !datasets[item.datasetIndex].interval,
+      generateLabels: (c) => Chart.defaults.plugins.legend.labels.generateLabels(c)
+        .map((item) => Object.assign(item, { lineDash: datasets[item.datasetIndex].borderDash || [] })) } } },
+  } });
 }
 
 // ---------------------------------------------------------------------------------------------
-// The dynamic Allan deviation: tau (log) against the window's time, log10 ADEV in colour.
+// The dynamic Allan deviation: tau (one row per tau) against the window's time, log10 ADEV in
+// colour. Each cell is a floating horizontal bar from the window's start to its end; the legend is
+// the colour key.
 
 const VIRIDIS = [[68, 1, 84], [72, 40, 120], [62, 74, 137], [49, 104, 142], [38, 130, 142], [31, 158, 137],
   [53, 183, 121], [109, 205, 89], [180, 222, 44], [253, 231, 37]];
@@ -100,40 +109,30 @@ function viridis(f) {
   return `rgb(${c[0]},${c[1]},${c[2]})`;
 }
 
-function heatMap(heat) {
-  const W = 420, H = 380, L = 64, R = 70, T = 24, B = 40;
-  const root = svg("svg", { width: W, height: H, viewBox: `0 0 ${W} ${H}`, class: "heat", role: "img", "aria-label": heat.title });
-  add(root, svg("text", { x: L, y: 14 }, heat.title));
+function heatChart(node) {
+  const heat = node.plot.heat;
   const values = heat.columns.flatMap((c) => c.value).filter((v) => v > 0);
-  if (values.length === 0 || heat.tau_s.length === 0) {
-    add(root, svg("text", { x: W / 2, y: H / 2, "text-anchor": "middle" }, "no window complete yet"));
-    return root;
-  }
+  if (values.length === 0 || heat.tau_s.length === 0) return make("p", { class: "empty" }, `${heat.title}: no window complete yet`);
   const lo = Math.log10(Math.min(...values)), hi = Math.max(Math.log10(Math.max(...values)), lo + 1e-9);
-  const t0 = heat.columns[0].start_s, t1 = heat.columns[heat.columns.length - 1].end_s;
-  const n = heat.tau_s.length, cellH = (H - T - B) / n;
-  const x = (t) => L + ((t - t0) / (t1 - t0 || 1)) * (W - L - R);
-  for (const c of heat.columns) {
-    c.value.forEach((v, i) => {
-      if (!(v > 0)) return;
-      add(root, svg("rect", { x: x(c.start_s), width: Math.max(1, x(c.end_s) - x(c.start_s)), y: H - B - (i + 1) * cellH,
-        height: cellH, fill: viridis((Math.log10(v) - lo) / (hi - lo)) }));
-    });
-  }
-  add(root, svg("rect", { class: "frame", x: L, y: T, width: W - L - R, height: H - T - B }));
-  heat.tau_s.forEach((tau, i) => {
-    if (i % Math.ceil(n / 8) === 0) add(root, svg("text", { x: L - 4, y: H - B - (i + 0.5) * cellH + 4, "text-anchor": "end" }, short(tau)));
-  });
-  add(root, svg("text", { x: 12, y: (T + H - B) / 2, "text-anchor": "middle", transform: `rotate(-90 12 ${(T + H - B) / 2})` }, "tau [s]"));
-  add(root, svg("text", { x: L, y: H - B + 14 }, `${short(t0 / 3600)} h`));
-  add(root, svg("text", { x: W - R, y: H - B + 14, "text-anchor": "end" }, `${short(t1 / 3600)} h`));
-  add(root, svg("text", { x: (L + W - R) / 2, y: H - 6, "text-anchor": "middle" }, "time in the run"));
-  for (let k = 0; k < 20; ++k)
-    add(root, svg("rect", { x: W - R + 12, width: 14, y: T + ((19 - k) * (H - T - B)) / 20, height: (H - T - B) / 20 + 0.5, fill: viridis(k / 19) }));
-  add(root, svg("text", { x: W - R + 30, y: T + 10 }, exp(10 ** hi, 1)));
-  add(root, svg("text", { x: W - R + 30, y: H - B }, exp(10 ** lo, 1)));
-  add(root, svg("text", { x: W - R + 8, y: H - 6 }, heat.unit));
-  return root;
+  const colour = (v) => viridis((Math.log10(v) - lo) / (hi - lo));
+  const labels = heat.tau_s.map(String);
+  const cells = heat.columns.flatMap((c) => c.value.map((v, i) => ({ y: labels[i], x: [c.start_s / 3600, c.end_s / 3600], v })))
+    .filter((p) => p.v > 0);
+  const key = [0, 1, 2, 3, 4].map((k) => ({ text: exp(10 ** (hi - ((hi - lo) * k) / 4), 1), fillStyle: viridis(1 - k / 4), lineWidth: 0 }));
+  return chart(`${node.node}/heat`, 420, 460, heat.title, { type: "bar", data: { labels, datasets: [{ label: heat.title, data: cells,
+    backgroundColor: (ctx) => (ctx.raw ? colour(ctx.raw.v) : "#888"), barPercentage: 1, categoryPercentage: 1 }] }, options: {
+    indexAxis: "y",
+    scales: {
+      y: { reverse: true, grid: { display: false }, title: { display: true, text: "tau [s]" }, ticks: { callback: (i) => short(heat.tau_s[i]) } },
+      x: { type: "linear", min: heat.columns[0].start_s / 3600, max: heat.columns[heat.columns.length - 1].end_s / 3600,
+        title: { display: true, text: "time in the run [h]" }, ticks: { callback: short } },
+    },
+    plugins: {
+      title: { display: true, text: heat.title },
+      legend: { position: "right", onClick: null, title: { display: true, text: heat.unit }, labels: { generateLabels: () => key } },
+      tooltip: { callbacks: { title: (items) => `tau ${items[0].label} s`, label: (ctx) => `${short(ctx.raw.x[0])} to ${short(ctx.raw.x[1])} h: ${exp(ctx.raw.v)} ${heat.unit}` } },
+    },
+  } });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -267,10 +266,8 @@ function nodeCard(node, snap, now) {
   if (next) add(card, make("p", { class: "meta next-tau", "data-node": node.node, "data-tau-s": next.tau, "data-wait-s": next.wait },
     `next tau ${short(next.tau)} s: its first estimate in about ${duration(next.wait)} of gyro time`));
   const figures = add(card, make("div", { class: "figures" }));
-  const left = add(figures, make("div"));
-  add(left, devPlot(node));
-  add(left, legend(node));
-  if (node.plot.heat) add(figures, heatMap(node.plot.heat));
+  add(figures, devChart(node, snap.ci_level));
+  if (node.plot.heat) add(figures, heatChart(node));
   for (const n of node.plot.notes) add(card, make("p", { class: "notes" }, n));
   add(card, fitTable(node));
   if (node.acceptance) add(card, acceptanceTable(node.acceptance));
@@ -294,9 +291,11 @@ function render(snap) {
   inputLine.setAttribute("data-frames", input.frames);
   inputLine.setAttribute("data-elapsed-s", snap.elapsed_s);
   const main = document.getElementById("nodes");
+  chartsUsed = new Set();
   const cards = snap.nodes.map((n) => nodeCard(n, snap, now));
   if (cards.length === 0) main.replaceChildren(make("p", { class: "empty" }, "no gyrochar node seen yet"));
   else main.replaceChildren(...cards);
+  for (const [key, c] of charts) if (!chartsUsed.has(key)) (c.destroy(), charts.delete(key));
 }
 
 let count = 0;  // snapshots received on the event stream

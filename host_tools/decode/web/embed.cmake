@@ -1,11 +1,16 @@
 # Writes OUTPUT, a C++ file holding the live page's files (this folder's index.html, app.js and
-# style.css) as raw string literals, so that the web server needs no file system at run time.
-# Run at build time by host_tools/CMakeLists.txt: cmake -DWEB_DIR=... -DOUTPUT=... -P embed.cmake
+# style.css, and CHART_JS: Chart.js as Debian's libjs-chart.js installs it, served as /chart.js) as
+# raw string literals, so that the web server needs no file system at run time.
+# Run at build time by host_tools/CMakeLists.txt: cmake -DWEB_DIR=... -DCHART_JS=... -DOUTPUT=... -P embed.cmake
 set(delimiter "gyrochar_asset")
 set(text "// Generated from host_tools/decode/web by embed.cmake: edit the files there.\n")
 string(APPEND text "#include \"web_assets.hpp\"\n\n#include <array>\n\nnamespace gyrochar::web {\n\nnamespace {\n")
 set(entries "")
-foreach(file IN ITEMS index.html app.js style.css)
+foreach(file IN ITEMS index.html app.js style.css chart.js)
+  set(source "${WEB_DIR}/${file}")
+  if(file STREQUAL "chart.js")
+    set(source "${CHART_JS}")
+  endif()
   if(file STREQUAL "index.html")
     set(path "/")
     set(type "text/html; charset=utf-8")
@@ -16,7 +21,7 @@ foreach(file IN ITEMS index.html app.js style.css)
     set(path "/${file}")
     set(type "text/css; charset=utf-8")
   endif()
-  file(READ "${WEB_DIR}/${file}" content)
+  file(READ "${source}" content)
   string(FIND "${content}" ")${delimiter}" clash)
   if(NOT clash EQUAL -1)
     message(FATAL_ERROR "${file} contains ')${delimiter}', the end of the literal that embeds it")
