@@ -67,32 +67,35 @@ case "$job" in
     ;;
   test)
     # Every configuration is built once; the host suite runs last so that its summary closes the log.
+    # Each stage's banner gives the time since the start, so a slow stage shows in the CI log.
+    stage() { echo "build.sh: [$((SECONDS / 60)) min $((SECONDS % 60)) s] $*" >&2; }
     for mcu in cortex-m4 cortex-m7; do
-      echo "build.sh: freestanding core for $mcu (text/data/bss of the MCU example):" >&2
+      stage "freestanding core for $mcu (text/data/bss of the MCU example):"
       cmake --preset "$mcu" >/dev/null
       cmake --build --preset "$mcu" >/dev/null
       arm-none-eabi-size "build/$mcu/firmware/mcu/gyrochar-mcu-example" >&2
     done
-    echo "build.sh: fuzz targets, smoke run" >&2
+    stage "fuzz targets, smoke run"
     cmake --preset fuzz >/dev/null
     cmake --build --preset fuzz -j "$(nproc)"
     tests/fuzz/run.sh 10
-    echo "build.sh: the board build (aarch64): tests under qemu-aarch64-static, install into a staging root" >&2
+    stage "the board build (aarch64): tests under qemu-aarch64-static, install into a staging root"
     cmake --preset aarch64 >/dev/null
     cmake --build --preset aarch64 -j "$(nproc)"
     ctest --preset aarch64 -j "$(nproc)"
     DESTDIR="$PWD/build/aarch64/staging" cmake --install build/aarch64 >/dev/null
     find build/aarch64/staging -type f | sed 's|^build/aarch64/staging|build.sh: staged |' >&2
-    echo "build.sh: the test suite under AddressSanitizer and UndefinedBehaviorSanitizer" >&2
+    stage "the test suite under AddressSanitizer and UndefinedBehaviorSanitizer"
     cmake --preset sanitize >/dev/null
     cmake --build --preset sanitize -j "$(nproc)"
     ctest --preset sanitize -j "$(nproc)"
-    echo "build.sh: the QEMU bench: a real kernel's CAN and GPIO drivers under emulation (docs/bench.md)" >&2
+    stage "the QEMU bench: a real kernel's CAN and GPIO drivers under emulation (docs/bench.md)"
     toolchain/bench/build.sh
     # A scenario whose edges the emulator stalled past an interval's end cannot be judged (docs/bench.md,
     # "GPIO timing"); a failed scenario runs once more, and fails CI only if it fails twice.
     ctest --preset host -L bench -j "$(nproc)" --repeat until-pass:2
-    echo "build.sh: the host test suite" >&2
+    stage "the host test suite"
     ctest --preset host -j "$(nproc)" -LE bench
+    stage "done"
     ;;
 esac
