@@ -78,6 +78,7 @@ struct NodeSpec {
   std::uint8_t protocol_version = version;  // 1: no fit summary, no Fitted flag
   Ieee952Status fit = Ieee952Status::ok;
   bool quantization_white = true;           // false: AVAR below 8 tau0, MVAR below 4 tau0 left out
+  float unconstrained_n = 0;                // > 0: N's unconstrained estimate (version 5), uncertainty 12.5 %
 };
 
 float adev_of(const NodeSpec& n, std::uint8_t seq, std::size_t i) {
@@ -146,6 +147,10 @@ Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t
         return Ieee952ParameterMsg{seq, p.parameter, 0, false, markov_tc_of, 0.25};
       return Ieee952ParameterMsg{seq, p.parameter, p.index, false, 0.0f, 0.0};
     }
+    case Slot::unconstrained:  // version 5: N's unconstrained estimate where the spec gives one
+      if (s.index == 1 && n.unconstrained_n > 0)
+        return Ieee952UnconstrainedMsg{seq, Ieee952Term::angle_random_walk, n.unconstrained_n, 0.125 * n.unconstrained_n};
+      return Ieee952UnconstrainedMsg{seq, static_cast<Ieee952Term>(s.index), 0.0f, 0.0};
   }
   return {};
 }
