@@ -21,8 +21,10 @@
 namespace gyrochar {
 namespace {
 
-/// The decoded IEEE-952 summary and terms against the fit the board made them from.
-void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, double tau0_s) {
+/// The decoded IEEE-952 summary and terms against the fit the board made them from. `negative`
+/// counts the terms whose unconstrained square is negative (sent as a negative signed root).
+void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, double tau0_s,
+                                      std::size_t* negative = nullptr) {
   ASSERT_TRUE(v.ieee952_summary.has_value());
   const protocol::Ieee952SummaryMsg& s = *v.ieee952_summary;
   EXPECT_STREQ(name(s.status), fit.status == FitStatus::ok               ? "ok"
@@ -64,6 +66,7 @@ void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, 
       continue;
     }
     ++unconstrained;
+    if (p.unconstrained_signed < 0 && negative != nullptr) ++*negative;
     ASSERT_NE(u, nullptr) << k;
     EXPECT_EQ(u->value, static_cast<float>(p.unconstrained_signed)) << k;
     EXPECT_EQ(std::max(u->value, 0.0f), static_cast<float>(p.unconstrained)) << k;
@@ -176,7 +179,11 @@ TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
   // The summary and the terms travel in report 3 (16 taus: the last part of the slow cycle), the
   // last one built: `content` holds the fit they came from.
   EXPECT_TRUE(content.fit.quantization_white);  // 2 arcsec of white angle noise: the counts are random
-  expect_decoded_fit_is_the_boards(v, content.fit, s.tau0_s);
+  // A white-noise gyro: the unconstrained squares of B and K come out negative (the non-negative
+  // fit shows them as 0): their negative roots must travel as the board computed them.
+  std::size_t negative = 0;
+  expect_decoded_fit_is_the_boards(v, content.fit, s.tau0_s, &negative);
+  EXPECT_GE(negative, 1u);
 }
 
 TEST(ReportEndToEnd, PeriodicQuantizationReachesTheDecoderAsTheBoardsFitSaysIt) {
