@@ -97,29 +97,29 @@ GYROCHAR_FLOAT_CLONES void steady_terms(const double* x, const double* ph, const
   for (std::size_t k = 0; k < 3; ++k) out[k] = s[k];
 }
 
-// The decimated series x_0, x_m, x_2m, ...: the characterizer's decimate(), point by point.
-void decimate(std::span<const double> xs, std::size_t m, TauResult<double>& result, NoiseIdAccumulator& noise) {
+// The decimated series x_0, x_m, x_2m, ...: the characterizer's decimate() (its terms, each sum in
+// its order: the AVAR term of the third point, then both terms of each later one), and with `sums`
+// false its noise sums alone.
+void decimate(std::span<const double> xs, std::size_t m, TauResult<double>& result, NoiseIdAccumulator& noise,
+              bool sums = true) {
   constexpr auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
   constexpr auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
-  double d[3] = {0, 0, 0};  // the last three decimated points, newest first
-  std::size_t have = 0;
-  for (std::size_t e = 0; e < xs.size(); e += m) {
-    const double x = xs[e];
-    double a = 0, h = 0;
-    if (have >= 2 && FloatArith::x_term2(x, d[0], d[1], a)) {
-      result.sum[avar_d] += a * a;
-      ++result.n[avar_d];
+  const std::size_t count = (xs.size() + m - 1) / m;
+  if (sums && count >= 3) {
+    const double* x = xs.data();
+    double sa = result.sum[avar_d], sh = result.sum[hvar_d], a = 0, h = 0;
+    FloatArith::x_term2(x[2 * m], x[m], x[0], a);
+    sa += a * a;
+    for (std::size_t k = 3, e = 3 * m; k < count; ++k, e += m) {
+      FloatArith::x_terms(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h);
+      sa += a * a;
+      sh += h * h;
     }
-    if (have >= 3 && FloatArith::x_terms(x, d[0], d[1], d[2], a, h)) {
-      result.sum[hvar_d] += h * h;
-      ++result.n[hvar_d];
-    }
-    d[2] = d[1];
-    d[1] = d[0];
-    d[0] = x;
-    if (have < 3) ++have;
+    result.sum[avar_d] = sa, result.sum[hvar_d] = sh;
+    result.n[avar_d] += count - 2;
+    result.n[hvar_d] += count - 3;
   }
-  noise.add(xs.data(), (xs.size() + m - 1) / m, m);
+  noise.add(xs.data(), count, m);
 }
 
 // Several taus at once (float_batch_taus()). A group's taus go through the record together, a
@@ -293,6 +293,8 @@ template <class V>
 // One tau while its points pass: the sums of squares (SumKind's order) and the running MVAR term.
 struct PhaseRun {
   std::size_t m = 0, stride = 1;
+  unsigned kinds = all_overlapping_sums;  // the overlapping sums formed (phase_batch_taus())
+  bool nonoverlapped = false;             // stride m: the non-overlapped sums are the AVAR and HVAR ones
   double sum[3] = {0, 0, 0};
   std::uint64_t n[3] = {0, 0, 0};
   double t_hi = 0, t_c = 0;
@@ -303,17 +305,18 @@ struct PhaseRun {
 void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) {
   const std::size_t m = r.m, step = r.stride;
   std::size_t counted = (from + step - 1) / step * step;  // the next point whose terms are summed
+  const bool mvar = (r.kinds & sum_bit(SumKind::mvar)) != 0;
   for (std::size_t e = from; e < to; ++e) {
     double a = 0, h = 0, hi = 0, lo = 0;
     const bool steady = e >= 3 * m;
     if (steady) {
       FloatArith::x_terms(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h);
-      exact_third(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], hi, lo);
+      if (mvar) exact_third(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], hi, lo);
     } else {
       FloatArith::x_term2(x[e], x[e - m], x[e - 2 * m], a);
-      exact_second(x[e], x[e - m], x[e - 2 * m], hi, lo);
+      if (mvar) exact_second(x[e], x[e - m], x[e - 2 * m], hi, lo);
     }
-    add_term(r.t_hi, r.t_c, hi, lo);
+    if (mvar) add_term(r.t_hi, r.t_c, hi, lo);
     if (e != counted) continue;
     counted += step;
     r.sum[0] += a * a;
@@ -322,7 +325,7 @@ void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) 
       r.sum[2] += h * h;
       ++r.n[2];
     }
-    if (e + 1 < 3 * m) continue;
+    if (e + 1 < 3 * m || !mvar) continue;
     const double t = r.t_hi + r.t_c;
     r.sum[1] += t * t;
     ++r.n[1];
@@ -335,9 +338,12 @@ void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) 
 // lane from its own start: no term below 2m, the AVAR term alone below 3m, the MVAR term from
 // 3m - 1; a lane adds 0 (0 * 0 to a sum of squares, which leaves it as it is) where it has none,
 // and reads its points below an age's start at e itself (the value unused).
-template <bool Ramp>
+// Only the sums of `Kinds` (sum_bit()s) are formed: the compiler drops the terms no sum takes.
+template <bool Ramp, unsigned Kinds>
 [[gnu::always_inline]] inline void lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
                                          std::size_t to) {
+  constexpr bool avar = (Kinds & sum_bit(SumKind::avar)) != 0, mvar = (Kinds & sum_bit(SumKind::mvar)) != 0;
+  constexpr bool hvar = (Kinds & sum_bit(SumKind::hvar)) != 0;
   std::size_t k1[4], k2[4], k3[4];  // the ages m, 2m, 3m of each lane
   alignas(32) double init[8][4];    // AVAR, MVAR, HVAR sums, t_hi, t_c of each lane; 2m, 3m, 3m - 1
   for (std::size_t j = 0; j < 4; ++j) {
@@ -371,18 +377,18 @@ template <bool Ramp>
       lo = has_h ? lo : (has_a ? a_lo : zero);
       a = has_a ? a : zero;
       h = has_h ? h : zero;
-      add_term(t_hi, t_c, hi, lo);
-      const Lanes t = has_t ? t_hi + t_c : zero;
-      sa += a * a;
-      st += t * t;
-      sh += h * h;
-    } else {
+      if constexpr (mvar) {
+        add_term(t_hi, t_c, hi, lo);
+        const Lanes t = has_t ? t_hi + t_c : zero;
+        st += t * t;
+      }
+    } else if constexpr (mvar) {
       add_term(t_hi, t_c, hi, lo);
       const Lanes t = t_hi + t_c;
-      sa += a * a;
       st += t * t;
-      sh += h * h;
     }
+    if constexpr (avar) sa += a * a;
+    if constexpr (hvar) sh += h * h;
   }
   std::memcpy(init[0], &sa, sizeof sa), std::memcpy(init[1], &st, sizeof st), std::memcpy(init[2], &sh, sizeof sh);
   std::memcpy(init[3], &t_hi, sizeof t_hi), std::memcpy(init[4], &t_c, sizeof t_c);
@@ -391,13 +397,28 @@ template <bool Ramp>
     r.sum[0] = init[0][j], r.sum[1] = init[1][j], r.sum[2] = init[2][j], r.t_hi = init[3][j], r.t_c = init[4][j];
   }
 }
+// lanes() for the sums runs[0].kinds asks (the same for the runs of a group).
+template <bool Ramp>
+[[gnu::always_inline]] inline void lanes_of_kinds(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
+                                                  std::size_t to) {
+  switch (runs[0].kinds & all_overlapping_sums) {
+    case 1: return lanes<Ramp, 1>(x, runs, count, from, to);
+    case 2: return lanes<Ramp, 2>(x, runs, count, from, to);
+    case 3: return lanes<Ramp, 3>(x, runs, count, from, to);
+    case 4: return lanes<Ramp, 4>(x, runs, count, from, to);
+    case 5: return lanes<Ramp, 5>(x, runs, count, from, to);
+    case 6: return lanes<Ramp, 6>(x, runs, count, from, to);
+    case 7: return lanes<Ramp, 7>(x, runs, count, from, to);
+    default: return;
+  }
+}
 GYROCHAR_FLOAT_CLONES void steady_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
                                         std::size_t to) {
-  lanes<false>(x, runs, count, from, to);
+  lanes_of_kinds<false>(x, runs, count, from, to);
 }
 GYROCHAR_FLOAT_CLONES void ramp_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
                                       std::size_t to) {
-  lanes<true>(x, runs, count, from, to);
+  lanes_of_kinds<true>(x, runs, count, from, to);
 }
 
 // The taus of runs[0 .. count) (fully overlapped, 3m < size for each) over the record, side by
@@ -422,8 +443,14 @@ void run_group(std::span<const double> x, PhaseRun* runs, std::size_t count) {
 
 void store(const PhaseRun& r, TauResult<double>& out) {
   for (std::size_t k = 0; k < 3; ++k) {
-    out.sum[k] = r.sum[k];
-    out.n[k] = r.n[k];
+    const bool formed = (r.kinds & (1u << k)) != 0;
+    out.sum[k] = formed ? r.sum[k] : 0.0;
+    out.n[k] = formed ? r.n[k] : 0;
+  }
+  if (!r.nonoverlapped) return;
+  for (const auto& [overlapped, alone] : {std::pair{SumKind::avar, SumKind::avar_nonoverlapped}, std::pair{SumKind::hvar, SumKind::hvar_nonoverlapped}}) {
+    out.sum[static_cast<std::size_t>(alone)] = r.sum[static_cast<std::size_t>(overlapped)];
+    out.n[static_cast<std::size_t>(alone)] = r.n[static_cast<std::size_t>(overlapped)];
   }
 }
 
@@ -494,7 +521,8 @@ void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> 
 }
 
 void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
-                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise) {
+                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise, unsigned kinds) {
+  kinds &= all_overlapping_sums;
   const std::size_t size = x.size();
   PhaseRun runs[phase_batch_lanes];
   std::size_t index[phase_batch_lanes];  // runs[j] is tau index[j]
@@ -514,11 +542,16 @@ void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> 
       continue;
     }
     const auto lag = static_cast<std::size_t>(m[i]);
-    decimate(x, lag, out[i], noise[i]);
-    if (size <= 2 * lag) continue;  // no overlapping term
     PhaseRun r;
     r.m = lag;
+    r.kinds = kinds;
     r.stride = stride[i] > 1 ? static_cast<std::size_t>(stride[i]) : 1;
+    // Terms every m points (m = 1 fully overlapped, or a stride of m) are the decimated series'
+    // own, in its order: its sums are the AVAR and HVAR ones (the same bits), taken from them.
+    constexpr unsigned both = sum_bit(SumKind::avar) | sum_bit(SumKind::hvar);
+    r.nonoverlapped = r.stride == lag && size > 2 * lag && (kinds & both) == both;
+    decimate(x, lag, out[i], noise[i], !r.nonoverlapped);
+    if (size <= 2 * lag) continue;  // no overlapping term
     if (r.stride != 1 || size <= 3 * lag) {
       run_points(x.data(), r, 2 * lag, size);
       store(r, out[i]);
