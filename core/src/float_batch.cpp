@@ -353,9 +353,12 @@ template <bool Ramp, unsigned Kinds>
     init[5][j] = static_cast<double>(2 * r.m), init[6][j] = static_cast<double>(3 * r.m);
     init[7][j] = static_cast<double>(3 * r.m - 1);
   }
-  Lanes sa, st, sh, t_hi, t_c, two_m, three_m, first_t;
-  load(sa, init[0]), load(st, init[1]), load(sh, init[2]), load(t_hi, init[3]), load(t_c, init[4]);
-  load(two_m, init[5]), load(three_m, init[6]), load(first_t, init[7]);
+  // The running vectors are copied from and to an array (v): a vector whose address is taken
+  // (by memcpy) stays in memory, and a running sum through memory waits on the store each step.
+  Lanes v[8];
+  std::memcpy(v, init, sizeof v);
+  Lanes sa = v[0], st = v[1], sh = v[2], t_hi = v[3], t_c = v[4];
+  const Lanes two_m = v[5], three_m = v[6], first_t = v[7];
   const Lanes zero{0, 0, 0, 0};
   const auto age = [&](std::size_t e, std::size_t k) { return Ramp && e < k ? e : e - k; };
   for (std::size_t e = from; e < to; ++e) {
@@ -390,8 +393,8 @@ template <bool Ramp, unsigned Kinds>
     if constexpr (avar) sa += a * a;
     if constexpr (hvar) sh += h * h;
   }
-  std::memcpy(init[0], &sa, sizeof sa), std::memcpy(init[1], &st, sizeof st), std::memcpy(init[2], &sh, sizeof sh);
-  std::memcpy(init[3], &t_hi, sizeof t_hi), std::memcpy(init[4], &t_c, sizeof t_c);
+  v[0] = sa, v[1] = st, v[2] = sh, v[3] = t_hi, v[4] = t_c;
+  std::memcpy(init, v, sizeof v);
   for (std::size_t j = 0; j < count; ++j) {
     PhaseRun& r = runs[j];
     r.sum[0] = init[0][j], r.sum[1] = init[1][j], r.sum[2] = init[2][j], r.t_hi = init[3][j], r.t_c = init[4][j];
