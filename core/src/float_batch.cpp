@@ -246,7 +246,7 @@ void run_group(const FloatRecord& record, Run* runs, const std::size_t* index, s
   }
 }
 
-// phase_batch_taus(): the MVAR term as a running sum of exact second and third differences.
+// phase_batch_taus(): the MVAR term as an exact running sum of the rounded AVAR terms.
 
 // a + b = s + err exactly (Knuth's two-sum), for a double or a vector of them. Vectors by reference:
 // by value they would change the ABI of the clone without AVX (clang's -Wpsabi).
@@ -257,31 +257,19 @@ template <class V>
   err = (a - (s - bb)) + (b - bb);
 }
 
-// x0 - 2 x1 + x2 = hi + lo, exact but for the rounding of lo (x1 + x1 is exact).
+// The terms at point e of x (x0 .. x3 at ages 0, m, 2m, 3m), as FloatArith::x_terms() forms them:
+// the AVAR term a and the HVAR term h = a - a1 (a1 the AVAR term of point e - m, the same bits as
+// when it was a), and h's rounding error (a - a1 = h + err exactly), the step of the MVAR term.
 template <class V>
-[[gnu::always_inline]] inline void exact_second(const V& x0, const V& x1, const V& x2, V& hi, V& lo) {
-  V s, e1, e2;
-  two_sum(x0, x2, s, e1);
-  two_sum(s, -(x1 + x1), hi, e2);
-  lo = e1 + e2;
+[[gnu::always_inline]] inline void terms_and_step(const V& x0, const V& x1, const V& x2, const V& x3, V& a, V& h, V& err) {
+  const V d2 = x1 - x2;
+  a = (x0 - x1) - d2;
+  const V a1 = d2 - (x2 - x3);
+  two_sum(a, -a1, h, err);  // a + (-a1) is a - a1, rounded alike
 }
 
-// (x0 - x3) - 3 (x1 - x2) = hi + lo, exact but for the rounding of lo: 3 q as q + q (exact) plus q,
-// whose error Dekker's fast two-sum gives (|2q| >= |q|).
-template <class V>
-[[gnu::always_inline]] inline void exact_third(const V& x0, const V& x1, const V& x2, const V& x3, V& hi, V& lo) {
-  V s, e1, q, e2, e4;
-  two_sum(x0, -x3, s, e1);
-  two_sum(x1, -x2, q, e2);
-  const V q2 = q + q;
-  const V p = q2 + q;
-  const V e3 = q - (p - q2);
-  two_sum(s, -p, hi, e4);
-  lo = ((e1 + e4) - e3) - e2 * 3.0;
-}
-
-// The running MVAR term hi + c: hi the rounded sum of the exact terms' high parts, c what it lost
-// and their low parts.
+// The running MVAR term hi + c: hi the rounded sum of the steps' high parts, c what it lost and
+// their low parts.
 template <class V>
 [[gnu::always_inline]] inline void add_term(V& hi, V& c, const V& term_hi, const V& term_lo) {
   V s, err;
@@ -307,16 +295,14 @@ void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) 
   std::size_t counted = (from + step - 1) / step * step;  // the next point whose terms are summed
   const bool mvar = (r.kinds & sum_bit(SumKind::mvar)) != 0;
   for (std::size_t e = from; e < to; ++e) {
-    double a = 0, h = 0, hi = 0, lo = 0;
+    double a = 0, h = 0, err = 0;
     const bool steady = e >= 3 * m;
     if (steady) {
-      FloatArith::x_terms(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h);
-      if (mvar) exact_third(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], hi, lo);
+      terms_and_step(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h, err);
     } else {
       FloatArith::x_term2(x[e], x[e - m], x[e - 2 * m], a);
-      if (mvar) exact_second(x[e], x[e - m], x[e - 2 * m], hi, lo);
     }
-    if (mvar) add_term(r.t_hi, r.t_c, hi, lo);
+    if (mvar) add_term(r.t_hi, r.t_c, steady ? h : a, err);
     if (e != counted) continue;
     counted += step;
     r.sum[0] += a * a;
@@ -366,27 +352,20 @@ template <bool Ramp, unsigned Kinds>
     const Lanes x1{x[age(e, k1[0])], x[age(e, k1[1])], x[age(e, k1[2])], x[age(e, k1[3])]};
     const Lanes x2{x[age(e, k2[0])], x[age(e, k2[1])], x[age(e, k2[2])], x[age(e, k2[3])]};
     const Lanes x3{x[age(e, k3[0])], x[age(e, k3[1])], x[age(e, k3[2])], x[age(e, k3[3])]};
-    const Lanes d2 = x1 - x2;
-    Lanes a = (x0 - x1) - d2;
-    Lanes h = a - (d2 - (x2 - x3));
-    Lanes hi, lo;
-    exact_third(x0, x1, x2, x3, hi, lo);
+    Lanes a, h, err;
+    terms_and_step(x0, x1, x2, x3, a, h, err);
     if constexpr (Ramp) {
       const Lanes ev = zero + static_cast<double>(e);
       const auto has_a = ev >= two_m, has_h = ev >= three_m, has_t = ev >= first_t;
-      Lanes a_hi, a_lo;
-      exact_second(x0, x1, x2, a_hi, a_lo);
-      hi = has_h ? hi : (has_a ? a_hi : zero);
-      lo = has_h ? lo : (has_a ? a_lo : zero);
       a = has_a ? a : zero;
       h = has_h ? h : zero;
       if constexpr (mvar) {
-        add_term(t_hi, t_c, hi, lo);
+        add_term(t_hi, t_c, has_h ? h : a, has_h ? err : zero);
         const Lanes t = has_t ? t_hi + t_c : zero;
         st += t * t;
       }
     } else if constexpr (mvar) {
-      add_term(t_hi, t_c, hi, lo);
+      add_term(t_hi, t_c, h, err);
       const Lanes t = t_hi + t_c;
       st += t * t;
     }
