@@ -293,7 +293,7 @@ struct PhaseRun {
 void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) {
   const std::size_t m = r.m, step = r.stride;
   std::size_t counted = (from + step - 1) / step * step;  // the next point whose terms are summed
-  const bool mvar = (r.kinds & sum_bit(SumKind::mvar)) != 0;
+  const bool mvar = (r.kinds & sum_bit(SumKind::mvar)) != 0 && 3 * m <= to;  // no MVAR term before 3m - 1
   for (std::size_t e = from; e < to; ++e) {
     double a = 0, h = 0, err = 0;
     const bool steady = e >= 3 * m;
