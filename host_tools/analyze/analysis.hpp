@@ -85,6 +85,10 @@ struct AnalysisOptions {
   double confidence = 0.682689492137086;
   std::optional<int> alpha;             // noise exponent for the EDF; empty: identified per tau
   EdfModel edf = EdfModel::exact;       // greenhall: Stable32's approximation (comparisons)
+  // false: the deviations alone, no noise identification and so no EDF or interval (the Python
+  // package's allantools functions, which return none); the total family identifies all the same
+  // (its bias corrections need it).
+  bool identify_noise = true;
   // The total and Theo family (total_analysis.hpp): asked for in `stats`, they make the analyzer
   // hold the record (8 bytes a phase point).
   std::vector<std::uint64_t> theo_m_list;  // averaging factors of Theo1 and TheoBR (even), increasing
