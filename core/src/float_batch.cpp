@@ -98,10 +98,10 @@ GYROCHAR_FLOAT_CLONES void steady_terms(const double* x, const double* ph, const
 }
 
 // The decimated series x_0, x_m, x_2m, ...: the characterizer's decimate() (its terms, each sum in
-// its order: the AVAR term of the third point, then both terms of each later one), and with `sums`
-// false its noise sums alone.
+// its order: the AVAR term of the third point, then both terms of each later one, when `sums`) and
+// its noise sums (when `lag1`).
 void decimate(std::span<const double> xs, std::size_t m, TauResult<double>& result, NoiseIdAccumulator& noise,
-              bool sums = true) {
+              bool sums = true, bool lag1 = true) {
   constexpr auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
   constexpr auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
   const std::size_t count = (xs.size() + m - 1) / m;
@@ -119,7 +119,7 @@ void decimate(std::span<const double> xs, std::size_t m, TauResult<double>& resu
     result.n[avar_d] += count - 2;
     result.n[hvar_d] += count - 3;
   }
-  noise.add(xs.data(), count, m);
+  if (lag1) noise.add(xs.data(), count, m);
 }
 
 // Several taus at once (float_batch_taus()). A group's taus go through the record together, a
@@ -504,7 +504,8 @@ void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> 
 
 void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
                       std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise, unsigned kinds) {
-  kinds &= all_overlapping_sums;
+  constexpr unsigned decimated = sum_bit(SumKind::avar_nonoverlapped) | sum_bit(SumKind::hvar_nonoverlapped);
+  const bool lag1 = (kinds & noise_sums) != 0, alone = (kinds & decimated) != 0;
   const std::size_t size = x.size();
   PhaseRun runs[phase_batch_lanes];
   std::size_t index[phase_batch_lanes];  // runs[j] is tau index[j]
@@ -520,19 +521,19 @@ void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> 
     out[i].stride = stride[i];
     if (m[i] == 0) continue;
     if (m[i] >= size) {  // no term; the decimated series is x_0 alone (when there is one)
-      if (size > 0) noise[i].add(x[0]);
+      if (size > 0 && lag1) noise[i].add(x[0]);
       continue;
     }
     const auto lag = static_cast<std::size_t>(m[i]);
     PhaseRun r;
     r.m = lag;
-    r.kinds = kinds;
+    r.kinds = kinds & all_overlapping_sums;
     r.stride = stride[i] > 1 ? static_cast<std::size_t>(stride[i]) : 1;
     // Terms every m points (m = 1 fully overlapped, or a stride of m) are the decimated series'
     // own, in its order: its sums are the AVAR and HVAR ones (the same bits), taken from them.
     constexpr unsigned both = sum_bit(SumKind::avar) | sum_bit(SumKind::hvar);
-    r.nonoverlapped = r.stride == lag && size > 2 * lag && (kinds & both) == both;
-    decimate(x, lag, out[i], noise[i], !r.nonoverlapped);
+    r.nonoverlapped = alone && r.stride == lag && size > 2 * lag && (kinds & both) == both;
+    decimate(x, lag, out[i], noise[i], alone && !r.nonoverlapped, lag1);
     if (size <= 2 * lag) continue;  // no overlapping term
     if (r.stride != 1 || size <= 3 * lag) {
       run_points(x.data(), r, 2 * lag, size);
@@ -544,6 +545,9 @@ void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> 
     if (count == phase_batch_lanes) flush();
   }
   if (count > 0) flush();
+  for (std::size_t i = 0; i < m.size() && i < stride.size() && i < out.size() && i < noise.size(); ++i)
+    for (const SumKind k : {SumKind::avar_nonoverlapped, SumKind::hvar_nonoverlapped})
+      if ((kinds & sum_bit(k)) == 0) out[i].sum[static_cast<std::size_t>(k)] = 0, out[i].n[static_cast<std::size_t>(k)] = 0;
 }
 
 }  // namespace gyrochar

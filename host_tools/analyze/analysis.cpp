@@ -217,12 +217,11 @@ bool identifies(const AnalysisOptions& o, bool hadamard) {
 
 }  // namespace
 
-unsigned overlapping_sums_needed(const AnalysisOptions& o) {
-  if (any_total(o)) return all_overlapping_sums;
+unsigned sums_needed(const AnalysisOptions& o) {
+  if (any_total(o)) return all_sums | noise_sums;
   unsigned kinds = 0;
-  for (const DevStat s : o.stats)
-    if (const SumKind k = sum_kind(s); k == SumKind::avar || k == SumKind::mvar || k == SumKind::hvar) kinds |= sum_bit(k);
-  if (identifies(o, false) || identifies(o, true)) kinds |= sum_bit(SumKind::avar) | sum_bit(SumKind::mvar);
+  for (const DevStat s : o.stats) kinds |= sum_bit(sum_kind(s));
+  if (identifies(o, false) || identifies(o, true)) kinds |= sum_bit(SumKind::avar) | sum_bit(SumKind::mvar) | noise_sums;
   return kinds;
 }
 

@@ -255,7 +255,7 @@ class FloatBatchEngine final : public EngineBase {
     a.n_values = type_ == DataType::phase ? a.n_phase : increments_;
     a.stride_factor = stride_factor_;
     const FloatRecord held{x_, p_hi_, p_lo_};
-    const unsigned kinds = overlapping_sums_needed(o);  // the others' terms are not formed
+    const unsigned kinds = sums_needed(o);  // the others' terms are not formed
     const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), prefix_sums_ ? float_batch_group : phase_batch_lanes, o,
                                                     [&](std::size_t first, std::span<TauSums> out) {
       const std::span<const std::uint64_t> m(m_list_.data() + first, out.size());

@@ -98,10 +98,13 @@ void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> 
 // taus at a time, each lane's sums in e's order (the same bits as that tau alone). O(N) per tau,
 // no allocation.
 
-/// The overlapping sums phase_batch_taus() is asked for: bit k for SumKind k (sum_bit()), AVAR,
-/// MVAR and HVAR; a sum not asked for is left 0 with n = 0 (and its terms are not formed).
+/// The sums phase_batch_taus() is asked for: bit k for SumKind k (sum_bit()), and noise_sums for
+/// the lag-1 sums of the decimated series; a sum not asked for is left 0 with n = 0 (its terms are
+/// not formed), the noise accumulators untouched.
 constexpr unsigned sum_bit(SumKind k) { return 1u << static_cast<unsigned>(k); }
-inline constexpr unsigned all_overlapping_sums = 7;
+inline constexpr unsigned all_overlapping_sums = 7;  // AVAR, MVAR, HVAR
+inline constexpr unsigned all_sums = 31;             // and the non-overlapped AVAR and HVAR
+inline constexpr unsigned noise_sums = 32;
 
 /// Taus phase_batch_taus() sums side by side.
 inline constexpr std::size_t phase_batch_lanes = 4;
@@ -109,11 +112,11 @@ inline constexpr std::size_t phase_batch_lanes = 4;
 /// The sums of the taus m[i] with strides stride[i] over the staged points x (as
 /// Characterizer<FloatArith> stages them: FloatRecord::x), into out[i], and the noise sums of each
 /// added to noise[i] (fresh accumulators). AVAR, HVAR, the non-overlapped and noise sums: the
-/// characterizer's to the last bit; MVAR's terms within the bound above. Of the overlapping sums only
-/// those of `kinds` (each the same bits as with all three). O(N) per tau. The four spans
-/// (m, stride, out, noise) have the same size.
+/// characterizer's to the last bit; MVAR's terms within the bound above. Only the sums of `kinds`
+/// (each the same bits as with all of them). O(N) per tau. The four spans (m, stride, out, noise)
+/// have the same size.
 void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
                       std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise,
-                      unsigned kinds = all_overlapping_sums);
+                      unsigned kinds = all_sums | noise_sums);
 
 }  // namespace gyrochar
