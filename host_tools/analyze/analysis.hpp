@@ -108,8 +108,9 @@ struct AnalysisOptions {
   // Phase and frequency only: hold the phase points as the characterizer stages them (8 bytes a
   // point) and sum the taus over them, four side by side (phase_batch_taus(),
   // core/include/gyrochar/float_batch.hpp): the characterizer's AVAR and HVAR sums to the last
-  // bit, the MVAR terms as exact running sums (within u relative and a second-order bound), O(N)
-  // per tau where the characterizer visits every tau at every point.
+  // bit, the MVAR terms as exact running sums of the rounded AVAR terms (within the roundings
+  // those owe, u relative and a second-order bound), only the sums the read-out needs, O(N) per
+  // tau where the characterizer visits every tau at every point.
   bool hold_phase = false;
   // With hold_phase, for dense tau lists (--taus all): hold the double-double prefix sums too (24
   // bytes a point) and sum 64 consecutive taus at a time from the cache (float_batch_taus(): the
