@@ -97,29 +97,29 @@ GYROCHAR_FLOAT_CLONES void steady_terms(const double* x, const double* ph, const
   for (std::size_t k = 0; k < 3; ++k) out[k] = s[k];
 }
 
-// The decimated series x_0, x_m, x_2m, ...: the characterizer's decimate(), point by point.
-void decimate(std::span<const double> xs, std::size_t m, TauResult<double>& result, NoiseIdAccumulator& noise) {
+// The decimated series x_0, x_m, x_2m, ...: the characterizer's decimate() (its terms, each sum in
+// its order: the AVAR term of the third point, then both terms of each later one, when `sums`) and
+// its noise sums (when `lag1`).
+void decimate(std::span<const double> xs, std::size_t m, TauResult<double>& result, NoiseIdAccumulator& noise,
+              bool sums = true, bool lag1 = true) {
   constexpr auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
   constexpr auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
-  double d[3] = {0, 0, 0};  // the last three decimated points, newest first
-  std::size_t have = 0;
-  for (std::size_t e = 0; e < xs.size(); e += m) {
-    const double x = xs[e];
-    double a = 0, h = 0;
-    if (have >= 2 && FloatArith::x_term2(x, d[0], d[1], a)) {
-      result.sum[avar_d] += a * a;
-      ++result.n[avar_d];
+  const std::size_t count = (xs.size() + m - 1) / m;
+  if (sums && count >= 3) {
+    const double* x = xs.data();
+    double sa = result.sum[avar_d], sh = result.sum[hvar_d], a = 0, h = 0;
+    FloatArith::x_term2(x[2 * m], x[m], x[0], a);
+    sa += a * a;
+    for (std::size_t k = 3, e = 3 * m; k < count; ++k, e += m) {
+      FloatArith::x_terms(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h);
+      sa += a * a;
+      sh += h * h;
     }
-    if (have >= 3 && FloatArith::x_terms(x, d[0], d[1], d[2], a, h)) {
-      result.sum[hvar_d] += h * h;
-      ++result.n[hvar_d];
-    }
-    d[2] = d[1];
-    d[1] = d[0];
-    d[0] = x;
-    if (have < 3) ++have;
+    result.sum[avar_d] = sa, result.sum[hvar_d] = sh;
+    result.n[avar_d] += count - 2;
+    result.n[hvar_d] += count - 3;
   }
-  noise.add(xs.data(), (xs.size() + m - 1) / m, m);
+  if (lag1) noise.add(xs.data(), count, m);
 }
 
 // Several taus at once (float_batch_taus()). A group's taus go through the record together, a
@@ -246,7 +246,7 @@ void run_group(const FloatRecord& record, Run* runs, const std::size_t* index, s
   }
 }
 
-// phase_batch_taus(): the MVAR term as a running sum of exact second and third differences.
+// phase_batch_taus(): the MVAR term as an exact running sum of the rounded AVAR terms.
 
 // a + b = s + err exactly (Knuth's two-sum), for a double or a vector of them. Vectors by reference:
 // by value they would change the ABI of the clone without AVX (clang's -Wpsabi).
@@ -257,31 +257,19 @@ template <class V>
   err = (a - (s - bb)) + (b - bb);
 }
 
-// x0 - 2 x1 + x2 = hi + lo, exact but for the rounding of lo (x1 + x1 is exact).
+// The terms at point e of x (x0 .. x3 at ages 0, m, 2m, 3m), as FloatArith::x_terms() forms them:
+// the AVAR term a and the HVAR term h = a - a1 (a1 the AVAR term of point e - m, the same bits as
+// when it was a), and h's rounding error (a - a1 = h + err exactly), the step of the MVAR term.
 template <class V>
-[[gnu::always_inline]] inline void exact_second(const V& x0, const V& x1, const V& x2, V& hi, V& lo) {
-  V s, e1, e2;
-  two_sum(x0, x2, s, e1);
-  two_sum(s, -(x1 + x1), hi, e2);
-  lo = e1 + e2;
+[[gnu::always_inline]] inline void terms_and_step(const V& x0, const V& x1, const V& x2, const V& x3, V& a, V& h, V& err) {
+  const V d2 = x1 - x2;
+  a = (x0 - x1) - d2;
+  const V a1 = d2 - (x2 - x3);
+  two_sum(a, -a1, h, err);  // a + (-a1) is a - a1, rounded alike
 }
 
-// (x0 - x3) - 3 (x1 - x2) = hi + lo, exact but for the rounding of lo: 3 q as q + q (exact) plus q,
-// whose error Dekker's fast two-sum gives (|2q| >= |q|).
-template <class V>
-[[gnu::always_inline]] inline void exact_third(const V& x0, const V& x1, const V& x2, const V& x3, V& hi, V& lo) {
-  V s, e1, q, e2, e4;
-  two_sum(x0, -x3, s, e1);
-  two_sum(x1, -x2, q, e2);
-  const V q2 = q + q;
-  const V p = q2 + q;
-  const V e3 = q - (p - q2);
-  two_sum(s, -p, hi, e4);
-  lo = ((e1 + e4) - e3) - e2 * 3.0;
-}
-
-// The running MVAR term hi + c: hi the rounded sum of the exact terms' high parts, c what it lost
-// and their low parts.
+// The running MVAR term hi + c: hi the rounded sum of the steps' high parts, c what it lost and
+// their low parts.
 template <class V>
 [[gnu::always_inline]] inline void add_term(V& hi, V& c, const V& term_hi, const V& term_lo) {
   V s, err;
@@ -293,6 +281,8 @@ template <class V>
 // One tau while its points pass: the sums of squares (SumKind's order) and the running MVAR term.
 struct PhaseRun {
   std::size_t m = 0, stride = 1;
+  unsigned kinds = all_overlapping_sums;  // the overlapping sums formed (phase_batch_taus())
+  bool nonoverlapped = false;             // stride m: the non-overlapped sums are the AVAR and HVAR ones
   double sum[3] = {0, 0, 0};
   std::uint64_t n[3] = {0, 0, 0};
   double t_hi = 0, t_c = 0;
@@ -303,17 +293,16 @@ struct PhaseRun {
 void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) {
   const std::size_t m = r.m, step = r.stride;
   std::size_t counted = (from + step - 1) / step * step;  // the next point whose terms are summed
+  const bool mvar = (r.kinds & sum_bit(SumKind::mvar)) != 0 && 3 * m <= to;  // no MVAR term before 3m - 1
   for (std::size_t e = from; e < to; ++e) {
-    double a = 0, h = 0, hi = 0, lo = 0;
+    double a = 0, h = 0, err = 0;
     const bool steady = e >= 3 * m;
     if (steady) {
-      FloatArith::x_terms(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h);
-      exact_third(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], hi, lo);
+      terms_and_step(x[e], x[e - m], x[e - 2 * m], x[e - 3 * m], a, h, err);
     } else {
       FloatArith::x_term2(x[e], x[e - m], x[e - 2 * m], a);
-      exact_second(x[e], x[e - m], x[e - 2 * m], hi, lo);
     }
-    add_term(r.t_hi, r.t_c, hi, lo);
+    if (mvar) add_term(r.t_hi, r.t_c, steady ? h : a, err);
     if (e != counted) continue;
     counted += step;
     r.sum[0] += a * a;
@@ -322,7 +311,7 @@ void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) 
       r.sum[2] += h * h;
       ++r.n[2];
     }
-    if (e + 1 < 3 * m) continue;
+    if (e + 1 < 3 * m || !mvar) continue;
     const double t = r.t_hi + r.t_c;
     r.sum[1] += t * t;
     ++r.n[1];
@@ -335,9 +324,12 @@ void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) 
 // lane from its own start: no term below 2m, the AVAR term alone below 3m, the MVAR term from
 // 3m - 1; a lane adds 0 (0 * 0 to a sum of squares, which leaves it as it is) where it has none,
 // and reads its points below an age's start at e itself (the value unused).
-template <bool Ramp>
+// Only the sums of `Kinds` (sum_bit()s) are formed: the compiler drops the terms no sum takes.
+template <bool Ramp, unsigned Kinds>
 [[gnu::always_inline]] inline void lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
                                          std::size_t to) {
+  constexpr bool avar = (Kinds & sum_bit(SumKind::avar)) != 0, mvar = (Kinds & sum_bit(SumKind::mvar)) != 0;
+  constexpr bool hvar = (Kinds & sum_bit(SumKind::hvar)) != 0;
   std::size_t k1[4], k2[4], k3[4];  // the ages m, 2m, 3m of each lane
   alignas(32) double init[8][4];    // AVAR, MVAR, HVAR sums, t_hi, t_c of each lane; 2m, 3m, 3m - 1
   for (std::size_t j = 0; j < 4; ++j) {
@@ -347,9 +339,12 @@ template <bool Ramp>
     init[5][j] = static_cast<double>(2 * r.m), init[6][j] = static_cast<double>(3 * r.m);
     init[7][j] = static_cast<double>(3 * r.m - 1);
   }
-  Lanes sa, st, sh, t_hi, t_c, two_m, three_m, first_t;
-  load(sa, init[0]), load(st, init[1]), load(sh, init[2]), load(t_hi, init[3]), load(t_c, init[4]);
-  load(two_m, init[5]), load(three_m, init[6]), load(first_t, init[7]);
+  // The running vectors are copied from and to an array (v): a vector whose address is taken
+  // (by memcpy) stays in memory, and a running sum through memory waits on the store each step.
+  Lanes v[8];
+  std::memcpy(v, init, sizeof v);
+  Lanes sa = v[0], st = v[1], sh = v[2], t_hi = v[3], t_c = v[4];
+  const Lanes two_m = v[5], three_m = v[6], first_t = v[7];
   const Lanes zero{0, 0, 0, 0};
   const auto age = [&](std::size_t e, std::size_t k) { return Ramp && e < k ? e : e - k; };
   for (std::size_t e = from; e < to; ++e) {
@@ -357,47 +352,55 @@ template <bool Ramp>
     const Lanes x1{x[age(e, k1[0])], x[age(e, k1[1])], x[age(e, k1[2])], x[age(e, k1[3])]};
     const Lanes x2{x[age(e, k2[0])], x[age(e, k2[1])], x[age(e, k2[2])], x[age(e, k2[3])]};
     const Lanes x3{x[age(e, k3[0])], x[age(e, k3[1])], x[age(e, k3[2])], x[age(e, k3[3])]};
-    const Lanes d2 = x1 - x2;
-    Lanes a = (x0 - x1) - d2;
-    Lanes h = a - (d2 - (x2 - x3));
-    Lanes hi, lo;
-    exact_third(x0, x1, x2, x3, hi, lo);
+    Lanes a, h, err;
+    terms_and_step(x0, x1, x2, x3, a, h, err);
     if constexpr (Ramp) {
       const Lanes ev = zero + static_cast<double>(e);
       const auto has_a = ev >= two_m, has_h = ev >= three_m, has_t = ev >= first_t;
-      Lanes a_hi, a_lo;
-      exact_second(x0, x1, x2, a_hi, a_lo);
-      hi = has_h ? hi : (has_a ? a_hi : zero);
-      lo = has_h ? lo : (has_a ? a_lo : zero);
       a = has_a ? a : zero;
       h = has_h ? h : zero;
-      add_term(t_hi, t_c, hi, lo);
-      const Lanes t = has_t ? t_hi + t_c : zero;
-      sa += a * a;
-      st += t * t;
-      sh += h * h;
-    } else {
-      add_term(t_hi, t_c, hi, lo);
+      if constexpr (mvar) {
+        add_term(t_hi, t_c, has_h ? h : a, has_h ? err : zero);
+        const Lanes t = has_t ? t_hi + t_c : zero;
+        st += t * t;
+      }
+    } else if constexpr (mvar) {
+      add_term(t_hi, t_c, h, err);
       const Lanes t = t_hi + t_c;
-      sa += a * a;
       st += t * t;
-      sh += h * h;
     }
+    if constexpr (avar) sa += a * a;
+    if constexpr (hvar) sh += h * h;
   }
-  std::memcpy(init[0], &sa, sizeof sa), std::memcpy(init[1], &st, sizeof st), std::memcpy(init[2], &sh, sizeof sh);
-  std::memcpy(init[3], &t_hi, sizeof t_hi), std::memcpy(init[4], &t_c, sizeof t_c);
+  v[0] = sa, v[1] = st, v[2] = sh, v[3] = t_hi, v[4] = t_c;
+  std::memcpy(init, v, sizeof v);
   for (std::size_t j = 0; j < count; ++j) {
     PhaseRun& r = runs[j];
     r.sum[0] = init[0][j], r.sum[1] = init[1][j], r.sum[2] = init[2][j], r.t_hi = init[3][j], r.t_c = init[4][j];
   }
 }
+// lanes() for the sums runs[0].kinds asks (the same for the runs of a group).
+template <bool Ramp>
+[[gnu::always_inline]] inline void lanes_of_kinds(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
+                                                  std::size_t to) {
+  switch (runs[0].kinds & all_overlapping_sums) {
+    case 1: return lanes<Ramp, 1>(x, runs, count, from, to);
+    case 2: return lanes<Ramp, 2>(x, runs, count, from, to);
+    case 3: return lanes<Ramp, 3>(x, runs, count, from, to);
+    case 4: return lanes<Ramp, 4>(x, runs, count, from, to);
+    case 5: return lanes<Ramp, 5>(x, runs, count, from, to);
+    case 6: return lanes<Ramp, 6>(x, runs, count, from, to);
+    case 7: return lanes<Ramp, 7>(x, runs, count, from, to);
+    default: return;
+  }
+}
 GYROCHAR_FLOAT_CLONES void steady_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
                                         std::size_t to) {
-  lanes<false>(x, runs, count, from, to);
+  lanes_of_kinds<false>(x, runs, count, from, to);
 }
 GYROCHAR_FLOAT_CLONES void ramp_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
                                       std::size_t to) {
-  lanes<true>(x, runs, count, from, to);
+  lanes_of_kinds<true>(x, runs, count, from, to);
 }
 
 // The taus of runs[0 .. count) (fully overlapped, 3m < size for each) over the record, side by
@@ -422,8 +425,14 @@ void run_group(std::span<const double> x, PhaseRun* runs, std::size_t count) {
 
 void store(const PhaseRun& r, TauResult<double>& out) {
   for (std::size_t k = 0; k < 3; ++k) {
-    out.sum[k] = r.sum[k];
-    out.n[k] = r.n[k];
+    const bool formed = (r.kinds & (1u << k)) != 0;
+    out.sum[k] = formed ? r.sum[k] : 0.0;
+    out.n[k] = formed ? r.n[k] : 0;
+  }
+  if (!r.nonoverlapped) return;
+  for (const auto& [overlapped, alone] : {std::pair{SumKind::avar, SumKind::avar_nonoverlapped}, std::pair{SumKind::hvar, SumKind::hvar_nonoverlapped}}) {
+    out.sum[static_cast<std::size_t>(alone)] = r.sum[static_cast<std::size_t>(overlapped)];
+    out.n[static_cast<std::size_t>(alone)] = r.n[static_cast<std::size_t>(overlapped)];
   }
 }
 
@@ -494,7 +503,9 @@ void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> 
 }
 
 void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
-                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise) {
+                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise, unsigned kinds) {
+  constexpr unsigned decimated = sum_bit(SumKind::avar_nonoverlapped) | sum_bit(SumKind::hvar_nonoverlapped);
+  const bool lag1 = (kinds & noise_sums) != 0, alone = (kinds & decimated) != 0;
   const std::size_t size = x.size();
   PhaseRun runs[phase_batch_lanes];
   std::size_t index[phase_batch_lanes];  // runs[j] is tau index[j]
@@ -510,15 +521,20 @@ void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> 
     out[i].stride = stride[i];
     if (m[i] == 0) continue;
     if (m[i] >= size) {  // no term; the decimated series is x_0 alone (when there is one)
-      if (size > 0) noise[i].add(x[0]);
+      if (size > 0 && lag1) noise[i].add(x[0]);
       continue;
     }
     const auto lag = static_cast<std::size_t>(m[i]);
-    decimate(x, lag, out[i], noise[i]);
-    if (size <= 2 * lag) continue;  // no overlapping term
     PhaseRun r;
     r.m = lag;
+    r.kinds = kinds & all_overlapping_sums;
     r.stride = stride[i] > 1 ? static_cast<std::size_t>(stride[i]) : 1;
+    // Terms every m points (m = 1 fully overlapped, or a stride of m) are the decimated series'
+    // own, in its order: its sums are the AVAR and HVAR ones (the same bits), taken from them.
+    constexpr unsigned both = sum_bit(SumKind::avar) | sum_bit(SumKind::hvar);
+    r.nonoverlapped = alone && r.stride == lag && size > 2 * lag && (kinds & both) == both;
+    decimate(x, lag, out[i], noise[i], alone && !r.nonoverlapped, lag1);
+    if (size <= 2 * lag) continue;  // no overlapping term
     if (r.stride != 1 || size <= 3 * lag) {
       run_points(x.data(), r, 2 * lag, size);
       store(r, out[i]);
@@ -529,6 +545,9 @@ void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> 
     if (count == phase_batch_lanes) flush();
   }
   if (count > 0) flush();
+  for (std::size_t i = 0; i < m.size() && i < stride.size() && i < out.size() && i < noise.size(); ++i)
+    for (const SumKind k : {SumKind::avar_nonoverlapped, SumKind::hvar_nonoverlapped})
+      if ((kinds & sum_bit(k)) == 0) out[i].sum[static_cast<std::size_t>(k)] = 0, out[i].n[static_cast<std::size_t>(k)] = 0;
 }
 
 }  // namespace gyrochar

@@ -203,9 +203,32 @@ std::unique_ptr<EdfTable> dense_edf_table(DevStat stat, const std::vector<TauSum
 
 }  // namespace
 
+namespace {
+
+bool any_total(const AnalysisOptions& o) { return std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); }); }
+
+// Whether the read-out identifies the noise of a curve: Hadamard's (dmax 3) for hdev and ohdev,
+// Allan's for the others; both for the total family (it leans on all three statistics' rows).
+bool identifies(const AnalysisOptions& o, bool hadamard) {
+  if (any_total(o)) return true;
+  if (o.alpha || !o.identify_noise) return false;
+  return std::any_of(o.stats.begin(), o.stats.end(), [&](DevStat s) { return (stat_of(s) == Stat::hvar) == hadamard; });
+}
+
+}  // namespace
+
+unsigned sums_needed(const AnalysisOptions& o) {
+  if (any_total(o)) return all_sums | noise_sums;
+  unsigned kinds = 0;
+  for (const DevStat s : o.stats) kinds |= sum_bit(sum_kind(s));
+  if (identifies(o, false) || identifies(o, true)) kinds |= sum_bit(SumKind::avar) | sum_bit(SumKind::mvar) | noise_sums;
+  return kinds;
+}
+
 // The read-out every engine shares: the noise identification of every tau (Allan and Hadamard
-// curves), then each statistic's rows with their EDF and interval, and the total family from the
-// record. `a` has its counts filled in; the rows are appended.
+// curves, each where a statistic asked for needs it), then each statistic's rows with their EDF and
+// interval, and the total family from the record. `a` has its counts filled in; the rows are
+// appended.
 void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, const AnalysisOptions& o,
               std::span<const double> record) {
   const std::size_t taus = sums.size();
@@ -221,9 +244,12 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
   // exact at anchors and interpolated between them (edf_table.hpp).
   std::map<DevStat, std::unique_ptr<EdfTable>> tables;
   std::unique_ptr<DenseNoiseSums> dense_sums;
+  const bool identify_allan = identifies(o, false), identify_hadamard = identifies(o, true);
   for (const DevStat stat : o.stats)
     for (const DevStat s : is_total(stat) ? std::vector<DevStat>{DevStat::oadev, DevStat::mdev, DevStat::ohdev} : std::vector{stat})
-      if (!tables.contains(s)) tables[s] = dense_edf_table(s, sums, a.n_phase, o.edf, cache);
+      if (!tables.contains(s))
+        tables[s] = o.alpha || identifies(o, stat_of(s) == Stat::hvar) ? dense_edf_table(s, sums, a.n_phase, o.edf, cache)
+                                                                        : nullptr;  // no EDF without a noise
   if (!o.alpha && std::any_of(tables.begin(), tables.end(), [](const auto& t) { return t.second != nullptr; })) {
     std::vector<std::uint64_t> m_list;
     for (const TauSums& t : sums)
@@ -235,8 +261,8 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
     std::fill(noise2.begin(), noise2.end(), given_noise(*o.alpha));
     std::fill(noise3.begin(), noise3.end(), given_noise(*o.alpha));
   } else {
-    identify_noise(sums, a.n_phase, 2, frequency_input, noise2, &cache);
-    identify_noise(sums, a.n_phase, 3, frequency_input, noise3, &cache);
+    if (identify_allan) identify_noise(sums, a.n_phase, 2, frequency_input, noise2, &cache);
+    if (identify_hadamard) identify_noise(sums, a.n_phase, 3, frequency_input, noise3, &cache);
   }
   const EstimateOptions options{o.tau0_s, type == DataType::freq ? o.tau0_s : 1.0, o.edf};
   auto rows_of = [&](DevStat stat, std::vector<AnalysisRow>& out) {
@@ -266,7 +292,7 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
     }
   };
   std::vector<AnalysisRow> allan;  // what the total family leans on (total_analysis.hpp)
-  if (std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); }))
+  if (any_total(o))
     for (const DevStat s : {DevStat::oadev, DevStat::mdev, DevStat::ohdev}) rows_of(s, allan);
   for (const DevStat stat : o.stats) {
     if (!is_total(stat)) {

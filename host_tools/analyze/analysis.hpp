@@ -85,6 +85,10 @@ struct AnalysisOptions {
   double confidence = 0.682689492137086;
   std::optional<int> alpha;             // noise exponent for the EDF; empty: identified per tau
   EdfModel edf = EdfModel::exact;       // greenhall: Stable32's approximation (comparisons)
+  // false: the deviations alone, no noise identification and so no EDF or interval (the Python
+  // package's allantools functions, which return none); the total family identifies all the same
+  // (its bias corrections need it).
+  bool identify_noise = true;
   // The total and Theo family (total_analysis.hpp): asked for in `stats`, they make the analyzer
   // hold the record (8 bytes a phase point).
   std::vector<std::uint64_t> theo_m_list;  // averaging factors of Theo1 and TheoBR (even), increasing
@@ -104,8 +108,9 @@ struct AnalysisOptions {
   // Phase and frequency only: hold the phase points as the characterizer stages them (8 bytes a
   // point) and sum the taus over them, four side by side (phase_batch_taus(),
   // core/include/gyrochar/float_batch.hpp): the characterizer's AVAR and HVAR sums to the last
-  // bit, the MVAR terms as exact running sums (within u relative and a second-order bound), O(N)
-  // per tau where the characterizer visits every tau at every point.
+  // bit, the MVAR terms as exact running sums of the rounded AVAR terms (within the roundings
+  // those owe, u relative and a second-order bound), only the sums the read-out needs, O(N) per
+  // tau where the characterizer visits every tau at every point.
   bool hold_phase = false;
   // With hold_phase, for dense tau lists (--taus all): hold the double-double prefix sums too (24
   // bytes a point) and sum 64 consecutive taus at a time from the cache (float_batch_taus(): the

@@ -34,6 +34,11 @@ struct EngineBase {
 void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, const AnalysisOptions& o,
               std::span<const double> record);
 
+// The sums the read-out of `o` needs, as phase_batch_taus()' kinds (float_batch.hpp): those of
+// each statistic asked for; AVAR, MVAR (R(n)) and the noise sums of the decimated series (lag-1,
+// B1) to identify the noise; all of them for the total family.
+unsigned sums_needed(const AnalysisOptions& o);
+
 // The record for the total family, in the characterizer's phase representation: phase relative
 // to the first point (the statistics ignore a constant), or the running sum of the increments.
 struct KeptRecord {

@@ -231,7 +231,9 @@ class FloatBatchEngine final : public EngineBase {
   }
 
   void add(std::span<const double> values) override {
-    for (std::size_t i = 0; i < values.size(); ++i) {
+    std::size_t i = 0;
+    if (type_ == DataType::freq && increments_ > 0 && !prefix_sums_) i = add_frequency(values);
+    for (; i < values.size(); ++i) {
       const double v = values[i];
       if (!std::isfinite(v)) throw BadValue(i, "not a finite number");
       if (type_ == DataType::phase) {
@@ -253,6 +255,7 @@ class FloatBatchEngine final : public EngineBase {
     a.n_values = type_ == DataType::phase ? a.n_phase : increments_;
     a.stride_factor = stride_factor_;
     const FloatRecord held{x_, p_hi_, p_lo_};
+    const unsigned kinds = sums_needed(o);  // the others' terms are not formed
     const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), prefix_sums_ ? float_batch_group : phase_batch_lanes, o,
                                                     [&](std::size_t first, std::span<TauSums> out) {
       const std::span<const std::uint64_t> m(m_list_.data() + first, out.size());
@@ -263,7 +266,7 @@ class FloatBatchEngine final : public EngineBase {
       if (prefix_sums_)
         float_batch_taus(held, m, stride, r, noise);
       else
-        phase_batch_taus(x_, m, stride, r, noise);
+        phase_batch_taus(x_, m, stride, r, noise, kinds);
       for (std::size_t j = 0; j < out.size(); ++j) out[j] = tau_sums(r[j], noise[j]);
     });
     read_out(a, sums, type_, o, record_.points);
@@ -281,6 +284,22 @@ class FloatBatchEngine final : public EngineBase {
     prefix_ = FloatArith::add_prefix(prefix_, x);
     p_hi_.push_back(prefix_.hi);
     p_lo_.push_back(prefix_.lo);
+  }
+
+  // Frequency values after the first, without prefix sums, in one tight loop (the running phase in
+  // a register, the points written in place): what add() stages one by one, the same bits. Stops
+  // at the first value that is not finite (add() refuses it); returns where it stopped.
+  std::size_t add_frequency(std::span<const double> values) {
+    const std::size_t base = x_.size();
+    x_.resize(base + values.size());
+    double* out = x_.data() + base;
+    double x = out[-1];
+    std::size_t i = 0;
+    for (; i < values.size() && std::isfinite(values[i]); ++i) out[i] = x = x + (values[i] - first_increment_);
+    x_.resize(base + i);
+    increments_ += i;
+    for (std::size_t k = 0; k < i; ++k) record_.keep(values[k]);
+    return i;
   }
 
   DataType type_;

@@ -152,7 +152,7 @@ struct Setup {
 Setup make_setup(double tau0, const std::string& type_text, const std::string& unit, const std::string& pulse_weight,
                  const std::string& pulse_unit, const std::string& rate_unit, const std::vector<std::string>& stat_names,
                  std::uint32_t stride_factor, std::uint32_t total_stride_factor, double confidence,
-                 std::optional<int> alpha, bool fit, unsigned threads) {
+                 std::optional<int> alpha, bool fit, unsigned threads, bool identify_noise) {
   Setup s;
   AnalysisOptions& o = s.o;
   o.type = data_type(type_text);
@@ -162,6 +162,7 @@ Setup make_setup(double tau0, const std::string& type_text, const std::string& u
   o.stride_factor = stride_factor;
   o.total_stride_factor = total_stride_factor;
   o.threads = threads;
+  o.identify_noise = identify_noise;
   o.stats.clear();
   for (const std::string& name : stat_names) {
     const auto st = parse_dev_stat(name);
@@ -352,7 +353,8 @@ PYBIND11_MODULE(_native, m) {
   py::class_<Setup>(m, "Setup");
   m.def("setup", &make_setup, py::arg("tau0"), py::arg("type"), py::arg("unit"), py::arg("pulse_weight"),
         py::arg("pulse_unit"), py::arg("rate_unit"), py::arg("stats"), py::arg("stride_factor"),
-        py::arg("total_stride_factor"), py::arg("confidence"), py::arg("alpha"), py::arg("fit"), py::arg("threads"));
+        py::arg("total_stride_factor"), py::arg("confidence"), py::arg("alpha"), py::arg("fit"), py::arg("threads"),
+        py::arg("identify_noise") = true);
   m.def("analyze", &analyze, py::arg("values"), py::arg("setup"), py::arg("taus"), py::arg("listed"));
   py::class_<Stream>(m, "Characterizer")
       .def(py::init<Setup, const std::string&, const std::vector<std::uint64_t>&>(), py::arg("setup"), py::arg("taus"),

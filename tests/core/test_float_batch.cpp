@@ -245,24 +245,37 @@ TEST(PhaseBatch, GivesTheCharacterizersAvarHvarAndNoiseSumsToTheLastBit) {
 // the sum of its m second differences, O(m) a term; 64-bit significands), with the tolerance each
 // sum is owed: a term of the kernel differs from the exact one by the roundings of its double
 // differences (first order: 2 u times the magnitudes it is formed from, doubled for the second
-// order), the MVAR term by the bound of float_batch.hpp (u |t| + (n^2 T + 8 n X) u^2, doubled),
-// and a sum of n squares by n u of itself for its own roundings, u = 2^-53. Every difference is
-// also within the long double's own rounding (2^-64 relative), far below these.
+// order), the MVAR term by the bound of float_batch.hpp (the roundings of its m AVAR terms, as
+// above, plus u |t| + n^2 u^2 (T + 2 A), doubled), and a sum of n squares by n u of itself for its
+// own roundings, u = 2^-53. Every difference is also within the long double's own rounding (2^-64
+// relative), far below these.
 struct Definition {
   long double sum[3] = {0, 0, 0}, tolerance[3] = {0, 0, 0};
   std::uint64_t n[3] = {0, 0, 0};
+  // MVAR again from the sums of m AVAR terms as the kernel rounds them (in double), with the
+  // tolerance of the double-double running sum alone: u |t| + n^2 u^2 (T + 2 A), doubled.
+  long double mvar_of_rounded = 0, rounded_tolerance = 0;
 };
 
 Definition definition(const std::vector<double>& x, std::size_t m, std::size_t stride) {
   using L = long double;
   const L u = 0x1p-53L;
   const std::size_t size = x.size();
-  L big_x = 0, big_t = 0;
-  for (const double v : x) big_x = std::max(big_x, std::fabs(static_cast<L>(v)));
+  L big_a = 0, big_t = 0;
   const auto second = [&](std::size_t e) { return static_cast<L>(x[e]) - 2 * static_cast<L>(x[e - m]) + static_cast<L>(x[e - 2 * m]); };
-  std::vector<L> t_of(size, 0);
+  // The rounding bound of the AVAR term at e (as below), and of the sum of m of them ending at e.
+  const auto avar_bound = [&](std::size_t e) {
+    const L d1 = static_cast<L>(x[e]) - x[e - m], d2 = static_cast<L>(x[e - m]) - x[e - 2 * m];
+    return 4 * u * (std::fabs(d1) + std::fabs(d2) + std::fabs(d1 - d2));
+  };
+  const auto rounded = [&](std::size_t e) { return (x[e] - x[e - m]) - (x[e - m] - x[e - 2 * m]); };  // in double
+  std::vector<L> t_of(size, 0), t_bound(size, 0), t_rounded(size, 0), t_rounded_abs(size, 0);
+  for (std::size_t e = 2 * m; e < size; ++e) big_a = std::max(big_a, std::fabs(second(e)));
   for (std::size_t e = 3 * m - 1; e < size; ++e) {
-    for (std::size_t j = 0; j < m; ++j) t_of[e] += second(e - j);
+    for (std::size_t j = 0; j < m; ++j) {
+      t_of[e] += second(e - j), t_bound[e] += avar_bound(e - j);
+      t_rounded[e] += rounded(e - j), t_rounded_abs[e] += std::fabs(static_cast<L>(rounded(e - j)));
+    }
     big_t = std::max(big_t, std::fabs(t_of[e]));
   }
   const L n_l = static_cast<L>(size);
@@ -283,13 +296,20 @@ Definition definition(const std::vector<double>& x, std::size_t m, std::size_t s
     }
     if (e + 1 >= 3 * m) {
       const L t = t_of[e];
-      const L dt = 2 * (u * std::fabs(t) + (n_l * n_l * big_t + 8 * n_l * big_x) * u * u);
+      const L dt = t_bound[e] + 2 * (u * std::fabs(t) + n_l * n_l * (big_t + 2 * big_a) * u * u);
       d.sum[1] += t * t;
       d.tolerance[1] += 2 * std::fabs(t) * dt + dt * dt;
       ++d.n[1];
+      // The long double sum of m doubles: within m 2^-64 of their magnitudes.
+      const L r = t_rounded[e];
+      const L dr = 2 * (u * std::fabs(r) + n_l * n_l * (big_t + 2 * big_a) * u * u) +
+                   static_cast<L>(m) * 0x1p-64L * t_rounded_abs[e];
+      d.mvar_of_rounded += r * r;
+      d.rounded_tolerance += 2 * std::fabs(r) * dr + dr * dr;
     }
   }
   for (std::size_t k = 0; k < 3; ++k) d.tolerance[k] += static_cast<L>(d.n[k] + 1) * u * d.sum[k];
+  d.rounded_tolerance += static_cast<L>(d.n[1] + 1) * u * d.mvar_of_rounded;
   return d;
 }
 
@@ -319,6 +339,9 @@ TEST(PhaseBatch, SumsAreTheDefinitionsWithinTheirRoundingBounds) {
         EXPECT_LE(std::fabs(static_cast<long double>(got[i].sum[k]) - want.sum[k]), want.tolerance[k])
             << where << ": " << got[i].sum[k] << " vs " << static_cast<double>(want.sum[k]);
       }
+      EXPECT_LE(std::fabs(static_cast<long double>(got[i].sum[1]) - want.mvar_of_rounded), want.rounded_tolerance)
+          << "record " << r << " m=" << m[i] << ": MVAR " << got[i].sum[1] << " vs the rounded AVAR terms' "
+          << static_cast<double>(want.mvar_of_rounded);
     }
   }
 }
@@ -345,6 +368,43 @@ TEST(PhaseBatch, TausSideBySideGiveTheSumsOfEachAlone) {
       for (std::size_t k = 0; k < sum_kinds; ++k)
         EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].sum[k]), std::bit_cast<std::uint64_t>(one[0].sum[k]))
             << "N=" << n << " m=" << m[i] << " kind " << k;
+    }
+  }
+}
+
+TEST(PhaseBatch, OnlyTheSumsAskedForEachWithTheSameBits) {
+  // Oracle: phase_batch_taus() with every sum (checked above against the characterizer and the
+  // definitions): asked for a subset, each sum formed is the same to the last bit, each other one 0
+  // with no term, and the noise sums the same or untouched (m = 1 takes its non-overlapped sums
+  // from its AVAR and HVAR sums when it forms both, from its own decimation otherwise).
+  std::mt19937_64 rng(37);
+  std::normal_distribution<double> g;
+  std::vector<double> x;
+  double walk = 0;
+  for (std::size_t k = 0; k < 1200; ++k) x.push_back(walk += g(rng));
+  const std::vector<std::uint64_t> m{1, 2, 3, 5, 8, 13, 21, 100, 250, 333, 399, 400, 600, 1200},
+      stride{1, 1, 1, 1, 1, 1, 4, 1, 2, 1, 1, 16, 1, 1};
+  std::vector<TauResult<double>> all(m.size());
+  std::vector<NoiseIdAccumulator> all_noise(m.size());
+  phase_batch_taus(x, m, stride, all, all_noise);
+  for (unsigned kinds = 1; kinds <= (all_sums | noise_sums); ++kinds) {
+    std::vector<TauResult<double>> got(m.size());
+    std::vector<NoiseIdAccumulator> noise(m.size());
+    phase_batch_taus(x, m, stride, got, noise, kinds);
+    for (std::size_t i = 0; i < m.size(); ++i) {
+      for (std::size_t k = 0; k < sum_kinds; ++k) {
+        const std::string where = "kinds " + std::to_string(kinds) + " m=" + std::to_string(m[i]) + " kind " + std::to_string(k);
+        const bool formed = (kinds & sum_bit(static_cast<SumKind>(k))) != 0;
+        EXPECT_EQ(got[i].n[k], formed ? all[i].n[k] : 0u) << where;
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].sum[k]), std::bit_cast<std::uint64_t>(formed ? all[i].sum[k] : 0.0))
+            << where;
+      }
+      const bool lag1 = (kinds & noise_sums) != 0;
+      for (int d = 0; d < 4; ++d) {
+        const Lag1Sums a = noise[i].order(d), b = lag1 ? all_noise[i].order(d) : Lag1Sums{};
+        EXPECT_TRUE(a.n == b.n && a.sum == b.sum && a.sum_sq == b.sum_sq && a.sum_lag == b.sum_lag)
+            << "kinds " << kinds << " m=" << m[i] << " order " << d;
+      }
     }
   }
 }

@@ -246,3 +246,31 @@ def test_edf_of_gives_the_programs_exact_edf(analyze_program, data_dir):
         assert e == r["edf"] and lo == r["ci_low"] and hi == r["ci_high"], t
     with pytest.raises(ValueError, match="edf_of takes a function"):
         ga.edf_of(len, values)
+
+
+@pytest.mark.parametrize("case", CASES[:2], ids=[c[0] for c in CASES[:2]])
+def test_allantools_functions_give_the_deviations_of_analyze_to_the_bit(data_dir, case):
+    # Oracle: gyrochar.analyze with the six statistics (every sum formed, the noise identified;
+    # itself equal to the program above). Each function of gyrochar.allantools forms its own
+    # statistic's sums alone and identifies no noise: the same taus, ns and devs to the last bit,
+    # and no EDF; the total family still identifies (its bias corrections need it).
+    import gyrochar.allantools as ga
+    name, _, kwargs, _ = case
+    values = load(data_dir / name)
+    for stat in ALLAN:
+        taus, devs, errs, ns = getattr(ga, stat)(values, rate=1.0, data_type=kwargs["type"], taus="octave")
+        m = np.round(taus).astype(np.int64)
+        stride = 2
+        while stride < m[-1]:
+            stride *= 2
+        want = gyrochar.analyze(values, 1.0, stats=ALLAN, taus=m, stride_factor=stride, total_stride_factor="exact",
+                                **kwargs).stats[stat]
+        keep = want.n > 1
+        np.testing.assert_array_equal(ns, want.n[keep].astype(float), err_msg=stat)
+        np.testing.assert_array_equal(devs, want.dev[keep], err_msg=stat)
+        np.testing.assert_array_equal(errs, want.dev[keep] / np.sqrt(want.n[keep]), err_msg=stat)
+        assert np.any(np.isfinite(want.edf[keep])), stat  # the oracle's rows have their EDF
+    bare = gyrochar._deviations(values, 1.0, kwargs["type"], "oadev", "octave", "full", "exact").stats["oadev"]
+    assert np.all(np.isnan(bare.edf)) and all(n is None for n in bare.noise_id)
+    total = gyrochar._deviations(values, 1.0, kwargs["type"], "totdev", "octave", "full", "exact").stats["totdev"]
+    assert any(n is not None for n in total.noise_id)

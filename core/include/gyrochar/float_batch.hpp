@@ -79,19 +79,32 @@ void float_batch_taus(const FloatRecord& record, std::span<const std::uint64_t> 
 // analyzer's held record (phase and frequency data of a known length, every tau rule):
 //   - the AVAR and HVAR terms are float_batch_sums()' (the same operations) and each sum of their
 //     squares runs in e's order, as the characterizer's: its sums to the last bit;
-//   - the MVAR term t_e = sum_{j<m} a_{e-j} (a the exact second difference) runs as t_{3m-1} =
-//     a_{2m} + ... + a_{3m-1}, then t_e = t_{e-1} + h_e (h_e = a_e - a_{e-m}, the exact third
-//     difference). Each a and h is formed as a double-double by two-sums (exact but for the
-//     rounding of its low part, within 8 u^2 X, X the largest |x|) and added by a two-sum to a
-//     running sum hi + c whose rounding errors c collects (c rounds too, within n u^2 T a step, T
-//     the largest |t|). Over a record of n points the term comes out (hi + c, rounded) within
-//     u |t_e| + (n^2 T + 8 n X) u^2 of the exact one (u = 2^-53): for n = 10^7 the second part
-//     is below 1.3e-18 T + 1e-24 X. No cancellation grows with n, as a running sum in doubles
-//     would (n u T); the prefix-sum form of float_batch_sums() is within a few u of its sums'
-//     differences.
+//   - the MVAR term t_e = sum_{j<m} a_{e-j} (a_k = x_k - 2 x_{k-m} + x_{k-2m}) is the sum of the m
+//     AVAR terms as they are rounded for the AVAR sum (A_k = (x_k - x_{k-m}) - (x_{k-m} - x_{k-2m})
+//     in doubles, the same bits), summed exactly: t_{3m-1} = A_{2m} + ... + A_{3m-1}, then
+//     t_e = t_{e-1} + (A_e - A_{e-m}), where A_e - A_{e-m} rounded is the HVAR term and a two-sum
+//     gives its rounding error, both added by a two-sum to a running sum hi + c whose rounding errors
+//     c collects (c rounds too: within n u^2 (T + 2A) a step, T the largest |t|, A the largest |A|).
+//     Telescoping, the running sum is exactly A_{e-m+1} + ... + A_e but for c's roundings, so over
+//     a record of n points the term comes out (hi + c, rounded) within
+//         u |t_e| + sum_{j<m} u (|x_k - x_{k-m}| + |x_{k-m} - x_{k-2m}| + |A_k|)_{k=e-j} + n^2 u^2 (T + 2A)
+//     of the exact one (u = 2^-53): the middle part is the roundings of its m AVAR terms, each
+//     within what the AVAR term itself owes (zero where the two differences are exact, as for
+//     points within a factor 2 of each other); for n = 10^7 the last is below 1.3e-18 (T + 2A).
+//     No rounding grows with n, as a running sum in doubles would (n u T). A step costs 14 floating
+//     additions where the exact third difference in double-double (before) took 33; the prefix-sum
+//     form of float_batch_sums() is within a few u of its sums' differences.
 // The terms of several fully overlapped taus run side by side in vector lanes, phase_batch_lanes
 // taus at a time, each lane's sums in e's order (the same bits as that tau alone). O(N) per tau,
 // no allocation.
+
+/// The sums phase_batch_taus() is asked for: bit k for SumKind k (sum_bit()), and noise_sums for
+/// the lag-1 sums of the decimated series; a sum not asked for is left 0 with n = 0 (its terms are
+/// not formed), the noise accumulators untouched.
+constexpr unsigned sum_bit(SumKind k) { return 1u << static_cast<unsigned>(k); }
+inline constexpr unsigned all_overlapping_sums = 7;  // AVAR, MVAR, HVAR
+inline constexpr unsigned all_sums = 31;             // and the non-overlapped AVAR and HVAR
+inline constexpr unsigned noise_sums = 32;
 
 /// Taus phase_batch_taus() sums side by side.
 inline constexpr std::size_t phase_batch_lanes = 4;
@@ -99,9 +112,11 @@ inline constexpr std::size_t phase_batch_lanes = 4;
 /// The sums of the taus m[i] with strides stride[i] over the staged points x (as
 /// Characterizer<FloatArith> stages them: FloatRecord::x), into out[i], and the noise sums of each
 /// added to noise[i] (fresh accumulators). AVAR, HVAR, the non-overlapped and noise sums: the
-/// characterizer's to the last bit; MVAR within the bound above. O(N) per tau. The four spans
-/// (m, stride, out, noise) have the same size.
+/// characterizer's to the last bit; MVAR's terms within the bound above. Only the sums of `kinds`
+/// (each the same bits as with all of them). O(N) per tau. The four spans (m, stride, out, noise)
+/// have the same size.
 void phase_batch_taus(std::span<const double> x, std::span<const std::uint64_t> m, std::span<const std::uint64_t> stride,
-                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise);
+                      std::span<TauResult<double>> out, std::span<NoiseIdAccumulator> noise,
+                      unsigned kinds = all_sums | noise_sums);
 
 }  // namespace gyrochar

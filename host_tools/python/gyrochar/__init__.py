@@ -176,8 +176,17 @@ def _array(values):
     return data
 
 
+def _deviations(values, tau0, type, stat, taus, stride_factor, total_stride_factor):
+    """analyze() of one statistic without the noise identification (so no EDF and no interval) where
+    the deviations do not need it (the total family's bias corrections do): the engine sums only
+    that statistic's terms. For gyrochar.allantools, whose functions return no interval."""
+    setup, rule, listed = _setup(tau0, type, "", None, (stat,), taus, stride_factor, 0.683, None, None, None,
+                                 total_stride_factor, 0, identify_noise=False)
+    return Analysis(_native.analyze(_array(values), setup, rule, listed), float(tau0), type, 0.683)
+
+
 def _setup(tau0, type, unit, pulse_weight, stats, taus, stride_factor, confidence, fit, rate_unit, alpha,
-           total_stride_factor, threads):
+           total_stride_factor, threads, identify_noise=True):
     """The checked arguments as the engine's setup, the tau rule and the listed taus."""
     if isinstance(tau0, bool) or not isinstance(tau0, _numbers.Real):
         raise TypeError("tau0 must be a number of seconds, not %r" % (tau0,))
@@ -218,7 +227,7 @@ def _setup(tau0, type, unit, pulse_weight, stats, taus, stride_factor, confidenc
                               or not -4 <= alpha <= 2):
         raise ValueError("alpha must be None (identified per tau) or an integer from -4 to 2, not %r" % (alpha,))
     setup = _native.setup(tau0, type, unit, pulse_text, pulse_unit, rate_unit or "", stats, sf, tsf, float(confidence), alpha,
-                          fit is not None, int(threads))
+                          fit is not None, int(threads), identify_noise)
     return setup, rule, listed
 
 

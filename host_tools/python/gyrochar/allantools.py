@@ -14,6 +14,7 @@ import numbers as _numbers
 import numpy as _np
 
 from . import analyze as _analyze
+from . import _deviations
 
 __all__ = ["adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev", "theo1",
            "edf_of"]
@@ -78,8 +79,8 @@ def _run(stat, data, rate, data_type, taus, even=False, max_m_of=None, freq_poin
     if len(m) == 0:
         raise ValueError("no tau of %r fits %d phase points" % (taus, n_points))
     stride = _overlapping_stride(m[-1])
-    r = _analyze(values, 1.0 / rate, type=data_type, stats=(stat,), taus=m, stride_factor=stride,
-                 total_stride_factor="exact").stats[stat]
+    # The deviations alone (no EDF: allantools' errs are devs / sqrt(ns)), only this statistic's sums.
+    r = _deviations(values, 1.0 / rate, data_type, stat, m, stride, "exact").stats[stat]
     keep = r.n > 1
     ns = r.n[keep]
     devs = r.dev[keep]
