@@ -3,7 +3,8 @@
 # and Theo1 at octave taus on 10^5 phase points, gyrochar (tests/benchmarks/bench_total.cpp, exact
 # and with the analysis' decimation plan) beside allantools (../shared/peers/allantools) on the
 # same file in the same run; the decimated estimators against the exact ones on the reference sets;
-# then 10^7 points of TOTDEV, MTOTDEV and TheoH with peak memory.
+# then 10^7 points of TOTDEV, MTOTDEV and TheoH with peak memory; then issue 23's RLG job (HOURS of
+# 1 kHz counts, 120 by default: about 1 GB of counts and, on the analyzer's side, many minutes).
 # allantools runs each tau in its own process with a time limit (TAU_LIMIT seconds, default 60);
 # after one tau times out the longer ones (at least as much work) are not run, and the ratio is
 # then a lower bound.
