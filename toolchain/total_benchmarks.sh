@@ -3,7 +3,8 @@
 # and Theo1 at octave taus on 10^5 phase points, gyrochar (tests/benchmarks/bench_total.cpp, exact
 # and with the analysis' decimation plan) beside allantools (../shared/peers/allantools) on the
 # same file in the same run; the decimated estimators against the exact ones on the reference sets;
-# then 10^7 points of TOTDEV, MTOTDEV and TheoH with peak memory.
+# then 10^7 points of TOTDEV, MTOTDEV and TheoH with peak memory; then issue 23's RLG job (HOURS of
+# 1 kHz counts, 120 by default: about 1 GB of counts and, on the analyzer's side, many minutes).
 # allantools runs each tau in its own process with a time limit (TAU_LIMIT seconds, default 60);
 # after one tau times out the longer ones (at least as much work) are not run, and the ratio is
 # then a lower bound.
@@ -113,6 +114,27 @@ echo
 echo '```'
 /usr/bin/time -v build/perf/tests/bench_total long 10000000 16 2> "$data/time_total.txt"
 echo "wall time $(awk -F': ' '/Elapsed/{print $2}' "$data/time_total.txt"), maximum resident set $(awk -F': ' '/Maximum resident/{printf "%.0f MiB", $2 / 1024}' "$data/time_total.txt")"
+echo '```'
+echo
+# The job of the project's issue 23: a simulated RLG counts record at 1 kHz (quantization, ARW,
+# bias instability, rate random walk, ramp), HOURS long (120 by default: 4.32 10^8 samples, a
+# counts file of about 4 GB; HOURS=12 for 4.32 10^7), through the analyzer with every total-family
+# row it names. The rows' stride column says which are exact (1) and which decimated.
+hours=${HOURS:-120}
+echo "### The ${hours}-hour RLG job (1 kHz counts, gyrochar-analyze)"
+echo
+rlg=$data/rlg_${hours}h.txt
+[ -f "$rlg" ] || build/perf/host_tools/gyrochar-sim --duration $((hours * 3600)) --tau0 0.001 --white-angle 1 \
+    --arw 0.003 --bias-instability 0.005 --rrw 0.0005 --ramp 0.0001 --seed 1 --out "$rlg"
+echo '```'
+echo "record: $((hours * 3600000)) samples, $(du -h "$rlg" | cut -f1)"
+/usr/bin/time -v build/perf/host_tools/gyrochar-analyze --type counts --tau0 0.001 --pulse-weight 1arcsec \
+    --stats oadev,mdev,ohdev,totdev,mtotdev,theoh --fit ieee952 --fit-long-tau theoh --format csv "$rlg" \
+    > "$data/rlg_rows.csv" 2> "$data/time_rlg.txt"
+awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+  $c["stat"] ~ /totdev|theoh/ { n[$c["stat"]]++; if ($c["stride"] == 1) e[$c["stat"]]++ }
+  END { for (s in n) printf "%s: %d rows, %d exact (stride 1)\n", s, n[s], e[s] }' "$data/rlg_rows.csv" | sort
+echo "wall time $(awk -F': ' '/Elapsed/{print $2}' "$data/time_rlg.txt"), user $(awk -F': ' '/User time/{print $2}' "$data/time_rlg.txt") s, system $(awk -F': ' '/System time/{print $2}' "$data/time_rlg.txt") s, maximum resident set $(awk -F': ' '/Maximum resident/{printf "%.0f MiB", $2 / 1024}' "$data/time_rlg.txt")"
 echo '```'
 echo "<!-- total:end -->"
 } > "$section"

@@ -13,7 +13,7 @@ double as_double(std::uint64_t v) { return static_cast<double>(v); }
 // The FFTs below leave the spectrum in bit-reversed order (forward, decimation in frequency) and
 // take it back from there (inverse, decimation in time): no reordering pass, and the blocks that
 // fit the cache are finished before the next is touched. Products of spectra pair frequency k with
-// n - k: `Spectrum` walks k in order and gives both positions, with rev(n - k) = (n - 1) ^ rev(k - 1).
+// n - k: `for_each_mirror_pair` gives both positions.
 constexpr Index cached = 2048;  // complex values a block keeps in the first-level cache
 
 // One stage's butterflies on a block of 2 half values, u its first half, t its second; tw the
@@ -61,27 +61,37 @@ void inverse_from_bitreversed(double* d, Index n, const double* table) {
     for (Index i = 0; i < n; i += len) inverse_butterflies(d + 2 * i, d + 2 * (i + len / 2), table + len, len / 2);
 }
 
-// Frequencies k = 0..n/2 with the positions of k and n - k in a bit-reversed spectrum of length n.
-struct Spectrum {
-  Index n, k = 0, rev = 0, rev_before = 0;  // rev(k), rev(k - 1)
-  Index here() const { return rev; }
-  Index mirror() const { return k == 0 ? 0 : (n - 1) ^ rev_before; }
-  bool next() {  // false past n / 2
-    rev_before = rev;
-    Index bit = n >> 1;
-    for (; (rev & bit) != 0; bit >>= 1) rev ^= bit;
-    rev ^= bit;
-    return 2 * ++k <= n;
+// Calls f(p, q, k) once for every pair of frequencies k and n - k (k = 0 .. n / 2) of a
+// bit-reversed spectrum of length n (a power of two, n >= 2), p and q their positions. With 2^b the
+// highest bit of p, k = rev(p) and rev(n - k) = (n - 1) ^ rev(k - 1) = p ^ (2^b - 1): the pairs are
+// mirror images within each block [2^b, 2^(b+1)), walked from both ends (two streams, where taking
+// k in order would touch the whole spectrum at random); p = 0 (k = 0) and p = 1 (k = n / 2) pair
+// with themselves.
+template <class F>
+void for_each_mirror_pair(Index n, F f) {
+  f(Index{0}, Index{0}, Index{0});
+  f(Index{1}, Index{1}, n / 2);
+  for (Index block = 2; block < n; block *= 2) {
+    Index k = n / (2 * block);  // rev(block)
+    for (Index p = block; p < block + block / 2; ++p) {
+      f(p, 3 * block - 1 - p, k);
+      Index bit = n >> 1;  // k = rev(p + 1)
+      for (; (k & bit) != 0; bit >>= 1) k ^= bit;
+      k ^= bit;
+    }
   }
-};
+}
 
 // Replaces the (bit-reversed) spectrum of a + i b, length n, by that of corr(a, b) (cross = true:
 // c(e) = sum_p a[p] b[p+e], real) or of acf(a) + i acf(b) (cross = false). The spectra of the two
 // real sequences: A_k = (Z_k + conj Z_{n-k}) / 2, B_k = (Z_k - conj Z_{n-k}) / (2i).
 void combine(double* d, Index n, bool cross) {
-  Spectrum s{n};
-  do {
-    const Index k = s.here(), j = s.mirror();
+  if (n < 2) {
+    if (cross) d[1] = 0.0;  // a[0] b[0]
+    else d[0] = d[0] * d[0], d[1] = d[1] * d[1];
+    return;
+  }
+  for_each_mirror_pair(n, [d, cross](Index k, Index j, Index) {
     const double zr = d[2 * k], zi = d[2 * k + 1], wr = d[2 * j], wi = d[2 * j + 1];
     const double ar = 0.5 * (zr + wr), ai = 0.5 * (zi - wi), br = 0.5 * (zi + wi), bi = -0.5 * (zr - wr);
     if (cross) {  // conj(A) B; at n - k its conjugate
@@ -93,7 +103,7 @@ void combine(double* d, Index n, bool cross) {
       d[2 * k] = re, d[2 * k + 1] = im;
       d[2 * j] = re, d[2 * j + 1] = im;
     }
-  } while (n > 1 && s.next());
+  });
 }
 
 // Loads a (and b, or zeros) into the FFT buffer of length n, zero-padded.
@@ -102,6 +112,41 @@ void load(double* d, Index n, std::span<const double> a, std::span<const double>
     d[2 * p] = p < a.size() ? a[p] : 0.0;
     d[2 * p + 1] = p < b.size() ? b[p] : 0.0;
   }
+}
+
+// The circular autocorrelation of the real sequence x zero-padded to P (a power of two, P >= 4),
+// times P, left at d[0 .. P): one complex FFT pair of half the length (docs/total.md, "The real
+// FFT"). The P values d[2j], d[2j+1] are x[2j] + i x[2j+1]; with Z their half-length spectrum,
+// E = (Z_k + conj Z_{n-k}) / 2 and O = (Z_k - conj Z_{n-k}) / (2i) are the spectra of the even and
+// the odd values, X_k = E + W^k O and X_{k+n} = E - W^k O (W = exp(-2 pi i / P)) the whole one, and
+// the autocorrelation's even and odd values come back together as the inverse of
+// (S_k + S_{k+n}) + i W^-k (S_k - S_{k+n}), S = |X|^2. The twiddle table is that of length P.
+void real_autocorrelation(std::span<const double> x, Index P, double* d, const double* table) {
+  const Index n = P / 2;
+  for (Index p = 0; p < P; ++p) d[p] = p < x.size() ? x[p] : 0.0;
+  forward_bitreversed(d, n, table);
+  // From Z_k = z and Z_{n-k} = v: E, O, then S_k, S_{k+n} and the inverse's input y at k; W^k =
+  // wr + i wi (the table's cos, -sin of pi k / n).
+  auto power = [](double zr, double zi, double vr, double vi, double wr, double wi, double& yr, double& yi) {
+    const double er = 0.5 * (zr + vr), ei = 0.5 * (zi - vi), or_ = 0.5 * (zi + vi), oi = -0.5 * (zr - vr);
+    const double tr = wr * or_ - wi * oi, ti = wr * oi + wi * or_;  // W^k O
+    const double plus = (er + tr) * (er + tr) + (ei + ti) * (ei + ti), minus = (er - tr) * (er - tr) + (ei - ti) * (ei - ti);
+    const double diff = plus - minus;  // i W^-k diff, W^-k = conj W^k = wr - i wi
+    yr = plus + minus + wi * diff, yi = wr * diff;
+  };
+  // W^k computed, not read: the table's values at k = rev(p) would be n / 2 scattered reads; the
+  // expression of fft_twiddles (the same values), and W^{n-k} = -conj W^k.
+  const double step = 2.0 * std::numbers::pi / static_cast<double>(P);
+  for_each_mirror_pair(n, [&](Index p, Index q, Index k) {
+    const double zr = d[2 * p], zi = d[2 * p + 1], vr = d[2 * q], vi = d[2 * q + 1];
+    const double c = std::cos(step * static_cast<double>(k)), si = std::sin(step * static_cast<double>(k));
+    double yr, yi, ur, ui;
+    power(zr, zi, vr, vi, c, -si, yr, yi);
+    power(vr, vi, zr, zi, -c, -si, ur, ui);  // at n - k (not written where q = p)
+    d[2 * p] = yr, d[2 * p + 1] = yi;
+    if (q != p) d[2 * q] = ur, d[2 * q + 1] = ui;
+  });
+  inverse_from_bitreversed(d, n, table);
 }
 
 // Theo1's end correction (docs/total.md): with v every other residual of one end of the record
@@ -208,16 +253,16 @@ std::size_t fft_length(std::size_t n) {
 
 void fft_twiddles(std::span<double> twiddle, std::size_t P) {
   // Stage by stage, each contiguous: exp(2 pi i k / len) at complex index len / 2 + k, k < len / 2;
-  // the largest stage computed, the others read from it.
+  // the largest stage computed, each smaller one read from the one above it.
   const double step = 2.0 * std::numbers::pi / static_cast<double>(P);
   for (Index k = 0; 2 * k < P; ++k) {
     twiddle[2 * (P / 2 + k)] = std::cos(step * static_cast<double>(k));
     twiddle[2 * (P / 2 + k) + 1] = std::sin(step * static_cast<double>(k));
   }
-  for (Index len = P / 2; len >= 2; len /= 2)
+  for (Index len = P / 2; len >= 2; len /= 2)  // every other value of the stage above: two streams
     for (Index k = 0; 2 * k < len; ++k) {
-      twiddle[2 * (len / 2 + k)] = twiddle[2 * (P / 2 + k * (P / len))];
-      twiddle[2 * (len / 2 + k) + 1] = twiddle[2 * (P / 2 + k * (P / len)) + 1];
+      twiddle[2 * (len / 2 + k)] = twiddle[2 * (len + 2 * k)];
+      twiddle[2 * (len / 2 + k) + 1] = twiddle[2 * (len + 2 * k) + 1];
     }
 }
 
@@ -308,15 +353,9 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) 
     w.s2[i + 1] = w.s2[i] + w.r[i] * w.r[i];
   }
   fft_twiddles(w.twiddle, w.P);
-  double* d = w.buffer.data();
-  load(d, w.P, w.r, {});
-  forward_bitreversed(d, w.P, w.twiddle.data());
-  for (Index k = 0; k < w.P; ++k) {  // |Z|^2 in any order
-    d[2 * k] = d[2 * k] * d[2 * k] + d[2 * k + 1] * d[2 * k + 1];
-    d[2 * k + 1] = 0.0;
-  }
-  inverse_from_bitreversed(d, w.P, w.twiddle.data());
-  for (Index lag = 0; lag < N; ++lag) w.ac[lag] = d[2 * lag] / as_double(w.P);
+  real_autocorrelation(w.r, w.P, w.buffer.data(), w.twiddle.data());
+  const double* d = w.buffer.data();
+  for (Index lag = 0; lag < N; ++lag) w.ac[lag] = d[lag] / as_double(w.P);
   w.ready = true;
   return w;
 }

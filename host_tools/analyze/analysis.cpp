@@ -294,12 +294,13 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
   std::vector<AnalysisRow> allan;  // what the total family leans on (total_analysis.hpp)
   if (any_total(o))
     for (const DevStat s : {DevStat::oadev, DevStat::mdev, DevStat::ohdev}) rows_of(s, allan);
+  LagSumRecord lag_sums;  // one preparation shared by Theo1, TheoH, MTOTDEV and TTOTDEV
   for (const DevStat stat : o.stats) {
     if (!is_total(stat)) {
       rows_of(stat, a.rows);
       continue;
     }
-    const auto total = total_rows(stat, record, options.unit, o, allan);
+    const auto total = total_rows(stat, record, options.unit, o, allan, lag_sums);
     a.rows.insert(a.rows.end(), total.begin(), total.end());
   }
 }

@@ -45,7 +45,7 @@ bool known(const AnalysisRow* r) { return r != nullptr && r->alpha.has_value(); 
 // Theo1, or TheoH (the overlapping ADEV rows below its switch point, TheoBR above): k2 is
 // phase_scale squared.
 std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, double k2, const AnalysisOptions& o,
-                                   const std::vector<AnalysisRow>& allan) {
+                                   const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums) {
   std::vector<AnalysisRow> rows;
   const std::uint64_t N = x.size();
   const double n = static_cast<double>(N), tau0 = o.tau0_s;
@@ -63,18 +63,13 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
     if (!(ratio > 0)) return rows;
   }
   // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for or its
-  // workspace would pass the memory budget (plan.hpp): the record prepared once (O(N log N),
-  // 6 N + 4 fft_length(2 N) doubles), then each tau. The rows' stride says which estimator ran.
-  std::unique_ptr<double[]> work;  // not zero-filled: prepare writes before it reads (1.6 GB at 10^7)
-  Theo1Workspace prepared;
+  // workspace would pass the memory budget (plan.hpp): the record prepared once for the run
+  // (O(N log N), 6 N + 4 fft_length(2 N) doubles, shared with MTOTDEV), then each tau. The rows'
+  // stride says which estimator ran.
   const bool decimated = o.theo_decimated || 8 * static_cast<std::uint64_t>(theo1_workspace_size(N)) > memory_budget();
   auto estimate = [&](std::uint64_t m) {
     if (decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));
-    if (!prepared.ready) {
-      work = std::make_unique_for_overwrite<double[]>(theo1_workspace_size(N));
-      prepared = theo1_prepare(x, {work.get(), theo1_workspace_size(N)});
-    }
-    return theo1_fast(prepared, m, tau0);
+    return theo1_fast(lag_sums.prepared(x, false), m, tau0);
   };
   for (const std::uint64_t m : o.theo_m_list) {
     if (stat == DevStat::theoh && 3 * m < 4 * k) continue;  // 0.75 m < k: ADEV's part
@@ -89,7 +84,8 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
 
 // TOTDEV, MTOTDEV, TTOTDEV or HTOTDEV at o.m_list: k2 is phase_scale squared.
 std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double> x, double k2,
-                                           const AnalysisOptions& o, const std::vector<AnalysisRow>& allan) {
+                                           const AnalysisOptions& o, const std::vector<AnalysisRow>& allan,
+                                           LagSumRecord& lag_sums) {
   std::vector<AnalysisRow> rows;
   const std::uint64_t N = x.size();
   const double n = static_cast<double>(N), tau0 = o.tau0_s;
@@ -101,22 +97,11 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
   // HTOTVAR its frequencies) prepared once as for Theo1, then O(m log m) a tau. The rows' stride
   // says which estimator ran.
   const bool hadamard = stat == DevStat::htotdev;
-  std::vector<double> y;                // HTOTVAR: the frequencies times tau0
-  std::unique_ptr<double[]> fast_work;  // not zero-filled: prepare writes before it reads
-  Theo1Workspace prepared;
   const std::size_t n_fast = hadamard ? N - 1 : N, fast_size = theo1_workspace_size(n_fast) + mtotvar_scratch_size(n_fast);
   const bool total_decimated = o.total_decimated || N < 2 || 8 * (static_cast<std::uint64_t>(fast_size) + N) > memory_budget();
   auto exact = [&](std::uint64_t m) {
-    if (!prepared.ready) {
-      if (hadamard) {
-        y.resize(n_fast);
-        for (std::size_t i = 0; i < n_fast; ++i) y[i] = x[i + 1] - x[i];
-      }
-      fast_work = std::make_unique_for_overwrite<double[]>(fast_size);
-      prepared = theo1_prepare(hadamard ? std::span<const double>(y) : x, {fast_work.get(), theo1_workspace_size(n_fast)});
-    }
-    const std::span<double> fast_scratch{fast_work.get() + theo1_workspace_size(n_fast), mtotvar_scratch_size(n_fast)};
-    return hadamard ? htotvar_fast(prepared, fast_scratch, m, tau0) : mtotvar_fast(prepared, fast_scratch, m, tau0);
+    Theo1Workspace& prepared = lag_sums.prepared(x, hadamard);  // HTOTVAR: the frequencies times tau0
+    return hadamard ? htotvar_fast(prepared, lag_sums.scratch(), m, tau0) : mtotvar_fast(prepared, lag_sums.scratch(), m, tau0);
   };
   auto mtot_estimate = [&](std::uint64_t m) {
     if (!total_decimated) return exact(m);
@@ -172,11 +157,38 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
 
 }  // namespace
 
+Theo1Workspace& LagSumRecord::prepared(std::span<const double> x, bool frequencies) {
+  const std::size_t n = frequencies ? x.size() - 1 : x.size();
+  if (w_.ready && frequencies_ == frequencies && w_.r.size() == n) return w_;
+  w_ = {};
+  work_.reset();  // the other kind's preparation goes before this one's is allocated
+  y_.clear();
+  if (frequencies) {
+    y_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) y_[i] = x[i + 1] - x[i];
+  }
+  work_ = std::make_unique_for_overwrite<double[]>(theo1_workspace_size(n));
+  w_ = theo1_prepare(frequencies ? std::span<const double>(y_) : x, {work_.get(), theo1_workspace_size(n)});
+  frequencies_ = frequencies;
+  return w_;
+}
+
+std::span<double> LagSumRecord::scratch() {
+  const std::size_t size = mtotvar_scratch_size(w_.r.size());
+  if (scratch_size_ < size) {
+    scratch_.reset();
+    scratch_ = std::make_unique_for_overwrite<double[]>(size);
+    scratch_size_ = size;
+  }
+  return {scratch_.get(), size};
+}
+
 std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, double phase_scale,
-                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan) {
+                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan,
+                                    LagSumRecord& lag_sums) {
   const double k2 = phase_scale * phase_scale;
-  if (stat == DevStat::theo1 || stat == DevStat::theoh) return theo_rows(stat, x, k2, o, allan);
-  return total_family_rows(stat, x, k2, o, allan);
+  if (stat == DevStat::theo1 || stat == DevStat::theoh) return theo_rows(stat, x, k2, o, allan, lag_sums);
+  return total_family_rows(stat, x, k2, o, allan, lag_sums);
 }
 
 }  // namespace gyrochar

@@ -10,12 +10,33 @@
 // HTOTDEV below m = 16 or for PM noise). Where alpha is known the deviations carry Stable32's bias
 // corrections (TOTDEV for flicker and random-walk FM, HTOTDEV for alpha <= 0). TheoH's rows below
 // its switch point are the overlapping ADEV rows themselves.
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "analysis.hpp"
+#include "gyrochar/total_fast.hpp"
 
 namespace gyrochar {
+
+/// The record prepared for the lag sums (total_fast.hpp), kept between the statistics of one run:
+/// Theo1, TheoH, MTOTDEV and TTOTDEV share the preparation of the phase points, HTOTDEV prepares
+/// their first differences. One preparation is held at a time (at 10^7 points 1.5 GB), the other
+/// kind replacing it; MTOTVAR's scratch is allocated beside it on first use.
+class LagSumRecord {
+ public:
+  /// The preparation of x (frequencies: of y[k] = x[k+1] - x[k]), made on first use.
+  Theo1Workspace& prepared(std::span<const double> x, bool frequencies);
+  /// mtotvar_scratch_size of the prepared record's length, allocated on first use.
+  std::span<double> scratch();
+
+ private:
+  std::unique_ptr<double[]> work_, scratch_;  // not zero-filled: prepare writes before it reads
+  std::vector<double> y_;
+  Theo1Workspace w_;
+  bool frequencies_ = false;
+  std::size_t scratch_size_ = 0;
+};
 
 /// The rows of total statistic `stat` (is_total(stat)) of phase points `phase` (phase unit /
 /// phase_scale: the engine's representation), at o.m_list (TOTDEV, MTOTDEV, TTOTDEV, HTOTDEV,
@@ -26,7 +47,9 @@ namespace gyrochar {
 /// back to the plan when its lag-sum workspace would pass the memory budget).
 /// `allan`: the run's oadev, mdev and ohdev rows at its taus. Allocates the block-sum buffer and the
 /// rows; O(N) per tau for TOTDEV, O(N S) to O(N S^2 / m) for the others (docs/total.md).
+/// `lag_sums`: the run's one LagSumRecord.
 std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> phase, double phase_scale,
-                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan);
+                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan,
+                                    LagSumRecord& lag_sums);
 
 }  // namespace gyrochar
