@@ -39,6 +39,7 @@ if [ "$job" = test ]; then
   packages+=(chromium)  # tests labelled browser: the HTML reports and the live page rendered headless (DOM, screenshot)
   # The QEMU bench (toolchain/bench/build.sh adds the kernel headers of the kernel it boots).
   packages+=(qemu-system-x86 busybox-static cpio can-utils)
+  packages+=(clang-format)  # toolchain/format.sh: the sources' style (.clang-format)
 fi
 
 missing=()

@@ -8,24 +8,6 @@
 
 namespace gyrochar {
 
-const char* name(DevStat s) {
-  switch (s) {
-    case DevStat::adev: return "adev";
-    case DevStat::oadev: return "oadev";
-    case DevStat::mdev: return "mdev";
-    case DevStat::tdev: return "tdev";
-    case DevStat::hdev: return "hdev";
-    case DevStat::ohdev: return "ohdev";
-    case DevStat::totdev: return "totdev";
-    case DevStat::mtotdev: return "mtotdev";
-    case DevStat::ttotdev: return "ttotdev";
-    case DevStat::htotdev: return "htotdev";
-    case DevStat::theo1: return "theo1";
-    case DevStat::theoh: return "theoh";
-  }
-  return "?";
-}
-
 const char* name(NoiseIdMethod m) {
   switch (m) {
     case NoiseIdMethod::none: return "none";

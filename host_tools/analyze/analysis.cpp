@@ -84,10 +84,15 @@ const char* name(DataType t) {
 }
 
 std::optional<DevStat> parse_dev_stat(const std::string& text) {
-  for (const auto& list : {all_dev_stats, total_dev_stats})
-    for (const DevStat s : list)
-      if (text == name(s)) return s;
+  for (const DevStatInfo& s : dev_stats)
+    if (text == s.name) return s.stat;
   return std::nullopt;
+}
+
+std::string dev_stat_names(const char* separator) {
+  std::string names;
+  for (const DevStatInfo& s : dev_stats) names += (names.empty() ? "" : separator) + std::string(s.name);
+  return names;
 }
 
 bool valid_stride_factor(std::uint32_t s) { return s >= 2 && std::has_single_bit(s) && s <= (1u << 24); }

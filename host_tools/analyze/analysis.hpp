@@ -35,6 +35,8 @@ enum class DataType {
 const char* name(DataType t);
 /// The statistic called `text`, or nothing.
 std::optional<DevStat> parse_dev_stat(const std::string& text);
+/// Every statistic's name, in DevStat's order, joined by `separator` ("adev,oadev,...,theoh").
+std::string dev_stat_names(const char* separator);
 
 /// Largest stride factor "full" uses: with S = 2^16 the history takes a few MB whatever the run
 /// length; taus above it are strided (terms every m/S points) and their EDF says so.

@@ -27,7 +27,7 @@ html::LogPlot curve_plot(const Report& r, const std::vector<AnalysisRow>& curves
                          const std::vector<Limit>& limits) {
   const bool adev = stat == DevStat::oadev;
   html::LogPlot plot;
-  plot.title = adev ? "Overlapping Allan deviation" : "Modified Allan deviation";
+  plot.title = std::string(title(stat)) + " deviation";
   plot.x_label = "tau [s]";
   plot.y_label = fmt::format("{} [{}]", adev ? "ADEV" : "MDEV", r.units.unit(stat));
   html::PlotSeries s{adev ? "OADEV" : "MDEV", adev ? adev_colour : mdev_colour, !adev, {}};
@@ -123,9 +123,7 @@ void fit_tables(html::Document& doc, const Report& r) {
                       number(st.amplitude.uncertainty / unit), text(r.units.unit(DevStat::oadev)),
                       text(st.amplitude.resolved ? "resolved" : "not resolved")});
     }
-    const char* curve = r.fits[f].curve == FitCurve::both ? "both curves (recommended)"
-                        : r.fits[f].curve == FitCurve::avar ? "the Allan curve alone"
-                                                             : "the modified Allan curve alone";
+    const char* curve = curve_title(r.fits[f].curve);
     doc.table(f == 0 ? "fit" : fmt::format("fit-{}", name(r.fits[f].curve)),
               fmt::format("Fit of {}: {}, chi2/dof {:.3g}, {} points, uncertainty scale {:.3g}", curve, name(fit.status),
                           fit.chi2_per_dof(), fit.points, fit.birge),

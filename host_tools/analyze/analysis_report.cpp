@@ -23,15 +23,6 @@ constexpr FitUnit clock_fit_units[5] = {{"Q", "s", 1}, {"N", "s^0.5", 1}, {"B", 
 
 const FitUnit* fit_units(const ReportUnits& u) { return u.gyro ? gyro_fit_units : clock_fit_units; }
 
-const char* curve_title(FitCurve c) {
-  switch (c) {
-    case FitCurve::both: return "both curves (recommended)";
-    case FitCurve::avar: return "the Allan curve alone";
-    case FitCurve::mvar: return "the modified Allan curve alone";
-  }
-  return "?";
-}
-
 // How the noise at a row was identified, and the plausible range when it is wider than one type:
 // "lag1", "rn -1..0", "given".
 std::string identification(const AnalysisRow& row) {
@@ -112,18 +103,27 @@ void DataRange::add(std::span<const double> values) {
 }
 
 std::string ReportUnits::unit(DevStat s) const {
-  const bool time = s == DevStat::tdev || s == DevStat::ttotdev;  // in phase units
+  const bool time = info(s).time;  // in phase units
   if (gyro) return time ? rate.angle : rate.name;
   return time ? "s" : "1";
 }
 
 const units::Ieee952Unit& fit_unit(const ReportUnits& u, std::size_t k) { return fit_units(u)[k]; }
 
+const char* curve_title(FitCurve c) {
+  switch (c) {
+    case FitCurve::both: return "both curves (recommended)";
+    case FitCurve::avar: return "the Allan curve alone";
+    case FitCurve::mvar: return "the modified Allan curve alone";
+  }
+  return "?";
+}
+
 const char* name(LongTau l) {
   switch (l) {
-    case LongTau::oadev: return "oadev";
-    case LongTau::totdev: return "totdev";
-    case LongTau::theoh: return "theoh";
+    case LongTau::oadev: return name(DevStat::oadev);
+    case LongTau::totdev: return name(DevStat::totdev);
+    case LongTau::theoh: return name(DevStat::theoh);
   }
   return "?";
 }
@@ -419,7 +419,7 @@ void add_model_json(nlohmann::json& one, const Ieee952Fit& fit, const ReportUnit
   json residuals = json::array();
   for (std::size_t i = 0; i < fit.n_residuals; ++i) {
     const FitResidual& r = fit.residuals[i];
-    residuals.push_back({{"stat", r.stat == Stat::avar ? "oadev" : "mdev"}, {"m", r.m},
+    residuals.push_back({{"stat", name(r.stat == Stat::avar ? DevStat::oadev : DevStat::mdev)}, {"m", r.m},
                          {"dev", std::sqrt(r.variance) * k}, {"model", std::sqrt(std::fmax(r.model, 0.0)) * k},
                          {"residual_sigma", r.normalized}});
   }
@@ -490,29 +490,25 @@ nlohmann::json to_json(const Report& r) {
 
 namespace {
 
-// Stable32's name of a statistic and its column line.
-struct Stable32Stat {
-  const char* sigma_type;
-  const char* columns;
-};
-Stable32Stat stable32_stat(DevStat s) {
+// Stable32's column line of a statistic (its name, the "Sigma Type", is the statistic's title()).
+const char* stable32_columns(DevStat s) {
   constexpr const char* allan = "#  AF        Tau        #    Alpha  Min Sigma      Sigma         Max Sigma";
   constexpr const char* hadamard = "#  AF        Tau         #    Alpha  Min Sigma   Hadamard Sig     Max Sigma";
   switch (s) {
-    case DevStat::adev: return {"Allan", allan};
-    case DevStat::oadev: return {"Overlapping Allan", allan};
-    case DevStat::mdev: return {"Modified Allan", "#  AF        Tau         #    Alpha  Min Sigma     Mod Sigma      Max Sigma"};
-    case DevStat::tdev: return {"Time", "#  AF        Tau         #    Alpha  Min Sigma    Time Sigma      Max Sigma"};
-    case DevStat::hdev: return {"Hadamard", hadamard};
-    case DevStat::ohdev: return {"Overlapping Hadamard", hadamard};
-    case DevStat::totdev: return {"Total", "#  AF        Tau         #    Alpha  Min Sigma    Total Sigma     Max Sigma"};
-    case DevStat::mtotdev: return {"Modified Total", "# AF          Tau        #     Alpha  Min Sigma     Mod Totdev      Max Sigma"};
-    case DevStat::ttotdev: return {"Time Total", "#AF          Tau       #      Alpha  Min Sigma    Time Totdev    Max Sigma"};
-    case DevStat::htotdev: return {"Hadamard Total", hadamard};
-    case DevStat::theo1: return {"Th\u00eao1", "#  AF   Th\u00eao1 Tau   Th\u00eao1 #    Alpha   Min Th\u00eao1    Th\u00eao1    Max Th\u00eao1"};
-    case DevStat::theoh: return {"Th\u00eaoH", "#  AF   Th\u00eaoH Tau   Th\u00eaoH #    Alpha   Min Th\u00eaoH    Th\u00eaoH    Max Th\u00eaoH"};
+    case DevStat::adev:
+    case DevStat::oadev: return allan;
+    case DevStat::mdev: return "#  AF        Tau         #    Alpha  Min Sigma     Mod Sigma      Max Sigma";
+    case DevStat::tdev: return "#  AF        Tau         #    Alpha  Min Sigma    Time Sigma      Max Sigma";
+    case DevStat::hdev:
+    case DevStat::ohdev:
+    case DevStat::htotdev: return hadamard;
+    case DevStat::totdev: return "#  AF        Tau         #    Alpha  Min Sigma    Total Sigma     Max Sigma";
+    case DevStat::mtotdev: return "# AF          Tau        #     Alpha  Min Sigma     Mod Totdev      Max Sigma";
+    case DevStat::ttotdev: return "#AF          Tau       #      Alpha  Min Sigma    Time Totdev    Max Sigma";
+    case DevStat::theo1: return "#  AF   Th\u00eao1 Tau   Th\u00eao1 #    Alpha   Min Th\u00eao1    Th\u00eao1    Max Th\u00eao1";
+    case DevStat::theoh: return "#  AF   Th\u00eaoH Tau   Th\u00eaoH #    Alpha   Min Th\u00eaoH    Th\u00eaoH    Max Th\u00eaoH";
   }
-  return {"?", allan};
+  return allan;
 }
 
 }  // namespace
@@ -527,16 +523,15 @@ std::string format_stable32(const Report& r) {
   std::string s;
   auto to = std::back_inserter(s);
   for (const DevStat stat : stats) {
-    const Stable32Stat names = stable32_stat(stat);
     if (!s.empty()) s += '\n';
     fmt::format_to(to, "# STATISTICS FOR FILE: {}\n", std::filesystem::path(r.source).filename().string());
     fmt::format_to(to, "# {} Data Points 1 thru {} of {}\n", r.type == DataType::phase ? "Phase" : "Frequency",
                    r.range.count, r.range.count);
     fmt::format_to(to, "# Maximum = {:e}\n# Minimum = {:e}\n# Average = {:e}\n", r.range.max, r.range.min, r.range.mean());
-    fmt::format_to(to, "# Sigma Type: {}\n# Confidence Factor = {:.3f}\n# Deadtime T/Tau = 1.000000\n", names.sigma_type,
+    fmt::format_to(to, "# Sigma Type: {}\n# Confidence Factor = {:.3f}\n# Deadtime T/Tau = 1.000000\n", title(stat),
                    r.confidence);
     if (u.gyro) fmt::format_to(to, "# Units: {}\n", u.unit(stat));
-    fmt::format_to(to, "#\n{}\n", names.columns);
+    fmt::format_to(to, "#\n{}\n", stable32_columns(stat));
     for (const AnalysisRow& row : a.rows) {
       if (row.stat != stat) continue;
       fmt::format_to(to, "{:5d}{:13.4e}{:9d}{:6d}{:13.4e}{:14.4e}{:15.4e}\n", row.m, row.tau_s, row.n,

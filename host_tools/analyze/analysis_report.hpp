@@ -54,9 +54,12 @@ struct CurveFit {
 /// What the Allan curve of a fit is made of at long tau (docs/metrology.md, "Long taus"): OADEV
 /// alone; TOTDEV (bias-corrected) wherever SP 1065's EDF for it exceeds OADEV's; or TheoH: OADEV
 /// below its switch point k, TheoBR points at tau = 1.5 k, 3 k, ... up to T/2.
+/// A subset of the statistics (stat.hpp), named as they are; its values index the fits.
 enum class LongTau : std::uint8_t { oadev, totdev, theoh };
-/// "oadev", "totdev", "theoh": a static string.
+/// "oadev", "totdev", "theoh": the statistic's name(), a static string.
 const char* name(LongTau l);
+/// "both curves (recommended)", "the Allan curve alone", "the modified Allan curve alone".
+const char* curve_title(FitCurve c);
 
 /// Fits the oadev and mdev rows of the analysis (one point per octave, m = 2^k), with the points
 /// in SI units; with long_tau totdev or theoh, the record (Analyzer::record()) gives total-family

@@ -171,8 +171,7 @@ void add_options(CLI::App& app, OptionText& t, Request& r) {
   app.add_option("--nominal-hz", t.nominal_hz, "freq values are in Hz around this nominal frequency");
   app.add_option("--column", r.column, "column holding the values (1-based; default: the only one, or the value of time,value)");
   app.add_option("--taus", t.taus, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
-  app.add_option("--stats", t.stats, "any of adev,oadev,mdev,tdev,hdev,ohdev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh")
-      ->capture_default_str();
+  app.add_option("--stats", t.stats, "any of " + dev_stat_names(","))->capture_default_str();
   app.add_option("--stride-factor", t.stride, "S, a power of two, or full")->capture_default_str();
   app.add_option("--total-stride-factor", t.total_stride,
                  "S of the decimated total/Theo estimators (a power of two from 2 to 2^20), or exact")
@@ -244,8 +243,7 @@ std::vector<DevStat> parse_stats(const std::string& text) {
   for (std::string item; std::getline(ss, item, ',');) {
     const auto s = parse_dev_stat(item);
     if (!s)
-      bad("--stats", "unknown statistic '" + item +
-                         "' (adev, oadev, mdev, tdev, hdev, ohdev, totdev, mtotdev, ttotdev, htotdev, theo1, theoh)");
+      bad("--stats", "unknown statistic '" + item + "' (" + dev_stat_names(", ") + ")");
     if (std::find(stats.begin(), stats.end(), *s) != stats.end()) bad("--stats", "'" + item + "' is asked twice");
     stats.push_back(*s);
   }

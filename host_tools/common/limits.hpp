@@ -38,6 +38,7 @@ inline constexpr double decision_confidence = 0.95;
 inline constexpr double decision_z = 1.959963984540054;  // Phi^-1(0.975)
 
 struct Limit {
+  // adev is the overlapping Allan deviation, as on the wire (docs/architecture.md, "Names of statistics").
   enum class Kind : unsigned char { term, adev, mdev };
   Kind kind = Kind::term;
   std::size_t term = 1;   // Kind::term: Q N B K R = 0..4

@@ -38,37 +38,7 @@
 
 namespace gyrochar {
 
-/// The six deviations: Allan (non-overlapped), overlapping Allan, modified Allan, time, Hadamard
-/// (non-overlapped), overlapping Hadamard; then the total and Theo family (total.hpp), which need
-/// the whole record and are computed offline only (estimate() does not take them).
-enum class DevStat : std::uint8_t { adev, oadev, mdev, tdev, hdev, ohdev, totdev, mtotdev, ttotdev, htotdev, theo1, theoh };
-inline constexpr std::array<DevStat, 6> all_dev_stats{DevStat::adev, DevStat::oadev, DevStat::mdev,
-                                                       DevStat::tdev, DevStat::hdev, DevStat::ohdev};
-inline constexpr std::array<DevStat, 6> total_dev_stats{DevStat::totdev,  DevStat::mtotdev, DevStat::ttotdev,
-                                                         DevStat::htotdev, DevStat::theo1,   DevStat::theoh};
-constexpr bool is_total(DevStat s) { return s >= DevStat::totdev; }
-/// "adev", "oadev", ..., "theoh": a static string.
-const char* name(DevStat s);
-/// The sums of a statistic; for the total family, the Allan-family statistic it stands for
-/// (TOTDEV, Theo1, TheoH: overlapping AVAR; MTOTDEV, TTOTDEV: MVAR; HTOTDEV: overlapping HVAR).
-constexpr SumKind sum_kind(DevStat s) {
-  switch (s) {
-    case DevStat::adev: return SumKind::avar_nonoverlapped;
-    case DevStat::oadev:
-    case DevStat::totdev:
-    case DevStat::theo1:
-    case DevStat::theoh: return SumKind::avar;
-    case DevStat::mdev:
-    case DevStat::tdev:
-    case DevStat::mtotdev:
-    case DevStat::ttotdev: return SumKind::mvar;
-    case DevStat::hdev: return SumKind::hvar_nonoverlapped;
-    case DevStat::ohdev:
-    case DevStat::htotdev: return SumKind::hvar;
-  }
-  return SumKind::avar;
-}
-constexpr Stat stat_of(DevStat s) { return stat_of(sum_kind(s)); }
+// The statistics (DevStat), their names and sums: stat.hpp.
 
 /// The sums of one tau in floating point. variance[k] is in (x step / tau0)^2 (variance() with
 /// tau0 = 1 and unit 1); `noise` summarizes the lag-1 sums of the decimated series (when has_noise).

@@ -116,6 +116,8 @@ struct FitSetup {
   std::array<double, max_sinusoids> sinusoid_hz{};  // candidate sinusoid frequencies (0: none)
 };
 
+/// The curve(s) a fit reads: the overlapping Allan deviation's (avar), the modified Allan
+/// deviation's (mvar) or both. Not a statistic: the statistics are DevStat (stat.hpp).
 enum class FitCurve : std::uint8_t { avar, mvar, both };
 enum class FitStatus : std::uint8_t {
   ok,

@@ -10,10 +10,9 @@
 
 namespace gyrochar {
 
-/// The sums of one tau. Overlapping sums (terms every `stride` points) and non-overlapped sums
-/// (terms every m points, on the decimated series). variance() turns them into variances.
-enum class SumKind : std::uint8_t { avar = 0, mvar = 1, hvar = 2, avar_nonoverlapped = 3, hvar_nonoverlapped = 4 };
-inline constexpr std::size_t sum_kinds = 5;
+/// The sums of one tau, indexed by SumKind (stat.hpp): overlapping sums (terms every `stride`
+/// points) and non-overlapped sums (terms every m points, on the decimated series). variance()
+/// turns them into variances.
 
 template <class Sum>
 struct TauResult {
@@ -25,10 +24,7 @@ struct TauResult {
   bool sum_overflow = false;                 // a sum of squares reached 2^127 (CountArith)
 };
 
-/// The statistic a sum belongs to, and its term stride.
-constexpr Stat stat_of(SumKind k) {
-  return k == SumKind::mvar ? Stat::mvar : (k == SumKind::hvar || k == SumKind::hvar_nonoverlapped) ? Stat::hvar : Stat::avar;
-}
+/// A sum's term stride.
 template <class Sum>
 constexpr std::uint64_t term_stride(const TauResult<Sum>& r, SumKind k) {
   return k == SumKind::avar_nonoverlapped || k == SumKind::hvar_nonoverlapped ? r.m : r.stride;

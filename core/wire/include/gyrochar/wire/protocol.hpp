@@ -78,6 +78,9 @@ enum class InputSource : std::uint8_t {
   simulated = 4,
 };
 
+/// The two deviations a node sends: a subset of the statistics (DevStat, core's stat.hpp). On the
+/// wire `adev` is the OVERLAPPING Allan deviation (DevStat::oadev, which the analyzer calls
+/// "oadev"), a name kept for compatibility: docs/architecture.md, "Names of statistics".
 enum class DevKind : std::uint8_t { adev = 0, mdev = 1 };  // overlapping Allan, modified Allan
 
 /// IEEE Std 952 gyro error-model terms and their units (A = angle unit, time in s).
