@@ -208,6 +208,13 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
     out.ieee952[k] = {seq, static_cast<Ieee952Term>(k), resolved, fitted ? static_cast<float>(p.value) : 0.0f,
                       fitted ? p.uncertainty / p.value : 0.0, fitted};
   }
+  // Each term's unconstrained estimate (version 5), what verdicts judge: zeros where it has none.
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Ieee952Parameter& p = fit.p[k];
+    const bool known = std::isfinite(p.unconstrained_uncertainty) && p.unconstrained_uncertainty > 0;
+    out.unconstrained[k] = {seq, static_cast<Ieee952Term>(k), known ? wire_float(p.unconstrained_signed) : 0.0f,
+                            known ? p.unconstrained_uncertainty : 0.0};
+  }
   out.ieee952_summary = ieee952_summary(fit, seq, s.tau0_s);
   out.ieee952_model = ieee952_model(fit, seq, s.tau0_s);
   for (std::size_t k = 0; k < fit_parameter_pages; ++k) out.ieee952_parameters[k] = ieee952_parameter(fit, seq, k);
@@ -233,6 +240,7 @@ protocol::Message report_message(const ReportContent& c, std::size_t k) {
     case Slot::window_dev: return c.window_dev[s.index];
     case Slot::fit_model: return c.ieee952_model;
     case Slot::fit_parameter: return c.ieee952_parameters[s.index];
+    case Slot::unconstrained: return c.unconstrained[s.index];
   }
   return c.status;
 }

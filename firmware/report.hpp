@@ -60,6 +60,8 @@ struct ReportContent {
   // The selected model beyond the five terms (version 4), from the same fit.
   protocol::Ieee952ModelMsg ieee952_model;
   std::array<protocol::Ieee952ParameterMsg, protocol::fit_parameter_pages> ieee952_parameters{};
+  // Each term's unconstrained estimate (version 5), from the same fit.
+  std::array<protocol::Ieee952UnconstrainedMsg, 5> unconstrained{};
   // The window curve (version 3): the window completed last when the slow cycle began.
   std::size_t window_taus = 0;  // 0: the node has no window, and the reports no window frames
   protocol::WindowMsg window;

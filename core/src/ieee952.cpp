@@ -166,6 +166,7 @@ Ieee952Parameter parameter(const Problem& pr, const Solution& sol, const Flags& 
     const double free_theta = sol.free_theta[t], free_sd = std::sqrt(sol.free_variance[t]) * birge;
     p.unconstrained = free_theta > 0 ? std::sqrt(free_theta) : 0.0;
     p.unconstrained_uncertainty = free_theta > 0 ? free_sd / (2 * p.unconstrained) : std::sqrt(free_sd);
+    p.unconstrained_signed = free_theta >= 0 ? p.unconstrained : -std::sqrt(-free_theta);
   }
   if (!p.fitted || !(theta > 2 * sd) || rejected_model) return p;
   for (std::size_t i = 0; i < pr.n && !p.resolved; ++i) {  // the largest contribution somewhere

@@ -78,7 +78,13 @@ struct LimitEstimate {
   std::string why;  // not usable: "N not resolved", "fit model rejected", ...
   double value = 0, low = 0, high = 0;
   double run_s = 0;
+  /// Which estimate of a fitted term a live node's verdict judged (gyrochar-decode):
+  /// estimate_unconstrained, or estimate_shown where the node sends no unconstrained estimate;
+  /// empty: not said (a deviation, or gyrochar-analyze, which judges the unconstrained one).
+  std::string kind;
 };
+inline constexpr const char* estimate_unconstrained = "unconstrained";
+inline constexpr const char* estimate_shown = "shown";
 /// A normal estimate: value -+ decision_z u (the low bound not below 0). O(1).
 LimitEstimate normal_estimate(double value, double standard_uncertainty, double run_s);
 /// A deviation with `edf` degrees of freedom (skew_dof as confidence.hpp): its chi-squared

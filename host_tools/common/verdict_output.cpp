@@ -138,6 +138,7 @@ nlohmann::json acceptance_json(const std::vector<Limit>& limits, const std::vect
                     {"decides_at_s", std::isfinite(d.decide_at_s) ? json(d.decide_at_s) : json(nullptr)},
                     {"decides_never", std::isinf(d.decide_at_s)},
                     {"why", d.reason}});
+    if (!d.estimate.kind.empty()) list.back()["estimate_kind"] = d.estimate.kind;  // a live node's verdict
   }
   return {{"confidence", decision_confidence},
           {"rule", "pass: upper bound within the limit; fail: lower bound beyond it; undecided otherwise"},

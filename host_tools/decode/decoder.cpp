@@ -136,7 +136,7 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
           mark_slot(v, a, Slot::config, 0);
         } else if constexpr (std::is_same_v<M, Ieee952Msg>) {
           v.ieee952[static_cast<std::size_t>(msg.term)] = {true, msg.resolved, msg.value, msg.rel_uncertainty,
-                                                           msg.fitted || msg.resolved};
+                                                           msg.fitted || msg.resolved, v.cycle()};
           mark_slot(v, a, Slot::ieee952, static_cast<std::uint8_t>(msg.term));
         } else if constexpr (std::is_same_v<M, Ieee952SummaryMsg>) {
           v.ieee952_summary = msg;
@@ -151,6 +151,11 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
           const std::size_t k = fit_parameter_position(msg.parameter, msg.index);
           fit_model_of_cycle(v).parameters[k] = msg;
           mark_slot(v, a, Slot::fit_parameter, static_cast<std::uint8_t>(k));
+        } else if constexpr (std::is_same_v<M, Ieee952UnconstrainedMsg>) {
+          const auto k = static_cast<std::size_t>(msg.term);
+          if (v.unconstrained[k].cycle != v.cycle()) v.previous_unconstrained[k] = v.unconstrained[k];
+          v.unconstrained[k] = {v.cycle(), msg};
+          mark_slot(v, a, Slot::unconstrained, static_cast<std::uint8_t>(k));
         } else if constexpr (std::is_same_v<M, WindowMsg>) {
           if (v.window_taus != 0 && msg.tau_count != v.window_taus) {  // reconfigured, like TauCount
             restart(v, a);

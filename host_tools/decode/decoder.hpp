@@ -44,8 +44,17 @@ struct Ieee952View {
   bool fitted = false;         // in the fitted model: value and uncertainty are the fit's even when
                                // not resolved (an upper-bound reading). A version-1 node sends no
                                // Fitted flag: there it is the Resolved flag.
+  std::uint64_t cycle = 0;      // NodeView::cycle() of the report that carried it
   /// In the node's model: received and fitted (a version-1 node: resolved).
   bool in_model() const { return received && (fitted || resolved); }
+};
+
+/// One IEEE-952 term's unconstrained estimate (protocol version 5) and the slow cycle it came in.
+/// The node takes its fit at the first report of a cycle, so it belongs with the term frame of the
+/// same cycle.
+struct UnconstrainedView {
+  std::uint64_t cycle = 0;  // NodeView::cycle() of the report that carried it; 0: none
+  protocol::Ieee952UnconstrainedMsg msg;
 };
 
 /// The selected model of the node's fit beyond the five terms (protocol version 4): the model page
@@ -133,6 +142,18 @@ struct NodeView {
   /// version-1 node, which has none.
   std::optional<protocol::Ieee952SummaryMsg> ieee952_summary;
   std::uint64_t ieee952_summary_cycle = 0;  // cycle() of the report that carried the summary
+  /// Each term's unconstrained estimate (protocol version 5) of the latest slow cycle that sent it,
+  /// and of the cycle before (a term frame may come after the next cycle's first estimates).
+  std::array<UnconstrainedView, 5> unconstrained{}, previous_unconstrained{};
+  /// Term k's unconstrained estimate from the fit its term frame describes (the same slow cycle);
+  /// null when none came (a node before version 5, or the frame was lost). Only an estimate with an
+  /// uncertainty (the term was free in the fit) counts.
+  const protocol::Ieee952UnconstrainedMsg* unconstrained_estimate(std::size_t k) const {
+    const std::uint64_t c = ieee952[k].received ? ieee952[k].cycle : 0;
+    for (const UnconstrainedView* u : {&unconstrained[k], &previous_unconstrained[k]})
+      if (c != 0 && u->cycle == c && u->msg.uncertainty > 0) return &u->msg;
+    return nullptr;
+  }
   /// The fit's model pages (protocol version 4) of the latest slow cycle that sent one, and of the
   /// cycle before (the summary of a cycle may come after the next cycle's first model pages).
   FitModelView fit_model, previous_fit_model;
@@ -155,8 +176,10 @@ struct NodeView {
   std::uint8_t unknown_version = 0;
 
   /// The protocol version whose schedule the node follows: the clock page's; before it arrives 4
-  /// once a model page came (only version 4 sends one), 3 once a window page came (from version
-  /// 3), 2 once a summary page came (from version 2), else 1. A version-1 report then misses nothing, and a newer report opened before the
+  /// once a model page came (from version 4), 3 once a window page came (from version 3), 2 once a
+  /// summary page came (from version 2), else 1. An unconstrained estimate (version 5) says nothing
+  /// here: it may come after parameter pages of its report that a version-1 layout did not count,
+  /// which a version-5 layout would then call missing; it is used, not counted, until the clock page. A version-1 report then misses nothing, and a newer report opened before the
   /// clock page only leaves its newer frames uncounted.
   std::uint8_t schedule_version() const {
     return clock            ? clock->protocol_version

@@ -349,10 +349,12 @@ std::string help_footer() {
          "undecided, with the run length at which an undecided one is expected to decide): in the CSV, columns\n"
          "after the others on every tau row (verdict: the node's over all limits; per limit its limit, verdict,\n"
          "estimate and the decision bounds lower and upper, filled where it applies: a term on every tau row,\n"
-         "a deviation on the row of its tau); in the JSON lines a record of type \"acceptance\" per node at each\n"
-         "closed report where a verdict changed (\"final\": false; the first report always) and at the end\n"
-         "(\"final\": true); at the end after the view, in the report, and with --summary FILE.csv as one row\n"
-         "per node. Without --limits the CSV has no verdict column. The exit code does not depend on them.\n"
+         "a deviation on the row of its tau; a term also its estimate kind: judged by the node's unconstrained\n"
+         "estimate where it sends one, protocol version 5, else by the shown value); in the JSON lines a\n"
+         "record of type \"acceptance\" per node at each closed report where a verdict changed (\"final\":\n"
+         "false; the first report always) and at the end (\"final\": true); at the end after the view, in the\n"
+         "report, and with --summary FILE.csv as one row per node. Without --limits the CSV has no verdict\n"
+         "column. The exit code does not depend on them.\n"
          "--report FILE.html: a self-contained page (inline SVG and CSS, no script, no external reference):\n"
          "provenance, each node's plot, taus with intervals, fit and verdicts.\n" +
          std::string(exit_code::help);

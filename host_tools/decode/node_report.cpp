@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "html_report.hpp"
@@ -39,8 +40,19 @@ LimitEstimate node_estimate(const NodeView& node, const Limit& l) {
     const Ieee952View& t = node.ieee952[l.term];
     if (!t.in_model()) return no_estimate(fmt::format("{} not in the fitted model", letter));
     if (!t.resolved) return no_estimate(fmt::format("{} not resolved", letter));
-    const double v = static_cast<double>(t.value) / *wire_si;
-    return normal_estimate(v, v * t.rel_uncertainty, run_s);
+    // The unconstrained estimate of the same fit where the node sends it (protocol version 5): the
+    // shown value leans low where the fit clips another term at zero (docs/metrology.md,
+    // "Acceptance limits"). Its square may be negative: the estimate is then 0, as the analyzer's.
+    LimitEstimate e;
+    if (const protocol::Ieee952UnconstrainedMsg* u = node.unconstrained_estimate(l.term)) {
+      e = normal_estimate(std::max(static_cast<double>(u->value), 0.0) / *wire_si, u->uncertainty / *wire_si, run_s);
+      e.kind = estimate_unconstrained;
+    } else {
+      const double v = static_cast<double>(t.value) / *wire_si;
+      e = normal_estimate(v, v * t.rel_uncertainty, run_s);
+      e.kind = estimate_shown;
+    }
+    return e;
   }
   if (!(tau0_of(node) > 0)) return no_estimate("tau0 not known yet");
   for (std::size_t i = 0; i < node.taus.size(); ++i) {
@@ -79,7 +91,11 @@ html::LogPlot node_plot(const NodePlot& p) {
 
 std::vector<Decision> node_decisions(const NodeView& node, const std::vector<Limit>& limits) {
   std::vector<Decision> out;
-  for (const Limit& l : limits) out.push_back(decide(l, node_estimate(node, l)));
+  for (const Limit& l : limits) {
+    out.push_back(decide(l, node_estimate(node, l)));
+    if (out.back().estimate.kind == estimate_shown)
+      out.back().reason += " (judged by the shown value: the node sends no unconstrained estimate)";
+  }
   return out;
 }
 
@@ -89,21 +105,30 @@ bool limit_applies(const Limit& limit, const NodeView& node, std::size_t tau_ind
 
 std::string verdict_csv_header(const std::vector<Limit>& limits) {
   std::string h = ",verdict";
-  for (const Limit& l : limits) h += "," + csv_field(l.quantity() + " limit [" + l.unit + "]") + decision_columns(l);
+  for (const Limit& l : limits) {
+    h += "," + csv_field(l.quantity() + " limit [" + l.unit + "]") + decision_columns(l);
+    if (l.kind == Limit::Kind::term) h += "," + csv_field(l.quantity() + " estimate kind");
+  }
   return h;
 }
 
-std::size_t verdict_csv_columns(const std::vector<Limit>& limits) { return 1 + 5 * limits.size(); }
+std::size_t verdict_csv_columns(const std::vector<Limit>& limits) {
+  std::size_t n = 1;
+  for (const Limit& l : limits) n += l.kind == Limit::Kind::term ? 6 : 5;
+  return n;
+}
 
 std::string verdict_csv_fields(const std::vector<Limit>& limits, const std::vector<Decision>& decisions,
                                const NodeView& node, std::size_t tau_index) {
   std::string f = std::string(",") + name(overall(decisions));
   for (std::size_t i = 0; i < limits.size(); ++i) {
     const Limit& l = limits[i];
-    if (i < decisions.size() && limit_applies(l, node, tau_index))
+    const bool applies = i < decisions.size() && limit_applies(l, node, tau_index);
+    if (applies)
       f += fmt::format(",{}", l.value_si / l.unit_si) + decision_fields(l, &decisions[i]);
     else
       f += "," + decision_fields(l, nullptr);
+    if (l.kind == Limit::Kind::term) f += "," + (applies ? decisions[i].estimate.kind : std::string());
   }
   return f;
 }

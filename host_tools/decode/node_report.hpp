@@ -30,7 +30,9 @@ bool limit_applies(const Limit& limit, const NodeView& node, std::size_t tau_ind
 
 /// The per-tau CSV's verdict columns with --limits (after its other columns, each with its leading
 /// comma): "verdict" (the node's over all limits, as the summary's), then per limit
-/// "<quantity> limit [unit]" and its decision_columns (verdict_output.hpp). O(limits).
+/// "<quantity> limit [unit]" and its decision_columns (verdict_output.hpp), and for a term limit
+/// "<quantity> estimate kind" (unconstrained, or shown where the node sends no unconstrained
+/// estimate; empty without an estimate). O(limits).
 std::string verdict_csv_header(const std::vector<Limit>& limits);
 /// Their number. O(1).
 std::size_t verdict_csv_columns(const std::vector<Limit>& limits);

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 namespace gyrochar::decoding {
 
 using namespace protocol;
@@ -308,6 +310,13 @@ void JsonlWriter::report(double time_s, const NodeView& node, std::uint8_t seq, 
                                                {"value", json_or_null(fitted, p.value * units.ieee[k])},
                                                {"unit", units.ieee_name[k]},
                                                {"rel_uncertainty", json_or_null(fitted, p.rel_uncertainty)}};
+    // What a verdict judges, as gyrochar-analyze's JSON gives it (protocol version 5): the estimate
+    // (0 where the unconstrained square is negative) and, signed, the root the node sent.
+    if (const Ieee952UnconstrainedMsg* u = node.unconstrained_estimate(k))
+      ieee[units::ieee952[k].letter]["unconstrained"] = {
+          {"value", std::max(static_cast<double>(u->value), 0.0) * units.ieee[k]},
+          {"uncertainty", u->uncertainty * units.ieee[k]},
+          {"signed", static_cast<double>(u->value) * units.ieee[k]}};
   }
   Json fit(nullptr);
   if (const auto& f = node.ieee952_summary) {

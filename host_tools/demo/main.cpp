@@ -100,7 +100,9 @@ void add_options(CLI::App& app, DemoOptions& d) {
   app.add_option("--speed", d.speed, "gyro seconds per wall-clock second (0: as fast as it can)")->capture_default_str();
   app.add_option("--refresh", d.refresh_s, "wall-clock seconds between updates of the live web page")
       ->capture_default_str();
-  app.add_option("--limits", d.limits_path, "acceptance limits (gyrochar-analyze --help): each node's verdicts on the live page (--http)");
+  app.add_option("--limits", d.limits_path,
+                 "acceptance limits (gyrochar-analyze --help): each node's verdicts on the live page (--http) and in "
+                 "the CSV's verdict columns, as gyrochar-decode --limits gives them");
 }
 
 // Every option checked, in this order, before anything is opened: the live page's address and the
@@ -111,7 +113,8 @@ void check_options(const DemoOptions& d, std::optional<web::ListenAddress>& http
   if (!(d.refresh_s > 0) || !std::isfinite(d.refresh_s))
     bad("--refresh", fmt::format("must be a number of seconds > 0, not {}", d.refresh_s));
   if (!d.limits_path.empty()) {
-    if (!http) bad("--limits", "the demo shows verdicts on its live page only: give --http too");
+    if (!http && d.csv_path.empty())
+      bad("--limits", "the demo shows verdicts on its live page (--http) and in its CSV (--csv): give one of them");
     try {
       limits = read_limits_file(d.limits_path);
     } catch (const LimitsError& e) {
@@ -294,6 +297,7 @@ int main(int argc, char** argv) {
   for (unsigned i = 0; i < d.nodes; ++i) gyros.push_back(make_node(d, i, bus, clock, truth));
   decoding::SessionOptions so;
   so.csv = csv;
+  so.limits = &limits;  // the CSV's verdict columns, as gyrochar-decode's (empty: none)
   if (web) so.on_report = web->hook();
   struct sigaction action {};
   action.sa_handler = request_stop;

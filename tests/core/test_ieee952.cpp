@@ -120,6 +120,30 @@ TEST(Ieee952, AnAbsentTermIsNotResolved) {
   for (std::size_t k : {0u, 1u, 3u}) EXPECT_TRUE(f.p[k].resolved) << k;
 }
 
+TEST(Ieee952, ANegativeUnconstrainedSquareKeepsItsSignInTheSignedRoot) {
+  // Oracle: the model is linear in the squares. The exact curve of the truth without K, less the
+  // curve of K = 8e-9 (a square of -6.4e-17, which no gyro has), is fitted exactly by the
+  // unconstrained estimate K^2 = -6.4e-17: its signed root is -8e-9. The non-negative fit leaves K
+  // out, and `unconstrained` (what a verdict judges) is 0 there; the other terms' signed roots are
+  // their unconstrained values.
+  auto p = truth;
+  p[3] = 0;
+  std::vector<FitPoint> pts = exact_points(p);
+  const std::array<double, 5> k_only{0, 0, 0, 8e-9, 0};
+  for (FitPoint& q : pts) q.variance -= ieee952_variance(k_only, q.stat, q.m, tau0);
+  const Ieee952Fit f = fit(pts, FitCurve::both);
+  ASSERT_TRUE(f.ok()) << name(f.status);
+  const Ieee952Parameter& k = f.p[3];
+  EXPECT_FALSE(k.fitted);
+  EXPECT_GT(k.unconstrained_uncertainty, 0);
+  EXPECT_NEAR(k.unconstrained_signed / -8e-9, 1.0, 1e-3);
+  EXPECT_EQ(k.unconstrained, 0.0);
+  for (std::size_t t : {0u, 1u, 2u}) {
+    EXPECT_EQ(f.p[t].unconstrained_signed, f.p[t].unconstrained) << t;
+    EXPECT_NEAR(f.p[t].unconstrained / truth[t], 1.0, 1e-3) << t;
+  }
+}
+
 // Points drawn from N(model, Sigma) with Sigma the exact covariance of the estimates under the
 // truth (pair_sums() over the unbroken grids, 2 sum c_t c_u h_t h_u / (n n' norm norm')).
 class Draw {

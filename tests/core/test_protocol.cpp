@@ -166,6 +166,7 @@ std::vector<Message> typical_messages() {
       WindowDevMsg{17, 5, 41 % 16, std::exp2(-10.0), std::exp2(-10.5)},
       Ieee952ParameterMsg{17, FitParameter::markov_sigma, 1, true, 0.25f, 0.125},
       Ieee952ModelMsg{17, 1, 0, true, 2, true, 2, 0, false, 3.5f},
+      Ieee952UnconstrainedMsg{17, Ieee952Term::angle_random_walk, -2.5e-4f, std::exp2(-12.5)},  // on the 1/256 grid
   };
 }
 
@@ -219,6 +220,10 @@ TEST(ProtocolRoundTrip, EveryFieldAtItsLimits) {
       Ieee952ModelMsg{0, 0, 0, false, 0, false, 0, 0, false, 0.0f},
       Ieee952ModelMsg{255, 2, 2, true, 31, true, 2, 2, true, FLT_MAX},
       Ieee952ModelMsg{1, 0, 2, false, 0, true, 0, 0, false, -FLT_MAX},
+      Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 0.0f, 0.0},  // no estimate
+      Ieee952UnconstrainedMsg{255, Ieee952Term::rate_ramp, -FLT_MAX, std::exp2(128.0 - 1.0 / 256)},  // code 65535
+      Ieee952UnconstrainedMsg{1, Ieee952Term::bias_instability, FLT_MAX, std::exp2(1.0 / 256 - 128)},  // code 1
+      Ieee952UnconstrainedMsg{2, Ieee952Term::rate_random_walk, -FLT_TRUE_MIN, 1.0},
   };
   for (std::uint8_t node : {std::uint8_t{0}, max_node_address}) {
     for (const Message& m : limits) {
@@ -363,6 +368,65 @@ TEST(ProtocolQuantization, WindowDeviationsWithinHalfAStepOfLog2) {
   EXPECT_EQ(sent(1e-300, 0.0).mdev_angle_per_s, 0.0);
   EXPECT_EQ(sent(1e300, 1.0).adev_angle_per_s, std::exp2(128.0 - 1.0 / 16384));
   EXPECT_EQ(sent(1e300, 1.0).mdev_angle_per_s, 1.0);
+}
+
+TEST(ProtocolQuantization, UnconstrainedEstimateSignedAndItsUncertaintyWithinHalfAStepOfLog2) {
+  // Oracle: the layout of docs/protocol.md (Ieee952Unconstrained): the value is the float32 itself,
+  // of either sign; the uncertainty goes as log2 in 1/256 steps, so the decoded one is within half a
+  // step, 2^(1/512) - 1 = 0.136 %, of what was sent, and clamps to codes 1 and 65535 outside
+  // [2^(1/256 - 128), 2^(128 - 1/256)] (saturation: a larger uncertainty reads as the largest).
+  std::mt19937_64 rng(952);
+  std::uniform_real_distribution<double> log2_u(-127.0, 127.0);
+  for (int k = 0; k < 10000; ++k) {
+    const double u = std::exp2(log2_u(rng));
+    const float value = (k % 2 ? -1.0f : 1.0f) * static_cast<float>(u) * 0.75f;
+    const auto back = std::get<Ieee952UnconstrainedMsg>(round_trip(Ieee952UnconstrainedMsg{1, Ieee952Term::rate_random_walk, value, u}));
+    EXPECT_EQ(back.value, value);  // the sign too: a negative unconstrained square
+    EXPECT_LE(std::abs(std::log2(back.uncertainty) - std::log2(u)), 1.0 / 512 + 1e-12) << u;
+  }
+  const auto saturated = [](double u) {
+    return std::get<Ieee952UnconstrainedMsg>(round_trip(Ieee952UnconstrainedMsg{3, Ieee952Term::rate_ramp, -1.0f, u})).uncertainty;
+  };
+  EXPECT_EQ(saturated(1e300), std::exp2(65535.0 / 256 - 128));
+  EXPECT_EQ(saturated(DBL_MAX), std::exp2(65535.0 / 256 - 128));
+  EXPECT_EQ(saturated(1e-300), std::exp2(1.0 / 256 - 128));
+  EXPECT_EQ(saturated(DBL_TRUE_MIN), std::exp2(1.0 / 256 - 128));
+  // Byte for byte: N, -2.5e-4f = 0xB983126F, 2^-12.5: code 256 (128 - 12.5) = 29568 = 0x7380.
+  const CanFrame f = encoded(Ieee952UnconstrainedMsg{9, Ieee952Term::angle_random_walk, -2.5e-4f, std::exp2(-12.5)}, 0x2A);
+  EXPECT_EQ(f.id, 0x18FF452Au);
+  EXPECT_EQ(f.len, 8);
+  const std::array<std::uint8_t, 8> want{0x01, 9, 0x6F, 0x12, 0x83, 0xB9, 0x80, 0x73};
+  for (std::size_t k = 0; k < 8; ++k) EXPECT_EQ(f.data[k], want[k]) << k;
+}
+
+TEST(ProtocolDecode, UnconstrainedFramesOutOfRangeOrWithUnknownTermsAreRefused) {
+  // Oracle: the layout and ranges of docs/protocol.md (Ieee952Unconstrained).
+  CanFrame f;
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, 0.0}, 1, f), ProtocolError::out_of_range)
+      << "a value without an uncertainty";
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, NAN, 1.0}, 1, f), ProtocolError::out_of_range);
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, -INFINITY, 1.0}, 1, f), ProtocolError::out_of_range);
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, -1.0}, 1, f), ProtocolError::out_of_range);
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, INFINITY}, 1, f), ProtocolError::out_of_range);
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, NAN}, 1, f), ProtocolError::out_of_range);
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, static_cast<Ieee952Term>(5), 1.0f, 1.0}, 1, f), ProtocolError::out_of_range);
+  const CanFrame good = encoded(Ieee952UnconstrainedMsg{4, Ieee952Term::rate_ramp, -3.0f, 0.5}, 7);
+  for (std::uint8_t term = 5; term < 8; ++term) {
+    CanFrame g = good;
+    g.data[0] = term;
+    EXPECT_EQ(decode(g).error, ProtocolError::unknown_page) << int(term);
+  }
+  for (unsigned bit = 3; bit < 8; ++bit) {
+    CanFrame g = good;
+    g.data[0] = static_cast<std::uint8_t>(g.data[0] | 1u << bit);
+    EXPECT_EQ(decode(g).error, ProtocolError::reserved_bits) << bit;
+  }
+  CanFrame no_uncertainty = good;
+  no_uncertainty.data[6] = no_uncertainty.data[7] = 0;
+  EXPECT_EQ(decode(no_uncertainty).error, ProtocolError::out_of_range) << "code 0 with a value";
+  CanFrame nan = good;
+  nan.data[5] = 0x7F, nan.data[4] = 0xC0;
+  EXPECT_EQ(decode(nan).error, ProtocolError::out_of_range);
 }
 
 TEST(ProtocolQuantization, CountsOfTheWindowPageSaturate) {
@@ -901,31 +965,63 @@ TEST(ProtocolSchedule, VersionFourAppendsTheModelListToEveryReport) {
   EXPECT_EQ(fit_parameter_position(FitParameter::filter_tf, 1), fit_parameter_pages);  // no such page
 }
 
+TEST(ProtocolSchedule, VersionFiveAppendsTheUnconstrainedListToEveryReport) {
+  // Brute force over every tau count and window tau count: the version-4 frames keep their
+  // positions; after them each report carries its part of the unconstrained list (Q N B K R), cut
+  // into parts of ceil(5 / 4) = 2 (2, 2, 1, 0), so that over a cycle every term comes exactly once.
+  for (std::size_t taus = 0; taus <= max_taus; ++taus) {
+    for (std::size_t window_taus : {std::size_t{0}, std::size_t{1}, taus / 2, taus}) {
+      std::map<int, int> count;
+      for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) {
+        const std::size_t v4 = report_frame_count(seq, taus, 4, window_taus), v5 = report_frame_count(seq, taus, 5, window_taus);
+        ASSERT_EQ(v5 - v4, std::size_t{seq < 2 ? 2u : seq == 2 ? 1u : 0u});
+        for (std::size_t p = 0; p < v5; ++p) {
+          const ReportSlot a = report_slot(seq, taus, p, 5, window_taus);
+          if (p < v4) {
+            const ReportSlot b = report_slot(seq, taus, p, 4, window_taus);
+            ASSERT_EQ(a.slot, b.slot) << taus << " " << window_taus << " " << int(seq) << " " << p;
+            ASSERT_EQ(a.index, b.index);
+            continue;
+          }
+          ASSERT_EQ(a.slot, Slot::unconstrained);
+          EXPECT_EQ(a.index, 2 * seq + (p - v4)) << "in term order";
+          ++count[a.index];
+        }
+      }
+      ASSERT_EQ(count.size(), 5u);
+      for (int k = 0; k < 5; ++k) EXPECT_EQ(count[k], 1) << k;
+    }
+  }
+  EXPECT_EQ(report_frame_count(0, 32), report_frame_count(0, 32, 5)) << "the default is version 5";
+}
+
 TEST(ProtocolBusLoad, WorstCaseFrameLengthsAndLoadPerNode) {
   // Davis et al. 2007: 8 s + 67 + floor((54 + 8 s - 1) / 4) bits for a 29-bit identifier.
   EXPECT_EQ(worst_case_frame_bits(0), 80u);
   EXPECT_EQ(worst_case_frame_bits(6), 140u);
   EXPECT_EQ(worst_case_frame_bits(8), 160u);
   // 32 taus, one report per second: longest report 2 + 64 + ceil(74 / 4) = 85 frames of 160 bits
-  // (version 1: ceil(73 / 4), the same 85: the summary fills a shorter report), and version 4's
-  // model list adds ceil(10 / 4) = 3 to it: 88 frames.
+  // (version 1: ceil(73 / 4), the same 85: the summary fills a shorter report), version 4's
+  // model list adds ceil(10 / 4) = 3 to it, version 5's unconstrained list ceil(5 / 4) = 2: 90 frames.
   const double load32 = worst_case_bus_load(32, 1.0, 500000.0);
-  EXPECT_DOUBLE_EQ(load32, 88 * 160 / 500000.0);
+  EXPECT_DOUBLE_EQ(load32, 90 * 160 / 500000.0);
   EXPECT_LE(load32, 0.03);
-  // 40 taus (the design brief's example): 2 + 80 + ceil(90 / 4) + 3 = 108 frames.
-  EXPECT_DOUBLE_EQ(worst_case_bus_load(40, 1.0, 500000.0), 108 * 160 / 500000.0);
+  // 40 taus (the design brief's example): 2 + 80 + ceil(90 / 4) + 3 + 2 = 110 frames.
+  EXPECT_DOUBLE_EQ(worst_case_bus_load(40, 1.0, 500000.0), 110 * 160 / 500000.0);
   // With the window curve: 32 taus and 30 window taus (the board's most) add ceil((2 + 30) / 4) = 8
-  // frames to the longest report: 96 frames, 3.072 % (version 3: 93, within 3 %).
+  // frames to the longest report: 98 frames, 3.136 % (version 4: 96; version 3: 93, within 3 %).
   const double window30 = worst_case_bus_load(32, 1.0, 500000.0, 30);
-  EXPECT_DOUBLE_EQ(window30, 96 * 160 / 500000.0);
+  EXPECT_DOUBLE_EQ(window30, 98 * 160 / 500000.0);
   EXPECT_DOUBLE_EQ(worst_case_bus_load(32, 1.0, 500000.0, 0), load32);
   // Averaged over the slow cycle (frames per second at the default 1 s report period), 32 taus
-  // without window: version 3 sends 85, 85, 85, 83 frames, version 4 3, 3, 3, 1 more.
-  std::size_t v3 = 0, v4 = 0;
+  // without window: version 3 sends 85, 85, 85, 83 frames, version 4 3, 3, 3, 1 more, version 5
+  // 2, 2, 1, 0 more than version 4.
+  std::size_t v3 = 0, v4 = 0, v5 = 0;
   for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq)
-    v3 += report_frame_count(seq, 32, 3), v4 += report_frame_count(seq, 32, 4);
+    v3 += report_frame_count(seq, 32, 3), v4 += report_frame_count(seq, 32, 4), v5 += report_frame_count(seq, 32, 5);
   EXPECT_EQ(v3, 338u);  // 84.5 frames/s
   EXPECT_EQ(v4, 348u);  // 87 frames/s
+  EXPECT_EQ(v5, 353u);  // 88.25 frames/s
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 //                                    are an error
 //
 // The frames are four paced reports of a 3-tau node with 2 window taus (every slot of the
-// schedule, sequence wrapping 254 -> 1) and a set of messages at their range limits, covering every enumeration value.
+// current version's schedule, sequence wrapping 254 -> 1) and a set of messages at their range limits, covering every enumeration value.
 #include <cerrno>
 #include <cfloat>
 #include <cmath>
@@ -115,6 +115,15 @@ Expected expected(const Ieee952ModelMsg& m) {
            {"CriterionMargin", physical(m.criterion_margin)}},
           {{"Term", "fit_model"}}};
 }
+Expected expected(const Ieee952UnconstrainedMsg& m) {
+  static const char* const value_signal[] = {"Q", "N", "B", "K", "R"};
+  const std::string p = value_signal[static_cast<int>(m.term)];
+  // Log2Uncertainty on the wire's grid (1/256 steps); raw 0 (no estimate) is the offset, -128.
+  const double log2_u = m.uncertainty == 0.0 ? -128.0 : std::round(std::log2(m.uncertainty) * 256.0) / 256.0;
+  return {{{"Term", static_cast<int>(m.term)}, {"Seq", m.seq}, {p + "_Unconstrained", physical(m.value)},
+           {p + "_Log2Uncertainty", log2_u}},
+          {{"Term", name(m.term)}}};
+}
 // A window deviation's log2 on the wire's grid (2^-14 steps); raw 0 (no estimate) is the offset, -128.
 double window_log2(double dev) {
   return dev == 0.0 ? -128.0 : std::round(std::log2(dev) * 16384.0) / 16384.0;
@@ -167,6 +176,9 @@ Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
                                  in_model ? 0.002f * static_cast<float>(i + 1) : 0.0f,
                                  in_model && p.parameter != FitParameter::sinusoid_frequency ? 0.1 * (i + 1) : 0.0};
     }
+    case Slot::unconstrained:  // N's unconstrained square negative, R not free
+      return Ieee952UnconstrainedMsg{seq, static_cast<Ieee952Term>(i), i == 1 ? -2.5e-4f : i < 4 ? 0.0011f * static_cast<float>(i + 1) : 0.0f,
+                                     i < 4 ? 0.0004 * (i + 1) : 0.0};
   }
   return StatusMsg{};
 }
@@ -215,6 +227,9 @@ std::vector<Entry> frames() {
       Ieee952ParameterMsg{0, FitParameter::markov_tc, 0, false, 0.0f, 0.0},
       Ieee952ModelMsg{255, 2, 2, true, 31, true, 2, 2, true, -FLT_MAX},
       Ieee952ModelMsg{0, 0, 0, false, 0, false, 0, 0, false, 0.0f},
+      Ieee952UnconstrainedMsg{255, Ieee952Term::rate_ramp, -FLT_MAX, 1e300},   // uncertainty code 65535 (saturated)
+      Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, FLT_MAX, 1e-300},  // code 1 (clamped)
+      Ieee952UnconstrainedMsg{1, Ieee952Term::bias_instability, 0.0f, 0.0},      // no estimate
       CounterInputMsg{0xFFFFFFFFu, 255, true, true},
       CounterInputMsg{0, 0, false, false},
       CounterInputMsg{123456789, 17, false, true},

@@ -5,11 +5,20 @@
 // reports crossing the in-process bus to the host decoder. The curve has a hump and a dip between
 // 80 s and 2 600 s that the five IEEE-952 terms cannot make (the offline fit of the same record
 // rejects them at chi2/dof 557 and more, tests/host/test_real_imu.cpp). Oracle: the fit's own
-// acceptance rule, as the decoder hears it: with the model selection on the board the node's fit
-// is accepted at the end of the run and in most of its reports, rather than "rejected" throughout;
-// the model it ends with comes whole from one slow cycle. (On the board's octave taus, 26 points
-// at the end, the five terms and the selection's candidates are closer than offline: which model
-// wins is printed, not prescribed; a Markov term's recovery is test_board_markov.cpp's.)
+// acceptance rule, as the decoder hears it: with the model selection on the board and the board's
+// default taus (octaves, config.hpp: the longest tau grows with the run, to half of it) the node's
+// fit is accepted at the end of the run and in most of its reports, rather than "rejected"
+// throughout; the model it ends with comes whole from one slow cycle. Which model wins is printed,
+// not prescribed; a Markov term's recovery is test_board_markov.cpp's.
+//
+// Why the default taus and not fewer: the board's fit of this record, made every 50 s of samples
+// from 1 000 s to the end (181 fits), was rejected in 6 with the default octaves (none after
+// 8 000 s: the taus to 2 621 s give K the curve's rise) and in 19 with octaves = 18 (taus to
+// 1 311 s, a quarter of the record; 6 of the last 41, at chi2/dof 2.5-2.8 on 26 points, where a
+// Markov term for the hump lowers the criterion but is not two Birge-scaled uncertainties above
+// zero). With 18 octaves whether the last report's fit was accepted depended on the very sample
+// its refit fell on, so on the report schedule, not on the data: a test of that would pass or
+// fail with any change to the frames of a report.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -58,7 +67,6 @@ TEST(BoardRealGyro, AHumpedCurveIsAcceptedNotRejectedForTheWholeRun) {
   c.tau0_s = 0.01;
   c.pulse_weight_arcsec = 1.8;
   c.stride_factor = 8;
-  c.octaves = 18;  // m up to 2^17: 1 311 s, a quarter of the record at the end of the run
   c.report_period_s = 1.0;
   hal::FakeCanBus bus;
   auto board_node = bus.attach();
@@ -100,7 +108,7 @@ TEST(BoardRealGyro, AHumpedCurveIsAcceptedNotRejectedForTheWholeRun) {
   EXPECT_EQ(v.ieee952_summary->status, protocol::Ieee952Status::ok) << "chi2/dof " << v.ieee952_summary->chi2_per_dof;
   EXPECT_GT(accepted, rejected) << "the node showed 'rejected' most of the run";
   // The model of the summary's own slow cycle, whole; a Markov term it holds has its correlation
-  // time inside the taus the node measures (0.01 s .. 1 311 s x 2).
+  // time inside the taus the node measures (0.01 s .. 2 621 s x 2).
   const FitModelView& m = v.fit_model.cycle == v.ieee952_summary_cycle ? v.fit_model : v.previous_fit_model;
   ASSERT_EQ(m.cycle, v.ieee952_summary_cycle);
   ASSERT_TRUE(m.complete());
@@ -116,7 +124,7 @@ TEST(BoardRealGyro, AHumpedCurveIsAcceptedNotRejectedForTheWholeRun) {
                 static_cast<double>(tc.value), 100 * tc.rel_uncertainty);
     EXPECT_GT(sigma.value, 0.0f);
     EXPECT_GT(tc.value, 0.02f);
-    EXPECT_LT(tc.value, 2622.0f);
+    EXPECT_LT(tc.value, 5243.0f);
   }
 }
 

@@ -13,14 +13,18 @@
 
 #include "analysis.hpp"
 #include "decoder.hpp"
+#include "limits.hpp"
+#include "node_report.hpp"
 #include "gyro_sim.hpp"
 #include "report.hpp"
 
 namespace gyrochar {
 namespace {
 
-/// The decoded IEEE-952 summary and terms against the fit the board made them from.
-void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, double tau0_s) {
+/// The decoded IEEE-952 summary and terms against the fit the board made them from. `negative`
+/// counts the terms whose unconstrained square is negative (sent as a negative signed root).
+void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, double tau0_s,
+                                      std::size_t* negative = nullptr) {
   ASSERT_TRUE(v.ieee952_summary.has_value());
   const protocol::Ieee952SummaryMsg& s = *v.ieee952_summary;
   EXPECT_STREQ(name(s.status), fit.status == FitStatus::ok               ? "ok"
@@ -45,6 +49,39 @@ void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, 
     // 0.01 % steps, saturating at 655.35 %.
     const double rel = fitted ? std::min(p.uncertainty / p.value, 6.5535) : 0.0;
     EXPECT_NEAR(t.rel_uncertainty, rel, 0.5e-4 + 1e-12) << k;
+  }
+  // Version 5: each term's unconstrained estimate from the same fit (the cycle of its term page):
+  // the signed root as float32, the uncertainty within half a 1/256 octave step, 2^(1/512) - 1 =
+  // 0.136 %; none where the term was not free. A verdict judges it as gyrochar-analyze does
+  // (acceptance.cpp: normal_estimate(unconstrained, unconstrained_uncertainty)), in SI: the wire's
+  // angle unit here is the arcsec.
+  const std::vector<Limit> limits = parse_limits("Q <= 1 arcsec\nN <= 1 rad/s^0.5\nB <= 1 rad/s\nK <= 1 rad/s^1.5\nR <= 1 rad/s^2\n");
+  const std::vector<Decision> decisions = decoding::node_decisions(v, limits);
+  std::size_t unconstrained = 0;
+  for (std::size_t k = 0; k < 5; ++k) {
+    const Ieee952Parameter& p = fit.p[k];
+    const protocol::Ieee952UnconstrainedMsg* u = v.unconstrained_estimate(k);
+    if (!(p.unconstrained_uncertainty > 0)) {
+      EXPECT_EQ(u, nullptr) << k;
+      continue;
+    }
+    ++unconstrained;
+    if (p.unconstrained_signed < 0 && negative != nullptr) ++*negative;
+    ASSERT_NE(u, nullptr) << k;
+    EXPECT_EQ(u->value, static_cast<float>(p.unconstrained_signed)) << k;
+    EXPECT_EQ(std::max(u->value, 0.0f), static_cast<float>(p.unconstrained)) << k;
+    EXPECT_NEAR(u->uncertainty, p.unconstrained_uncertainty, 0.00136 * p.unconstrained_uncertainty) << k;
+    const LimitEstimate& e = decisions[k].estimate;
+    if (!e.usable) continue;  // not resolved, or the fit not accepted: no verdict on it
+    EXPECT_EQ(e.kind, estimate_unconstrained) << k;
+    const double value = static_cast<double>(static_cast<float>(p.unconstrained)) * units::arcsec;
+    EXPECT_DOUBLE_EQ(e.value, value) << k;
+    EXPECT_NEAR(e.high - e.value, decision_z * p.unconstrained_uncertainty * units::arcsec,
+                0.00136 * decision_z * p.unconstrained_uncertainty * units::arcsec) << k;
+  }
+  EXPECT_GE(unconstrained, fit.ok() ? 1u : 0u) << "an accepted fit has free terms";
+  if (fit.ok() && fit.p[1].resolved && fit.p[1].unconstrained_uncertainty > 0) {
+    EXPECT_TRUE(decisions[1].estimate.usable) << "N judged by its unconstrained estimate";
   }
   // Version 4: the model pages of the summary's slow cycle, whole, say the fit's model.
   const FitModelView& m = v.fit_model.cycle == v.ieee952_summary_cycle ? v.fit_model : v.previous_fit_model;
@@ -142,7 +179,11 @@ TEST(ReportEndToEnd, DecodedEstimatesEqualTheOfflineAnalyzer) {
   // The summary and the terms travel in report 3 (16 taus: the last part of the slow cycle), the
   // last one built: `content` holds the fit they came from.
   EXPECT_TRUE(content.fit.quantization_white);  // 2 arcsec of white angle noise: the counts are random
-  expect_decoded_fit_is_the_boards(v, content.fit, s.tau0_s);
+  // A white-noise gyro: the unconstrained squares of B and K come out negative (the non-negative
+  // fit shows them as 0): their negative roots must travel as the board computed them.
+  std::size_t negative = 0;
+  expect_decoded_fit_is_the_boards(v, content.fit, s.tau0_s, &negative);
+  EXPECT_GE(negative, 1u);
 }
 
 TEST(ReportEndToEnd, PeriodicQuantizationReachesTheDecoderAsTheBoardsFitSaysIt) {

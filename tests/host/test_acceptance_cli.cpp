@@ -260,12 +260,15 @@ std::vector<std::string> csv_fields(const std::string& line) {
 // file with the verdict columns taken off. N <= 1 deg/sqrt(h) is far above the demo's gyros (N a
 // few 1e-3), adev(10.24 s) <= 1e-9 deg/h far below any gyro's: both are decided as soon as there
 // is an estimate, the ADEV at 10.24 s within the run's first minutes (its first EDF is there after
-// a few taus).
+// a few taus). The demo's board speaks protocol version 5: its terms are judged by the unconstrained
+// estimates it sends. The demo's own CSV with the same --limits (its in-process decoder, the same
+// frames) must carry the same verdict columns as the decoder's.
 TEST(AcceptanceCli, DecoderJudgesEveryReportInCsvAndJsonLines) {
-  const std::string log = temp("demo_judged.log");
-  Outcome r = run_shell(demo + " --hours 0.34 --window 0 --view-every 0 --csv '' --plot '' --candump " + log + " > /dev/null");
-  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string log = temp("demo_judged.log"), demo_csv = temp("demo_judged.csv");
   const std::string lim = file_with("judged_limits.txt", "N <= 1 deg/sqrt(h)\nadev(10.24 s) <= 1e-9 deg/h\nB <= 1e3 deg/h\n");
+  Outcome r = run_shell(demo + " --hours 0.34 --window 0 --view-every 0 --csv " + demo_csv + " --limits " + lim +
+                        " --plot '' --candump " + log + " > /dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
   const std::string csv = temp("judged.csv"), plain = temp("plain.csv"), jsonl = temp("judged.jsonl"),
                     summary = temp("judged_summary.csv");
   std::remove(summary.c_str());
@@ -275,12 +278,13 @@ TEST(AcceptanceCli, DecoderJudgesEveryReportInCsvAndJsonLines) {
   r = run_shell(decode + " " + log + " --view none --csv " + plain);
   ASSERT_EQ(r.code, 0) << r.err;
 
-  // Without --limits: the same bytes as with them, less the 16 verdict columns (1 + 5 a limit).
+  // Without --limits: the same bytes as with them, less the 18 verdict columns (1 + 5 a limit, and
+  // the estimate kind of each of the 2 term limits).
   std::istringstream judged_lines(slurp(csv));
   std::string stripped, line;
   while (std::getline(judged_lines, line)) {
     std::size_t cut = line.size();
-    for (int k = 0; k < 16; ++k) cut = line.rfind(',', cut - 1);
+    for (int k = 0; k < 18; ++k) cut = line.rfind(',', cut - 1);
     stripped += line.substr(0, cut) + "\n";
   }
   EXPECT_TRUE(stripped == slurp(plain)) << "the CSV without --limits is byte for byte the CSV less its verdict columns";
@@ -306,16 +310,25 @@ TEST(AcceptanceCli, DecoderJudgesEveryReportInCsvAndJsonLines) {
     EXPECT_NE(it, header.end()) << name;
     return static_cast<std::size_t>(it - header.begin());
   };
-  std::map<std::string, std::vector<std::vector<std::string>>> last_report;  // node -> rows of its last report
-  while (std::getline(csv_lines, line)) {
-    const auto f = csv_fields(line);
-    ASSERT_EQ(f.size(), header.size()) << line;
-    if (f[column("type")] != "tau") continue;
-    auto& rows = last_report[fmt_node(f[column("node")])];
-    if (!rows.empty() && rows.back()[column("seq")] != f[column("seq")]) rows.clear();
-    rows.push_back(f);
-  }
+  // node -> rows of its last report, from the decoder's CSV and from the demo's
+  std::map<std::string, std::vector<std::vector<std::string>>> last_report, demo_last_report;
+  const auto last_reports = [&](std::istream& lines, auto& out) {
+    while (std::getline(lines, line)) {
+      const auto f = csv_fields(line);
+      ASSERT_EQ(f.size(), header.size()) << line;
+      if (f[column("type")] != "tau") continue;
+      auto& rows = out[fmt_node(f[column("node")])];
+      if (!rows.empty() && rows.back()[column("seq")] != f[column("seq")]) rows.clear();
+      rows.push_back(f);
+    }
+  };
+  last_reports(csv_lines, last_report);
   ASSERT_EQ(last_report.size(), 2u);
+  std::istringstream demo_lines(slurp(demo_csv));
+  std::getline(demo_lines, line);
+  ASSERT_EQ(csv_fields(line), header) << "the demo's CSV has the decoder's columns, verdicts included";
+  last_reports(demo_lines, demo_last_report);
+  ASSERT_EQ(demo_last_report.size(), 2u);
   for (const auto& [node, rows] : last_report) {
     SCOPED_TRACE(node);
     const auto& want = final_row.at(node);
@@ -344,6 +357,13 @@ TEST(AcceptanceCli, DecoderJudgesEveryReportInCsvAndJsonLines) {
     }
     EXPECT_EQ(adev_rows, 1u) << "the one row of tau 10.24 s";
     EXPECT_EQ(want.at("adev(10.24 s) verdict"), "fail");
+    // Version 5: N (free in the board's fit, resolved) is judged by its unconstrained estimate.
+    EXPECT_EQ(rows.back()[column("N estimate kind")], "unconstrained");
+    // The demo's own CSV: the same verdict columns in its last report (from "verdict" on).
+    const auto& demo_rows = demo_last_report.at(node);
+    ASSERT_EQ(demo_rows.size(), rows.size());
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      for (std::size_t c = column("verdict"); c < header.size(); ++c) EXPECT_EQ(demo_rows[i][c], rows[i][c]) << header[c];
   }
 
   // The JSON lines: each node's verdicts when they change, the decided adev fail long before the

@@ -78,6 +78,7 @@ struct NodeSpec {
   std::uint8_t protocol_version = version;  // 1: no fit summary, no Fitted flag
   Ieee952Status fit = Ieee952Status::ok;
   bool quantization_white = true;           // false: AVAR below 8 tau0, MVAR below 4 tau0 left out
+  float unconstrained_n = 0;                // > 0: N's unconstrained estimate (version 5), uncertainty 12.5 %
 };
 
 float adev_of(const NodeSpec& n, std::uint8_t seq, std::size_t i) {
@@ -146,6 +147,10 @@ Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t
         return Ieee952ParameterMsg{seq, p.parameter, 0, false, markov_tc_of, 0.25};
       return Ieee952ParameterMsg{seq, p.parameter, p.index, false, 0.0f, 0.0};
     }
+    case Slot::unconstrained:  // version 5: N's unconstrained estimate where the spec gives one
+      if (s.index == 1 && n.unconstrained_n > 0)
+        return Ieee952UnconstrainedMsg{seq, Ieee952Term::angle_random_walk, n.unconstrained_n, 0.125 * n.unconstrained_n};
+      return Ieee952UnconstrainedMsg{seq, static_cast<Ieee952Term>(s.index), 0.0f, 0.0};
   }
   return {};
 }
@@ -422,7 +427,7 @@ TEST(DecodeCli, LimitsAddVerdictColumnsAndRecordsWhenAVerdictChanges) {
 
   const Csv csv = read_csv(csv_path);
   const std::vector<std::string> added{"verdict",     "N limit [deg/sqrt(h)]",        "N verdict",          "N estimate [deg/sqrt(h)]",
-                                       "N lower",     "N upper",                      "adev(0.04 s) limit [deg/h]",
+                                       "N lower",     "N upper",                      "N estimate kind",   "adev(0.04 s) limit [deg/h]",
                                        "adev(0.04 s) verdict", "adev(0.04 s) estimate [deg/h]", "adev(0.04 s) lower",
                                        "adev(0.04 s) upper"};
   const Csv plain = read_csv(plain_path);
@@ -446,8 +451,10 @@ TEST(DecodeCli, LimitsAddVerdictColumnsAndRecordsWhenAVerdictChanges) {
       EXPECT_NEAR(std::stod(csv.get(row, "N estimate [deg/sqrt(h)]")), n, 1e-12 * n);
       EXPECT_NEAR(std::stod(csv.get(row, "N lower")), n * (1 - 1.959963984540054 * 0.125), 1e-12 * n);
       EXPECT_NEAR(std::stod(csv.get(row, "N upper")), n * (1 + 1.959963984540054 * 0.125), 1e-12 * n);
+      EXPECT_EQ(csv.get(row, "N estimate kind"), "shown") << "these nodes send no unconstrained estimate";
     } else {
       EXPECT_EQ(csv.get(row, "N estimate [deg/sqrt(h)]"), "");
+      EXPECT_EQ(csv.get(row, "N estimate kind"), "");
     }
     // adev(0.04 s): only on the row of that tau, once its m is known.
     const bool at_tau = arcsec && csv.get(row, "tau_index") == "2" && csv.get(row, "m") == "4";
@@ -490,6 +497,60 @@ TEST(DecodeCli, LimitsAddVerdictColumnsAndRecordsWhenAVerdictChanges) {
     EXPECT_GE(list.size(), 3u) << "undecided at report 0, decided at report 3, final";
   }
   EXPECT_EQ(records.size(), 2u);
+}
+
+// --limits with a version-5 node that sends N's unconstrained estimate (0.0015 arcsec/sqrt(s), its
+// term page showing 0.002) and a version-4 node that cannot: the first is judged by the
+// unconstrained estimate, the second by the shown value, and the CSV and JSON lines say which.
+// Oracles: the values encoded, 1 arcsec/sqrt(s) = 1/60 deg/sqrt(h), the codec's uncertainty grid
+// (log2 in 1/256 steps: within 0.136 % of the 12.5 % sent), the decision rule of limits.hpp.
+TEST(DecodeCli, LimitsJudgeTheUnconstrainedEstimateWhereTheNodeSendsIt) {
+  NodeSpec sends{0x10, 6, AngleUnit::arcsec, 0.01f};
+  sends.unconstrained_n = 0.0015f;
+  NodeSpec older{0x2A, 6, AngleUnit::arcsec, 0.01f, 4};
+  LogWriter log;
+  for (std::uint8_t seq = 0; seq < 5; ++seq) {
+    log.report(sends, seq, 1000.0 + seq, 100u * (seq + 1));
+    log.report(older, seq, 1000.3 + seq, 100u * (seq + 1));
+  }
+  const std::string limits = temp("unconstrained_limits.txt"), csv_path = temp("unconstrained.csv"),
+                    jsonl_path = temp("unconstrained.jsonl"), plain_path = temp("unconstrained_plain.jsonl");
+  std::ofstream(limits) << "N <= 1e-4 deg/sqrt(h)\n";
+  const std::string log_path = log.write("unconstrained.log");
+  const Outcome r = run(log_path + " --view none --limits " + limits + " --csv " + csv_path + " --jsonl " + jsonl_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const double to_deg_sqrt_h = 1.0 / 60.0;
+  const double unconstrained = static_cast<double>(0.0015f) * to_deg_sqrt_h, shown = static_cast<double>(ieee_of(1)) * to_deg_sqrt_h;
+  const Csv csv = read_csv(csv_path);
+  std::size_t judged = 0;
+  for (const auto& row : csv.rows) {
+    if (std::stoi(csv.get(row, "seq")) < 3) continue;  // the fit summary arrives in report 3
+    const bool v5 = csv.get(row, "node") == "16";
+    SCOPED_TRACE(csv.get(row, "node"));
+    const double n = v5 ? unconstrained : shown, u = 0.125 * n;
+    EXPECT_EQ(csv.get(row, "N estimate kind"), v5 ? "unconstrained" : "shown");
+    EXPECT_NEAR(std::stod(csv.get(row, "N estimate [deg/sqrt(h)]")), n, 1e-12 * n);
+    EXPECT_NEAR(std::stod(csv.get(row, "N upper")), n + 1.959963984540054 * u, 1.959963984540054 * u * (v5 ? 0.00136 : 1e-12));
+    ++judged;
+  }
+  EXPECT_EQ(judged, 2u * 2 * 6) << "reports 3 and 4 of both nodes, 6 taus each";
+  std::map<int, Json> last_acceptance, last_report;
+  for (const Json& j : read_jsonl(jsonl_path)) {
+    if (j.at("type") == "acceptance") last_acceptance[j.at("node").get<int>()] = j;
+    if (j.at("type") == "report") last_report[j.at("node").get<int>()] = j;
+  }
+  ASSERT_EQ(last_acceptance.size(), 2u);
+  EXPECT_EQ(last_acceptance[0x10].at("limits")[0].at("estimate_kind"), "unconstrained");
+  EXPECT_EQ(last_acceptance[0x2A].at("limits")[0].at("estimate_kind"), "shown");
+  EXPECT_NE(last_acceptance[0x2A].at("limits")[0].at("why").get<std::string>().find("no unconstrained estimate"),
+            std::string::npos);
+  // The report record carries the estimate as gyrochar-analyze's JSON does, where the node sends it.
+  const Json& n5 = last_report[0x10].at("ieee952").at("N");
+  ASSERT_TRUE(n5.contains("unconstrained")) << n5.dump();
+  EXPECT_NEAR(n5.at("unconstrained").at("value").get<double>(), unconstrained, 1e-12 * unconstrained);
+  EXPECT_NEAR(n5.at("unconstrained").at("signed").get<double>(), unconstrained, 1e-12 * unconstrained);
+  EXPECT_NEAR(n5.at("unconstrained").at("uncertainty").get<double>(), 0.125 * unconstrained, 0.00136 * 0.125 * unconstrained);
+  EXPECT_FALSE(last_report[0x2A].at("ieee952").at("N").contains("unconstrained"));
 }
 
 TEST(DecodeCli, RatesInDegreesPerHourAndPulsesNeverConverted) {

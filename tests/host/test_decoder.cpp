@@ -7,11 +7,15 @@
 #include <vector>
 
 #include "decoder.hpp"
+#include "limits.hpp"
+#include "node_report.hpp"
+#include "units.hpp"
 
 namespace gyrochar {
 namespace {
 
 using namespace protocol;
+using decoding::node_decisions;
 
 const Ieee952SummaryMsg fit_summary{0, Ieee952Status::ok, 0.93f, 24, true, {0, 0}};
 
@@ -25,6 +29,17 @@ Ieee952ParameterMsg parameter_page(std::uint8_t seq, std::size_t k) {
   if (p.index == 0 && p.parameter == FitParameter::markov_tc) m.value = 30.0f, m.rel_uncertainty = 0.2;
   if (p.parameter == FitParameter::filter_tf) m.value = 0.005f, m.rel_uncertainty = 0.3;
   return m;
+}
+
+// Version 5's unconstrained estimates (angle unit arcsec, as the scale page says): N 0.3 (the term
+// page shows 0.25) with uncertainty 0.05; K's unconstrained square negative, its signed root -0.125
+// with uncertainty 0.5; B 0.5 with 1; Q and R none (not free in the fit).
+Ieee952UnconstrainedMsg unconstrained_page(std::uint8_t seq, std::size_t k) {
+  const auto term = static_cast<Ieee952Term>(k);
+  if (k == 1) return {seq, term, 0.3f, 0.05};
+  if (k == 2) return {seq, term, 0.5f, 1.0};
+  if (k == 3) return {seq, term, -0.125f, 0.5};
+  return {seq, term, 0.0f, 0.0};
 }
 
 // The frames of report `seq` of a node with `taus` taus, values derived from (seq, tau), speaking
@@ -71,6 +86,7 @@ std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t t
                          window_dev(s.index) / 2};
         break;      case Slot::fit_model: m = model_page(seq); break;
       case Slot::fit_parameter: m = parameter_page(seq, s.index); break;
+      case Slot::unconstrained: m = unconstrained_page(seq, s.index); break;
     }
     CanFrame f;
     EXPECT_EQ(encode(m, node, f), ProtocolError::none);
@@ -171,6 +187,91 @@ TEST(Decoder, ModelPagesAreKeptPerSlowCycleAcrossLostReports) {
   EXPECT_TRUE(w.fit_model.complete());           // seq 0-3 (256-259): the page of seq 0 came
 }
 
+// The uncertainty the codec makes of `u` (log2 in 1/256 steps): what the decoder can know.
+double on_the_wire(double u) {
+  CanFrame f;
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::angle_random_walk, 1.0f, u}, 1, f), ProtocolError::none);
+  return std::get<Ieee952UnconstrainedMsg>(decode(f).message).uncertainty;
+}
+
+TEST(Decoder, VerdictsJudgeTheUnconstrainedEstimateWhereTheNodeSendsIt) {
+  // Oracles: the values encoded (unconstrained_page, term pages 0.25 arcsec-based with 10 %), the
+  // codec's uncertainty grid (on_the_wire), 1 arcsec = units::arcsec rad, and the decision rule of
+  // limits.hpp: value -+ 1.959964 u, the lower bound not below 0; K's negative unconstrained square
+  // is judged as 0 (gyrochar-analyze's rule: Ieee952Parameter::unconstrained).
+  const std::vector<Limit> limits = parse_limits("Q <= 1 arcsec\nN <= 1 rad/s^0.5\nK <= 1 rad/s^1.5\n");
+  Feed feed;
+  for (std::uint8_t s = 0; s < 4; ++s) feed.frames(report(5, s, 8, 1000 + s * 100));
+  feed.decoder.flush();
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.health.frames_missing, 0u);
+  EXPECT_EQ(v.schedule_version(), 5);
+  const std::vector<Decision> d = node_decisions(v, limits);
+  ASSERT_EQ(d.size(), 3u);
+  // Q: no unconstrained estimate (not free): the shown value, and the verdict says so.
+  EXPECT_EQ(d[0].estimate.kind, estimate_shown);
+  EXPECT_DOUBLE_EQ(d[0].estimate.value, static_cast<double>(0.25f) * units::arcsec);
+  EXPECT_NE(d[0].reason.find("no unconstrained estimate"), std::string::npos) << d[0].reason;
+  // N: 0.3 arcsec/s^0.5 -+ z 0.05 (as the wire carries it).
+  const double n = static_cast<double>(0.3f) * units::arcsec, un = on_the_wire(0.05) * units::arcsec;
+  EXPECT_NEAR(on_the_wire(0.05), 0.05, 0.00136 * 0.05);
+  EXPECT_EQ(d[1].estimate.kind, estimate_unconstrained);
+  EXPECT_DOUBLE_EQ(d[1].estimate.value, n);
+  EXPECT_DOUBLE_EQ(d[1].estimate.high, n + decision_z * un);
+  EXPECT_DOUBLE_EQ(d[1].estimate.low, n - decision_z * un);
+  EXPECT_EQ(d[1].verdict, Verdict::pass);
+  EXPECT_EQ(d[1].reason, "upper bound within the limit");
+  // K: signed root -0.125: estimate 0, upper bound z 0.5 (as on the wire).
+  EXPECT_EQ(d[2].estimate.kind, estimate_unconstrained);
+  EXPECT_EQ(d[2].estimate.value, 0.0);
+  EXPECT_EQ(d[2].estimate.low, 0.0);
+  EXPECT_DOUBLE_EQ(d[2].estimate.high, decision_z * on_the_wire(0.5) * units::arcsec);
+  ASSERT_NE(v.unconstrained_estimate(3), nullptr);
+  EXPECT_EQ(v.unconstrained_estimate(3)->value, -0.125f) << "the sign travels";
+
+  // The same node at version 4: no unconstrained estimates; every term judged by its shown value.
+  Feed old;
+  for (std::uint8_t s = 0; s < 4; ++s) old.frames(report(5, s, 8, 1000 + s * 100, 0, 7, 4));
+  old.decoder.flush();
+  const NodeView& w = old.node(5);
+  EXPECT_EQ(w.health.frames_missing, 0u);
+  EXPECT_EQ(w.schedule_version(), 4);
+  const std::vector<Decision> e = node_decisions(w, limits);
+  for (const Decision& x : e) {
+    EXPECT_EQ(x.estimate.kind, estimate_shown);
+    EXPECT_NE(x.reason.find("(judged by the shown value: the node sends no unconstrained estimate)"), std::string::npos);
+  }
+  const double shown = static_cast<double>(0.25f) * units::arcsec;
+  EXPECT_DOUBLE_EQ(e[1].estimate.value, shown);
+  EXPECT_DOUBLE_EQ(e[1].estimate.high, shown * (1 + decision_z * 0.1));
+  EXPECT_DOUBLE_EQ(e[2].estimate.value, shown);
+}
+
+TEST(Decoder, AnUnconstrainedEstimateIsUsedOnlyWithTheTermFrameOfItsOwnSlowCycle) {
+  // 8 taus: N's unconstrained estimate comes in the first report of a cycle, its term page in the
+  // last. Cycle 1 without its unconstrained frames, then reports 4-6 of cycle 2: N's term page is
+  // still cycle 1's, and cycle 2's estimate (another fit, perhaps) is not taken for it. Report 7
+  // brings cycle 2's term page: now they belong together.
+  const std::vector<Limit> limits = parse_limits("N <= 1 rad/s^0.5\n");
+  const auto without_unconstrained = [](std::vector<CanFrame> fs) {
+    std::erase_if(fs, [](const CanFrame& f) { return (f.id & ~0xFFu) == unconstrained_id; });
+    return fs;
+  };
+  Feed feed;
+  for (std::uint8_t s = 0; s < 4; ++s) feed.frames(without_unconstrained(report(5, s, 8, 1000 + s * 100)));
+  for (std::uint8_t s = 4; s < 7; ++s) feed.frames(report(5, s, 8, 1000 + s * 100));
+  const NodeView& v = feed.node(5);
+  EXPECT_EQ(v.ieee952[1].cycle, 1u);
+  EXPECT_EQ(v.unconstrained[1].cycle, 2u);
+  EXPECT_EQ(v.unconstrained_estimate(1), nullptr);
+  EXPECT_EQ(node_decisions(v, limits)[0].estimate.kind, estimate_shown);
+  feed.frames(report(5, 7, 8, 1700));
+  EXPECT_EQ(v.ieee952[1].cycle, 2u);
+  ASSERT_NE(v.unconstrained_estimate(1), nullptr);
+  EXPECT_EQ(node_decisions(v, limits)[0].estimate.kind, estimate_unconstrained);
+  EXPECT_DOUBLE_EQ(node_decisions(v, limits)[0].estimate.value, static_cast<double>(0.3f) * units::arcsec);
+}
+
 TEST(Decoder, VersionOneNodeHasNoSummaryAndMissesNothing) {
   // A version-1 node's reports have no summary frame: the decoder expects none (its clock page says
   // version 1), and reads Resolved as fitted.
@@ -206,10 +307,10 @@ TEST(Decoder, VersionTwoNodeJoinedLateMissesNothingAndItsLostSummaryCounts) {
 }
 
 TEST(Decoder, UnknownProtocolVersionStopsDecodingUntilAKnownOneReturns) {
-  // docs/protocol.md 2.2. A node announcing version 5 (its clock page, in report 0 of the 4-report
+  // docs/protocol.md 2.2. A node announcing version 6 (its clock page, in report 0 of the 4-report
   // slow cycle, comes after the 2 + 2 x 8 fast frames and the sampling page) is decoded no further: the frames after
   // its clock page and of its next reports are counted as not decoded and change no value. When it
-  // announces version 4 (this decoder's) again, a new session starts.
+  // announces version 5 (this decoder's) again, a new session starts.
   Feed feed;
   std::vector<DecoderEvent> events;
   feed.decoder = Decoder([&](DecoderEvent e, const NodeView&, std::uint8_t) { events.push_back(e); });

@@ -318,7 +318,9 @@ TEST(ToolErrors, LimitsSummaryAndReportNameTheirRule) {
   expect("gyrochar-decode", "/dev/null --plot-every 5", bad, "--plot-every: needs --plot PREFIX or --report FILE.html");
   expect("gyrochar-decode", "/dev/null --limits /nonexistent-dir/limits.txt", bad,
          "--limits: /nonexistent-dir/limits.txt: cannot be read");
-  expect("gyrochar-demo", "--limits /dev/null", bad, "--limits: the demo shows verdicts on its live page only: give --http too");
+  expect("gyrochar-demo", "--csv '' --limits /dev/null", bad,
+         "--limits: the demo shows verdicts on its live page (--http) and in its CSV (--csv): give one of them");
+  expect("gyrochar-demo", "--limits /dev/null", bad, "--limits: /dev/null: no limit in the file");
   expect("gyrochar-demo", "--http 127.0.0.1:0 --limits /nonexistent-dir/limits.txt", bad,
          "--limits: /nonexistent-dir/limits.txt: cannot be read");
 }

@@ -138,6 +138,9 @@ struct Ieee952Parameter {
   // where the model holds (the non-negative value above leans low or high where another term is
   // clipped at zero); 0 and 0 where the term was not free. What acceptance verdicts judge.
   double unconstrained = 0, unconstrained_uncertainty = 0;
+  // The signed root of that unconstrained square s, sign(s) sqrt(|s|): negative where s is (and
+  // `unconstrained` 0); 0 where the term was not free. What the CAN protocol carries (version 5).
+  double unconstrained_signed = 0;
 };
 
 /// A Markov term of the fit: sigma its stationary standard deviation [r/s], Tc its correlation time.

@@ -25,6 +25,8 @@ constexpr std::uint64_t min_window_length = 4;  // the shortest window holds an 
 constexpr unsigned window_dev_code_bits = 22;
 constexpr double window_dev_codes_per_octave = 16384.0;  // log2(dev) = code / 2^14 - 128; code 0: none
 constexpr double window_dev_log2_offset = -128.0;
+constexpr double uncertainty_codes_per_octave = 256.0;  // Ieee952Unconstrained: log2(u) = code / 256 - 128; 0: none
+constexpr double uncertainty_log2_offset = -128.0;
 
 // --- little-endian fields --------------------------------------------------------------------
 
@@ -75,6 +77,14 @@ std::uint32_t window_dev_code(double dev) {
 }
 double window_dev_from_code(std::uint32_t c) {
   return c == 0 ? 0.0 : std::exp2(c / window_dev_codes_per_octave + window_dev_log2_offset);
+}
+std::uint16_t uncertainty_code(double u) {
+  if (u == 0.0) return 0;
+  const double c = std::round(uncertainty_codes_per_octave * (std::log2(u) - uncertainty_log2_offset));
+  return static_cast<std::uint16_t>(c < 1.0 ? 1.0 : c > 65535.0 ? 65535.0 : c);
+}
+double uncertainty_from_code(unsigned c) {
+  return c == 0 ? 0.0 : std::exp2(c / uncertainty_codes_per_octave + uncertainty_log2_offset);
 }
 std::uint16_t rel_uncertainty_code(double rel) {
   const double c = std::round(rel / rel_uncertainty_step);
@@ -146,6 +156,10 @@ ProtocolError check(const Ieee952ModelMsg& m) {
                m.bandwidth_excluded_below_log2_m < (1u << excluded_code_bits) &&
                m.runner_up_markov <= wire_markov_terms && m.runner_up_sinusoids <= wire_sinusoids &&
                std::isfinite(m.criterion_margin) && (m.runner_up || runner_up_blank));
+}
+ProtocolError check(const Ieee952UnconstrainedMsg& m) {
+  return ok_if(m.term <= Ieee952Term::rate_ramp && std::isfinite(m.value) && nonnegative(m.uncertainty) &&
+               (m.uncertainty > 0.0 || m.value == 0.0f));
 }
 ProtocolError check(const CounterInputMsg&) { return ProtocolError::none; }
 
@@ -317,6 +331,18 @@ ProtocolError decode_ieee952(const CanFrame& f, Message& out) {
   m.fitted = (f.data[0] & ieee952_fitted_bit) != 0;
   m.value = get_float(f, 2);
   m.rel_uncertainty = static_cast<double>(get(f, 6, 2)) * rel_uncertainty_step;
+  return accept(m, out);
+}
+
+ProtocolError decode_unconstrained(const CanFrame& f, Message& out) {
+  const unsigned page = f.data[0] & 7u;
+  if (page > code(Ieee952Term::rate_ramp)) return ProtocolError::unknown_page;
+  if (f.data[0] & 0xF8u) return ProtocolError::reserved_bits;
+  Ieee952UnconstrainedMsg m;
+  m.seq = f.data[1];
+  m.term = static_cast<Ieee952Term>(page);
+  m.value = get_float(f, 2);
+  m.uncertainty = uncertainty_from_code(static_cast<unsigned>(get(f, 6, 2)));
   return accept(m, out);
 }
 
@@ -504,6 +530,15 @@ ProtocolError encode(const Ieee952ModelMsg& msg, std::uint8_t node, CanFrame& fr
   });
 }
 
+ProtocolError encode(const Ieee952UnconstrainedMsg& msg, std::uint8_t node, CanFrame& frame) {
+  return encode_with(msg, node, unconstrained_id, report_len, frame, [&](CanFrame& f) {
+    f.data[0] = u8(code(msg.term));
+    f.data[1] = msg.seq;
+    put_float(f, 2, msg.value);
+    put(f, 6, 2, uncertainty_code(msg.uncertainty));
+  });
+}
+
 ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame) {
   return encode_with(msg, node, counter_input_id, counter_input_len, frame, [&](CanFrame& f) {
     put(f, 0, 4, msg.count);
@@ -529,7 +564,8 @@ Decoded decode(const CanFrame& frame) {
   const std::uint32_t base = frame.id & ~std::uint32_t{0xFF};
   const bool known = frame.id <= id_mask && (base == status_id || base == tau_stats_id ||
                                              base == metadata_id || base == ieee952_id ||
-                                             base == window_id || base == counter_input_id);
+                                             base == window_id || base == unconstrained_id ||
+                                             base == counter_input_id);
   if (!known) return fail(ProtocolError::unknown_id);
   out.node = u8(frame.id & 0xFFu);  // set before any later refusal: the frame is counted against its node
   if (out.node > max_node_address) return fail(ProtocolError::bad_address);
@@ -542,6 +578,7 @@ Decoded decode(const CanFrame& frame) {
     case metadata_id: out.error = decode_metadata(frame, out.message); break;
     case ieee952_id: out.error = decode_ieee952(frame, out.message); break;
     case window_id: out.error = decode_window(frame, out.message); break;
+    case unconstrained_id: out.error = decode_unconstrained(frame, out.message); break;
     default: out.error = decode_counter_input(frame, out.message); break;
   }
   return out;

@@ -50,6 +50,15 @@ constexpr std::size_t model_part_length(std::uint8_t protocol_version) {
   return (model_list_length(protocol_version) + slow_cycle_reports - 1) / slow_cycle_reports;
 }
 
+/// The unconstrained list (version 5): the Ieee952Unconstrained frames of Q N B K R. Cut into parts
+/// like the slow list.
+constexpr std::size_t unconstrained_list_length(std::uint8_t protocol_version) {
+  return protocol_version >= 5 ? ieee952_terms : 0;
+}
+constexpr std::size_t unconstrained_part_length(std::uint8_t protocol_version) {
+  return (unconstrained_list_length(protocol_version) + slow_cycle_reports - 1) / slow_cycle_reports;
+}
+
 /// Entry j of the slow list: metadata pages, tau info for every tau, terms for every tau, IEEE-952
 /// terms, then the fit summary (version 2; the caller keeps j below the version's list length).
 ReportSlot slow_slot(std::size_t j, std::size_t tau_count) {
@@ -87,12 +96,18 @@ std::size_t frames_before_model(std::uint8_t seq, std::size_t tau_count, std::ui
   return frames_before_window(seq, tau_count, protocol_version) +
          part_of(seq, window_list_length(window_taus, protocol_version), window_part_length(window_taus, protocol_version));
 }
+/// Frames of report seq before its unconstrained part: those and its part of the model list.
+std::size_t frames_before_unconstrained(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version,
+                                        std::size_t window_taus) {
+  return frames_before_model(seq, tau_count, protocol_version, window_taus) +
+         part_of(seq, model_list_length(protocol_version), model_part_length(protocol_version));
+}
 }  // namespace
 
 std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version,
                                std::size_t window_taus) {
-  return frames_before_model(seq, tau_count, protocol_version, window_taus) +
-         part_of(seq, model_list_length(protocol_version), model_part_length(protocol_version));
+  return frames_before_unconstrained(seq, tau_count, protocol_version, window_taus) +
+         part_of(seq, unconstrained_list_length(protocol_version), unconstrained_part_length(protocol_version));
 }
 
 ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position, std::uint8_t protocol_version,
@@ -110,7 +125,12 @@ ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t posi
   if (position < before_model)
     return window_slot(seq % slow_cycle_reports * window_part_length(window_taus, protocol_version) + position -
                        before_window);
-  return model_slot(seq % slow_cycle_reports * model_part_length(protocol_version) + position - before_model);
+  const std::size_t before_unconstrained = frames_before_unconstrained(seq, tau_count, protocol_version, window_taus);
+  if (position < before_unconstrained)
+    return model_slot(seq % slow_cycle_reports * model_part_length(protocol_version) + position - before_model);
+  return {Slot::unconstrained, std::uint8_t(static_cast<unsigned>(seq % slow_cycle_reports *
+                                                                   unconstrained_part_length(protocol_version) +
+                                                                   position - before_unconstrained))};
 }
 
 double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps, std::size_t window_taus) {

@@ -1,9 +1,10 @@
 #pragma once
-// The gyrochar CAN protocol, version 4: one value type per frame kind, encode() and decode()
+// The gyrochar CAN protocol, version 5: one value type per frame kind, encode() and decode()
 // between those values and CanFrame, and the report schedule. The codec decodes the frames of
-// versions 1 to 3 too (each version only adds: version 2 the IEEE-952 fit summary page and the
+// versions 1 to 4 too (each version only adds: version 2 the IEEE-952 fit summary page and the
 // Fitted flag of the term frames, version 3 the Window message of the dynamic Allan deviation,
-// version 4 the Ieee952 model and parameter pages of the fit's selected model),
+// version 4 the Ieee952 model and parameter pages of the fit's selected model, version 5 the
+// Ieee952Unconstrained message: each term's unconstrained estimate, what verdicts judge),
 // and the schedule of every version is available. docs/protocol.md is the specification,
 // docs/gyrochar.dbc describes the same frames for CAN tools (tests/dbc checks it against this codec).
 // The board firmware and the host decoder both use this codec; there is no other.
@@ -22,7 +23,7 @@
 
 namespace gyrochar::protocol {
 
-inline constexpr std::uint8_t version = 4;             // what this codec's nodes send
+inline constexpr std::uint8_t version = 5;             // what this codec's nodes send
 inline constexpr std::uint8_t oldest_version = 1;      // the oldest version decoders accept
 inline constexpr std::size_t max_taus = 64;          // tau index is 6 bits
 inline constexpr std::uint8_t max_node_address = 0xFD;  // J1939: 0xFE null, 0xFF global
@@ -33,6 +34,7 @@ inline constexpr std::uint32_t tau_stats_id = 0x18FF4100;      // priority 6, ev
 inline constexpr std::uint32_t metadata_id = 0x18FF4200;       // priority 6, slow cycle
 inline constexpr std::uint32_t ieee952_id = 0x18FF4300;        // priority 6, slow cycle
 inline constexpr std::uint32_t window_id = 0x18FF4400;         // priority 6, slow cycle (version 3)
+inline constexpr std::uint32_t unconstrained_id = 0x18FF4500;  // priority 6, slow cycle (version 5)
 inline constexpr std::uint32_t counter_input_id = 0x0CFF5000;  // priority 3, gyro electronics -> board
 
 constexpr std::uint32_t frame_id(std::uint32_t base, std::uint8_t node) { return base | node; }
@@ -283,6 +285,26 @@ struct Ieee952ModelMsg {
   bool operator==(const Ieee952ModelMsg&) const = default;
 };
 
+/// The unconstrained estimate of one IEEE-952 term (message Ieee952Unconstrained, version 5), in the
+/// slow cycle, from the fit every Ieee952 frame of its cycle describes: the term in the model with
+/// every free term, its square not held non-negative (gyrochar::Ieee952Parameter::unconstrained).
+/// The term pages carry the non-negative fit's value, which leans low where another term is clipped
+/// at zero; acceptance verdicts judge this estimate.
+struct Ieee952UnconstrainedMsg {
+  std::uint8_t seq = 0;
+  Ieee952Term term = Ieee952Term::quantization;
+  /// The signed root of the unconstrained estimate s of the term's square, sign(s) sqrt(|s|), in the
+  /// term's unit: negative where s is (the estimate for a verdict is then 0); finite. 0 without an
+  /// estimate.
+  float value = 0.0f;
+  /// Its standard uncertainty (Ieee952Parameter::unconstrained_uncertainty), in the term's unit,
+  /// >= 0 and finite; 0: no estimate (the term was not free in the fit, or no fit), and then value
+  /// is 0. On the wire as log2 in 1/256 steps (relative rounding error at most 0.14 %), clamped to
+  /// [2^(1/256 - 128), 2^(128 - 1/256)].
+  double uncertainty = 0.0;
+  bool operator==(const Ieee952UnconstrainedMsg&) const = default;
+};
+
 /// Window page 0 (version 3): which window of the node's dynamic Allan deviation the Window frames
 /// of this slow cycle describe. The node restarts a second characterizer every `length` samples
 /// (WindowLengthMsg); window k covers the samples k length .. (k+1) length - 1 of the SampleCount.
@@ -332,7 +354,7 @@ struct CounterInputMsg {
 using Message = std::variant<StatusMsg, StatusFaultsMsg, TauDevMsg, TauTermsMsg, TauInfoMsg,
                              MetaSamplingMsg, MetaClockMsg, MetaScaleMsg, MetaConfigMsg, Ieee952Msg,
                              CounterInputMsg, Ieee952SummaryMsg, WindowMsg, WindowLengthMsg, WindowDevMsg,
-                             Ieee952ParameterMsg, Ieee952ModelMsg>;
+                             Ieee952ParameterMsg, Ieee952ModelMsg, Ieee952UnconstrainedMsg>;
 
 // ---------------------------------------------------------------------------------------------
 // Codec
@@ -341,7 +363,7 @@ enum class ProtocolError : std::uint8_t {
   none = 0,
   error_frame,    // the controller reported an error frame
   not_extended,   // 11-bit identifier
-  fd_frame,       // CAN FD frame: protocol versions 1 to 4 are classic CAN only
+  fd_frame,       // CAN FD frame: protocol versions 1 to 5 are classic CAN only
   unknown_id,     // not one of the identifiers above (PGN or priority differ)
   bad_address,    // node address 0xFE or 0xFF
   wrong_length,   // data length differs from the frame kind's (8, counter input 6)
@@ -381,6 +403,7 @@ ProtocolError encode(const WindowLengthMsg& msg, std::uint8_t node, CanFrame& fr
 ProtocolError encode(const WindowDevMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Ieee952ParameterMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Ieee952ModelMsg& msg, std::uint8_t node, CanFrame& frame);
+ProtocolError encode(const Ieee952UnconstrainedMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const CounterInputMsg& msg, std::uint8_t node, CanFrame& frame);
 ProtocolError encode(const Message& msg, std::uint8_t node, CanFrame& frame);
 
@@ -411,31 +434,36 @@ Decoded decode(const CanFrame& frame);
 // where version 1's 9 + 2T is odd, so both cut into parts of the same length ceil(L/4): every frame
 // keeps its position, and one report of the cycle has one frame more. Version 3 keeps every
 // version-2 position too: the window part follows them; version 4 keeps every version-3 position:
-// the model part follows the window part.
+// the model part follows the window part. From version 5 every report appends a part of the
+// unconstrained list (the Ieee952Unconstrained frames of Q N B K R), cut the same way, after its
+// model part; every version-4 position stays.
 
 inline constexpr std::size_t slow_cycle_reports = 4;
 
 enum class Slot : std::uint8_t {
   status, faults, adev, mdev, terms, tau_info, sampling, clock, scale, config, ieee952,
   window, window_length, window_dev,  // version 3
-  fit_model, fit_parameter            // version 4
+  fit_model, fit_parameter,           // version 4
+  unconstrained                       // version 5
 };
-inline constexpr std::size_t slot_kinds = 16;
+inline constexpr std::size_t slot_kinds = 17;
 struct ReportSlot {
   Slot slot = Slot::status;
   std::uint8_t index = 0;  // tau index (adev, mdev, terms, tau_info, window_dev); for ieee952 the
                            // page: an Ieee952Term (0-4) or ieee952_summary_page (5); for
-                           // fit_parameter the position in fit_parameter_slot()'s order
+                           // fit_parameter the position in fit_parameter_slot()'s order; for
+                           // unconstrained the Ieee952Term
 };
 
 /// Number of frames in report `seq` for `tau_count` taus (<= max_taus) and `window_taus` window
 /// taus (<= tau_count; 0: no window, and for versions 1 and 2) of a node speaking
-/// `protocol_version` (1, 2, 3, or 4 and above: the current schedule).
+/// `protocol_version` (1, 2, 3, 4, or 5 and above: the current schedule).
 std::size_t report_frame_count(std::uint8_t seq, std::size_t tau_count, std::uint8_t protocol_version = version,
                                std::size_t window_taus = 0);
 /// Frame `position` (< report_frame_count()) of report `seq`, in sending order: status, faults,
 /// ADEV and MDEV of tau 0, 1, ..., then this report's part of the slow list, then (version 3) its
-/// part of the window list, then (version 4) its part of the model list.
+/// part of the window list, then (version 4) its part of the model list, then (version 5) its part
+/// of the unconstrained list.
 ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t position,
                        std::uint8_t protocol_version = version, std::size_t window_taus = 0);
 
