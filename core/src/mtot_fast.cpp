@@ -185,17 +185,27 @@ struct EndWindows {
 Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail,
                  std::span<double> (&X)[4], Theo1Workspace& w) {
   const Pos len = g.len, h = g.h;
-  const Index L = static_cast<Index>(len);
-  autocorrelation_sum(head, tail, fft_length(2 * L), w);
-  for (Index p = 1; p <= L; ++p) X[3][p] = w.buffer[L - p];
-  X[3][0] = 0.0;
-  const Index n = fft_length(static_cast<Index>(h + len));
+  const Index L = static_cast<Index>(len), H = static_cast<Index>(h);
   for (Index p = 0; p <= L; ++p) X[1][p] = 0.0;
-  for (const std::span<const double> Sp : {head, tail}) {
-    cross_correlation(Sp.first(static_cast<Index>(h)), Sp, n, w);
-    for (Pos p = 0; p <= len; ++p) X[1][static_cast<Index>(p)] += w.buffer[static_cast<Index>(p - h >= 0 ? p - h : p - h + static_cast<Pos>(n))];
+  X[3][0] = 0.0;
+  const Index n = fft_length(2 * L);  // at least h + len: no wrap-around for X[1] either
+  if (4 * n <= w.buffer.size()) {
+    // X[3] and X[1] from three FFTs: the ends' autocorrelations and their correlations with their
+    // first h values, both real, come back together from one inverse (docs/total.md).
+    ends_correlations(head, tail, H, n, w);
+    const double* d = w.buffer.data();
+    const double scale = 1.0 / static_cast<double>(n);
+    for (Index p = 1; p <= L; ++p) X[3][p] = d[2 * (L - p)] * scale;
+    for (Index p = 0; p <= L; ++p) X[1][p] = d[2 * ((p + n - H) % n) + 1] * scale;
+  } else {  // the buffer holds one spectrum of length n, not two: six FFTs
+    autocorrelation_sum(head, tail, n, w);
+    for (Index p = 1; p <= L; ++p) X[3][p] = w.buffer[L - p];
+    const Index c = fft_length(H + L);
+    for (const std::span<const double> Sp : {head, tail}) {
+      cross_correlation(Sp.first(H), Sp, c, w);
+      for (Index p = 0; p <= L; ++p) X[1][p] += w.buffer[(p + c - H) % c];
+    }
   }
-  const Index H = static_cast<Index>(h);
   X[2][0] = 0.0;
   for (Index p = 1; p <= L; ++p)
     X[2][p] = len % 2 == 0 ? X[1][p] : X[1][p - 1] + (p >= 2 ? head[H] * head[p - 1] + tail[H] * tail[p - 1] : 0.0);

@@ -16,6 +16,19 @@ double as_double(std::uint64_t v) { return static_cast<double>(v); }
 // n - k: `for_each_mirror_pair` gives both positions.
 constexpr Index cached = 2048;  // complex values a block keeps in the first-level cache
 
+// The twiddle table (fft_twiddles): the stages len <= cached whole, exp(2 pi i k / len) at complex
+// index len / 2 + k; each larger stage, up to P, as two short lists from which its twiddle k = c fine
+// + j is one complex product: exp(2 pi i j / len) for j < fine, then exp(2 pi i c fine / len) for c <
+// len / (2 fine). 2 fine + len / fine doubles a stage instead of len: at P = 2^25 the table is 1.5 MB
+// instead of 512 MB (docs/total.md, "The twiddle table").
+constexpr Index fine = 256;
+// Complex offset of stage len's lists (len > cached, a power of two).
+Index large_stage(Index len) {
+  Index at = cached;
+  for (Index s = 2 * cached; s < len; s *= 2) at += fine + s / (2 * fine);
+  return at;
+}
+
 // One stage's butterflies on a block of 2 half values, u its first half, t its second; tw the
 // stage's twiddles. Forward (decimation in frequency): u + t, (u - t) w^-k. Inverse (in time):
 // u + t w^k, u - t w^k.
@@ -37,10 +50,39 @@ void inverse_butterflies(double* u, double* t, const double* tw, Index half) {
   }
 }
 
+// The same over a stage larger than cached, its twiddles from the stage's two lists (large_stage).
+void forward_butterflies_large(double* u, double* t, const double* stage, Index half) {
+  const double* coarse = stage + 2 * fine;
+  for (Index c = 0; c * fine < half; ++c, u += 2 * fine, t += 2 * fine) {
+    const double cr = coarse[2 * c], ci = coarse[2 * c + 1];
+    for (Index k = 0; k < fine; ++k) {
+      const double fr = stage[2 * k], fi = stage[2 * k + 1];
+      const double ar = u[2 * k], ai = u[2 * k + 1], br = t[2 * k], bi = t[2 * k + 1];
+      const double wr = cr * fr - ci * fi, wi = -(cr * fi + ci * fr);
+      u[2 * k] = ar + br, u[2 * k + 1] = ai + bi;
+      const double dr = ar - br, di = ai - bi;
+      t[2 * k] = dr * wr - di * wi, t[2 * k + 1] = dr * wi + di * wr;
+    }
+  }
+}
+void inverse_butterflies_large(double* u, double* t, const double* stage, Index half) {
+  const double* coarse = stage + 2 * fine;
+  for (Index c = 0; c * fine < half; ++c, u += 2 * fine, t += 2 * fine) {
+    const double cr = coarse[2 * c], ci = coarse[2 * c + 1];
+    for (Index k = 0; k < fine; ++k) {
+      const double fr = stage[2 * k], fi = stage[2 * k + 1];
+      const double wr = cr * fr - ci * fi, wi = cr * fi + ci * fr;
+      const double br = t[2 * k] * wr - t[2 * k + 1] * wi, bi = t[2 * k] * wi + t[2 * k + 1] * wr;
+      t[2 * k] = u[2 * k] - br, t[2 * k + 1] = u[2 * k + 1] - bi;
+      u[2 * k] += br, u[2 * k + 1] += bi;
+    }
+  }
+}
+
 void forward_bitreversed(double* d, Index n, const double* table) {
   if (n > cached) {  // one stage over the whole, then each half while it stays in the cache
     const Index half = n / 2;
-    forward_butterflies(d, d + 2 * half, table + 2 * half, half);
+    forward_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
     forward_bitreversed(d, half, table);
     forward_bitreversed(d + 2 * half, half, table);
     return;
@@ -54,7 +96,7 @@ void inverse_from_bitreversed(double* d, Index n, const double* table) {
     const Index half = n / 2;
     inverse_from_bitreversed(d, half, table);
     inverse_from_bitreversed(d + 2 * half, half, table);
-    inverse_butterflies(d, d + 2 * half, table + 2 * half, half);
+    inverse_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
     return;
   }
   for (Index len = 2; len <= n; len *= 2)
@@ -251,19 +293,29 @@ std::size_t fft_length(std::size_t n) {
   return p;
 }
 
+std::size_t fft_twiddle_size(std::size_t P) {
+  return P <= cached ? 2 * P : 2 * large_stage(2 * P);
+}
+
 void fft_twiddles(std::span<double> twiddle, std::size_t P) {
-  // Stage by stage, each contiguous: exp(2 pi i k / len) at complex index len / 2 + k, k < len / 2;
-  // the largest stage computed, each smaller one read from the one above it.
-  const double step = 2.0 * std::numbers::pi / static_cast<double>(P);
-  for (Index k = 0; 2 * k < P; ++k) {
-    twiddle[2 * (P / 2 + k)] = std::cos(step * static_cast<double>(k));
-    twiddle[2 * (P / 2 + k) + 1] = std::sin(step * static_cast<double>(k));
-  }
-  for (Index len = P / 2; len >= 2; len /= 2)  // every other value of the stage above: two streams
+  // The whole stages, each contiguous: the largest computed, each smaller one read from the one
+  // above it (every other value: two streams).
+  const Index top = P < cached ? P : cached;
+  auto cis = [&](Index at, Index k, Index len) {  // exp(2 pi i k / len) at complex index `at`
+    const double a = 2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(len);
+    twiddle[2 * at] = std::cos(a), twiddle[2 * at + 1] = std::sin(a);
+  };
+  for (Index k = 0; 2 * k < top; ++k) cis(top / 2 + k, k, top);
+  for (Index len = top / 2; len >= 2; len /= 2)
     for (Index k = 0; 2 * k < len; ++k) {
       twiddle[2 * (len / 2 + k)] = twiddle[2 * (len + 2 * k)];
       twiddle[2 * (len / 2 + k) + 1] = twiddle[2 * (len + 2 * k) + 1];
     }
+  for (Index len = 2 * cached; len <= P; len *= 2) {  // the larger stages' two lists
+    const Index at = large_stage(len);
+    for (Index j = 0; j < fine; ++j) cis(at + j, j, len);
+    for (Index c = 0; c * fine < len / 2; ++c) cis(at + fine + c, c * fine, len);
+  }
 }
 
 void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle, bool inverse) {
@@ -311,8 +363,37 @@ void autocorrelation_sum(std::span<const double> a, std::span<const double> b, s
   for (Index e = 0; e < n; ++e) d[e] = d[2 * e] / as_double(n);
 }
 
+void ends_correlations(std::span<const double> a, std::span<const double> b, std::size_t first, std::size_t n,
+                       Theo1Workspace& w) {
+  // Two spectra: of a + i b and of their first values. Per pair of frequencies k, n - k the four real
+  // sequences' spectra (as in `combine`), then S = |A|^2 + |B|^2 (real, even) and C = conj(A_first) A
+  // + conj(B_first) B (the spectrum of a real correlation: C at n - k is conj C), and one inverse of
+  // S + i C: both real results at once.
+  double* d = w.buffer.data();
+  double* e = d + 2 * n;
+  load(d, n, a, b);
+  load(e, n, a.first(first), b.first(first));
+  forward_bitreversed(d, n, w.twiddle.data());
+  forward_bitreversed(e, n, w.twiddle.data());
+  auto split = [](const double* z, const double* v, double (&s)[4]) {  // A (re, im), B (re, im) at k
+    s[0] = 0.5 * (z[0] + v[0]), s[1] = 0.5 * (z[1] - v[1]), s[2] = 0.5 * (z[1] + v[1]), s[3] = -0.5 * (z[0] - v[0]);
+  };
+  for_each_mirror_pair(n, [d, e, &split](Index p, Index q, Index) {
+    double whole[4], head[4];
+    split(d + 2 * p, d + 2 * q, whole);
+    split(e + 2 * p, e + 2 * q, head);
+    const double S = whole[0] * whole[0] + whole[1] * whole[1] + whole[2] * whole[2] + whole[3] * whole[3];
+    const double cr = head[0] * whole[0] + head[1] * whole[1] + head[2] * whole[2] + head[3] * whole[3];
+    const double ci = head[0] * whole[1] - head[1] * whole[0] + head[2] * whole[3] - head[3] * whole[2];
+    d[2 * p] = S - ci, d[2 * p + 1] = cr;  // S + i C at k; at n - k S + i conj C (the same where q = p)
+    d[2 * q] = S + ci, d[2 * q + 1] = cr;
+  });
+  inverse_from_bitreversed(d, n, w.twiddle.data());
+}
+
 std::size_t theo1_workspace_size(std::size_t n_phase) {
-  return 6 * n_phase + 2 + 4 * fft_length(2 * n_phase);
+  const std::size_t P = fft_length(2 * n_phase);
+  return 6 * n_phase + 2 + fft_twiddle_size(P) + 2 * P;
 }
 
 Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) {
@@ -327,7 +408,7 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) 
     return s;
   };
   w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N), w.ends = take(2 * N);
-  w.twiddle = take(2 * w.P), w.buffer = take(2 * w.P);
+  w.twiddle = take(fft_twiddle_size(w.P)), w.buffer = take(2 * w.P);
   // Least-squares quadratic of d = x - x[0] in the orthogonal basis 1, t, t^2 - mean(t^2) (t centred,
   // symmetric), fitted and removed in long double: the residual then carries the rounding of its
   // own size, not that of the phase values (a 1e-3 ramp over 1e-12 noise keeps its noise).

@@ -25,13 +25,17 @@ std::size_t fft_length(std::size_t n);
 /// In-place complex FFT of `data` (n interleaved re, im pairs, n a power of two up to the table's
 /// length): forward exp(-2 pi i k p / n), inverse exp(+2 pi i k p / n) unscaled. O(n log n).
 void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle, bool inverse);
-/// Fills the twiddle table of FFTs up to length P (2 P doubles: cos, sin of 2 pi k / len at complex
-/// index len / 2 + k for every stage len <= P, k < len / 2). O(P).
+/// Doubles of the twiddle table of FFTs up to length P (a power of two): 2 P up to P = 2048, then
+/// about 2 P / 256 (1.5 MB at P = 2^25). O(log P).
+std::size_t fft_twiddle_size(std::size_t P);
+/// Fills the twiddle table of FFTs up to length P (fft_twiddle_size(P) doubles): cos, sin of 2 pi k /
+/// len for every stage len <= P, k < len / 2, the stages up to 2048 whole, each larger one as two
+/// short lists whose products are its twiddles (total_fast.cpp). O(P / 256 + 2048).
 void fft_twiddles(std::span<double> twiddle, std::size_t P);
 
 /// Doubles of workspace theo1_prepare needs for a record of N phase points: the residual, its two
-/// prefix sums, its autocorrelation, the ends' pieces (6 N + 2) and the FFT's twiddles and
-/// buffer (4 P, P = fft_length(2 N)).
+/// prefix sums, its autocorrelation, the ends' pieces (6 N + 2), the FFT's twiddles
+/// (fft_twiddle_size(P)) and buffer (2 P), P = fft_length(2 N).
 std::size_t theo1_workspace_size(std::size_t n_phase);
 
 struct Theo1Workspace {
@@ -62,6 +66,13 @@ void cross_correlation(std::span<const double> a, std::span<const double> b, std
 /// a[p] a[p+e], by one FFT pair of length n (as cross_correlation): left at w.buffer[e] for
 /// 0 <= e < n - max(a.size(), b.size()). O(n log n).
 void autocorrelation_sum(std::span<const double> a, std::span<const double> b, std::size_t n, Theo1Workspace& w);
+
+/// For two real sequences a and b of equal length and their first `first` values: acf(a)(e) +
+/// acf(b)(e), and c(e) = sum over p < first of a[p] a[p+e] + b[p] b[p+e], both times n, left at
+/// w.buffer[2 (e mod n)] and w.buffer[2 (e mod n) + 1] for e in (-n, n) (n a power of two, n >=
+/// 2 a.size(), 4 n doubles of buffer). Three FFTs of length n. O(n log n).
+void ends_correlations(std::span<const double> a, std::span<const double> b, std::size_t first, std::size_t n,
+                       Theo1Workspace& w);
 
 /// Doubles of scratch mtotvar_fast needs beside a prepared Theo1Workspace of N points: 8 N + 16.
 std::size_t mtotvar_scratch_size(std::size_t n_phase);
