@@ -16,16 +16,18 @@ double as_double(std::uint64_t v) { return static_cast<double>(v); }
 // n - k: `for_each_mirror_pair` gives both positions.
 constexpr Index cached = 2048;  // complex values a block keeps in the first-level cache
 
-// The twiddle table (fft_twiddles): the stages len <= cached whole, exp(2 pi i k / len) at complex
-// index len / 2 + k; each larger stage, up to P, as two short lists from which its twiddle k = c fine
-// + j is one complex product: exp(2 pi i j / len) for j < fine, then exp(2 pi i c fine / len) for c <
-// len / (2 fine). 2 fine + len / fine doubles a stage instead of len: at P = 2^25 the table is 1.5 MB
-// instead of 512 MB (docs/total.md, "The twiddle table").
+// The twiddle table (fft_twiddles): the stages len <= whole_up_to whole, exp(2 pi i k / len) at complex
+// index len / 2 + k (1 MB: they stay in the second-level cache); each larger stage, up to P, as two
+// short lists from which its twiddle k = c fine + j is one complex product: exp(2 pi i j / len) for
+// j < fine, then exp(2 pi i c fine / len) for c < len / (2 fine). 2 fine + len / fine doubles a stage
+// instead of len: at P = 2^25 the table is 2.5 MB instead of 512 MB (docs/total.md, "The twiddle
+// table"). The stages above `whole_up_to` stream from main memory: they also go two in one pass.
+constexpr Index whole_up_to = Index{1} << 16;
 constexpr Index fine = 256;
-// Complex offset of stage len's lists (len > cached, a power of two).
+// Complex offset of stage len's lists (len > whole_up_to, a power of two).
 Index large_stage(Index len) {
-  Index at = cached;
-  for (Index s = 2 * cached; s < len; s *= 2) at += fine + s / (2 * fine);
+  Index at = whole_up_to;
+  for (Index s = 2 * whole_up_to; s < len; s *= 2) at += fine + s / (2 * fine);
   return at;
 }
 
@@ -50,7 +52,7 @@ void inverse_butterflies(double* u, double* t, const double* tw, Index half) {
   }
 }
 
-// The same over a stage larger than cached, its twiddles from the stage's two lists (large_stage).
+// The same over a stage larger than whole_up_to, its twiddles from the stage's two lists (large_stage).
 void forward_butterflies_large(double* u, double* t, const double* stage, Index half) {
   const double* coarse = stage + 2 * fine;
   for (Index c = 0; c * fine < half; ++c, u += 2 * fine, t += 2 * fine) {
@@ -79,13 +81,13 @@ void inverse_butterflies_large(double* u, double* t, const double* stage, Index 
   }
 }
 
-// The twiddles of stage len: from the whole stages (len <= cached) or as the product of the large
+// The twiddles of stage len: from the whole stages (len <= whole_up_to) or as the product of the large
 // stage's two lists, the same product as the butterflies above.
 struct StageTwiddles {
   const double* at;
   bool large;
   StageTwiddles(const double* table, Index len)
-      : at(len <= cached ? table + len : table + 2 * large_stage(len)), large(len > cached) {}
+      : at(len <= whole_up_to ? table + len : table + 2 * large_stage(len)), large(len > whole_up_to) {}
   void get(Index k, double& wr, double& wi) const {
     if (!large) {
       wr = at[2 * k], wi = at[2 * k + 1];
@@ -150,14 +152,15 @@ void inverse_two_stages(double* d, Index n, const double* table) {
 }
 
 void forward_bitreversed(double* d, Index n, const double* table) {
-  if (n / 2 > cached) {  // two stages over the whole, then each quarter
+  if (n / 2 > whole_up_to) {  // two stages over the whole, then each quarter
     forward_two_stages(d, n, table);
     for (Index i = 0; i < 4; ++i) forward_bitreversed(d + 2 * i * (n / 4), n / 4, table);
     return;
   }
   if (n > cached) {  // one stage over the whole, then each half while it stays in the cache
     const Index half = n / 2;
-    forward_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
+    if (n > whole_up_to) forward_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
+    else forward_butterflies(d, d + 2 * half, table + 2 * half, half);
     forward_bitreversed(d, half, table);
     forward_bitreversed(d + 2 * half, half, table);
     return;
@@ -167,7 +170,7 @@ void forward_bitreversed(double* d, Index n, const double* table) {
 }
 
 void inverse_from_bitreversed(double* d, Index n, const double* table) {
-  if (n / 2 > cached) {
+  if (n / 2 > whole_up_to) {
     for (Index i = 0; i < 4; ++i) inverse_from_bitreversed(d + 2 * i * (n / 4), n / 4, table);
     inverse_two_stages(d, n, table);
     return;
@@ -176,7 +179,8 @@ void inverse_from_bitreversed(double* d, Index n, const double* table) {
     const Index half = n / 2;
     inverse_from_bitreversed(d, half, table);
     inverse_from_bitreversed(d + 2 * half, half, table);
-    inverse_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
+    if (n > whole_up_to) inverse_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
+    else inverse_butterflies(d, d + 2 * half, table + 2 * half, half);
     return;
   }
   for (Index len = 2; len <= n; len *= 2)
@@ -374,13 +378,13 @@ std::size_t fft_length(std::size_t n) {
 }
 
 std::size_t fft_twiddle_size(std::size_t P) {
-  return P <= cached ? 2 * P : 2 * large_stage(2 * P);
+  return P <= whole_up_to ? 2 * P : 2 * large_stage(2 * P);
 }
 
 void fft_twiddles(std::span<double> twiddle, std::size_t P) {
   // The whole stages, each contiguous: the largest computed, each smaller one read from the one
   // above it (every other value: two streams).
-  const Index top = P < cached ? P : cached;
+  const Index top = P < whole_up_to ? P : whole_up_to;
   auto cis = [&](Index at, Index k, Index len) {  // exp(2 pi i k / len) at complex index `at`
     const double a = 2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(len);
     twiddle[2 * at] = std::cos(a), twiddle[2 * at + 1] = std::sin(a);
@@ -391,7 +395,7 @@ void fft_twiddles(std::span<double> twiddle, std::size_t P) {
       twiddle[2 * (len / 2 + k)] = twiddle[2 * (len + 2 * k)];
       twiddle[2 * (len / 2 + k) + 1] = twiddle[2 * (len + 2 * k) + 1];
     }
-  for (Index len = 2 * cached; len <= P; len *= 2) {  // the larger stages' two lists
+  for (Index len = 2 * whole_up_to; len <= P; len *= 2) {  // the larger stages' two lists
     const Index at = large_stage(len);
     for (Index j = 0; j < fine; ++j) cis(at + j, j, len);
     for (Index c = 0; c * fine < len / 2; ++c) cis(at + fine + c, c * fine, len);
