@@ -20,7 +20,7 @@ constexpr Index cached = 2048;  // complex values a block keeps in the first-lev
 // index len / 2 + k (1 MB: they stay in the second-level cache); each larger stage, up to P, as two
 // short lists from which its twiddle k = c fine + j is one complex product: exp(2 pi i j / len) for
 // j < fine, then exp(2 pi i c fine / len) for c < len / (2 fine). 2 fine + len / fine doubles a stage
-// instead of len: at P = 2^25 the table is 2.5 MB instead of 512 MB (docs/total.md, "The twiddle
+// instead of len: at P = 2^25 the table is 3.2 MB instead of 537 MB (docs/total.md, "The twiddle
 // table"). The stages above `whole_up_to` stream from main memory: they also go two in one pass.
 constexpr Index whole_up_to = Index{1} << 16;
 constexpr Index fine = 256;

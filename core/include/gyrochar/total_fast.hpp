@@ -26,7 +26,7 @@ std::size_t fft_length(std::size_t n);
 /// length): forward exp(-2 pi i k p / n), inverse exp(+2 pi i k p / n) unscaled. O(n log n).
 void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle, bool inverse);
 /// Doubles of the twiddle table of FFTs up to length P (a power of two): 2 P up to P = 2^16, then
-/// 2^17 and about 2 P / 256 more (2.5 MB at P = 2^25). O(log P).
+/// 2^17 and about 2 P / 256 more (3.2 MB at P = 2^25). O(log P).
 std::size_t fft_twiddle_size(std::size_t P);
 /// Fills the twiddle table of FFTs up to length P (fft_twiddle_size(P) doubles): cos, sin of 2 pi k /
 /// len for every stage len <= P, k < len / 2, the stages up to 2^16 whole, each larger one as two
