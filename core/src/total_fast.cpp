@@ -360,8 +360,14 @@ struct Triangles {
 // corrections H + T of docs/total.md.
 double end_corrections(std::span<const double> r, Index M, Theo1Workspace& w) {
   const Index N = r.size(), h = M / 2;
-  const std::span<double> head_even = w.ends.first(h), tail_even = w.ends.subspan(h, h);
-  const std::span<double> head_odd = w.ends.subspan(2 * h, h - 1), tail_odd = w.ends.subspan(3 * h - 1, h - 1);
+  // The four sequences (4 h - 2 values) go in the FFT buffer past the triangles' largest FFTs (4 n
+  // doubles, n = fft_length(2 ceil(h / 2)) <= Q = fft_length(h + 1), that of the first square):
+  // memory theo1_fast's end autocorrelations have touched already. There is room: h <= (N - 1) / 2,
+  // so the buffer's 2 fft_length(2 N) >= 2 fft_length(4 h + 2) = 8 Q >= 4 n + 4 (h + 1).
+  const Index used = 4 * fft_length(2 * ((h + 1) / 2));
+  const std::span<double> ends = w.buffer.subspan(used, 4 * h);
+  const std::span<double> head_even = ends.first(h), tail_even = ends.subspan(h, h);
+  const std::span<double> head_odd = ends.subspan(2 * h, h - 1), tail_odd = ends.subspan(3 * h - 1, h - 1);
   for (Index p = 0; p < h; ++p) head_even[p] = r[2 * p], tail_even[p] = r[N - 1 - 2 * p];
   for (Index p = 0; p + 1 < h; ++p) head_odd[p] = r[2 * p + 1], tail_odd[p] = r[N - 2 - 2 * p];
   const Sums even = Triangles{head_even, tail_even, h, h, w}.half();
@@ -477,7 +483,7 @@ void ends_correlations(std::span<const double> a, std::span<const double> b, std
 
 std::size_t theo1_workspace_size(std::size_t n_phase) {
   const std::size_t P = fft_length(2 * n_phase);
-  return 6 * n_phase + 2 + fft_twiddle_size(P) + 2 * P;
+  return 4 * n_phase + 2 + fft_twiddle_size(P) + 2 * P;
 }
 
 Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) {
@@ -491,7 +497,7 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) 
     at += count;
     return s;
   };
-  w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N), w.ends = take(2 * N);
+  w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N);
   w.twiddle = take(fft_twiddle_size(w.P)), w.buffer = take(2 * w.P);
   // Least-squares quadratic of d = x - x[0] in the orthogonal basis 1, t, t^2 - mean(t^2) (t centred,
   // symmetric), fitted and removed in long double: the residual then carries the rounding of its

@@ -34,7 +34,7 @@ std::size_t fft_twiddle_size(std::size_t P);
 void fft_twiddles(std::span<double> twiddle, std::size_t P);
 
 /// Doubles of workspace theo1_prepare needs for a record of N phase points: the residual, its two
-/// prefix sums, its autocorrelation, the ends' pieces (6 N + 2), the FFT's twiddles
+/// prefix sums, its autocorrelation (4 N + 2), the FFT's twiddles
 /// (fft_twiddle_size(P)) and buffer (2 P), P = fft_length(2 N).
 std::size_t theo1_workspace_size(std::size_t n_phase);
 
@@ -42,7 +42,6 @@ struct Theo1Workspace {
   std::span<double> r;          // x less its least-squares quadratic
   std::span<double> s1, s2;     // prefix sums of r and r^2 (N + 1 each)
   std::span<double> ac;         // sum_i r[i] r[i+d], d < N
-  std::span<double> ends;       // per-tau scratch: every other residual of both ends (2 N)
   std::span<double> twiddle, buffer;
   std::size_t P = 0;            // the twiddle table's FFT length
   double curvature = 0.0;       // the removed quadratic's coefficient of i^2
