@@ -181,21 +181,33 @@ struct EndWindows {
 // ends and their windows of Sp[n + fixed_f] Sp[n + p] = sum_{i=1}^{fixed_f - 1} Sp[i] Sp[i + p -
 // fixed_f] (f = 0 gives nothing: Sp[n] = 0 for n < 0). X[3] is the ends' autocorrelation read
 // backwards; X[1] a correlation of each end's first h values with the end; X[2] the same as X[1]
-// when len is even (len - h = h), one point longer and one lag further when it is odd.
+// when len is even (len - h = h), one point longer and one lag further when it is odd. X[1] and X[3]
+// in the caller's scratch, X[2] in the FFT buffer once its results are read out.
 Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail,
                  std::span<double> (&X)[4], Theo1Workspace& w) {
   const Pos len = g.len, h = g.h;
-  const Index L = static_cast<Index>(len);
-  autocorrelation_sum(head, tail, fft_length(2 * L), w);
-  for (Index p = 1; p <= L; ++p) X[3][p] = w.buffer[L - p];
-  X[3][0] = 0.0;
-  const Index n = fft_length(static_cast<Index>(h + len));
+  const Index L = static_cast<Index>(len), H = static_cast<Index>(h);
   for (Index p = 0; p <= L; ++p) X[1][p] = 0.0;
-  for (const std::span<const double> Sp : {head, tail}) {
-    cross_correlation(Sp.first(static_cast<Index>(h)), Sp, n, w);
-    for (Pos p = 0; p <= len; ++p) X[1][static_cast<Index>(p)] += w.buffer[static_cast<Index>(p - h >= 0 ? p - h : p - h + static_cast<Pos>(n))];
+  X[3][0] = 0.0;
+  const Index n = fft_length(2 * L);  // at least h + len: no wrap-around for X[1] either
+  if (4 * n <= w.buffer.size()) {
+    // X[3] and X[1] from three FFTs: the ends' autocorrelations and their correlations with their
+    // first h values, both real, come back together from one inverse (docs/total.md).
+    ends_correlations(head, tail, H, n, w);
+    const double* d = w.buffer.data();
+    const double scale = 1.0 / static_cast<double>(n);
+    for (Index p = 1; p <= L; ++p) X[3][p] = d[2 * (L - p)] * scale;
+    for (Index p = 0; p <= L; ++p) X[1][p] = d[2 * ((p + n - H) % n) + 1] * scale;
+  } else {  // the buffer holds one spectrum of length n, not two: six FFTs
+    autocorrelation_sum(head, tail, n, w);
+    for (Index p = 1; p <= L; ++p) X[3][p] = w.buffer[L - p];
+    const Index c = fft_length(H + L);
+    for (const std::span<const double> Sp : {head, tail}) {
+      cross_correlation(Sp.first(H), Sp, c, w);
+      for (Index p = 0; p <= L; ++p) X[1][p] += w.buffer[(p + c - H) % c];
+    }
   }
-  const Index H = static_cast<Index>(h);
+  X[2] = w.buffer.first(L + 1);
   X[2][0] = 0.0;
   for (Index p = 1; p <= L; ++p)
     X[2][p] = len % 2 == 0 ? X[1][p] : X[1][p - 1] + (p >= 2 ? head[H] * head[p - 1] + tail[H] * tail[p - 1] : 0.0);
@@ -225,8 +237,12 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
     rest = rest.subspan(count);
     return s;
   };
-  const std::span<double> A = take(len + 1), B = take(len + 1), head = take(len), tail = take(len), T2 = take(len + 2);
-  std::span<double> X[4] = {{}, take(len + 1), take(len + 1), take(len + 1)};
+  // The arrays needed while the FFT buffer is free live in it (its first P doubles are already
+  // touched by the preparation): on this scale first touching fresh memory costs as much as the
+  // arithmetic (docs/total.md). The caller's scratch holds the ends and two of the correlations.
+  const std::span<double> A = w.buffer.first(len + 1), B = w.buffer.subspan(len + 1, len + 1);
+  const std::span<double> head = take(len), tail = take(len);
+  std::span<double> X[4] = {{}, take(len + 1), {}, take(len + 1)};
   // Every window that meets the record, the residual zero outside: the autocorrelation weighted.
   kernel_autocorrelation(g, A, B);
   Wide sum = static_cast<Wide>(A[0]) * w.ac[0];
@@ -235,12 +251,13 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
   // not change when the window is reversed: the end's residuals are read backwards).
   head[0] = tail[0] = 0.0;
   for (Index i = 1; i < len; ++i) head[i] = head[i - 1] + w.r[i - 1], tail[i] = tail[i - 1] + w.r[N - i];
+  const std::span<double> T2 = w.buffer.first(len + 2);  // A and B no longer needed
   sum -= EndWindows{g, head, T2}.moving_terms() + EndWindows{g, tail, T2}.moving_terms();
   sum -= fixed_terms(g, head, tail, X, w);
   // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
   const Wide c = w.curvature;
   if (c != 0) {
-    std::span<double> G = B;  // G[t] = sum over windows of U_n[t]
+    const std::span<double> G = w.buffer.first(len + 1);  // G[t] = sum over windows of U_n[t]
     G[0] = 0.0;
     for (Index t = 0; t < len; ++t) G[t + 1] = G[t] + (w.s1[windows + t] - w.s1[t]);
     Wide cross = 0, square = 0;
@@ -257,7 +274,7 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
 
 }  // namespace
 
-std::size_t mtotvar_scratch_size(std::size_t n_phase) { return 8 * n_phase + 16; }
+std::size_t mtotvar_scratch_size(std::size_t n_phase) { return 4 * n_phase + 2; }
 
 TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
   const std::uint64_t N = w.r.size();

@@ -16,6 +16,21 @@ double as_double(std::uint64_t v) { return static_cast<double>(v); }
 // n - k: `for_each_mirror_pair` gives both positions.
 constexpr Index cached = 2048;  // complex values a block keeps in the first-level cache
 
+// The twiddle table (fft_twiddles): the stages len <= whole_up_to whole, exp(2 pi i k / len) at complex
+// index len / 2 + k (1 MB: they stay in the second-level cache); each larger stage, up to P, as two
+// short lists from which its twiddle k = c fine + j is one complex product: exp(2 pi i j / len) for
+// j < fine, then exp(2 pi i c fine / len) for c < len / (2 fine). 2 fine + len / fine doubles a stage
+// instead of len: at P = 2^25 the table is 3.2 MB instead of 537 MB (docs/total.md, "The twiddle
+// table"). The stages above `whole_up_to` stream from main memory: they also go two in one pass.
+constexpr Index whole_up_to = Index{1} << 16;
+constexpr Index fine = 256;
+// Complex offset of stage len's lists (len > whole_up_to, a power of two).
+Index large_stage(Index len) {
+  Index at = whole_up_to;
+  for (Index s = 2 * whole_up_to; s < len; s *= 2) at += fine + s / (2 * fine);
+  return at;
+}
+
 // One stage's butterflies on a block of 2 half values, u its first half, t its second; tw the
 // stage's twiddles. Forward (decimation in frequency): u + t, (u - t) w^-k. Inverse (in time):
 // u + t w^k, u - t w^k.
@@ -37,10 +52,115 @@ void inverse_butterflies(double* u, double* t, const double* tw, Index half) {
   }
 }
 
+// The same over a stage larger than whole_up_to, its twiddles from the stage's two lists (large_stage).
+void forward_butterflies_large(double* u, double* t, const double* stage, Index half) {
+  const double* coarse = stage + 2 * fine;
+  for (Index c = 0; c * fine < half; ++c, u += 2 * fine, t += 2 * fine) {
+    const double cr = coarse[2 * c], ci = coarse[2 * c + 1];
+    for (Index k = 0; k < fine; ++k) {
+      const double fr = stage[2 * k], fi = stage[2 * k + 1];
+      const double ar = u[2 * k], ai = u[2 * k + 1], br = t[2 * k], bi = t[2 * k + 1];
+      const double wr = cr * fr - ci * fi, wi = -(cr * fi + ci * fr);
+      u[2 * k] = ar + br, u[2 * k + 1] = ai + bi;
+      const double dr = ar - br, di = ai - bi;
+      t[2 * k] = dr * wr - di * wi, t[2 * k + 1] = dr * wi + di * wr;
+    }
+  }
+}
+void inverse_butterflies_large(double* u, double* t, const double* stage, Index half) {
+  const double* coarse = stage + 2 * fine;
+  for (Index c = 0; c * fine < half; ++c, u += 2 * fine, t += 2 * fine) {
+    const double cr = coarse[2 * c], ci = coarse[2 * c + 1];
+    for (Index k = 0; k < fine; ++k) {
+      const double fr = stage[2 * k], fi = stage[2 * k + 1];
+      const double wr = cr * fr - ci * fi, wi = cr * fi + ci * fr;
+      const double br = t[2 * k] * wr - t[2 * k + 1] * wi, bi = t[2 * k] * wi + t[2 * k + 1] * wr;
+      t[2 * k] = u[2 * k] - br, t[2 * k + 1] = u[2 * k + 1] - bi;
+      u[2 * k] += br, u[2 * k + 1] += bi;
+    }
+  }
+}
+
+// The twiddles of stage len: from the whole stages (len <= whole_up_to) or as the product of the large
+// stage's two lists, the same product as the butterflies above.
+struct StageTwiddles {
+  const double* at;
+  bool large;
+  StageTwiddles(const double* table, Index len)
+      : at(len <= whole_up_to ? table + len : table + 2 * large_stage(len)), large(len > whole_up_to) {}
+  void get(Index k, double& wr, double& wi) const {
+    if (!large) {
+      wr = at[2 * k], wi = at[2 * k + 1];
+      return;
+    }
+    const double* c = at + 2 * fine + 2 * (k / fine);
+    const double* f = at + 2 * (k % fine);
+    wr = c[0] * f[0] - c[1] * f[1], wi = c[0] * f[1] + c[1] * f[0];
+  }
+};
+
+// Two stages in one pass over memory, where neither fits the cache: stage n, then stage n / 2 on
+// both halves, on the quarters' values k, k + q, k + 2q, k + 3q (q = n / 4) together. The same
+// operations on the same values as the two passes, in the same order: the same results, half the
+// memory traffic (the large stages stream from main memory).
+void forward_two_stages(double* d, Index n, const double* table) {
+  const Index q = n / 4;
+  const StageTwiddles whole(table, n), halves(table, n / 2);
+  for (Index k = 0; k < q; ++k) {
+    double w1r, w1i, w2r, w2i, vr, vi;
+    whole.get(k, w1r, w1i);
+    whole.get(k + q, w2r, w2i);
+    halves.get(k, vr, vi);
+    w1i = -w1i, w2i = -w2i, vi = -vi;  // forward: exp(-2 pi i k / len)
+    double* u0 = d + 2 * k;
+    double* u1 = u0 + 2 * q;
+    double* u2 = u1 + 2 * q;
+    double* u3 = u2 + 2 * q;
+    const double a0r = u0[0] + u2[0], a0i = u0[1] + u2[1], e0r = u0[0] - u2[0], e0i = u0[1] - u2[1];
+    const double a1r = u1[0] + u3[0], a1i = u1[1] + u3[1], e1r = u1[0] - u3[0], e1i = u1[1] - u3[1];
+    const double a2r = e0r * w1r - e0i * w1i, a2i = e0r * w1i + e0i * w1r;
+    const double a3r = e1r * w2r - e1i * w2i, a3i = e1r * w2i + e1i * w2r;
+    u0[0] = a0r + a1r, u0[1] = a0i + a1i;
+    const double f0r = a0r - a1r, f0i = a0i - a1i;
+    u1[0] = f0r * vr - f0i * vi, u1[1] = f0r * vi + f0i * vr;
+    u2[0] = a2r + a3r, u2[1] = a2i + a3i;
+    const double f1r = a2r - a3r, f1i = a2i - a3i;
+    u3[0] = f1r * vr - f1i * vi, u3[1] = f1r * vi + f1i * vr;
+  }
+}
+void inverse_two_stages(double* d, Index n, const double* table) {
+  const Index q = n / 4;
+  const StageTwiddles whole(table, n), halves(table, n / 2);
+  for (Index k = 0; k < q; ++k) {
+    double w1r, w1i, w2r, w2i, vr, vi;
+    whole.get(k, w1r, w1i);
+    whole.get(k + q, w2r, w2i);
+    halves.get(k, vr, vi);
+    double* u0 = d + 2 * k;
+    double* u1 = u0 + 2 * q;
+    double* u2 = u1 + 2 * q;
+    double* u3 = u2 + 2 * q;
+    const double b0r = u1[0] * vr - u1[1] * vi, b0i = u1[0] * vi + u1[1] * vr;
+    const double b1r = u3[0] * vr - u3[1] * vi, b1i = u3[0] * vi + u3[1] * vr;
+    const double a0r = u0[0] + b0r, a0i = u0[1] + b0i, a1r = u0[0] - b0r, a1i = u0[1] - b0i;
+    const double a2r = u2[0] + b1r, a2i = u2[1] + b1i, a3r = u2[0] - b1r, a3i = u2[1] - b1i;
+    const double c0r = a2r * w1r - a2i * w1i, c0i = a2r * w1i + a2i * w1r;
+    const double c1r = a3r * w2r - a3i * w2i, c1i = a3r * w2i + a3i * w2r;
+    u0[0] = a0r + c0r, u0[1] = a0i + c0i, u2[0] = a0r - c0r, u2[1] = a0i - c0i;
+    u1[0] = a1r + c1r, u1[1] = a1i + c1i, u3[0] = a1r - c1r, u3[1] = a1i - c1i;
+  }
+}
+
 void forward_bitreversed(double* d, Index n, const double* table) {
+  if (n / 2 > whole_up_to) {  // two stages over the whole, then each quarter
+    forward_two_stages(d, n, table);
+    for (Index i = 0; i < 4; ++i) forward_bitreversed(d + 2 * i * (n / 4), n / 4, table);
+    return;
+  }
   if (n > cached) {  // one stage over the whole, then each half while it stays in the cache
     const Index half = n / 2;
-    forward_butterflies(d, d + 2 * half, table + 2 * half, half);
+    if (n > whole_up_to) forward_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
+    else forward_butterflies(d, d + 2 * half, table + 2 * half, half);
     forward_bitreversed(d, half, table);
     forward_bitreversed(d + 2 * half, half, table);
     return;
@@ -50,11 +170,17 @@ void forward_bitreversed(double* d, Index n, const double* table) {
 }
 
 void inverse_from_bitreversed(double* d, Index n, const double* table) {
+  if (n / 2 > whole_up_to) {
+    for (Index i = 0; i < 4; ++i) inverse_from_bitreversed(d + 2 * i * (n / 4), n / 4, table);
+    inverse_two_stages(d, n, table);
+    return;
+  }
   if (n > cached) {
     const Index half = n / 2;
     inverse_from_bitreversed(d, half, table);
     inverse_from_bitreversed(d + 2 * half, half, table);
-    inverse_butterflies(d, d + 2 * half, table + 2 * half, half);
+    if (n > whole_up_to) inverse_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
+    else inverse_butterflies(d, d + 2 * half, table + 2 * half, half);
     return;
   }
   for (Index len = 2; len <= n; len *= 2)
@@ -234,8 +360,14 @@ struct Triangles {
 // corrections H + T of docs/total.md.
 double end_corrections(std::span<const double> r, Index M, Theo1Workspace& w) {
   const Index N = r.size(), h = M / 2;
-  const std::span<double> head_even = w.ends.first(h), tail_even = w.ends.subspan(h, h);
-  const std::span<double> head_odd = w.ends.subspan(2 * h, h - 1), tail_odd = w.ends.subspan(3 * h - 1, h - 1);
+  // The four sequences (4 h - 2 values) go in the FFT buffer past the triangles' largest FFTs (4 n
+  // doubles, n = fft_length(2 ceil(h / 2)) <= Q = fft_length(h + 1), that of the first square):
+  // memory theo1_fast's end autocorrelations have touched already. There is room: h <= (N - 1) / 2,
+  // so the buffer's 2 fft_length(2 N) >= 2 fft_length(4 h + 2) = 8 Q >= 4 n + 4 (h + 1).
+  const Index used = 4 * fft_length(2 * ((h + 1) / 2));
+  const std::span<double> ends = w.buffer.subspan(used, 4 * h);
+  const std::span<double> head_even = ends.first(h), tail_even = ends.subspan(h, h);
+  const std::span<double> head_odd = ends.subspan(2 * h, h - 1), tail_odd = ends.subspan(3 * h - 1, h - 1);
   for (Index p = 0; p < h; ++p) head_even[p] = r[2 * p], tail_even[p] = r[N - 1 - 2 * p];
   for (Index p = 0; p + 1 < h; ++p) head_odd[p] = r[2 * p + 1], tail_odd[p] = r[N - 2 - 2 * p];
   const Sums even = Triangles{head_even, tail_even, h, h, w}.half();
@@ -251,19 +383,29 @@ std::size_t fft_length(std::size_t n) {
   return p;
 }
 
+std::size_t fft_twiddle_size(std::size_t P) {
+  return P <= whole_up_to ? 2 * P : 2 * large_stage(2 * P);
+}
+
 void fft_twiddles(std::span<double> twiddle, std::size_t P) {
-  // Stage by stage, each contiguous: exp(2 pi i k / len) at complex index len / 2 + k, k < len / 2;
-  // the largest stage computed, each smaller one read from the one above it.
-  const double step = 2.0 * std::numbers::pi / static_cast<double>(P);
-  for (Index k = 0; 2 * k < P; ++k) {
-    twiddle[2 * (P / 2 + k)] = std::cos(step * static_cast<double>(k));
-    twiddle[2 * (P / 2 + k) + 1] = std::sin(step * static_cast<double>(k));
-  }
-  for (Index len = P / 2; len >= 2; len /= 2)  // every other value of the stage above: two streams
+  // The whole stages, each contiguous: the largest computed, each smaller one read from the one
+  // above it (every other value: two streams).
+  const Index top = P < whole_up_to ? P : whole_up_to;
+  auto cis = [&](Index at, Index k, Index len) {  // exp(2 pi i k / len) at complex index `at`
+    const double a = 2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(len);
+    twiddle[2 * at] = std::cos(a), twiddle[2 * at + 1] = std::sin(a);
+  };
+  for (Index k = 0; 2 * k < top; ++k) cis(top / 2 + k, k, top);
+  for (Index len = top / 2; len >= 2; len /= 2)
     for (Index k = 0; 2 * k < len; ++k) {
       twiddle[2 * (len / 2 + k)] = twiddle[2 * (len + 2 * k)];
       twiddle[2 * (len / 2 + k) + 1] = twiddle[2 * (len + 2 * k) + 1];
     }
+  for (Index len = 2 * whole_up_to; len <= P; len *= 2) {  // the larger stages' two lists
+    const Index at = large_stage(len);
+    for (Index j = 0; j < fine; ++j) cis(at + j, j, len);
+    for (Index c = 0; c * fine < len / 2; ++c) cis(at + fine + c, c * fine, len);
+  }
 }
 
 void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle, bool inverse) {
@@ -311,8 +453,37 @@ void autocorrelation_sum(std::span<const double> a, std::span<const double> b, s
   for (Index e = 0; e < n; ++e) d[e] = d[2 * e] / as_double(n);
 }
 
+void ends_correlations(std::span<const double> a, std::span<const double> b, std::size_t first, std::size_t n,
+                       Theo1Workspace& w) {
+  // Two spectra: of a + i b and of their first values. Per pair of frequencies k, n - k the four real
+  // sequences' spectra (as in `combine`), then S = |A|^2 + |B|^2 (real, even) and C = conj(A_first) A
+  // + conj(B_first) B (the spectrum of a real correlation: C at n - k is conj C), and one inverse of
+  // S + i C: both real results at once.
+  double* d = w.buffer.data();
+  double* e = d + 2 * n;
+  load(d, n, a, b);
+  load(e, n, a.first(first), b.first(first));
+  forward_bitreversed(d, n, w.twiddle.data());
+  forward_bitreversed(e, n, w.twiddle.data());
+  auto split = [](const double* z, const double* v, double (&s)[4]) {  // A (re, im), B (re, im) at k
+    s[0] = 0.5 * (z[0] + v[0]), s[1] = 0.5 * (z[1] - v[1]), s[2] = 0.5 * (z[1] + v[1]), s[3] = -0.5 * (z[0] - v[0]);
+  };
+  for_each_mirror_pair(n, [d, e, &split](Index p, Index q, Index) {
+    double whole[4], head[4];
+    split(d + 2 * p, d + 2 * q, whole);
+    split(e + 2 * p, e + 2 * q, head);
+    const double S = whole[0] * whole[0] + whole[1] * whole[1] + whole[2] * whole[2] + whole[3] * whole[3];
+    const double cr = head[0] * whole[0] + head[1] * whole[1] + head[2] * whole[2] + head[3] * whole[3];
+    const double ci = head[0] * whole[1] - head[1] * whole[0] + head[2] * whole[3] - head[3] * whole[2];
+    d[2 * p] = S - ci, d[2 * p + 1] = cr;  // S + i C at k; at n - k S + i conj C (the same where q = p)
+    d[2 * q] = S + ci, d[2 * q + 1] = cr;
+  });
+  inverse_from_bitreversed(d, n, w.twiddle.data());
+}
+
 std::size_t theo1_workspace_size(std::size_t n_phase) {
-  return 6 * n_phase + 2 + 4 * fft_length(2 * n_phase);
+  const std::size_t P = fft_length(2 * n_phase);
+  return 4 * n_phase + 2 + fft_twiddle_size(P) + 2 * P;
 }
 
 Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) {
@@ -326,8 +497,8 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) 
     at += count;
     return s;
   };
-  w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N), w.ends = take(2 * N);
-  w.twiddle = take(2 * w.P), w.buffer = take(2 * w.P);
+  w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N);
+  w.twiddle = take(fft_twiddle_size(w.P)), w.buffer = take(2 * w.P);
   // Least-squares quadratic of d = x - x[0] in the orthogonal basis 1, t, t^2 - mean(t^2) (t centred,
   // symmetric), fitted and removed in long double: the residual then carries the rounding of its
   // own size, not that of the phase values (a 1e-3 ramp over 1e-12 noise keeps its noise).

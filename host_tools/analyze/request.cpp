@@ -97,10 +97,10 @@ TheoBR rows carry m as their averaging factor at tau = 0.75 m tau0 (m even, from
 octave 16, 32, ...; decade 10, 20, 40, ...); theoh is overlapping ADEV below its switch point (the
 largest octave at or below 10 % of the record) and TheoBR from there on. Theo1 and TheoBR rows
 are exact at every tau (lag sums, O(N log N) once and about O(m log^2 m) per tau; it holds about
-6 N + 4 fft_length(2 N) doubles, 1.6 GB at 10^7 points, or the decimated estimator below when
+4 N + 2 fft_length(2 N) doubles, 0.9 GB at 10^7 points, or the decimated estimator below when
 that passes the memory budget); --theo-decimated takes the decimated estimator instead where the
 direct one costs over 2^26 operations. Mtotdev, ttotdev and htotdev rows are exact at every tau
-the same way (lag sums, about O(m log m) per tau, holding 8 N doubles more than Theo1;
+the same way (lag sums, about O(m log m) per tau, holding 4 N doubles more than Theo1;
 --total-decimated takes the plan below instead). TheoBR's bias ratio, and totdev (and mtotdev,
 ttotdev, htotdev under --total-decimated), are exact where that costs at most 2^26 operations at their
 tau and decimated beyond (blocks or sub-sequences every m/S samples, S from

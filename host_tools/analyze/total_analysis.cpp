@@ -64,8 +64,8 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
   }
   // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for or its
   // workspace would pass the memory budget (plan.hpp): the record prepared once for the run
-  // (O(N log N), 6 N + 4 fft_length(2 N) doubles, shared with MTOTDEV), then each tau. The rows'
-  // stride says which estimator ran.
+  // (O(N log N), 4 N + 2 fft_length(2 N) doubles and the twiddle table, shared with MTOTDEV), then
+  // each tau. The rows' stride says which estimator ran.
   const bool decimated = o.theo_decimated || 8 * static_cast<std::uint64_t>(theo1_workspace_size(N)) > memory_budget();
   auto estimate = [&](std::uint64_t m) {
     if (decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));

@@ -157,11 +157,16 @@ std::vector<double> simulated(std::uint64_t n) {
 int lag_sums(std::uint64_t n, std::uint32_t S) {
   const std::vector<double> x = simulated(n);
   auto t0 = Clock::now();
+  double c0 = cpu_seconds();
   const std::size_t size = theo1_workspace_size(n);
   const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
-  std::printf("prepare: %.2f s (%.0f MB of workspace)\n", seconds_since(t0), 8e-6 * static_cast<double>(size));
-  std::printf("theo1 exact: every octave m in %.2f s after prepare\n", lag_sum_octaves(w));
+  const double prepare = seconds_since(t0), prepare_cpu = cpu_seconds() - c0;
+  std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace)\n", prepare, prepare_cpu, 8e-6 * static_cast<double>(size));
+  c0 = cpu_seconds();
+  const double taus = lag_sum_octaves(w), taus_cpu = cpu_seconds() - c0;
+  std::printf("theo1 exact: every octave m in %.2f s (CPU %.2f s) after prepare; in all %.2f s, CPU %.2f s\n", taus,
+              taus_cpu, prepare + taus, prepare_cpu + taus_cpu);
   t0 = Clock::now();
   const std::uint64_t k = theoh_switch(n);
   int rows = 0;
@@ -171,10 +176,11 @@ int lag_sums(std::uint64_t n, std::uint32_t S) {
   const TheoBiasRatio ratio = theo_bias_ratio(x, 1.0, S, theo_bias_taus(n, S));
   const double t_ratio = seconds_since(t0);
   t0 = Clock::now();
+  c0 = cpu_seconds();
   for (std::uint64_t m = 2 * k; m <= n - 1; m *= 2, ++rows) theo1_fast(w, m, 1.0);
-  std::printf("theoh: %d taus: AVAR %.2f s, ratio %.4f over %llu taus (%s) %.2f s, exact Theo1 rows %.2f s\n", rows,
-              t_avar, ratio.ratio, static_cast<unsigned long long>(ratio.taus), ratio.exact ? "exact" : "plan", t_ratio,
-              seconds_since(t0));
+  std::printf("theoh: %d taus: AVAR %.2f s, ratio %.4f over %llu taus (%s) %.2f s, exact Theo1 rows %.2f s (CPU %.2f s)\n",
+              rows, t_avar, ratio.ratio, static_cast<unsigned long long>(ratio.taus), ratio.exact ? "exact" : "plan",
+              t_ratio, seconds_since(t0), cpu_seconds() - c0);
   std::printf("peak RSS: %ld KiB\n", peak_rss_kib());
   return 0;
 }

@@ -188,6 +188,38 @@ TEST(TotalFast, FftEqualsTheDftWrittenOut) {
     }
 }
 
+TEST(TotalFast, FftEqualsTheDftWrittenOutBeyondTheWholeStages) {
+  // Lengths whose stages above 2^16 take their twiddles as products from the table's two short
+  // lists, one such stage alone (2^17) and two in one pass (2^18). Oracle: the DFT summed directly
+  // in long double at 97 outputs, exp(-+2 pi i j / n) from a table of std::polar in long double.
+  // Bound: an FFT's error is at most a few units of rounding times log2 n times the norm of its
+  // output, sqrt(n) times that of its input; 8 log2(n) 2^-53 sqrt(n) |x|_2.
+  const std::size_t P = 1u << 18;
+  std::vector<double> tw(fft_twiddle_size(P));
+  EXPECT_LT(tw.size(), 2 * P);
+  fft_twiddles(tw, P);
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> z;
+  for (const std::size_t n : {1u << 17, 1u << 18})
+    for (const bool inverse : {false, true}) {
+      std::vector<double> d(2 * n), in;
+      double norm = 0;
+      for (double& v : d) v = z(rng), norm += v * v;
+      in = d;
+      fft(d, n, tw, inverse);
+      std::vector<std::complex<long double>> cis(n);
+      for (std::size_t j = 0; j < n; ++j)
+        cis[j] = std::polar(1.0L, (inverse ? 2 : -2) * std::numbers::pi_v<long double> * static_cast<long double>(j) / n);
+      const double bound = 8.0 * std::log2(static_cast<double>(n)) * 0x1p-53 * std::sqrt(static_cast<double>(n) * norm);
+      for (std::size_t k = 0; k < n; k += n / 97 + 1) {  // every part of the spectrum
+        std::complex<long double> sum = 0;
+        for (std::size_t p = 0; p < n; ++p) sum += std::complex<long double>(in[2 * p], in[2 * p + 1]) * cis[k * p % n];
+        EXPECT_NEAR(d[2 * k], static_cast<double>(sum.real()), bound) << n << " k=" << k;
+        EXPECT_NEAR(d[2 * k + 1], static_cast<double>(sum.imag()), bound) << n << " k=" << k;
+      }
+    }
+}
+
 // ---- Exact MTOTVAR from lag sums (mtotvar_fast) against MTOTVAR's definition summed in long double
 // at every m of small records (and n against the direct mtotvar of total.hpp). Records as above, plus
 // pure white phase and a pure random walk.

@@ -25,20 +25,23 @@ std::size_t fft_length(std::size_t n);
 /// In-place complex FFT of `data` (n interleaved re, im pairs, n a power of two up to the table's
 /// length): forward exp(-2 pi i k p / n), inverse exp(+2 pi i k p / n) unscaled. O(n log n).
 void fft(std::span<double> data, std::size_t n, std::span<const double> twiddle, bool inverse);
-/// Fills the twiddle table of FFTs up to length P (2 P doubles: cos, sin of 2 pi k / len at complex
-/// index len / 2 + k for every stage len <= P, k < len / 2). O(P).
+/// Doubles of the twiddle table of FFTs up to length P (a power of two): 2 P up to P = 2^16, then
+/// 2^17 and about 2 P / 256 more (3.2 MB at P = 2^25). O(log P).
+std::size_t fft_twiddle_size(std::size_t P);
+/// Fills the twiddle table of FFTs up to length P (fft_twiddle_size(P) doubles): cos, sin of 2 pi k /
+/// len for every stage len <= P, k < len / 2, the stages up to 2^16 whole, each larger one as two
+/// short lists whose products are its twiddles (total_fast.cpp). O(P / 256 + 2^16).
 void fft_twiddles(std::span<double> twiddle, std::size_t P);
 
 /// Doubles of workspace theo1_prepare needs for a record of N phase points: the residual, its two
-/// prefix sums, its autocorrelation, the ends' pieces (6 N + 2) and the FFT's twiddles and
-/// buffer (4 P, P = fft_length(2 N)).
+/// prefix sums, its autocorrelation (4 N + 2), the FFT's twiddles
+/// (fft_twiddle_size(P)) and buffer (2 P), P = fft_length(2 N).
 std::size_t theo1_workspace_size(std::size_t n_phase);
 
 struct Theo1Workspace {
   std::span<double> r;          // x less its least-squares quadratic
   std::span<double> s1, s2;     // prefix sums of r and r^2 (N + 1 each)
   std::span<double> ac;         // sum_i r[i] r[i+d], d < N
-  std::span<double> ends;       // per-tau scratch: every other residual of both ends (2 N)
   std::span<double> twiddle, buffer;
   std::size_t P = 0;            // the twiddle table's FFT length
   double curvature = 0.0;       // the removed quadratic's coefficient of i^2
@@ -63,7 +66,15 @@ void cross_correlation(std::span<const double> a, std::span<const double> b, std
 /// 0 <= e < n - max(a.size(), b.size()). O(n log n).
 void autocorrelation_sum(std::span<const double> a, std::span<const double> b, std::size_t n, Theo1Workspace& w);
 
-/// Doubles of scratch mtotvar_fast needs beside a prepared Theo1Workspace of N points: 8 N + 16.
+/// For two real sequences a and b of equal length and their first `first` values: acf(a)(e) +
+/// acf(b)(e), and c(e) = sum over p < first of a[p] a[p+e] + b[p] b[p+e], both times n, left at
+/// w.buffer[2 (e mod n)] and w.buffer[2 (e mod n) + 1] for e in (-n, n) (n a power of two, n >=
+/// 2 a.size(), 4 n doubles of buffer). Three FFTs of length n. O(n log n).
+void ends_correlations(std::span<const double> a, std::span<const double> b, std::size_t first, std::size_t n,
+                       Theo1Workspace& w);
+
+/// Doubles of scratch mtotvar_fast needs beside a prepared Theo1Workspace of N points: 4 N + 2 (the
+/// workspace's FFT buffer holds the rest).
 std::size_t mtotvar_scratch_size(std::size_t n_phase);
 
 /// MTOTVAR at averaging factor m (1 <= m <= N / 3), exactly the estimator mtotvar(x, 1, m, tau0_s, .)
