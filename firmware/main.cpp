@@ -9,6 +9,7 @@
 #include <sys/signalfd.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -42,7 +43,7 @@ int no_hardware(const std::exception& e) {
 
 // The configured count source; nullptr for CounterInput frames (they arrive on the CAN bus).
 std::unique_ptr<hal::CountSource> open_source(const firmware::Config& c, std::uint64_t now_ns) {
-  const auto tau0_ns = static_cast<std::uint64_t>(c.tau0_s * 1e9 + 0.5);
+  const auto tau0_ns = static_cast<std::uint64_t>(std::llround(c.tau0_s * 1e9));
   switch (c.source) {
     case firmware::SourceKind::quadrature: {
       hal::GpioQuadratureSettings s;

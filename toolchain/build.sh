@@ -53,6 +53,14 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+# Each stage's banner gives the time since the start, so a slow stage shows in the CI log.
+stage() { echo "build.sh: [$((SECONDS / 60)) min $((SECONDS % 60)) s] $*" >&2; }
+if [ "$job" = test ]; then
+  # First and cheap (seconds, no build): CI fails on sources not in the style of .clang-format.
+  stage "the sources' format (toolchain/format.sh --check)"
+  toolchain/format.sh --check
+fi
+
 cmake --preset host >/dev/null
 cmake --build --preset host -j "$(nproc)"
 
@@ -68,8 +76,6 @@ case "$job" in
     ;;
   test)
     # Every configuration is built once; the host suite runs last so that its summary closes the log.
-    # Each stage's banner gives the time since the start, so a slow stage shows in the CI log.
-    stage() { echo "build.sh: [$((SECONDS / 60)) min $((SECONDS % 60)) s] $*" >&2; }
     for mcu in cortex-m4 cortex-m7; do
       stage "freestanding core for $mcu (text/data/bss of the MCU example):"
       cmake --preset "$mcu" >/dev/null

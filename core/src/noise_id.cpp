@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstring>
 #include <initializer_list>
-#include <cstring>
 
 #if defined(__aarch64__) && defined(__ARM_NEON)
 #include <arm_neon.h>

@@ -151,8 +151,8 @@ inline double flicker_r(int twice_d, std::int64_t ak, const std::array<double, 5
   const double a = static_cast<double>(ak);
   double p = 1;
   for (int i = 1; i <= j; ++i) p *= a * a - (i - 0.5) * (i - 0.5);
-  const double s = j <= 2 ? psi[static_cast<std::size_t>(2 + j)] + psi[static_cast<std::size_t>(2 - j)]
-                          : digamma_half(ak + j) + digamma_half(ak - j);
+  const auto uj = static_cast<std::size_t>(j);  // j >= 0: twice_d is odd and positive
+  const double s = j <= 2 ? psi[2 + uj] + psi[2 - uj] : digamma_half(ak + j) + digamma_half(ak - j);
   return (j % 2 ? p : -p) * s / (2 * pi * factorial(2 * j));
 }
 

@@ -494,6 +494,8 @@ namespace {
 const char* stable32_columns(DevStat s) {
   constexpr const char* allan = "#  AF        Tau        #    Alpha  Min Sigma      Sigma         Max Sigma";
   constexpr const char* hadamard = "#  AF        Tau         #    Alpha  Min Sigma   Hadamard Sig     Max Sigma";
+  // The columns as a table, one statistic a line (kept as written):
+  // clang-format off
   switch (s) {
     case DevStat::adev:
     case DevStat::oadev: return allan;
@@ -508,6 +510,7 @@ const char* stable32_columns(DevStat s) {
     case DevStat::theo1: return "#  AF   Th\u00eao1 Tau   Th\u00eao1 #    Alpha   Min Th\u00eao1    Th\u00eao1    Max Th\u00eao1";
     case DevStat::theoh: return "#  AF   Th\u00eaoH Tau   Th\u00eaoH #    Alpha   Min Th\u00eaoH    Th\u00eaoH    Max Th\u00eaoH";
   }
+  // clang-format on
   return allan;
 }
 

@@ -47,6 +47,8 @@ struct Expected {
 
 double physical(float v) { return static_cast<double>(v); }
 
+// The signals of each message as a table, one message a line or two (kept as written):
+// clang-format off
 Expected expected(const StatusMsg& m) {
   return {{{"Page", 0}, {"State", static_cast<int>(m.state)}, {"Seq", m.seq}, {"TauCount", m.tau_count},
            {"SampleCount", m.sample_count}},
@@ -141,9 +143,12 @@ Expected expected(const CounterInputMsg& m) {
   return {{{"Count", m.count}, {"Seq", m.seq}, {"CountError", m.count_error ? 1 : 0},
            {"SensorNotReady", m.sensor_not_ready ? 1 : 0}}};
 }
+// clang-format on
 
 // --- the frames ------------------------------------------------------------------------------
 
+// The slots as a table, one a line (kept as written):
+// clang-format off
 /// A message of a plausible node for one slot of the schedule.
 Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
   const std::uint8_t i = slot.index;
@@ -182,6 +187,7 @@ Message for_slot(ReportSlot slot, std::uint8_t seq, std::uint64_t report) {
   }
   return StatusMsg{};
 }
+// clang-format on
 
 std::vector<Entry> frames() {
   std::vector<Entry> out;

@@ -152,9 +152,12 @@ class Characterizer {
 
   /// Adds the next phase point (floating phase data). O(S) amortized; no allocation; never fails.
   /// Counts go through add_increment(), which keeps the input bounds exactness relies on.
+  // The `requires` clause on a line of its own (clang-format 14 would join it to the parameters):
+  // clang-format off
   void add_phase_point(double x)
     requires(!Arith::exact)
   {
+    // clang-format on
     // Relative to the line through the first two points: x - x0 is formed exactly (as hi + lo)
     // and the line taken off by one fused multiply-add.
     const std::uint64_t k = run_.line_points++;
@@ -389,6 +392,9 @@ class Characterizer {
   // only ring 0 as it was before the block, so the order of the two passes does not matter.
   // Working memory on the stack: about 22 KiB (x86-64, 256 points per block), 34 KiB when S > 32
   // (the gathered points).
+  // The `requires` clauses on lines of their own (clang-format 14 would join them to the parameter
+  // lists), and the comments aligned as written:
+  // clang-format off
   struct Block {
     std::uint64_t e0;  // index of the first point
     std::size_t n;
@@ -429,6 +435,7 @@ class Characterizer {
     requires(Arith::exact);
   void gather(const Block& b, std::uint64_t age, std::int64_t* x, std::uint64_t* p) const
     requires(Arith::exact);
+  // clang-format on
   static std::uint64_t add_block(UInt128& sum, const BlockSquares& s, const std::int64_t* terms, std::size_t n);
 
   // A point of the decimated series x[k m]: the non-overlapped second and third differences, and

@@ -1,6 +1,8 @@
 #pragma once
 // The characterizer's block path (counts, steady state): the definitions of the members
 // characterizer.hpp declares under "The block kernel". Included at the end of characterizer.hpp.
+// Each signature keeps its `requires` clause on a line of its own, between `// clang-format off`
+// and `// clang-format on` (clang-format 14 would join it to the parameter list).
 #include <array>
 #include <bit>
 #include <cstddef>
@@ -12,10 +14,12 @@
 
 namespace gyrochar {
 
+// clang-format off
 template <class Arith>
 inline void Characterizer<Arith>::push_block(const X* x, std::size_t n)
   requires(Arith::exact)
 {
+  // clang-format on
   // The window: the last `depth` points before the block (from ring 0), then the block.
   const std::uint32_t ring0 = 3u * stride();
   const std::size_t depth = ring0 < window_depth ? ring0 : window_depth;
@@ -61,10 +65,12 @@ inline void Characterizer<Arith>::push_block(const X* x, std::size_t n)
 }
 
 // One point of a block (P: its prefix) through the history and the taus from `first` on.
+// clang-format off
 template <class Arith>
 inline void Characterizer<Arith>::block_point(std::size_t first, X x, Int128 p)
   requires(Arith::exact)
 {
+  // clang-format on
   const std::uint64_t e = run_.next_e++;
   run_.p = p;
   const Entry current{x, p};
@@ -73,11 +79,13 @@ inline void Characterizer<Arith>::block_point(std::size_t first, X x, Int128 p)
 }
 
 // Points run_.next_e (>= 1) .. + n - 1 enter the history at once, and run_ moves on past them.
+// clang-format off
 template <class Arith>
 inline void Characterizer<Arith>::insert_run(const X* x, const std::uint64_t* p_lo, const std::uint64_t* p_hi,
                                               std::size_t n)
   requires(Arith::exact)
 {
+  // clang-format on
   history_.insert_run(run_.next_e, x, p_lo, p_hi, n, run_.head);
   run_.next_e += n;
   run_.p = {p_lo[n - 1], p_hi[n - 1]};
@@ -89,11 +97,13 @@ inline void Characterizer<Arith>::insert_run(const X* x, const std::uint64_t* p_
 // points (the younger half from level L-1's window, the older half from ring L) and the block's
 // points of level L. Stops at the first level not yet steady in this segment or whose terms are
 // not proved to fit. Returns how many taus (a prefix of the list) the kernel took.
+// clang-format off
 template <class Arith>
 inline std::size_t Characterizer<Arith>::higher_levels(const Block& level0, const std::int64_t* x_prev,
                                                         const std::uint64_t* p_prev)
   requires(Arith::exact)
 {
+  // clang-format on
   std::size_t done = fast_count_;
   const std::uint64_t e0 = level0.e0;
   const std::size_t depth = 3u * stride();
@@ -163,10 +173,12 @@ inline std::uint64_t Characterizer<Arith>::step_bound(std::uint64_t m) const {
 }
 
 // The block's terms of one level-0 tau, and its decimated points.
+// clang-format off
 template <class Arith>
 inline void Characterizer<Arith>::level0_block(TauState& t, const Block& b)
   requires(Arith::exact)
 {
+  // clang-format on
   const auto m = static_cast<std::size_t>(t.result.m >> b.level);  // the lag in the block's series (<= S)
   if (!terms_fit(t.result.m)) {  // level 0 only (higher_levels() checks first)
     for (std::size_t j = 0; j < b.n; ++j) {  // the checked path, point by point
@@ -185,10 +197,12 @@ inline void Characterizer<Arith>::level0_block(TauState& t, const Block& b)
 }
 
 // The gathered points live in this function's frame only, not in the usual path's.
+// clang-format off
 template <class Arith>
 void Characterizer<Arith>::gathered_sums(TauState& t, const Block& b, std::size_t m)
   requires(Arith::exact)
 {
+  // clang-format on
   std::array<std::int64_t, block_points> x1, x2, x3;
   std::array<std::uint64_t, block_points> p1, p2, p3;
   gather(b, m, x1.data(), p1.data());
@@ -199,12 +213,14 @@ void Characterizer<Arith>::gathered_sums(TauState& t, const Block& b, std::size_
 
 // The block's terms of a tau of lag m from the points at ages m, 2m, 3m, their sums, the
 // decimated points and the noise sums.
+// clang-format off
 template <class Arith>
 inline void Characterizer<Arith>::block_sums(TauState& t, const Block& b, std::size_t m, const std::int64_t* x1,
                                               const std::int64_t* x2, const std::int64_t* x3, const std::uint64_t* p1,
                                               const std::uint64_t* p2, const std::uint64_t* p3)
   requires(Arith::exact)
 {
+  // clang-format on
   std::array<std::int64_t, block_points> a, h, mt;
   BlockTerms terms;
   if (proved_small(t.result.m, b.n, terms)) {
@@ -269,10 +285,12 @@ inline void Characterizer<Arith>::block_sums(TauState& t, const Block& b, std::s
 }
 
 // x and the low word of P at age `age` of each point of the block.
+// clang-format off
 template <class Arith>
 inline void Characterizer<Arith>::gather(const Block& b, std::uint64_t age, std::int64_t* x, std::uint64_t* p) const
   requires(Arith::exact)
 {
+  // clang-format on
   const std::size_t from_history = age < b.n ? static_cast<std::size_t>(age) : b.n;
   const std::uint32_t size = 3u * stride();
   std::uint32_t slot = static_cast<std::uint32_t>((b.e0 - age) % size);
