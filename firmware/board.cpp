@@ -18,10 +18,10 @@ namespace {
 
 // Logs for journald: a priority prefix (<3> error, <4> warning, <6> info, <7> debug). printf-style
 // so that logging in the loop allocates nothing.
-#define BOARD_LOG(level, ...)                  \
-  do {                                         \
+#define BOARD_LOG(level, ...)                                   \
+  do {                                                          \
     std::fprintf(stderr, "<" level ">gyrochard: " __VA_ARGS__); \
-    std::fputc('\n', stderr);                  \
+    std::fputc('\n', stderr);                                   \
   } while (0)
 
 protocol::InputSource input_source(SourceKind s) {
@@ -72,8 +72,7 @@ std::string describe_identity(std::uint32_t id) {
   char text[64];
   if ((id & 0x10000u) != 0)
     std::snprintf(text, sizeof text, "node address 0x%02X, counter node 0x%02X", id & 0xFFu, (id >> 8) & 0xFFu);
-  else
-    std::snprintf(text, sizeof text, "node address 0x%02X, no CAN counter", id & 0xFFu);
+  else std::snprintf(text, sizeof text, "node address 0x%02X, no CAN counter", id & 0xFFu);
   return text;
 }
 
@@ -89,8 +88,11 @@ std::string restore_why(RestoreStatus s, const char* field, std::uint32_t found,
 }  // namespace
 
 Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
-    : config_(config), io_(io), can_counter_(static_cast<std::uint8_t>(config.counter_node)),
-      checkpoint_file_(config.checkpoint_path), report_work_(config.octaves, fit_mode),
+    : config_(config),
+      io_(io),
+      can_counter_(static_cast<std::uint8_t>(config.counter_node)),
+      checkpoint_file_(config.checkpoint_path),
+      report_work_(config.octaves, fit_mode),
       shown_path_(printable(config.checkpoint_path)) {
   settings_.tau0_s = config.tau0_s;
   settings_.pulse_weight_arcsec = config.pulse_weight_arcsec;
@@ -106,9 +108,8 @@ Board::Board(const Config& config, BoardIo io, FitMode fit_mode)
   settings_.config_hash = hash_settings(settings_);
   settings_.identity = gyro_identity(config);
   if (!configure(characterizer_, settings_)) throw std::invalid_argument("estimator settings out of range");
-  if (settings_.window_taus != 0 &&
-      !window_.configure(settings_.stride_factor, settings_.config_hash, settings_.window_taus, settings_.window_length,
-                         settings_.identity))
+  if (settings_.window_taus != 0 && !window_.configure(settings_.stride_factor, settings_.config_hash, settings_.window_taus,
+                                                       settings_.window_length, settings_.identity))
     throw std::invalid_argument("window settings out of range");
   checkpoint_buffer_.resize(characterizer_.checkpoint_size() + (settings_.window_taus ? window_.checkpoint_size() : 0));
   checkpoint_period_ns_ = static_cast<std::uint64_t>(config.checkpoint_period_s * 1e9);
@@ -226,8 +227,8 @@ void Board::on_tick() {
   if (frame_ == 0) {
     faults_.tx_dropped_frames = static_cast<std::uint32_t>(io_.can.counters().tx_dropped);
     faults_.bus_off_events = static_cast<std::uint32_t>(io_.can.counters().bus_off_events);
-    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, report_work_, content_,
-                 &window_.latest());
+    build_report(characterizer_, settings_, seq_, (io_.clock.now_ns() - start_ns_) / 1000000u, faults_, report_work_,
+                 content_, &window_.latest());
     frames_ = protocol::report_frame_count(seq_, config_.octaves, protocol::version, settings_.window_taus);
     if (config_.verbose)
       BOARD_LOG("7", "report %u: %llu samples", static_cast<unsigned>(seq_),

@@ -31,7 +31,7 @@ struct BoardIo {
   hal::CountSource* source = nullptr;  // nullptr: counts come as CounterInput frames on `can`
   const hal::Clock& clock;
   hal::PeriodicTimer& timer;
-  int stop_fd = -1;                    // readable: stop (gyrochard's signalfd)
+  int stop_fd = -1;  // readable: stop (gyrochard's signalfd)
 };
 
 class Board final : public hal::CountSink {

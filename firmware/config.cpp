@@ -66,8 +66,7 @@ std::unique_ptr<CLI::App> make_app(Config& c, unsigned& node, std::string& confi
   app->add_option("--octaves", c.octaves, "number of octave taus, 1..40")->capture_default_str();
   app->add_option("--report-period", c.report_period_s, "seconds between reports, 0.1..2 (the protocol's range)")
       ->capture_default_str();
-  app->add_option("--window", c.window_s,
-                  "dynamic Allan deviation: seconds per window, restarted every window (0: none)")
+  app->add_option("--window", c.window_s, "dynamic Allan deviation: seconds per window, restarted every window (0: none)")
       ->capture_default_str();
   app->add_option("--checkpoint", c.checkpoint_path, "checkpoint file (empty: none)");
   app->add_option("--checkpoint-period", c.checkpoint_period_s, "seconds between checkpoints")->capture_default_str();
@@ -101,7 +100,8 @@ std::optional<ConfigError> read_bounded(const std::string& path, std::string& te
   if (in.bad()) return ConfigError{"config", path + ": " + std::strerror(errno)};
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > max_config_bytes)
-    return ConfigError{"config", path + ": larger than " + std::to_string(max_config_bytes) + " bytes (the limit for a configuration file)"};
+    return ConfigError{"config", path + ": larger than " + std::to_string(max_config_bytes) +
+                                     " bytes (the limit for a configuration file)"};
   return std::nullopt;
 }
 
@@ -126,8 +126,7 @@ std::optional<ConfigError> read_file(const std::string& path, std::vector<FileEn
     const std::string_view line = trim(std::string_view(text).substr(0, end));
     if (line.empty()) continue;
     const std::size_t equals = line.find('=');
-    if (equals == std::string_view::npos)
-      return ConfigError{std::string(line), "not a 'key = value' line", where};
+    if (equals == std::string_view::npos) return ConfigError{std::string(line), "not a 'key = value' line", where};
     const std::string key(trim(line.substr(0, equals)));
     std::string value(trim(line.substr(equals + 1)));
     if (value.size() >= 2 && value.front() == '"' && value.back() == '"') value = value.substr(1, value.size() - 2);
@@ -224,14 +223,14 @@ std::optional<ConfigError> validate(const Config& c) {
     return ConfigError{"report-period", "must be 0.1..2 s (the protocol's range)"};
   if (c.report_period_s < c.tau0_s) return ConfigError{"report-period", "must be at least tau0"};
   if (!std::isfinite(c.window_s) || c.window_s < 0 ||
-      (c.window_s > 0 && (c.window_s < 4 * c.report_period_s || c.window_s < 4 * c.tau0_s || c.window_s / c.tau0_s >= 0x1p40)))
+      (c.window_s > 0 &&
+       (c.window_s < 4 * c.report_period_s || c.window_s < 4 * c.tau0_s || c.window_s / c.tau0_s >= 0x1p40)))
     return ConfigError{"window", "must be 0 (none) or at least 4 report periods and 4 tau0, below 2^40 tau0"};
   if (!c.checkpoint_path.empty() && !positive(c.checkpoint_period_s))
     return ConfigError{"checkpoint-period", "must be positive"};
   if (const std::string why = interface_name_problem(c.can_interface); !why.empty())
     return ConfigError{"can-interface", why};
-  if (c.source == SourceKind::quadrature && c.line_a == c.line_b)
-    return ConfigError{"line-b", "must differ from line-a"};
+  if (c.source == SourceKind::quadrature && c.line_a == c.line_b) return ConfigError{"line-b", "must differ from line-a"};
   if (c.source == SourceKind::strobe && c.counter_path.empty())
     return ConfigError{"counter-path", "is required by the strobe source"};
   if (c.counter_node > 253) return ConfigError{"counter-node", "must be an address 0..253"};

@@ -18,8 +18,8 @@ inline constexpr std::size_t max_config_line = 4096;
 
 struct Config {
   // CAN output
-  std::uint8_t node = 0x01;             // node address: low byte of every 29-bit identifier
-  std::string can_interface = "can0";   // SocketCAN interface
+  std::uint8_t node = 0x01;            // node address: low byte of every 29-bit identifier
+  std::string can_interface = "can0";  // SocketCAN interface
   // Count source
   SourceKind source = SourceKind::quadrature;
   std::string gpio_chip = "gpiochip0";  // quadrature and strobe sources
@@ -29,14 +29,14 @@ struct Config {
   unsigned counter_node = 0x80;         // can_counter source: address of the gyro electronics
                                         // (their CounterInput frames are 0x0CFF50xx, docs/protocol.md)
   // Estimation
-  double tau0_s = 0.001;                // sample interval
-  double pulse_weight_arcsec = 1.0;     // angle per pulse
-  std::uint32_t stride_factor = 8;      // S: power of two, 2..64
-  unsigned octaves = 32;                // taus m = 1, 2, 4, ..., 2^(octaves-1)
-  double report_period_s = 1.0;         // one report per period, frames paced over it
-  double window_s = 0.0;                // dynamic Allan deviation: window length (0: none), at least
-                                        // 4 report periods and 4 tau0 (window.hpp)
-  std::string checkpoint_path;          // empty: no checkpoint
+  double tau0_s = 0.001;             // sample interval
+  double pulse_weight_arcsec = 1.0;  // angle per pulse
+  std::uint32_t stride_factor = 8;   // S: power of two, 2..64
+  unsigned octaves = 32;             // taus m = 1, 2, 4, ..., 2^(octaves-1)
+  double report_period_s = 1.0;      // one report per period, frames paced over it
+  double window_s = 0.0;             // dynamic Allan deviation: window length (0: none), at least
+                                     // 4 report periods and 4 tau0 (window.hpp)
+  std::string checkpoint_path;       // empty: no checkpoint
   double checkpoint_period_s = 60.0;
   bool verbose = false;
 };

@@ -56,8 +56,7 @@ FitWorker::Result FitWorker::latest() const {
 
 void FitWorker::fit_job() {
   // The job's fields are not written while busy_ is set: read them without the lock.
-  const Ieee952Fit fit =
-      fit_ieee952(std::span(points_.data(), n_points_), setup_, FitCurve::both, workspace_, &cache_);
+  const Ieee952Fit fit = fit_ieee952(std::span(points_.data(), n_points_), setup_, FitCurve::both, workspace_, &cache_);
   const std::lock_guard lock(mutex_);
   result_ = {fit, job_samples_};
   busy_ = false;

@@ -102,15 +102,17 @@ int main(int argc, char** argv) {
   }
   std::fprintf(stderr, "<6>gyrochard: %s\n", printable(board->resume()).c_str());
   std::fprintf(stderr, "<6>gyrochard: running: node %u on %s, tau0 %g s, %u octaves, stride factor %u\n",
-               static_cast<unsigned>(config.node), printable(config.can_interface).c_str(), config.tau0_s,
-               config.octaves, config.stride_factor);
+               static_cast<unsigned>(config.node), printable(config.can_interface).c_str(), config.tau0_s, config.octaves,
+               config.stride_factor);
 
   while (board->run_once(1000)) {
   }
   const int e = board->checkpoint();
   std::fprintf(stderr, "<6>gyrochard: stopping on signal after %llu samples%s\n",
                static_cast<unsigned long long>(board->characterizer().increments()),
-               config.checkpoint_path.empty() ? "" : e == 0 ? ", checkpoint written" : ", checkpoint NOT written");
+               config.checkpoint_path.empty() ? ""
+               : e == 0                       ? ", checkpoint written"
+                                              : ", checkpoint NOT written");
   close(stop_fd);
   if (board->checkpoint_failures() == 0) return finish(program, exit_code::ok);
   print_error(program, "checkpoint " + printable(config.checkpoint_path),

@@ -14,7 +14,8 @@ bool configure(BoardCharacterizer& c, const ReportSettings& s) {
   if (s.octaves < 1 || s.octaves > max_octaves || s.stride_factor > max_stride_factor || !(s.tau0_s > 0)) return false;
   std::array<std::uint64_t, max_octaves> m_list{};
   for (unsigned k = 0; k < s.octaves; ++k) m_list[k] = std::uint64_t{1} << k;
-  return c.configure({s.stride_factor, s.config_hash, s.identity}, std::span(m_list.data(), s.octaves)) == ConfigureStatus::ok;
+  return c.configure({s.stride_factor, s.config_hash, s.identity}, std::span(m_list.data(), s.octaves)) ==
+         ConfigureStatus::ok;
 }
 
 namespace {
@@ -94,9 +95,7 @@ protocol::Ieee952ParameterMsg ieee952_parameter(const Ieee952Fit& fit, std::uint
         value = fit.markov[slot.index].tc_s, uncertainty = fit.markov[slot.index].tc_uncertainty_s;
       }
       break;
-    case FitParameter::filter_tf:
-      value = fit.bandwidth_tc_s, uncertainty = fit.bandwidth_tc_uncertainty_s;
-      break;
+    case FitParameter::filter_tf: value = fit.bandwidth_tc_s, uncertainty = fit.bandwidth_tc_uncertainty_s; break;
     case FitParameter::sinusoid_amplitude:
     case FitParameter::sinusoid_frequency:
       if (slot.index >= fit.n_sinusoids) break;
@@ -153,9 +152,8 @@ bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau
   return grown >= 0.25 * static_cast<double>(last_fit_samples) || grown * tau0_s >= refit_after_s;
 }
 
-void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
-                  std::uint64_t uptime_ms, const FaultCounters& f, ReportWorkspace& work, ReportContent& out,
-                  const WindowCurve* window) {
+void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq, std::uint64_t uptime_ms,
+                  const FaultCounters& f, ReportWorkspace& work, ReportContent& out, const WindowCurve* window) {
   using namespace protocol;
   const std::size_t taus = c.tau_count();
   const std::uint64_t samples = c.increments();
@@ -205,8 +203,12 @@ void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, s
     const Ieee952Parameter& p = fit.p[k];
     const bool fitted = p.fitted && p.value > 0;
     const bool resolved = fitted && fit.ok() && p.resolved;
-    out.ieee952[k] = {seq, static_cast<Ieee952Term>(k), resolved, fitted ? static_cast<float>(p.value) : 0.0f,
-                      fitted ? p.uncertainty / p.value : 0.0, fitted};
+    out.ieee952[k] = {seq,
+                      static_cast<Ieee952Term>(k),
+                      resolved,
+                      fitted ? static_cast<float>(p.value) : 0.0f,
+                      fitted ? p.uncertainty / p.value : 0.0,
+                      fitted};
   }
   // Each term's unconstrained estimate (version 5), what verdicts judge: zeros where it has none.
   for (std::size_t k = 0; k < 5; ++k) {

@@ -26,11 +26,11 @@ struct ReportSettings {
   std::uint32_t stride_factor = 8;
   unsigned octaves = 32;
   protocol::InputSource source = protocol::InputSource::unknown;
-  std::uint32_t config_hash = 0;     // also the characterizer's checkpoint tag
-  std::uint32_t identity = 0;        // the gyro the data belongs to (gyro_identity()), in checkpoints
+  std::uint32_t config_hash = 0;  // also the characterizer's checkpoint tag
+  std::uint32_t identity = 0;     // the gyro the data belongs to (gyro_identity()), in checkpoints
   std::uint16_t report_period_ms = 1000;
-  std::uint64_t window_length = 0;   // samples per window of the dynamic Allan deviation (window.hpp)
-  unsigned window_taus = 0;          // its taus, window_taus(octaves, window_length); 0: no window
+  std::uint64_t window_length = 0;  // samples per window of the dynamic Allan deviation (window.hpp)
+  unsigned window_taus = 0;         // its taus, window_taus(octaves, window_length); 0: no window
 };
 
 /// Configures `c` for octave taus 1, 2, ..., 2^(octaves-1) with the settings' stride factor and
@@ -104,8 +104,8 @@ bool refit_due(std::uint64_t samples, std::uint64_t last_fit_samples, double tau
 /// board's latest completed window), taken at the first report of each slow cycle and repeated
 /// through it. No allocation: everything is worked out in `work` (built for the same number of
 /// octaves).
-void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq,
-                  std::uint64_t uptime_ms, const FaultCounters& faults, ReportWorkspace& work, ReportContent& out,
+void build_report(const Characterizer<CountArith>& c, const ReportSettings& s, std::uint8_t seq, std::uint64_t uptime_ms,
+                  const FaultCounters& faults, ReportWorkspace& work, ReportContent& out,
                   const WindowCurve* window = nullptr);
 
 /// The message at position k of report `content.status.seq` (protocol::report_slot order, with

@@ -23,7 +23,8 @@ bool DynamicWindow::configure(std::uint32_t stride_factor, std::uint32_t tag, un
     return false;
   std::array<std::uint64_t, max_window_taus> m_list{};
   for (unsigned k = 0; k < taus; ++k) m_list[k] = std::uint64_t{1} << k;
-  if (pyramid_.configure({stride_factor, tag, identity}, std::span(m_list.data(), taus)) != ConfigureStatus::ok) return false;
+  if (pyramid_.configure({stride_factor, tag, identity}, std::span(m_list.data(), taus)) != ConfigureStatus::ok)
+    return false;
   length_ = length;
   return true;
 }

@@ -28,11 +28,11 @@ unsigned window_taus(unsigned octaves, std::uint64_t length);
 
 /// The curve of one completed window, in pulses per tau0: variance() of the core with tau0 = 1.
 struct WindowCurve {
-  bool complete = false;      // false: no window has completed yet
-  std::uint32_t window = 0;   // k: the window covered samples k length .. (k+1) length - 1
-  std::uint32_t gaps = 0;     // gaps inside it (a restart from a checkpoint is one)
+  bool complete = false;                               // false: no window has completed yet
+  std::uint32_t window = 0;                            // k: the window covered samples k length .. (k+1) length - 1
+  std::uint32_t gaps = 0;                              // gaps inside it (a restart from a checkpoint is one)
   std::array<double, max_window_taus> avar{}, mvar{};  // (pulses / tau0)^2
-  std::array<bool, max_window_taus> valid{};  // a term formed, none out of range: avar and mvar hold
+  std::array<bool, max_window_taus> valid{};           // a term formed, none out of range: avar and mvar hold
 };
 
 class DynamicWindow {

@@ -15,8 +15,8 @@ enum class BusState : std::uint8_t { active, warning, passive, bus_off, down };
 struct CanCounters {
   std::uint64_t sent = 0;
   std::uint64_t received = 0;
-  std::uint64_t tx_dropped = 0;   // could not be queued (TX queue full: ENOBUFS / EAGAIN)
-  std::uint64_t rx_dropped = 0;   // lost in the socket's receive queue (SO_RXQ_OVFL)
+  std::uint64_t tx_dropped = 0;  // could not be queued (TX queue full: ENOBUFS / EAGAIN)
+  std::uint64_t rx_dropped = 0;  // lost in the socket's receive queue (SO_RXQ_OVFL)
   std::uint64_t error_frames = 0;
   std::uint64_t bus_off_events = 0;
   std::uint8_t tx_error_counter = 0;  // the controller's TEC and REC, as its last error frame said

@@ -28,11 +28,11 @@ class CountSink {
 };
 
 struct CountSourceCounters {
-  std::uint64_t samples = 0;      // intervals delivered (gaps included)
-  std::uint64_t edges = 0;        // input events read
-  std::uint64_t lost_edges = 0;   // illegal transitions, missed strobes' counts, overruns
-  std::uint64_t late_edges = 0;   // events that arrived after their interval was closed
-  std::uint64_t gaps = 0;         // gap samples delivered
+  std::uint64_t samples = 0;     // intervals delivered (gaps included)
+  std::uint64_t edges = 0;       // input events read
+  std::uint64_t lost_edges = 0;  // illegal transitions, missed strobes' counts, overruns
+  std::uint64_t late_edges = 0;  // events that arrived after their interval was closed
+  std::uint64_t gaps = 0;        // gap samples delivered
   std::uint64_t gap_intervals = 0;
 };
 

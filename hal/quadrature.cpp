@@ -48,10 +48,8 @@ void QuadratureDecoder::advance_to(std::uint64_t interval, CountSink& sink) {
 void QuadratureDecoder::on_edge(std::uint64_t t_ns, QuadratureLine line, bool level, CountSink& sink) {
   ++counters_.edges;
   const std::uint64_t interval = interval_of(t_ns);
-  if (interval < open_)
-    ++counters_.late_edges;
-  else
-    advance_to(interval, sink);
+  if (interval < open_) ++counters_.late_edges;
+  else advance_to(interval, sink);
   active_ = true;
   bool& changed = line == QuadratureLine::a ? a_ : b_;
   if (changed == level) {  // the opposite edge of this line was missed

@@ -18,7 +18,7 @@
 namespace gyrochar::hal {
 
 struct QuadratureSettings {
-  std::uint64_t start_ns = 0;      // start of interval 0
+  std::uint64_t start_ns = 0;  // start of interval 0
   std::uint64_t tau0_ns = 1000000;
   std::uint64_t close_margin_ns = 0;  // an interval is closed this long after its end
   std::uint64_t max_silent_intervals = 1000;
@@ -43,11 +43,11 @@ class QuadratureDecoder {
             std::uint64_t gap_intervals = 0);  // gap_intervals > 0: a gap sample
   QuadratureSettings s_;
   bool a_, b_;
-  std::uint64_t open_ = 0;   // index of the open interval
-  std::int64_t count_ = 0;   // its count so far
-  std::uint32_t lost_ = 0;   // its lost edges so far
+  std::uint64_t open_ = 0;    // index of the open interval
+  std::int64_t count_ = 0;    // its count so far
+  std::uint32_t lost_ = 0;    // its lost edges so far
   bool active_ = false;       // it saw an edge
-  std::uint64_t silent_ = 0; // closed intervals without edges, not yet delivered
+  std::uint64_t silent_ = 0;  // closed intervals without edges, not yet delivered
   CountSourceCounters counters_;
 };
 

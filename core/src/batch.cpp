@@ -99,7 +99,7 @@ inline void add_selected(Totals& tot, int k, const std::int64_t* v, std::size_t 
 // t[j] = t[j-1] + h[j] from t[-1] = previous, in four independent runs (a quarter each, started
 // from the quarters' sums) so that the additions overlap. Returns t[n-1].
 [[gnu::always_inline]] inline std::uint64_t running_sum(const std::int64_t* __restrict h, std::int64_t* __restrict t,
-                                                         std::size_t n, std::uint64_t previous) {
+                                                        std::size_t n, std::uint64_t previous) {
   const std::size_t q = n / 4;
   std::uint64_t s0 = 0, s1 = 0, s2 = 0;
   for (std::size_t j = 0; j < q; ++j) {
@@ -271,8 +271,8 @@ inline bool has_avx512() { return __builtin_cpu_supports("avx512f"); }
 // it) over the segment r[0 .. size), whose terms are proved to fit in int64: AVAR for s >= 2m,
 // MVAR for s >= 3m - 1, HVAR for s >= 3m (s: index in the segment).
 template <class R>
-[[gnu::always_inline]] inline void overlapping(const R* __restrict r, std::size_t size, std::size_t m,
-                                               std::uint64_t first_e, std::uint64_t stride, Totals& tot) {
+[[gnu::always_inline]] inline void overlapping(const R* __restrict r, std::size_t size, std::size_t m, std::uint64_t first_e,
+                                               std::uint64_t stride, Totals& tot) {
   alignas(64) std::int64_t a[chunk], h[chunk], t[chunk];
   const auto selected = [&](std::size_t s0) {  // first index of the chunk from s0 with a term
     return static_cast<std::size_t>((stride - (first_e + s0) % stride) % stride);
@@ -377,8 +377,7 @@ struct DecimatedChunk {
   Squares a, h;
 };
 GYROCHAR_CLONES DecimatedChunk decimated_chunk(const std::int64_t* v, std::size_t n, std::size_t from, bool terms,
-                                               std::size_t first_a, std::size_t first_h, std::int64_t* a,
-                                               std::int64_t* h) {
+                                               std::size_t first_a, std::size_t first_h, std::int64_t* a, std::int64_t* h) {
   DecimatedChunk c;
   for (std::size_t k = from; k < n; ++k) {
     const std::uint64_t d = static_cast<std::uint64_t>(v[3 + k]) - static_cast<std::uint64_t>(v[2 + k]);
@@ -408,7 +407,8 @@ bool terms_fit(std::uint64_t m, std::uint64_t spread) {
 
 template <class R>
 std::int64_t point(const PhaseSegment<R>& s, std::size_t j) {
-  return static_cast<std::int64_t>(static_cast<std::uint64_t>(s.x0) + static_cast<std::uint64_t>(s.slope) * j + word(s.r[j]));
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(s.x0) + static_cast<std::uint64_t>(s.slope) * j +
+                                   word(s.r[j]));
 }
 
 }  // namespace
@@ -443,7 +443,8 @@ void BatchTau::add(const PhaseSegment<R>& segment) {
   if (every_point)
     for (const SumKind kind : {SumKind::avar, SumKind::hvar}) {
       const auto k = static_cast<std::size_t>(kind);
-      const auto d = static_cast<std::size_t>(kind == SumKind::avar ? SumKind::avar_nonoverlapped : SumKind::hvar_nonoverlapped);
+      const auto d = static_cast<std::size_t>(kind == SumKind::avar ? SumKind::avar_nonoverlapped
+                                                                    : SumKind::hvar_nonoverlapped);
       const Int128 segment_sum = Int128{tot.sum[k].lo, tot.sum[k].hi} - Int128{result_.sum[k].lo, result_.sum[k].hi};
       tot.sticky |= add_high_word(result_.sum[d], {segment_sum.lo, segment_sum.hi});
       result_.n[d] += tot.n[k] - result_.n[k];
@@ -466,13 +467,13 @@ void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits, bool terms) {
   std::uint64_t s = (m - segment.first_e % m) % m;
   std::int64_t v[3 + chunk];  // the three points before the chunk, then the chunk
   std::int64_t a[chunk], h[chunk];
-  std::uint64_t have = 0;     // points of this segment before the chunk
+  std::uint64_t have = 0;  // points of this segment before the chunk
   const auto avar_d = static_cast<std::size_t>(SumKind::avar_nonoverlapped);
   const auto hvar_d = static_cast<std::size_t>(SumKind::hvar_nonoverlapped);
   // Int32 residuals: x[k m] - x[(k-1) m] = slope m + (a difference of two residuals, below 2^32
   // in magnitude), which fits in int64 when |slope| m <= 2^62: no overflow check needed.
   const std::uint64_t slope = segment.slope < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(segment.slope)
-                                                 : static_cast<std::uint64_t>(segment.slope);
+                                                : static_cast<std::uint64_t>(segment.slope);
   const bool small_steps = sizeof(R) == 4 && m <= (std::uint64_t{1} << 31) && slope <= (std::uint64_t{1} << 31);
   while (s < size) {
     const std::uint64_t left = (size - s + m - 1) / m;
@@ -490,7 +491,9 @@ void BatchTau::decimate(const PhaseSegment<R>& segment, bool fits, bool terms) {
       for (std::size_t k = from; k < n; ++k) {
         std::int64_t d = 0;
         const bool wide = __builtin_sub_overflow(v[3 + k], v[2 + k], &d);
-        const auto mag = wide ? ~std::uint64_t{0} : d < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(d) : static_cast<std::uint64_t>(d);
+        const auto mag = wide    ? ~std::uint64_t{0}
+                         : d < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(d)
+                                 : static_cast<std::uint64_t>(d);
         if (mag > c.step) c.step = mag;
       }
       if (fits && terms) {
@@ -537,7 +540,8 @@ void BatchTau::checked_terms(const PhaseSegment<R>& segment) {
   const std::uint64_t size = segment.r.size();
   Int128 p[4];  // P[s + 1 - k m] at point s
   for (std::uint64_t s = 0; s < size; ++s) {
-    for (std::uint64_t k = 0; k < 4 && k * m <= s; ++k) p[k] = p[k] + widen(point(segment, static_cast<std::size_t>(s - k * m)));
+    for (std::uint64_t k = 0; k < 4 && k * m <= s; ++k)
+      p[k] = p[k] + widen(point(segment, static_cast<std::size_t>(s - k * m)));
     if (s < 2 * m || (segment.first_e + s) % stride != 0) continue;
     const std::int64_t x0 = point(segment, static_cast<std::size_t>(s));
     const std::int64_t x1 = point(segment, static_cast<std::size_t>(s - m));

@@ -15,9 +15,7 @@ namespace {
 
 // v XOR sign(v): |v| for v >= 0, |v| - 1 below, so every |v| <= 2^bit_width of an OR of them.
 // One shifted operand on Arm, a compare and an XOR with SIMD.
-inline std::uint64_t fold(std::uint64_t v) {
-  return v ^ static_cast<std::uint64_t>(static_cast<std::int64_t>(v) >> 63);
-}
+inline std::uint64_t fold(std::uint64_t v) { return v ^ static_cast<std::uint64_t>(static_cast<std::int64_t>(v) >> 63); }
 // The square of v's low 32-bit half taken as signed (one multiply-add on Arm): v^2 when v fits in int32.
 inline std::uint64_t low_square(std::uint64_t v) {
   const auto low = static_cast<std::int32_t>(static_cast<std::uint32_t>(v));
@@ -32,8 +30,8 @@ struct Ages {
 
 // Terms of points from .. n-1, one at a time. Running: t is t_{from-1} and becomes t_{n-1}.
 template <bool Running>
-void proved_points(std::size_t from, std::size_t n, const Ages& g, std::uint64_t& t, ProvedSums& s,
-                   std::int64_t* avar_out, std::int64_t* hvar_out) {
+void proved_points(std::size_t from, std::size_t n, const Ages& g, std::uint64_t& t, ProvedSums& s, std::int64_t* avar_out,
+                   std::int64_t* hvar_out) {
   for (std::size_t j = from; j < n; ++j) {
     const auto u0 = static_cast<std::uint64_t>(g.x0[j]), u1 = static_cast<std::uint64_t>(g.x1[j]);
     const auto u2 = static_cast<std::uint64_t>(g.x2[j]), u3 = static_cast<std::uint64_t>(g.x3[j]);
@@ -84,8 +82,7 @@ template <bool Running>
       pair_last = pair;
     } else {
       const __m256i d = _mm256_sub_epi64(load(g.p2 + j), load(g.p1 + j));
-      tv = _mm256_add_epi64(_mm256_sub_epi64(load(g.p0 + j), load(g.p3 + j)),
-                            _mm256_add_epi64(d, _mm256_add_epi64(d, d)));
+      tv = _mm256_add_epi64(_mm256_sub_epi64(load(g.p0 + j), load(g.p3 + j)), _mm256_add_epi64(d, _mm256_add_epi64(d, d)));
     }
     sa = _mm256_add_epi64(sa, _mm256_mul_epi32(av, av));
     sh = _mm256_add_epi64(sh, _mm256_mul_epi32(hv, hv));
@@ -120,7 +117,8 @@ ProvedSums proved_neon(std::size_t n, const Ages& g, std::uint64_t t, std::int64
       carry = vdupq_laneq_s64(tv, 1);
     } else {
       const uint64x2_t d = vsubq_u64(vld1q_u64(g.p2 + j), vld1q_u64(g.p1 + j));
-      tv = vreinterpretq_s64_u64(vaddq_u64(vsubq_u64(vld1q_u64(g.p0 + j), vld1q_u64(g.p3 + j)), vaddq_u64(d, vaddq_u64(d, d))));
+      tv = vreinterpretq_s64_u64(
+          vaddq_u64(vsubq_u64(vld1q_u64(g.p0 + j), vld1q_u64(g.p3 + j)), vaddq_u64(d, vaddq_u64(d, d))));
     }
   };
   const auto square = [](int64x2_t& sum, int64x2_t lo, int64x2_t hi) {
@@ -161,9 +159,8 @@ ProvedSums proved(std::size_t n, const Ages& g, std::uint64_t t, std::int64_t* a
 }  // namespace
 
 ProvedSums proved_terms(std::size_t n, const std::int64_t* x0, const std::int64_t* x1, const std::int64_t* x2,
-                        const std::int64_t* x3, const std::uint64_t* p0, const std::uint64_t* p1,
-                        const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
-                        std::int64_t* hvar_out) {
+                        const std::int64_t* x3, const std::uint64_t* p0, const std::uint64_t* p1, const std::uint64_t* p2,
+                        const std::uint64_t* p3, std::int64_t* avar_out, std::int64_t* hvar_out) {
   return proved<false>(n, {x0, x1, x2, x3, p0, p1, p2, p3}, 0, avar_out, hvar_out);
 }
 
@@ -183,10 +180,11 @@ ProvedSums proved_running_terms(std::size_t n, const std::int64_t* x0, const std
 #if defined(__x86_64__) && defined(__linux__) && !defined(__clang__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-BlockTerms block_terms(std::size_t n, const std::int64_t* __restrict x0, const std::int64_t* __restrict x1, const std::int64_t* __restrict x2,
-                       const std::int64_t* __restrict x3, const std::uint64_t* __restrict p0, const std::uint64_t* __restrict p1,
-                       const std::uint64_t* __restrict p2, const std::uint64_t* __restrict p3, std::int64_t* __restrict avar_out,
-                       std::int64_t* __restrict hvar_out, std::int64_t* __restrict mvar_out) {
+BlockTerms
+block_terms(std::size_t n, const std::int64_t* __restrict x0, const std::int64_t* __restrict x1,
+            const std::int64_t* __restrict x2, const std::int64_t* __restrict x3, const std::uint64_t* __restrict p0,
+            const std::uint64_t* __restrict p1, const std::uint64_t* __restrict p2, const std::uint64_t* __restrict p3,
+            std::int64_t* __restrict avar_out, std::int64_t* __restrict hvar_out, std::int64_t* __restrict mvar_out) {
   std::uint64_t bits_a = 0, bits_m = 0, bits_h = 0, sum_a = 0, sum_m = 0, sum_h = 0;
   for (std::size_t j = 0; j < n; ++j) {
     // Modular arithmetic: exact whenever the true value fits in int64.

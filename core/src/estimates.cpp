@@ -193,8 +193,8 @@ void identify_noise(std::span<const TauSums> taus, std::uint64_t n_phase, int dm
   }
 }
 
-Estimate estimate(const TauSums& t, std::uint64_t n_phase, DevStat stat, const NoiseId& noise,
-                  const EstimateOptions& o, PairSumCache* cache) {
+Estimate estimate(const TauSums& t, std::uint64_t n_phase, DevStat stat, const NoiseId& noise, const EstimateOptions& o,
+                  PairSumCache* cache) {
   Estimate e;
   e.stat = stat;
   e.m = t.m;

@@ -189,8 +189,8 @@ GYROCHAR_FLOAT_CLONES void alone_chunk(const double* x, Run* runs, std::size_t c
 
 // The four-point steps of the runs that start in [c0, c1) (each run's steps start at 3m + 4i, so
 // a step may reach three points past c1).
-GYROCHAR_FLOAT_CLONES void steady_chunk(const double* x, const double* ph, const double* pl, Run* runs,
-                                        std::size_t count, std::size_t c0, std::size_t c1) {
+GYROCHAR_FLOAT_CLONES void steady_chunk(const double* x, const double* ph, const double* pl, Run* runs, std::size_t count,
+                                        std::size_t c0, std::size_t c1) {
   for (std::size_t j = 0; j < count; ++j) {
     Run& r = runs[j];
     const std::size_t start = 3 * r.m;
@@ -292,7 +292,7 @@ struct PhaseRun {
 // the squares of the terms at multiples of its stride only (the running term takes every point).
 void run_points(const double* x, PhaseRun& r, std::size_t from, std::size_t to) {
   const std::size_t m = r.m, step = r.stride;
-  std::size_t counted = (from + step - 1) / step * step;  // the next point whose terms are summed
+  std::size_t counted = (from + step - 1) / step * step;                     // the next point whose terms are summed
   const bool mvar = (r.kinds & sum_bit(SumKind::mvar)) != 0 && 3 * m <= to;  // no MVAR term before 3m - 1
   for (std::size_t e = from; e < to; ++e) {
     double a = 0, h = 0, err = 0;
@@ -398,8 +398,7 @@ GYROCHAR_FLOAT_CLONES void steady_lanes(const double* x, PhaseRun* runs, std::si
                                         std::size_t to) {
   lanes_of_kinds<false>(x, runs, count, from, to);
 }
-GYROCHAR_FLOAT_CLONES void ramp_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from,
-                                      std::size_t to) {
+GYROCHAR_FLOAT_CLONES void ramp_lanes(const double* x, PhaseRun* runs, std::size_t count, std::size_t from, std::size_t to) {
   lanes_of_kinds<true>(x, runs, count, from, to);
 }
 
@@ -430,7 +429,8 @@ void store(const PhaseRun& r, TauResult<double>& out) {
     out.n[k] = formed ? r.n[k] : 0;
   }
   if (!r.nonoverlapped) return;
-  for (const auto& [overlapped, alone] : {std::pair{SumKind::avar, SumKind::avar_nonoverlapped}, std::pair{SumKind::hvar, SumKind::hvar_nonoverlapped}}) {
+  for (const auto& [overlapped, alone] :
+       {std::pair{SumKind::avar, SumKind::avar_nonoverlapped}, std::pair{SumKind::hvar, SumKind::hvar_nonoverlapped}}) {
     out.sum[static_cast<std::size_t>(alone)] = r.sum[static_cast<std::size_t>(overlapped)];
     out.n[static_cast<std::size_t>(alone)] = r.n[static_cast<std::size_t>(overlapped)];
   }

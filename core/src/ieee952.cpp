@@ -57,7 +57,8 @@ Model model_of(const Ieee952Fit& fit, double tau0) {
 Terms theta_of(const Ieee952Fit& fit) {
   Terms theta{};
   for (std::size_t t = 0; t < power_terms; ++t) theta[t] = fit.p[t].value * fit.p[t].value;
-  for (std::size_t j = 0; j < fit.n_markov; ++j) theta[power_terms + j] = fit.markov[j].sigma.value * fit.markov[j].sigma.value;
+  for (std::size_t j = 0; j < fit.n_markov; ++j)
+    theta[power_terms + j] = fit.markov[j].sigma.value * fit.markov[j].sigma.value;
   for (std::size_t j = 0; j < fit.n_sinusoids; ++j)
     theta[power_terms + fit.n_markov + j] = fit.sinusoids[j].amplitude.value * fit.sinusoids[j].amplitude.value;
   return theta;
@@ -291,8 +292,8 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
 
 }  // namespace
 
-Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
-                       std::span<double> workspace, PairSumCache* cache) {
+Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve, std::span<double> workspace,
+                       PairSumCache* cache) {
   Ieee952Fit out;
   out.curve = curve;
   Problem pr;
@@ -301,8 +302,7 @@ Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, 
   pr.spread = setup.model_spread;
   for (const FitPoint& p : points) {
     const bool wanted = curve == FitCurve::both || (curve == FitCurve::avar) == (p.stat == Stat::avar);
-    if (!wanted || (p.stat != Stat::avar && p.stat != Stat::mvar) || p.n == 0 || !(p.variance > 0) ||
-        pr.n >= max_fit_points)
+    if (!wanted || (p.stat != Stat::avar && p.stat != Stat::mvar) || p.n == 0 || !(p.variance > 0) || pr.n >= max_fit_points)
       continue;
     if (unbroken_grid(p.stat, p.m, p.stride, setup.n_phase).n == 0) continue;
     pr.point[pr.n++] = &p;

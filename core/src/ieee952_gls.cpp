@@ -195,7 +195,8 @@ void covariance_of_points(const Problem& pr, const Terms& theta) {
         const double db = tb * tb * (b.stat == Stat::mvar ? static_cast<double>(b.m) : 1.0);
         double lin = 0;
         for (std::size_t t = 0; t < noises; ++t) lin += h[t] * g[10 + t];
-        for (std::size_t k = 0; mg && k < pr.model.markov; ++k) lin += s[k] * mg[max_markov * noises + max_markov * max_markov + k];
+        for (std::size_t k = 0; mg && k < pr.model.markov; ++k)
+          lin += s[k] * mg[max_markov * noises + max_markov * max_markov + k];
         v += 4 * ramp * da * db * lin;
       }
       // Sums over the unbroken grids; gaps removed terms (share = grid terms / terms formed).

@@ -66,19 +66,19 @@ struct Problem {
   double tau0 = 1;
   std::uint64_t n_phase = 0;
   double spread = 0;
-  Model model;              // the model the rows are made for
+  Model model;  // the model the rows are made for
   // Each point's place in the first fit of this call: the pair sums and the sinusoids' sums are
   // kept by place and made once (a later fit has fewer points, never new ones).
   std::size_t place[max_fit_points];
   std::size_t places = 0;
   bool sums_made = false;
-  double* pair = nullptr;   // per pair of places (i <= j): 10 sums c_t c_u, then 4 sums c_t
-  double* markov_pair = nullptr;  // per pair (i <= j): the Markov terms' sums (markov_slots)
-  bool exact_markov = false;      // markov_pair holds the sums of model.a: Sigma is exact
-  double* sinusoid_pair = nullptr;            // per pair (i <= j): the sums of the given sinusoids
-  std::array<double, max_sinusoids> hz{};     // the given sinusoids (FitSetup::sinusoid_hz)
-  double* sigma = nullptr;  // n x n
-  double* rows = nullptr;   // per point: the design, y, Sigma's diagonal, y less the held terms
+  double* pair = nullptr;                  // per pair of places (i <= j): 10 sums c_t c_u, then 4 sums c_t
+  double* markov_pair = nullptr;           // per pair (i <= j): the Markov terms' sums (markov_slots)
+  bool exact_markov = false;               // markov_pair holds the sums of model.a: Sigma is exact
+  double* sinusoid_pair = nullptr;         // per pair (i <= j): the sums of the given sinusoids
+  std::array<double, max_sinusoids> hz{};  // the given sinusoids (FitSetup::sinusoid_hz)
+  double* sigma = nullptr;                 // n x n
+  double* rows = nullptr;                  // per point: the design, y, Sigma's diagonal, y less the held terms
   double* row(std::size_t i) const { return rows + i * width; }
   std::size_t place_pair(std::size_t i, std::size_t j) const {
     i = place[i];

@@ -110,7 +110,8 @@ double profile_log_sd(Problem& pr, const Flags& free, const Terms& fixed, std::s
 // zero. Not "resolved": a Markov term shares its rising side with K and its falling side with N,
 // and need not be the largest anywhere to be there (the fit still says whether it is resolved).
 bool column_significant(const Candidate& c, std::size_t t) {
-  const double birge = c.dof && c.sol.chi2 > static_cast<double>(c.dof) ? std::sqrt(c.sol.chi2 / static_cast<double>(c.dof)) : 1.0;
+  const double birge = c.dof && c.sol.chi2 > static_cast<double>(c.dof) ? std::sqrt(c.sol.chi2 / static_cast<double>(c.dof))
+                                                                        : 1.0;
   return c.sol.active[t] && c.sol.theta[t] > 2 * std::sqrt(std::fabs(c.sol.cov[t][t])) * birge;
 }
 

@@ -15,7 +15,7 @@ namespace gyrochar {
 namespace {
 
 using Index = std::size_t;
-using Pos = std::int64_t;    // positions relative to a window, may be negative
+using Pos = std::int64_t;  // positions relative to a window, may be negative
 using Wide = long double;
 
 struct Terms {
@@ -183,8 +183,8 @@ struct EndWindows {
 // backwards; X[1] a correlation of each end's first h values with the end; X[2] the same as X[1]
 // when len is even (len - h = h), one point longer and one lag further when it is odd. X[1] and X[3]
 // in the caller's scratch, X[2] in the FFT buffer once its results are read out.
-Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail,
-                 std::span<double> (&X)[4], Theo1Workspace& w) {
+Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail, std::span<double> (&X)[4],
+                 Theo1Workspace& w) {
   const Pos len = g.len, h = g.h;
   const Index L = static_cast<Index>(len), H = static_cast<Index>(h);
   for (Index p = 0; p <= L; ++p) X[1][p] = 0.0;

@@ -153,8 +153,8 @@ struct RunSums {
   std::int64_t s0 = 0;
   std::int64_t q[5] = {};
 };
-[[gnu::always_inline]] inline void run_sums(const std::uint32_t* w, std::size_t from, std::size_t end,
-                                            std::uint32_t base, RunSums& r) {
+[[gnu::always_inline]] inline void run_sums(const std::uint32_t* w, std::size_t from, std::size_t end, std::uint32_t base,
+                                            RunSums& r) {
   for (std::size_t i = from; i < end; ++i) {
     const auto v0 = static_cast<std::int32_t>(w[i] - base);
     const auto v1 = static_cast<std::int32_t>(w[i] - w[i - 1]);

@@ -217,8 +217,16 @@ class NodeWalker {
  public:
   NodeWalker(std::int64_t lo, std::int64_t hi, std::int64_t step, std::int64_t max_step, std::int64_t smooth_lo,
              std::int64_t smooth_hi, const std::int64_t* breaks, int n_breaks)
-      : hi_(hi), step_(step), max_step_(max_step), smooth_lo_(smooth_lo), smooth_hi_(smooth_hi), lo_(lo),
-        breaks_(breaks), n_breaks_(n_breaks), current_(lo), lattice_(static_cast<double>(step)) {}
+      : hi_(hi),
+        step_(step),
+        max_step_(max_step),
+        smooth_lo_(smooth_lo),
+        smooth_hi_(smooth_hi),
+        lo_(lo),
+        breaks_(breaks),
+        n_breaks_(n_breaks),
+        current_(lo),
+        lattice_(static_cast<double>(step)) {}
   // False once every node was given.
   bool next(std::int64_t& lag, double& weight) {
     if (done_) return false;
@@ -260,7 +268,7 @@ class NodeWalker {
 
 template <class Visit>
 inline void visit_nodes(std::int64_t lo, std::int64_t hi, std::int64_t step, std::int64_t max_step, std::int64_t smooth_lo,
-                 std::int64_t smooth_hi, const std::int64_t* breaks, int n_breaks, Visit&& visit) {
+                        std::int64_t smooth_hi, const std::int64_t* breaks, int n_breaks, Visit&& visit) {
   NodeWalker walk(lo, hi, step, max_step, smooth_lo, smooth_hi, breaks, n_breaks);
   std::int64_t lag = 0;
   double weight = 0;
@@ -342,14 +350,10 @@ inline bool pair_setup(const NoiseSet& set, const TermGrid& a, const TermGrid& b
     s.many.count = t + 1;
   }
   s.step = static_cast<std::int64_t>(fine);
-  s.pairs = PairCounter{static_cast<std::int64_t>(a.first),
-                        static_cast<std::int64_t>(a.first + (a.n - 1) * a.stride),
-                        static_cast<std::int64_t>(b.first),
-                        static_cast<std::int64_t>(b.first + (b.n - 1) * b.stride),
-                        static_cast<std::int64_t>(a.stride),
-                        static_cast<std::int64_t>(b.stride),
-                        static_cast<std::int64_t>(a.n),
-                        static_cast<std::int64_t>(b.n)};
+  s.pairs = PairCounter{static_cast<std::int64_t>(a.first),  static_cast<std::int64_t>(a.first + (a.n - 1) * a.stride),
+                        static_cast<std::int64_t>(b.first),  static_cast<std::int64_t>(b.first + (b.n - 1) * b.stride),
+                        static_cast<std::int64_t>(a.stride), static_cast<std::int64_t>(b.stride),
+                        static_cast<std::int64_t>(a.n),      static_cast<std::int64_t>(b.n)};
   s.extent_lo = s.pairs.first_a - s.pairs.last_b;
   s.extent_hi = s.pairs.last_a - s.pairs.first_b;
   return true;
@@ -410,7 +414,9 @@ struct NoiseAtAnyLag {
   std::array<std::size_t, max_noises> flicker_of{};  // flickers' entry f is the set's noise flicker_of[f]
 
   NoiseAtAnyLag(const PairSetup& s, const TermGrid& a, const TermGrid& b)
-      : span_lo(-s.k.u_max()), span_hi(-s.k.u_min()), center(-0.5 * static_cast<double>(s.k.u_min() + s.k.u_max())),
+      : span_lo(-s.k.u_max()),
+        span_hi(-s.k.u_min()),
+        center(-0.5 * static_cast<double>(s.k.u_min() + s.k.u_max())),
         p(tail_powers(s, a, b)) {
     const std::int64_t width = span_hi - span_lo + 1;
     flicker_lo = span_lo - 3 * width;

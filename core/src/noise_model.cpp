@@ -26,8 +26,7 @@ double term_covariance(int alpha, Stat a, std::uint64_t m_a, Stat b, std::uint64
   return covariance(k, 2 - alpha + 2 * k.level, lag);
 }
 
-double markov_term_covariance(double a, Stat a_stat, std::uint64_t m_a, Stat b_stat, std::uint64_t m_b,
-                              std::int64_t lag) {
+double markov_term_covariance(double a, Stat a_stat, std::uint64_t m_a, Stat b_stat, std::uint64_t m_b, std::int64_t lag) {
   if (!(a > 0)) return 0.0;
   return markov_covariance(kernel(a_stat, m_a, b_stat, m_b), a, lag);
 }
@@ -141,8 +140,8 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b) {
   return pass.out;
 }
 
-void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b1, const TermGrid& a2,
-                      const TermGrid& b2, PairSums& out1, PairSums& out2) {
+void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b1, const TermGrid& a2, const TermGrid& b2,
+                      PairSums& out1, PairSums& out2) {
   const bool same_kernel = a1.stat == a2.stat && a1.m == a2.m && b1.stat == b2.stat && b1.m == b2.m &&
                            a1.stride == a2.stride && b1.stride == b2.stride;
   PowerPass one, two;
@@ -177,8 +176,7 @@ void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b
   out2 = two.out;
 }
 
-MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rates, const TermGrid& a,
-                                const TermGrid& b) {
+MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rates, const TermGrid& a, const TermGrid& b) {
   MarkovPairSums out;
   PairSetup setup;
   const std::size_t markov = rates.size() < max_markov_rates ? rates.size() : max_markov_rates;

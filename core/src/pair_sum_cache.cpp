@@ -78,7 +78,8 @@ double exact_skew_dof(int alpha, const TermGrid& g) {
     while (reach / q > cap) q *= 2;
     const std::int64_t top = reach / q;
     std::array<double, 2 * cap + 2> table{};  // c at lags 0, q, 2q, ... 2 top (u + v reaches 2 top)
-    for (std::int64_t j = 0; j <= 2 * top; ++j) table[static_cast<std::size_t>(j)] = j * q <= reach ? covariance(k, twice_d, j * q * s) : 0.0;
+    for (std::int64_t j = 0; j <= 2 * top; ++j)
+      table[static_cast<std::size_t>(j)] = j * q <= reach ? covariance(k, twice_d, j * q * s) : 0.0;
     auto c = [&](std::int64_t j) { return table[static_cast<std::size_t>(j < 0 ? -j : j)]; };
     for (std::int64_t u = -top; u <= top; ++u)
       for (std::int64_t v = -top; v <= top; ++v) {
@@ -124,8 +125,8 @@ PairSumCache::Entry* PairSumCache::slot(const TermGrid& a, const TermGrid& b) {
   Entry* entry = nullptr;
   for (std::size_t probe = 0; probe < entries_.size() && probe < 64; ++probe) {
     Entry& e = entries_[static_cast<std::size_t>((h + probe) % entries_.size())];
-    if (!e.used || (e.stat_a == a.stat && e.stat_b == b.stat && e.m_a == a.m && e.m_b == b.m &&
-                    e.stride_a == a.stride && e.stride_b == b.stride)) {
+    if (!e.used || (e.stat_a == a.stat && e.stat_b == b.stat && e.m_a == a.m && e.m_b == b.m && e.stride_a == a.stride &&
+                    e.stride_b == b.stride)) {
       entry = &e;
       break;
     }
@@ -149,8 +150,8 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b) {
   // less than 2 % (the sums are nearly proportional to it: the EDF moves by less than 1e-3), or by
   // 10 % for grids of different taus (their covariance only weights the fit: 1 % at most).
   const std::uint64_t growth = a.m == b.m ? 50 : 10;
-  if (entry->used && !entry->linear && a.n >= entry->n_a && b.n >= entry->n_b &&
-      growth * (a.n - entry->n_a) <= entry->n_a && growth * (b.n - entry->n_b) <= entry->n_b) {
+  if (entry->used && !entry->linear && a.n >= entry->n_a && b.n >= entry->n_b && growth * (a.n - entry->n_a) <= entry->n_a &&
+      growth * (b.n - entry->n_b) <= entry->n_b) {
     PairSums out;
     add_scaled(out, entry->sums, static_cast<double>(n) / static_cast<double>(a_coarse ? entry->n_a : entry->n_b),
                PairSums{});

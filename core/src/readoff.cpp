@@ -8,9 +8,7 @@ namespace gyrochar {
 
 namespace {
 
-bool usable(const AdevPoint& p) {
-  return std::isfinite(p.tau_s) && p.tau_s > 0 && std::isfinite(p.adev) && p.adev > 0;
-}
+bool usable(const AdevPoint& p) { return std::isfinite(p.tau_s) && p.tau_s > 0 && std::isfinite(p.adev) && p.adev > 0; }
 
 // The next usable index after i, or `end`.
 std::size_t next_usable(std::span<const AdevPoint> pts, std::size_t i) {
@@ -20,9 +18,7 @@ std::size_t next_usable(std::span<const AdevPoint> pts, std::size_t i) {
 }
 
 // The value read at point p with factor f (adev x f), its interval scaled alike.
-ReadoffValue read_at(const AdevPoint& p, double f) {
-  return {true, p.adev * f, p.ci_low * f, p.ci_high * f, p.tau_s};
-}
+ReadoffValue read_at(const AdevPoint& p, double f) { return {true, p.adev * f, p.ci_low * f, p.ci_high * f, p.tau_s}; }
 
 // Keeps the candidate with the smaller value (the first on ties: the shortest tau).
 void keep_smaller(ReadoffValue& best, const ReadoffValue& candidate) {
@@ -56,17 +52,14 @@ Readoff read_off(std::span<const AdevPoint> pts, const ReadoffOptions& options) 
   std::size_t lo = first, hi = first;
   for (std::size_t i = first; i < end; i = next_usable(pts, i)) {
     const double tau = pts[i].tau_s;
-    for (std::size_t j = next_usable(pts, lo); j < i && pts[j].tau_s <= 0.5 * tau * (1 + tolerance);
-         j = next_usable(pts, j))
+    for (std::size_t j = next_usable(pts, lo); j < i && pts[j].tau_s <= 0.5 * tau * (1 + tolerance); j = next_usable(pts, j))
       lo = j;
     if (hi < i) hi = i;
     while (hi != last && pts[hi].tau_s < 2.0 * tau * (1 - tolerance)) hi = next_usable(pts, hi);
     if (lo == hi) continue;  // a single point: no slope
     const double slope = std::log(pts[hi].adev / pts[lo].adev) / std::log(pts[hi].tau_s / pts[lo].tau_s);
-    if (i <= floor && std::fabs(slope + 0.5) <= options.slope_band)
-      keep_smaller(r.n, read_at(pts[i], std::sqrt(tau)));
-    if (i >= floor && std::fabs(slope - 0.5) <= options.slope_band)
-      keep_smaller(r.k, read_at(pts[i], std::sqrt(3.0 / tau)));
+    if (i <= floor && std::fabs(slope + 0.5) <= options.slope_band) keep_smaller(r.n, read_at(pts[i], std::sqrt(tau)));
+    if (i >= floor && std::fabs(slope - 0.5) <= options.slope_band) keep_smaller(r.k, read_at(pts[i], std::sqrt(3.0 / tau)));
   }
   return r;
 }

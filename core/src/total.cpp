@@ -33,7 +33,7 @@ double total_kernel(const Seq& v, Index S, std::span<double> E, std::uint64_t& r
   const Index len = 3 * S, total = v.size();
   const Index starts = total >= len ? total - len + 1 : 0;
   runs = starts;
-  const Index half = len / 2;  // points in each half; the middle one of an odd run is in neither
+  const Index half = len / 2;                // points in each half; the middle one of an odd run is in neither
   const double run = as_double(len - half);  // distance between the centres of the halves
   double sum = 0.0;
   for (Index n = 0; n < starts; ++n) {
@@ -53,8 +53,7 @@ double total_kernel(const Seq& v, Index S, std::span<double> E, std::uint64_t& r
       const Index s = len - 1 - t;
       E[t + 1] = E[t] + (v(n + s) - slope * (as_double(s) - centre) - mean);
     }
-    for (Index t = 0; t < len; ++t)
-      E[len + t + 1] = E[len + t] + (v(n + t) - slope * (as_double(t) - centre) - mean);
+    for (Index t = 0; t < len; ++t) E[len + t + 1] = E[len + t] + (v(n + t) - slope * (as_double(t) - centre) - mean);
     for (Index t = 0; t < len; ++t) E[2 * len + t + 1] = E[2 * len + t] + (E[t + 1] - E[t]);
     // z over [0, 6S) is symmetric: the extension is even about -1/2 and the modified Allan filter
     // about its centre, so z_k = z_{3S-k} on [0, 3S] and z_k = z_{9S-k} on (3S, 6S). Each pair once,
@@ -162,7 +161,7 @@ TotalVariance oavar(std::span<const double> x, std::uint64_t m, double tau0_s, s
 }
 
 std::uint64_t theo_bias_last(std::uint64_t n_phase) {
-  std::uint64_t last = n_phase / 6 - 3;  // n of the definition, floor(N / 6 - 3)
+  std::uint64_t last = n_phase / 6 - 3;          // n of the definition, floor(N / 6 - 3)
   if (2 * (9 + 3 * last) + 1 > n_phase) --last;  // its AVAR would need N + 1 points
   return last;
 }
@@ -281,9 +280,18 @@ double edf_mtotvar(int alpha, double n_phase, double m) {
 double edf_htotvar(int alpha, double n_phase, double m) {
   double b0 = 0, b1 = 0;
   switch (alpha) {
-    case 0: b0 = 0.559; b1 = 1.004; break;
-    case -1: b0 = 0.868; b1 = 1.140; break;
-    case -2: b0 = 0.938; b1 = 1.696; break;
+    case 0:
+      b0 = 0.559;
+      b1 = 1.004;
+      break;
+    case -1:
+      b0 = 0.868;
+      b1 = 1.140;
+      break;
+    case -2:
+      b0 = 0.938;
+      b1 = 1.696;
+      break;
     default: return 0.0;
   }
   return (n_phase / m) / (b0 + b1 * m / n_phase);

@@ -383,9 +383,7 @@ std::size_t fft_length(std::size_t n) {
   return p;
 }
 
-std::size_t fft_twiddle_size(std::size_t P) {
-  return P <= whole_up_to ? 2 * P : 2 * large_stage(2 * P);
-}
+std::size_t fft_twiddle_size(std::size_t P) { return P <= whole_up_to ? 2 * P : 2 * large_stage(2 * P); }
 
 void fft_twiddles(std::span<double> twiddle, std::size_t P) {
   // The whole stages, each contiguous: the largest computed, each smaller one read from the one
@@ -465,7 +463,7 @@ void ends_correlations(std::span<const double> a, std::span<const double> b, std
   load(e, n, a.first(first), b.first(first));
   forward_bitreversed(d, n, w.twiddle.data());
   forward_bitreversed(e, n, w.twiddle.data());
-  auto split = [](const double* z, const double* v, double (&s)[4]) {  // A (re, im), B (re, im) at k
+  auto split = [](const double* z, const double* v, double(&s)[4]) {  // A (re, im), B (re, im) at k
     s[0] = 0.5 * (z[0] + v[0]), s[1] = 0.5 * (z[1] - v[1]), s[2] = 0.5 * (z[1] + v[1]), s[3] = -0.5 * (z[0] - v[0]);
   };
   for_each_mirror_pair(n, [d, e, &split](Index p, Index q, Index) {
@@ -554,8 +552,8 @@ TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s) {
     // sum_i (r[i] - r[i+k] - r[i+m-k] + r[i+m])^2 over i < L: squares, then the six products as
     // lag sums over i in [s, s + L), each the whole record's less its ends (docs/total.md).
     const double squares = sum2(0) + sum2(k) + sum2(M - k) + sum2(M);
-    const double products = -(R[k] - last(k)) - (R[M - k] - last(M - k)) + R[M] + R[M - 2 * k] -
-                            (R[M - k] - first(M - k)) - (R[k] - first(k));
+    const double products = -(R[k] - last(k)) - (R[M - k] - last(M - k)) + R[M] + R[M - 2 * k] - (R[M - k] - first(M - k)) -
+                            (R[k] - first(k));
     const double gamma = 2.0 * w.curvature * as_double(k) * as_double(M - k);  // the quadratic's term
     const double linear = sum1(0) - sum1(k) - sum1(M - k) + sum1(M);
     sum += (squares + 2.0 * products + 2.0 * gamma * linear + as_double(L) * gamma * gamma) / as_double(k);
@@ -568,8 +566,7 @@ TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s) {
   return {sum / (0.75 * as_double(L) * tau * tau), static_cast<std::uint64_t>(L) * h, 1};
 }
 
-TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s,
-                                   std::uint64_t ratio_taus) {
+TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s, std::uint64_t ratio_taus) {
   const std::uint64_t N = x.size();
   if (N < 24 || ratio_taus < 2 || !(tau0_s > 0) || !w.ready || w.r.size() != N) return {};
   const std::uint64_t last = theo_bias_last(N);

@@ -81,8 +81,7 @@ void GpioQuadratureSource::fill(Queue& q) {
   if (q.size == batch) return;
   gpiod_line_event raw[batch];
   const int n = gpiod_line_event_read_multiple(q.line, raw, static_cast<unsigned>(batch - q.size));
-  for (int k = 0; k < n; ++k)
-    q.events[q.size++] = {to_ns(raw[k].ts), raw[k].event_type == GPIOD_LINE_EVENT_RISING_EDGE};
+  for (int k = 0; k < n; ++k) q.events[q.size++] = {to_ns(raw[k].ts), raw[k].event_type == GPIOD_LINE_EVENT_RISING_EDGE};
 }
 
 void GpioQuadratureSource::poll(std::uint64_t now_ns, CountSink& sink) {
@@ -100,7 +99,8 @@ void GpioQuadratureSource::poll(std::uint64_t now_ns, CountSink& sink) {
     int line = 0;
     for (int k = 0; k < 2; ++k) {
       Queue& q = queues_[k];
-      if (q.head < q.size && q.events[q.head].t_ns <= now_ns && (next == nullptr || q.events[q.head].t_ns < next->events[next->head].t_ns)) {
+      if (q.head < q.size && q.events[q.head].t_ns <= now_ns &&
+          (next == nullptr || q.events[q.head].t_ns < next->events[next->head].t_ns)) {
         next = &q;
         line = k;
       }

@@ -11,8 +11,7 @@
 
 namespace gyrochar::hal {
 
-GpioStrobeSource::GpioStrobeSource(const GpioStrobeSettings& s)
-    : decoder_(StrobeDecoder({s.tau0_ns, s.counter_bits})) {
+GpioStrobeSource::GpioStrobeSource(const GpioStrobeSettings& s) : decoder_(StrobeDecoder({s.tau0_ns, s.counter_bits})) {
   chip_ = gpiod_chip_open_lookup(s.chip.c_str());
   if (chip_ == nullptr) throw std::runtime_error(s.chip + ": cannot open GPIO chip: " + std::strerror(errno));
   const std::string what = s.chip + " line " + std::to_string(s.line) + ": ";

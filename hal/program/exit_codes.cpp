@@ -66,7 +66,8 @@ bool close_output(std::FILE* file, std::string_view program, std::string_view na
   const bool closed = std::fclose(file) == 0;
   if (error == 0) error = errno;
   if (flushed && closed && !failed_before) return true;
-  print_error(program, name, std::string("write failed: ") + (error != 0 ? std::strerror(error) : "an earlier write was refused"));
+  print_error(program, name,
+              std::string("write failed: ") + (error != 0 ? std::strerror(error) : "an earlier write was refused"));
   return false;
 }
 

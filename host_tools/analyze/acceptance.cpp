@@ -4,10 +4,8 @@
 
 #include <cmath>
 
-
 namespace gyrochar {
 namespace {
-
 
 LimitEstimate term_estimate(const Report& r, std::size_t k, double run_s) {
   const char* letter = units::ieee952[k].letter;
@@ -20,8 +18,7 @@ LimitEstimate term_estimate(const Report& r, std::size_t k, double run_s) {
   return fitted_term_estimate(p, run_s);
 }
 
-LimitEstimate deviation_row_estimate(const Limit& l, const Report& r, const std::vector<AnalysisRow>& rows,
-                                     double run_s) {
+LimitEstimate deviation_row_estimate(const Limit& l, const Report& r, const std::vector<AnalysisRow>& rows, double run_s) {
   const DevStat stat = l.kind == Limit::Kind::adev ? DevStat::oadev : DevStat::mdev;
   double below = 0, above = 0;
   for (const AnalysisRow& row : rows) {
@@ -58,8 +55,8 @@ std::uint64_t limit_m(const Limit& limit, double tau0_s) {
   return static_cast<std::uint64_t>(m);
 }
 
-std::vector<Decision> decide_limits(const std::vector<Limit>& limits, const Report& r,
-                                    const std::vector<AnalysisRow>& rows, double run_s) {
+std::vector<Decision> decide_limits(const std::vector<Limit>& limits, const Report& r, const std::vector<AnalysisRow>& rows,
+                                    double run_s) {
   std::vector<Decision> out;
   for (const Limit& l : limits)
     out.push_back(decide(l, l.kind == Limit::Kind::term ? term_estimate(r, l.term, run_s)

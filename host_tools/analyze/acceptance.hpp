@@ -30,7 +30,7 @@ LimitEstimate fitted_term_estimate(const Ieee952Parameter& p, double run_s);
 /// The decision of every limit for `r` over `rows` (every row computed, in engine units; the
 /// report's own rows may be a subset) and a run of run_s seconds. Limits need gyro data (the
 /// caller checks). O(limits x rows).
-std::vector<Decision> decide_limits(const std::vector<Limit>& limits, const Report& r,
-                                    const std::vector<AnalysisRow>& rows, double run_s);
+std::vector<Decision> decide_limits(const std::vector<Limit>& limits, const Report& r, const std::vector<AnalysisRow>& rows,
+                                    double run_s);
 
 }  // namespace gyrochar

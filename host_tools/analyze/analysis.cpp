@@ -48,8 +48,9 @@ std::string non_finite_reason(const Estimate& e, const TauSums& sums, double tau
   const std::string where = where_of(e);
   for (const double v : sums.variance)
     if (!std::isfinite(v))
-      return where + ": the squared differences of the values overflow a double (largest 1.8e308): the values "
-                     "are too large; scale them";
+      return where +
+             ": the squared differences of the values overflow a double (largest 1.8e308): the values "
+             "are too large; scale them";
   if (std::string why; tau0_out_of_range(e, tau0_s, why)) return why;
   return where + fmt::format(": the squared differences divided by tau0^2 = ({:g} s)^2 overflow a double", tau0_s);
 }
@@ -64,12 +65,15 @@ std::string underflow_reason(const Estimate& e, const TauSums& sums, double tau0
     return where + fmt::format(": tau = m tau0 = {} x {:g} s is not a finite number: tau0 is too large", e.m, tau0_s);
   const double v = sums.variance[static_cast<std::size_t>(sum_kind(e.stat))];
   if (v > 0 && v < DBL_MIN)
-    return where + ": the squared differences of the values underflow a double (smallest normal 2.2e-308): the "
-                   "values are too small; scale them";
+    return where +
+           ": the squared differences of the values underflow a double (smallest normal 2.2e-308): the "
+           "values are too small; scale them";
   if (!(v > 0) || e.variance >= DBL_MIN) return {};
   if (std::string why; tau0_out_of_range(e, tau0_s, why)) return why;
-  return where + fmt::format(": the squared differences divided by tau0^2 = ({:g} s)^2 underflow a double (smallest "
-                             "normal 2.2e-308): the values are too small for this tau0; scale them", tau0_s);
+  return where + fmt::format(
+                     ": the squared differences divided by tau0^2 = ({:g} s)^2 underflow a double (smallest "
+                     "normal 2.2e-308): the values are too small for this tau0; scale them",
+                     tau0_s);
 }
 
 }  // namespace
@@ -210,7 +214,9 @@ std::unique_ptr<EdfTable> dense_edf_table(DevStat stat, const std::vector<TauSum
 
 namespace {
 
-bool any_total(const AnalysisOptions& o) { return std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); }); }
+bool any_total(const AnalysisOptions& o) {
+  return std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
+}
 
 // Whether the read-out identifies the noise of a curve: Hadamard's (dmax 3) for hdev and ohdev,
 // Allan's for the others; both for the total family (it leans on all three statistics' rows).
@@ -251,10 +257,11 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
   std::unique_ptr<DenseNoiseSums> dense_sums;
   const bool identify_allan = identifies(o, false), identify_hadamard = identifies(o, true);
   for (const DevStat stat : o.stats)
-    for (const DevStat s : is_total(stat) ? std::vector<DevStat>{DevStat::oadev, DevStat::mdev, DevStat::ohdev} : std::vector{stat})
+    for (const DevStat s :
+         is_total(stat) ? std::vector<DevStat>{DevStat::oadev, DevStat::mdev, DevStat::ohdev} : std::vector{stat})
       if (!tables.contains(s))
         tables[s] = o.alpha || identifies(o, stat_of(s) == Stat::hvar) ? dense_edf_table(s, sums, a.n_phase, o.edf, cache)
-                                                                        : nullptr;  // no EDF without a noise
+                                                                       : nullptr;  // no EDF without a noise
   if (!o.alpha && std::any_of(tables.begin(), tables.end(), [](const auto& t) { return t.second != nullptr; })) {
     std::vector<std::uint64_t> m_list;
     for (const TauSums& t : sums)
@@ -336,8 +343,11 @@ class Engine final : public EngineBase {
  public:
   Engine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list, bool keep_record,
          std::uint32_t tag)
-      : type_(type), record_(type, keep_record), history_(history_entries(stride_factor, m_list.back())),
-        states_(m_list.size()), characterizer_(history_, states_) {
+      : type_(type),
+        record_(type, keep_record),
+        history_(history_entries(stride_factor, m_list.back())),
+        states_(m_list.size()),
+        characterizer_(history_, states_) {
     if (!history_.data()) throw std::bad_alloc();
     if (characterizer_.configure({stride_factor, tag}, m_list) != ConfigureStatus::ok)
       throw std::invalid_argument("the taus do not fit the stride factor");
@@ -361,10 +371,8 @@ class Engine final : public EngineBase {
       for (std::size_t i = 0; i < values.size(); ++i) {
         const double v = values[i];
         if (!std::isfinite(v)) throw BadValue(i, "not a finite number");
-        if (type_ == DataType::phase)
-          characterizer_.add_phase_point(v);
-        else
-          characterizer_.add_increment(v);  // frequency: phase in units of y tau0
+        if (type_ == DataType::phase) characterizer_.add_phase_point(v);
+        else characterizer_.add_increment(v);  // frequency: phase in units of y tau0
         record_.keep(v);
       }
     }
@@ -406,7 +414,6 @@ class Engine final : public EngineBase {
   std::vector<std::int32_t> counts_;  // a block of counts on its way to the block API
 };
 
-
 }  // namespace
 
 struct Analyzer::Impl {
@@ -429,19 +436,20 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   for (const std::uint64_t m : o.m_list)
     if (!tau_representable(m, s))
       throw std::invalid_argument("averaging factor " + std::to_string(m) + " cannot be formed with stride factor " +
-                                  std::to_string(s) + ": above S it must be a multiple of its stride (m/S rounded up to a power of two)");
+                                  std::to_string(s) +
+                                  ": above S it must be a multiple of its stride (m/S rounded up to a power of two)");
   for (std::size_t i = 1; i < o.theo_m_list.size(); ++i)
     if (o.theo_m_list[i] <= o.theo_m_list[i - 1]) throw std::invalid_argument("Theo1 averaging factors must increase");
   impl_->options = o;
-  const bool keep_record = o.keep_record || std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
+  const bool keep_record = o.keep_record ||
+                           std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
   if (o.type == DataType::counts && o.hold_counts)
     impl_->engine = make_count_batch_engine(s, o.m_list, keep_record, o.values_hint);
   else if (o.type != DataType::counts && o.hold_phase)
     impl_->engine = make_float_batch_engine(o.type, s, o.m_list, keep_record, o.values_hint, o.hold_prefix_sums);
   else if (o.type == DataType::counts)
     impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record, o.checkpoint_tag);
-  else
-    impl_->engine = std::make_unique<Engine<FloatArith>>(o.type, s, o.m_list, keep_record, o.checkpoint_tag);
+  else impl_->engine = std::make_unique<Engine<FloatArith>>(o.type, s, o.m_list, keep_record, o.checkpoint_tag);
 }
 
 Analyzer::~Analyzer() = default;

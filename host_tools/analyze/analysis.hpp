@@ -73,20 +73,21 @@ std::vector<std::uint64_t> decade_taus(std::uint64_t n_phase);
 /// its even factors from 10 on, continued by its own rule (octave: doubling; decade: 1, 2, 4 per
 /// decade) up to n_phase - 1 (2^40 when n_phase is 0, unknown); "all": every even m from 10 to
 /// n_phase - 1. O(list).
-std::vector<std::uint64_t> theo_taus(const std::string& rule, const std::vector<std::uint64_t>& m_list, std::uint64_t n_phase);
+std::vector<std::uint64_t> theo_taus(const std::string& rule, const std::vector<std::uint64_t>& m_list,
+                                     std::uint64_t n_phase);
 /// Every averaging factor up to n_phase / 2 that stride factor S can form (every m when
 /// n_phase / 2 <= S). The list has O(min(n_phase, S log n_phase)) entries.
 std::vector<std::uint64_t> all_taus(std::uint64_t n_phase, std::uint32_t stride_factor);
 
 struct AnalysisOptions {
   DataType type = DataType::phase;
-  double tau0_s = 1.0;                  // sample interval
-  std::vector<std::uint64_t> m_list;    // averaging factors, strictly increasing
+  double tau0_s = 1.0;                                        // sample interval
+  std::vector<std::uint64_t> m_list;                          // averaging factors, strictly increasing
   std::vector<DevStat> stats{DevStat::oadev, DevStat::mdev};  // rows come out in this order
-  std::uint32_t stride_factor = 0;      // S, a power of two >= 2; 0: full (resolve_stride_factor)
+  std::uint32_t stride_factor = 0;                            // S, a power of two >= 2; 0: full (resolve_stride_factor)
   double confidence = 0.682689492137086;
-  std::optional<int> alpha;             // noise exponent for the EDF; empty: identified per tau
-  EdfModel edf = EdfModel::exact;       // greenhall: Stable32's approximation (comparisons)
+  std::optional<int> alpha;        // noise exponent for the EDF; empty: identified per tau
+  EdfModel edf = EdfModel::exact;  // greenhall: Stable32's approximation (comparisons)
   // false: the deviations alone, no noise identification and so no EDF or interval (the Python
   // package's allantools functions, which return none); the total family identifies all the same
   // (its bias corrections need it).
@@ -134,17 +135,17 @@ struct AnalysisOptions {
 struct AnalysisRow {
   DevStat stat = DevStat::oadev;
   std::uint64_t m = 0;
-  double tau_s = 0.0;           // m tau0 (Theo1, TheoBR: 0.75 m tau0)
-  std::uint64_t n = 0;          // terms in the estimate (Stable32's "#")
-  double dev = 0.0;             // deviation: phase unit per second (TDEV, TTOTDEV: phase unit)
-  std::optional<int> alpha;     // identified (or given) noise exponent; empty: not identified
-  NoiseId noise;                // the identification: plausible range and method
-  int edf_alpha = 0;            // the alpha whose EDF was used (the smallest of the plausible)
-  std::uint64_t stride = 1;     // terms every `stride` phase points (m for adev and hdev); total
-                                // family: 1 exact, else the decimated estimator's block or stride
-  double edf = 0.0;             // EDF of this estimator; 0: not available
-  double skew_dof = 0.0;        // skewness of its distribution (confidence.hpp); 0: plain chi-squared
-  Interval ci;                  // same unit as dev
+  double tau_s = 0.0;        // m tau0 (Theo1, TheoBR: 0.75 m tau0)
+  std::uint64_t n = 0;       // terms in the estimate (Stable32's "#")
+  double dev = 0.0;          // deviation: phase unit per second (TDEV, TTOTDEV: phase unit)
+  std::optional<int> alpha;  // identified (or given) noise exponent; empty: not identified
+  NoiseId noise;             // the identification: plausible range and method
+  int edf_alpha = 0;         // the alpha whose EDF was used (the smallest of the plausible)
+  std::uint64_t stride = 1;  // terms every `stride` phase points (m for adev and hdev); total
+                             // family: 1 exact, else the decimated estimator's block or stride
+  double edf = 0.0;          // EDF of this estimator; 0: not available
+  double skew_dof = 0.0;     // skewness of its distribution (confidence.hpp); 0: plain chi-squared
+  Interval ci;               // same unit as dev
 };
 
 /// The phase record the analyzer holds for the total family: points in the engine's representation

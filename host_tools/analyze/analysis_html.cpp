@@ -52,7 +52,8 @@ html::LogPlot curve_plot(const Report& r, const std::vector<AnalysisRow>& curves
       y.push_back(std::sqrt(fitted_variance(r.fits.front().fit, adev ? Stat::avar : Stat::mvar, mi, r.tau0_s)) / unit);
     if (r.truth && adev) {
       const Ieee952Truth& t = *r.truth;
-      ty.push_back(std::sqrt(ieee952_avar({t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2}, x.back())) / unit);
+      ty.push_back(std::sqrt(ieee952_avar({t.q_rad, t.n_rad_sqrt_s, t.b_rad_s, t.k_rad_s_sqrt_s, t.r_rad_s2}, x.back())) /
+                   unit);
     }
   }
   if (!y.empty()) plot.lines.push_back({"fitted model", model_colour, false, x, y});
@@ -75,9 +76,12 @@ void statistic_tables(html::Document& doc, const Report& r) {
     std::vector<std::vector<Cell>> rows;
     for (const AnalysisRow& row : r.analysis.rows) {
       if (row.stat != st) continue;
-      rows.push_back({number(row.tau_s), {fmt::format("{}", row.m), fmt::format("{}", row.m), {}},
-                      {fmt::format("{}", row.n), fmt::format("{}", row.n), {}}, number(row.dev * k),
-                      row.ci.valid ? number(row.ci.low * k) : Cell{}, row.ci.valid ? number(row.ci.high * k) : Cell{},
+      rows.push_back({number(row.tau_s),
+                      {fmt::format("{}", row.m), fmt::format("{}", row.m), {}},
+                      {fmt::format("{}", row.n), fmt::format("{}", row.n), {}},
+                      number(row.dev * k),
+                      row.ci.valid ? number(row.ci.low * k) : Cell{},
+                      row.ci.valid ? number(row.ci.high * k) : Cell{},
                       row.edf > 0 ? number(row.edf) : Cell{},
                       row.alpha ? Cell{fmt::format("{}", *row.alpha), fmt::format("{}", *row.alpha), {}} : Cell{},
                       {fmt::format("{}", row.stride), fmt::format("{}", row.stride), {}}});
@@ -104,7 +108,9 @@ void fit_tables(html::Document& doc, const Report& r) {
       }
       rows.push_back({text(u.letter), p.fitted ? number(p.value / u.si) : Cell{},
                       p.fitted ? number(p.uncertainty / u.si) : Cell{}, text(u.name),
-                      text(!p.fitted ? "not in model" : p.resolved ? "resolved" : "not resolved")});
+                      text(!p.fitted    ? "not in model"
+                           : p.resolved ? "resolved"
+                                        : "not resolved")});
       if (r.truth && f == 0) rows.back().push_back(truth);
     }
     for (std::size_t i = 0; i < fit.n_markov; ++i) {
@@ -113,8 +119,8 @@ void fit_tables(html::Document& doc, const Report& r) {
       rows.push_back({text(fmt::format("Markov {} sigma", i + 1)), number(mt.sigma.value / unit),
                       number(mt.sigma.uncertainty / unit), text(r.units.unit(DevStat::oadev)),
                       text(mt.sigma.resolved ? "resolved" : "not resolved")});
-      rows.push_back({text(fmt::format("Markov {} Tc", i + 1)), number(mt.tc_s), number(mt.tc_uncertainty_s), text("s"),
-                      text("")});
+      rows.push_back(
+          {text(fmt::format("Markov {} Tc", i + 1)), number(mt.tc_s), number(mt.tc_uncertainty_s), text("s"), text("")});
     }
     for (std::size_t i = 0; i < fit.n_sinusoids; ++i) {
       const SinusoidTerm& st = fit.sinusoids[i];
@@ -127,8 +133,9 @@ void fit_tables(html::Document& doc, const Report& r) {
     doc.table(f == 0 ? "fit" : fmt::format("fit-{}", name(r.fits[f].curve)),
               fmt::format("Fit of {}: {}, chi2/dof {:.3g}, {} points, uncertainty scale {:.3g}", curve, name(fit.status),
                           fit.chi2_per_dof(), fit.points, fit.birge),
-              r.truth && f == 0 ? std::vector<std::string>{"term", "value", "standard uncertainty", "unit", "status", "simulated truth"}
-                                : std::vector<std::string>{"term", "value", "standard uncertainty", "unit", "status"},
+              r.truth && f == 0
+                  ? std::vector<std::string>{"term", "value", "standard uncertainty", "unit", "status", "simulated truth"}
+                  : std::vector<std::string>{"term", "value", "standard uncertainty", "unit", "status"},
               rows);
   }
 }
@@ -161,8 +168,10 @@ void readoff_table(html::Document& doc, const Report& r) {
                     number(e.v.tau_s), text(e.unit), text(agrees)});
   }
   doc.heading("Read-off values", 2, "readoff-heading");
-  doc.paragraph("Read off the Allan deviation as data sheets do: N on the -1/2 line at 1 s, the floor and B = floor / "
-                "0.664, K on the +1/2 line at 3 s; each with the interval of the point it was read at.", "note");
+  doc.paragraph(
+      "Read off the Allan deviation as data sheets do: N on the -1/2 line at 1 s, the floor and B = floor / "
+      "0.664, K on the +1/2 line at 3 s; each with the interval of the point it was read at.",
+      "note");
   doc.table("readoff", "", {"value", "read off", "ci low", "ci high", "at tau [s]", "unit", "agrees with fit"}, rows);
 }
 

@@ -13,7 +13,7 @@
 namespace gyrochar {
 
 struct ReportProvenance {
-  std::string command;  // the command line, as given
+  std::string command;      // the command line, as given
   std::string limits_path;  // --limits FILE; empty: none
 };
 

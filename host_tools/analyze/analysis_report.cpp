@@ -11,7 +11,6 @@
 #include <limits>
 #include <numbers>
 
-
 namespace gyrochar {
 
 namespace {
@@ -19,7 +18,8 @@ namespace {
 // IEEE-952 parameters Q, N, B, K, R: letter, unit and size of the unit in SI.
 using FitUnit = units::Ieee952Unit;
 constexpr const FitUnit* gyro_fit_units = units::ieee952.data();
-constexpr FitUnit clock_fit_units[5] = {{"Q", "s", 1}, {"N", "s^0.5", 1}, {"B", "1", 1}, {"K", "s^-0.5", 1}, {"R", "1/s", 1}};
+constexpr FitUnit clock_fit_units[5] = {
+    {"Q", "s", 1}, {"N", "s^0.5", 1}, {"B", "1", 1}, {"K", "s^-0.5", 1}, {"R", "1/s", 1}};
 
 const FitUnit* fit_units(const ReportUnits& u) { return u.gyro ? gyro_fit_units : clock_fit_units; }
 
@@ -46,9 +46,8 @@ std::string excluded_text(const Ieee952Fit& fit) {
 std::string fit_summary(const CurveFit& f) {
   const Ieee952Fit& fit = f.fit;
   std::string s = fmt::format("IEEE-952 fit of {}{}: {} points", curve_title(f.curve),
-                              f.long_tau != 0
-                                  ? fmt::format(", long taus from {}", name(static_cast<LongTau>(f.long_tau)))
-                                  : std::string(),
+                              f.long_tau != 0 ? fmt::format(", long taus from {}", name(static_cast<LongTau>(f.long_tau)))
+                                              : std::string(),
                               fit.points);
   if (fit.status == FitStatus::too_few_points || fit.status == FitStatus::singular)
     return s + fmt::format(": not identified ({})", name(fit.status));
@@ -145,7 +144,8 @@ std::string simulated_sinusoid(const std::optional<Ieee952Truth>& truth, double 
   const SinusoidRate* nearest = &truth->sinusoids.front();
   for (const SinusoidRate& s : truth->sinusoids)
     if (std::fabs(s.frequency_hz - hz) < std::fabs(nearest->frequency_hz - hz)) nearest = &s;
-  return fmt::format("   simulated {:.4g} {} at {:.6g} Hz", nearest->amplitude_rad_s / rate.si, rate.name, nearest->frequency_hz);
+  return fmt::format("   simulated {:.4g} {} at {:.6g} Hz", nearest->amplitude_rad_s / rate.si, rate.name,
+                     nearest->frequency_hz);
 }
 
 std::array<double, 5> truth_values(const Ieee952Truth& t) {
@@ -202,22 +202,25 @@ constexpr std::array<ReadoffTerm, 3> readoff_terms{{
 // "2.313 [2.31, 2.316] deg/sqrt(h)": a value and its interval in a unit of `si` SI units.
 std::string readoff_text(const ReadoffValue& v, double si, const char* unit) {
   const bool ci = std::isfinite(v.ci_low) && std::isfinite(v.ci_high);
-  return fmt::format("{:.4g}{} {}", v.value / si, ci ? fmt::format(" [{:.4g}, {:.4g}]", v.ci_low / si, v.ci_high / si)
-                                                     : std::string(" (no interval)"), unit);
+  return fmt::format("{:.4g}{} {}", v.value / si,
+                     ci ? fmt::format(" [{:.4g}, {:.4g}]", v.ci_low / si, v.ci_high / si) : std::string(" (no interval)"),
+                     unit);
 }
 
 void format_readoff(std::string& out, const Report& r) {
   const Readoff& ro = *r.readoff;
   const FitUnit* fu = fit_units(r.units);
   const RateUnit& rate = r.units.rate;
-  const std::string n = ro.n.valid ? fmt::format("N = {} at tau {:.4g} s", readoff_text(ro.n, fu[1].si, fu[1].name), ro.n.tau_s)
-                                   : "N not read (no point up to the floor follows slope -1/2)";
-  const std::string floor =
-      fmt::format("bias floor {} at tau {:.4g} s{}, B = floor/0.664 = {}", readoff_text(ro.floor, rate.rad_per_s, rate.name),
-                  ro.floor.tau_s, ro.floor_at_end ? " (an end of the curve: it has not turned there)" : "",
-                  readoff_text(ro.b, fu[2].si, fu[2].name));
-  const std::string k = ro.k.valid ? fmt::format("K = {} at tau {:.4g} s", readoff_text(ro.k, fu[3].si, fu[3].name), ro.k.tau_s)
-                                   : "K not read (the curve never rises at slope +1/2 after its floor)";
+  const std::string n = ro.n.valid
+                            ? fmt::format("N = {} at tau {:.4g} s", readoff_text(ro.n, fu[1].si, fu[1].name), ro.n.tau_s)
+                            : "N not read (no point up to the floor follows slope -1/2)";
+  const std::string floor = fmt::format("bias floor {} at tau {:.4g} s{}, B = floor/0.664 = {}",
+                                        readoff_text(ro.floor, rate.rad_per_s, rate.name), ro.floor.tau_s,
+                                        ro.floor_at_end ? " (an end of the curve: it has not turned there)" : "",
+                                        readoff_text(ro.b, fu[2].si, fu[2].name));
+  const std::string k = ro.k.valid
+                            ? fmt::format("K = {} at tau {:.4g} s", readoff_text(ro.k, fu[3].si, fu[3].name), ro.k.tau_s)
+                            : "K not read (the curve never rises at slope +1/2 after its floor)";
   fmt::format_to(std::back_inserter(out), "# read-off (IEEE-952 graphical, data-sheet style): {}; {}; {}\n", n, floor, k);
   const Ieee952Fit* fit = recommended_fit(r);
   for (const ReadoffTerm& t : readoff_terms) {
@@ -241,8 +244,11 @@ nlohmann::json readoff_json(const Report& r) {
   const FitUnit* fu = fit_units(r.units);
   const auto entry = [](const ReadoffValue& v, double si, const char* unit) {
     const auto number = [&](double x) { return v.valid && std::isfinite(x) ? json(x / si) : json(nullptr); };
-    return json{{"value", number(v.value)}, {"ci_low", number(v.ci_low)}, {"ci_high", number(v.ci_high)},
-                {"tau", v.valid ? json(v.tau_s) : json(nullptr)}, {"unit", unit}};
+    return json{{"value", number(v.value)},
+                {"ci_low", number(v.ci_low)},
+                {"ci_high", number(v.ci_high)},
+                {"tau", v.valid ? json(v.tau_s) : json(nullptr)},
+                {"unit", unit}};
   };
   json j = {{"method", "IEEE-952 graphical read-off of the OADEV curve (data-sheet style)"},
             {"slope_band", ReadoffOptions{}.slope_band}};
@@ -270,8 +276,8 @@ std::string format_table(const Report& r) {
                  name(r.type), u.input, a.n_values, r.tau0_s, a.stride_factor, 100.0 * r.confidence);
   fmt::format_to(to, "# deviations in {}{}\n", u.gyro ? u.rate.name : "fractional frequency",
                  u.gyro ? fmt::format(", TDEV in {}", u.rate.angle) : std::string(", TDEV in s"));
-  fmt::format_to(to, "{:<6} {:>12} {:>12} {:>12} {:>13} {:>13} {:>13} {:>6} {:>12} {:>9}  {}\n", "stat", "m", "tau [s]",
-                 "n", "ci low", "dev", "ci high", "alpha", "noise id", "edf", "unit");
+  fmt::format_to(to, "{:<6} {:>12} {:>12} {:>12} {:>13} {:>13} {:>13} {:>6} {:>12} {:>9}  {}\n", "stat", "m", "tau [s]", "n",
+                 "ci low", "dev", "ci high", "alpha", "noise id", "edf", "unit");
   const double k = u.factor();
   for (const AnalysisRow& row : a.rows) {
     fmt::format_to(to, "{:<6} {:>12} {:>12.6g} {:>12} {:>13} {:>13.5e} {:>13} {:>6} {:>12} {:>9}  {}\n", name(row.stat),
@@ -283,19 +289,22 @@ std::string format_table(const Report& r) {
   for (const CurveFit& f : r.fits) {
     fmt::format_to(to, "# {}\n", fit_summary(f));
     if (!f.fit.quantization_white)
-      fmt::format_to(to, "#   quantization is not white (the short taus do not follow white quantization: a steady rate "
-                         "makes a periodic pattern without dither): points it reaches left out ({}), Q held at "
-                         "pulse weight / sqrt(12)\n",
+      fmt::format_to(to,
+                     "#   quantization is not white (the short taus do not follow white quantization: a steady rate "
+                     "makes a periodic pattern without dither): points it reaches left out ({}), Q held at "
+                     "pulse weight / sqrt(12)\n",
                      excluded_text(f.fit));
     if (f.fit.status == FitStatus::too_few_points || f.fit.status == FitStatus::singular) continue;
     fmt::format_to(to, "#   model: {}\n", model_text(f.fit));
     if (f.fit.bandwidth_excluded_below_tau_s > 0)
-      fmt::format_to(to, "#   the sensor's own filter shapes the curve below {:.4g} s (a first-order filter does not describe "
-                         "it there): those points left out\n",
+      fmt::format_to(to,
+                     "#   the sensor's own filter shapes the curve below {:.4g} s (a first-order filter does not describe "
+                     "it there): those points left out\n",
                      f.fit.bandwidth_excluded_below_tau_s);
     if (f.fit.status == FitStatus::rejected) {
-      fmt::format_to(to, "#   no term is given as a result: even the best model found does not describe this curve (the "
-                         "residuals per tau are in --format json)\n");
+      fmt::format_to(to,
+                     "#   no term is given as a result: even the best model found does not describe this curve (the "
+                     "residuals per tau are in --format json)\n");
       continue;
     }
     for (std::size_t i = 0; i < 5; ++i) {
@@ -315,20 +324,21 @@ std::string format_table(const Report& r) {
     }
     const FitUnit& rate = fit_units(u)[2];  // B's unit: a rate
     if (f.fit.bandwidth_tc_s > 0)
-      fmt::format_to(to, "#   sensor bandwidth: N's white noise through a first-order filter, Tf = {:.3g} {} "
-                         "(corner {:.4g} Hz)\n",
+      fmt::format_to(to,
+                     "#   sensor bandwidth: N's white noise through a first-order filter, Tf = {:.3g} {} "
+                     "(corner {:.4g} Hz)\n",
                      f.fit.bandwidth_tc_s, with_uncertainty(f.fit.bandwidth_tc_uncertainty_s),
                      1 / (2 * std::numbers::pi * f.fit.bandwidth_tc_s));
     for (std::size_t j = 0; j < f.fit.n_markov; ++j) {
       const MarkovTerm& m = f.fit.markov[j];
-      fmt::format_to(to, "#   Markov {}: sigma = {:.4g} +- {:.2g} {}, Tc = {:.4g} {}{}{}\n", j + 1,
-                     m.sigma.value / rate.si, m.sigma.uncertainty / rate.si, rate.name, m.tc_s, with_uncertainty(m.tc_uncertainty_s),
+      fmt::format_to(to, "#   Markov {}: sigma = {:.4g} +- {:.2g} {}, Tc = {:.4g} {}{}{}\n", j + 1, m.sigma.value / rate.si,
+                     m.sigma.uncertainty / rate.si, rate.name, m.tc_s, with_uncertainty(m.tc_uncertainty_s),
                      m.sigma.resolved ? "" : "  (not resolved)", simulated_markov(r.truth, m.tc_s, rate));
     }
     if (r.truth && f.fit.n_markov == 0)
       for (const MarkovRate& m : r.truth->markov)
-        fmt::format_to(to, "#   no Markov term in the model   simulated sigma {:.4g} {}, Tc {:.4g} s\n", m.sigma_rad_s / rate.si,
-                       rate.name, m.tc_s);
+        fmt::format_to(to, "#   no Markov term in the model   simulated sigma {:.4g} {}, Tc {:.4g} s\n",
+                       m.sigma_rad_s / rate.si, rate.name, m.tc_s);
     for (std::size_t j = 0; j < f.fit.n_sinusoids; ++j) {
       const SinusoidTerm& sn = f.fit.sinusoids[j];
       fmt::format_to(to, "#   sinusoid {}: amplitude = {:.4g} +- {:.2g} {} at {:.6g} Hz{}{}\n", j + 1,
@@ -385,12 +395,16 @@ nlohmann::json positive_or_null(double v) { return v > 0 ? nlohmann::json(v) : n
 nlohmann::json summary_json(const ModelSummary& m) {
   using nlohmann::json;
   if (!m.valid) return json(nullptr);
-  return {{"markov", m.markov}, {"sinusoids", m.sinusoids}, {"bandwidth", m.bandwidth}, {"status", name(m.status)},
-          {"chi2", m.chi2}, {"dof", m.dof}, {"parameters", m.parameters}, {"criterion", m.criterion}};
+  return {{"markov", m.markov},         {"sinusoids", m.sinusoids}, {"bandwidth", m.bandwidth},
+          {"status", name(m.status)},   {"chi2", m.chi2},           {"dof", m.dof},
+          {"parameters", m.parameters}, {"criterion", m.criterion}};
 }
 
 nlohmann::json parameter_json(const Ieee952Parameter& p, double si, const std::string& unit) {
-  return {{"value", p.value / si}, {"uncertainty", p.uncertainty / si}, {"unit", unit}, {"fitted", p.fitted},
+  return {{"value", p.value / si},
+          {"uncertainty", p.uncertainty / si},
+          {"unit", unit},
+          {"fitted", p.fitted},
           {"resolved", p.resolved}};
 }
 
@@ -401,26 +415,35 @@ void add_model_json(nlohmann::json& one, const Ieee952Fit& fit, const ReportUnit
   json markov = json::array();
   for (std::size_t j = 0; j < fit.n_markov; ++j)
     markov.push_back({{"sigma", parameter_json(fit.markov[j].sigma, rate.si, rate.name)},
-                      {"tc", {{"value", fit.markov[j].tc_s}, {"uncertainty", positive_or_null(fit.markov[j].tc_uncertainty_s)}, {"unit", "s"}}}});
+                      {"tc",
+                       {{"value", fit.markov[j].tc_s},
+                        {"uncertainty", positive_or_null(fit.markov[j].tc_uncertainty_s)},
+                        {"unit", "s"}}}});
   json sinusoids = json::array();
   for (std::size_t j = 0; j < fit.n_sinusoids; ++j)
-    sinusoids.push_back({{"amplitude", parameter_json(fit.sinusoids[j].amplitude, rate.si, rate.name)},
-                         {"frequency", {{"value", fit.sinusoids[j].frequency_hz}, {"uncertainty", nullptr}, {"unit", "Hz"}}}});
+    sinusoids.push_back(
+        {{"amplitude", parameter_json(fit.sinusoids[j].amplitude, rate.si, rate.name)},
+         {"frequency", {{"value", fit.sinusoids[j].frequency_hz}, {"uncertainty", nullptr}, {"unit", "Hz"}}}});
   one["markov"] = std::move(markov);
   one["sinusoids"] = std::move(sinusoids);
-  one["bandwidth"] = fit.bandwidth_tc_s > 0 ? json{{"tc", {{"value", fit.bandwidth_tc_s},
-                                                          {"uncertainty", positive_or_null(fit.bandwidth_tc_uncertainty_s)}, {"unit", "s"}}},
+  one["bandwidth"] = fit.bandwidth_tc_s > 0 ? json{{"tc",
+                                                    {{"value", fit.bandwidth_tc_s},
+                                                     {"uncertainty", positive_or_null(fit.bandwidth_tc_uncertainty_s)},
+                                                     {"unit", "s"}}},
                                                    {"corner_hz", 1 / (2 * std::numbers::pi * fit.bandwidth_tc_s)}}
                                             : json(nullptr);
-  one["bandwidth_excluded_below_tau"] = fit.bandwidth_excluded_below_tau_s > 0 ? json(fit.bandwidth_excluded_below_tau_s) : json(nullptr);
+  one["bandwidth_excluded_below_tau"] = fit.bandwidth_excluded_below_tau_s > 0 ? json(fit.bandwidth_excluded_below_tau_s)
+                                                                               : json(nullptr);
   one["model"] = summary_json(fit.chosen);
   one["runner_up"] = summary_json(fit.runner_up);
   const double k = u.factor() / u.phase_unit_si;  // SI deviation -> output unit
   json residuals = json::array();
   for (std::size_t i = 0; i < fit.n_residuals; ++i) {
     const FitResidual& r = fit.residuals[i];
-    residuals.push_back({{"stat", name(r.stat == Stat::avar ? DevStat::oadev : DevStat::mdev)}, {"m", r.m},
-                         {"dev", std::sqrt(r.variance) * k}, {"model", std::sqrt(std::fmax(r.model, 0.0)) * k},
+    residuals.push_back({{"stat", name(r.stat == Stat::avar ? DevStat::oadev : DevStat::mdev)},
+                         {"m", r.m},
+                         {"dev", std::sqrt(r.variance) * k},
+                         {"model", std::sqrt(std::fmax(r.model, 0.0)) * k},
                          {"residual_sigma", r.normalized}});
   }
   one["residuals"] = std::move(residuals);
@@ -456,13 +479,17 @@ nlohmann::json to_json(const Report& r) {
                   {"chi2_per_dof", fit.chi2_per_dof()},
                   {"uncertainty_scale", fit.birge},
                   {"quantization_white", fit.quantization_white},
-                  {"excluded_below_tau", {{"avar", fit.excluded_below_tau_s[0] > 0 ? json(fit.excluded_below_tau_s[0]) : json(nullptr)},
-                                          {"mvar", fit.excluded_below_tau_s[1] > 0 ? json(fit.excluded_below_tau_s[1]) : json(nullptr)}}}};
+                  {"excluded_below_tau",
+                   {{"avar", fit.excluded_below_tau_s[0] > 0 ? json(fit.excluded_below_tau_s[0]) : json(nullptr)},
+                    {"mvar", fit.excluded_below_tau_s[1] > 0 ? json(fit.excluded_below_tau_s[1]) : json(nullptr)}}}};
       for (std::size_t i = 0; i < 5; ++i) {
         const FitUnit& fu = fit_units(u)[i];
         const Ieee952Parameter& p = fit.p[i];
-        one[fu.letter] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si}, {"fitted", p.fitted},
-                        {"resolved", p.resolved}, {"unit", fu.name}};
+        one[fu.letter] = {{"value", p.value / fu.si},
+                          {"uncertainty", p.uncertainty / fu.si},
+                          {"fitted", p.fitted},
+                          {"resolved", p.resolved},
+                          {"unit", fu.name}};
         if (p.unconstrained_uncertainty > 0)  // what a verdict judges (docs/metrology.md, "Acceptance limits")
           one[fu.letter]["unconstrained"] = {{"value", p.unconstrained / fu.si},
                                              {"uncertainty", p.unconstrained_uncertainty / fu.si}};
@@ -537,9 +564,8 @@ std::string format_stable32(const Report& r) {
     fmt::format_to(to, "#\n{}\n", stable32_columns(stat));
     for (const AnalysisRow& row : a.rows) {
       if (row.stat != stat) continue;
-      fmt::format_to(to, "{:5d}{:13.4e}{:9d}{:6d}{:13.4e}{:14.4e}{:15.4e}\n", row.m, row.tau_s, row.n,
-                     row.alpha.value_or(0), row.ci.valid ? row.ci.low * k : 0.0, row.dev * k,
-                     row.ci.valid ? row.ci.high * k : 0.0);
+      fmt::format_to(to, "{:5d}{:13.4e}{:9d}{:6d}{:13.4e}{:14.4e}{:15.4e}\n", row.m, row.tau_s, row.n, row.alpha.value_or(0),
+                     row.ci.valid ? row.ci.low * k : 0.0, row.dev * k, row.ci.valid ? row.ci.high * k : 0.0);
     }
   }
   return s;

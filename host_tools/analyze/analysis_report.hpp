@@ -47,7 +47,7 @@ const units::Ieee952Unit& fit_unit(const ReportUnits& u, std::size_t k);
 /// curves at once, then the Allan and the modified Allan curve alone (for experts).
 struct CurveFit {
   FitCurve curve = FitCurve::both;
-  Ieee952Fit fit;  // parameters in SI: Q rad (s), N rad/s^0.5, B rad/s, K rad/s^1.5, R rad/s^2
+  Ieee952Fit fit;    // parameters in SI: Q rad (s), N rad/s^0.5, B rad/s, K rad/s^1.5, R rad/s^2
   int long_tau = 0;  // the LongTau (below) its Allan curve was made of at long tau (0: OADEV alone)
 };
 
@@ -68,9 +68,8 @@ const char* curve_title(FitCurve c);
 /// O(points^2) covariance sums, allocates the workspace; empty when the analysis has neither
 /// curve. A fit that fails says why in its status.
 /// sinusoid_hz: frequencies of sinusoids the model selection may add (Spectrum::fit_hz(); 0: none).
-std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
-                                 double white_quantization_si, LongTau long_tau = LongTau::oadev,
-                                 const PhaseRecord& record = {},
+std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s, double white_quantization_si,
+                                 LongTau long_tau = LongTau::oadev, const PhaseRecord& record = {},
                                  const std::array<double, max_sinusoids>& sinusoid_hz = {});
 /// The points fit_curves() fits (SI units), for a single fit_ieee952() of one curve. Allocates.
 std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s,

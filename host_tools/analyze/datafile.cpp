@@ -68,10 +68,10 @@ bool is_comment(char c) { return c == '#' || c == '%'; }
 // fields; a comment ends the line.
 struct Fields {
   unsigned count = 0;
-  std::string_view first, chosen;  // field 1 and field `column`
-  bool bare_comma = false;         // a ',' between two digits
-  bool other_separator = false;    // any separator that is not such a comma
-  bool point = false;              // a '.' or an exponent in some field: ',' cannot be decimal
+  std::string_view first, chosen;                  // field 1 and field `column`
+  bool bare_comma = false;                         // a ',' between two digits
+  bool other_separator = false;                    // any separator that is not such a comma
+  bool point = false;                              // a '.' or an exponent in some field: ',' cannot be decimal
   std::size_t binary_at = std::string_view::npos;  // offset of a control byte
 };
 
@@ -105,10 +105,8 @@ Fields split(std::string_view line, unsigned column) {
     while (p < e && is_blank(*p)) ++p;
     const bool had_blanks = p > blanks;
     if (p < e && (*p == ',' || *p == ';')) {
-      if (*p == ',' && !had_blanks && p > b && is_digit(p[-1]) && p + 1 < e && is_digit(p[1]))
-        f.bare_comma = true;
-      else
-        f.other_separator = true;
+      if (*p == ',' && !had_blanks && p > b && is_digit(p[-1]) && p + 1 < e && is_digit(p[1])) f.bare_comma = true;
+      else f.other_separator = true;
       ++p;
       while (p < e && is_blank(*p)) ++p;
       expect_field = true;
@@ -234,10 +232,10 @@ class Source {
 struct DataFile::Impl {
   Source source;
   std::unique_ptr<char[]> text{new char[text_capacity + 1]};  // + 1: a '\n' after the last byte
-  std::size_t begin = 0, end = 0;  // unparsed text
-  bool at_end = false;             // the source has no more bytes
-  std::uint64_t line = 0;          // lines consumed
-  unsigned column_asked = 0, column = 0, fields = 0;  // fields: 0 until the first data line
+  std::size_t begin = 0, end = 0;                             // unparsed text
+  bool at_end = false;                                        // the source has no more bytes
+  std::uint64_t line = 0;                                     // lines consumed
+  unsigned column_asked = 0, column = 0, fields = 0;          // fields: 0 until the first data line
   std::uint64_t first_data_line = 0;
   bool values_seen = false;
   std::vector<std::uint64_t> lines;  // line of each value of the last read()
@@ -297,15 +295,18 @@ struct DataFile::Impl {
       return;
     }
     if (f.bare_comma && !f.other_separator && !f.point)
-      throw DataFileError(quoted(text_line) + ": ',' may be a decimal comma or a column separator: write decimal "
-                          "points, or give --column", line);
+      throw DataFileError(quoted(text_line) +
+                              ": ',' may be a decimal comma or a column separator: write decimal "
+                              "points, or give --column",
+                          line);
     if (f.count == 2 && first_column_increases(f.first, next_line)) {
       column = 2;
       note = "column 2 (column 1 increases from line to line: time stamps; --column chooses another)";
       return;
     }
     throw DataFileError("has " + std::to_string(f.count) + " columns: give the one to analyze with --column (1 to " +
-                        std::to_string(f.count) + ")", line);
+                            std::to_string(f.count) + ")",
+                        line);
   }
 
   // A complete line (without its '\n'): a value, or nothing (blank, comment). Throws on a line
@@ -316,7 +317,8 @@ struct DataFile::Impl {
     Fields f = split(text_line, fields == 0 ? std::max(column_asked, 1u) : column);
     if (f.binary_at != std::string_view::npos)
       throw DataFileError("not text: byte " + quoted(text_line.substr(f.binary_at, 1)) + " at column " +
-                          std::to_string(f.binary_at + 1) + " (a binary file?)", line);
+                              std::to_string(f.binary_at + 1) + " (a binary file?)",
+                          line);
     if (f.count == 0) {
       if (!values_seen && !text_line.empty() && text_line[0] == '#' && header.size() < max_header_lines) {
         while (!text_line.empty() && text_line.back() == '\r') text_line.remove_suffix(1);
@@ -332,11 +334,13 @@ struct DataFile::Impl {
     }
     if (f.count != fields)
       throw DataFileError("has " + std::to_string(f.count) + " field(s) where line " + std::to_string(first_data_line) +
-                              " has " + std::to_string(fields) + (f.bare_comma ? " (a decimal comma? write decimal points)" : ""),
+                              " has " + std::to_string(fields) +
+                              (f.bare_comma ? " (a decimal comma? write decimal points)" : ""),
                           line);
     if (f.count < column)
       throw DataFileError("line has " + std::to_string(f.count) + " column(s), column " + std::to_string(column) +
-                              " was asked for", line);
+                              " was asked for",
+                          line);
     if (!parse_number(f.chosen.data(), f.chosen.data() + f.chosen.size(), value))
       throw DataFileError("not a finite number in column " + std::to_string(column) + ": " + quoted(f.chosen), line);
     values_seen = true;

@@ -83,16 +83,17 @@ std::vector<const AnalysisRow*> rows_of(const WindowAnalysis& w, DevStat s) {
 std::string format_dynamic_table(const DynamicReport& r) {
   std::string out;
   auto to = std::back_inserter(out);
-  fmt::format_to(to, "# {} data: {}; {} values, tau0 = {} s; dynamic: windows of {} values ({} s) every {} values ({} s), "
-                     "{} complete\n",
-                 name(r.type), r.units.input, r.values, r.tau0_s, r.window, static_cast<double>(r.window) * r.tau0_s,
-                 r.step, static_cast<double>(r.step) * r.tau0_s, r.windows.size());
+  fmt::format_to(to,
+                 "# {} data: {}; {} values, tau0 = {} s; dynamic: windows of {} values ({} s) every {} values ({} s), "
+                 "{} complete\n",
+                 name(r.type), r.units.input, r.values, r.tau0_s, r.window, static_cast<double>(r.window) * r.tau0_s, r.step,
+                 static_cast<double>(r.step) * r.tau0_s, r.windows.size());
   if (r.windows.empty()) return out;
   const double k = r.units.factor();
   for (const DevStat s : r.stats) {
     const std::vector<const AnalysisRow*> taus = rows_of(r.windows.front(), s);
-    fmt::format_to(to, "# {} in {} per window (rows) and tau (columns, s)\n{:>12} {:>12}", upper(name(s)),
-                   r.units.unit(s), "start [s]", "end [s]");
+    fmt::format_to(to, "# {} in {} per window (rows) and tau (columns, s)\n{:>12} {:>12}", upper(name(s)), r.units.unit(s),
+                   "start [s]", "end [s]");
     for (const AnalysisRow* row : taus) fmt::format_to(to, " {:>11.5g}", row->tau_s);
     out += '\n';
     for (const WindowAnalysis& w : r.windows) {

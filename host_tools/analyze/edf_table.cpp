@@ -38,7 +38,8 @@ std::vector<std::uint64_t> dense_anchors(std::span<const Stat> stats, std::uint6
       std::uint64_t lo = m_min, hi = m_max + 1;  // the first m with terms <= j m
       while (lo < hi) {
         const std::uint64_t mid = lo + (hi - lo) / 2;
-        if (terms(s, mid) <= j * mid) hi = mid; else lo = mid + 1;
+        if (terms(s, mid) <= j * mid) hi = mid;
+        else lo = mid + 1;
       }
       if (lo > m_min && lo <= m_max) kinks.insert(kinks.end(), {lo - 1, lo});
     }
@@ -87,7 +88,8 @@ EdfTable::EdfTable(DevStat stat, std::uint64_t n_phase, std::uint64_t m_min, std
 EdfTable::Value EdfTable::at(std::uint64_t m, int alpha, bool skew) const {
   if (alpha > 2 || alpha < -4) return {};
   const auto k = static_cast<std::size_t>(2 - alpha);
-  const auto hi = std::lower_bound(anchors_.begin(), anchors_.end(), m, [](const Anchor& a, std::uint64_t v) { return a.m < v; });
+  const auto hi = std::lower_bound(anchors_.begin(), anchors_.end(), m,
+                                   [](const Anchor& a, std::uint64_t v) { return a.m < v; });
   // The skewness of an anchor when first asked for (it costs more than the EDF).
   for (Anchor* a : {&*hi, hi == anchors_.begin() ? &*hi : &*(hi - 1)}) {
     if (!skew || a->skew_known[k]) continue;
@@ -135,7 +137,8 @@ PairSums interpolate(const PairSums& p0, const PairSums& p1, double w) {
     return ((1 - w) * v0 / s0 + w * v1 / s1) * interpolate(s0, s1, w);
   };
   for (std::size_t t = 0; t < max_noises; ++t) {
-    for (std::size_t u = 0; u < max_noises; ++u) out.cc[t][u] = mix(p0.cc[t][u], scale(p0, t, u), p1.cc[t][u], scale(p1, t, u));
+    for (std::size_t u = 0; u < max_noises; ++u)
+      out.cc[t][u] = mix(p0.cc[t][u], scale(p0, t, u), p1.cc[t][u], scale(p1, t, u));
     out.c[t] = mix(p0.c[t], std::sqrt(p0.cc[t][t]), p1.c[t], std::sqrt(p1.cc[t][t]));
   }
   return out;

@@ -79,7 +79,9 @@ std::vector<TauSums> sum_every_tau(std::size_t taus, std::size_t block, const An
       if (tell && o.on_summed && summed < taus) o.on_summed(summed, taus);
     }
   };
-  const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()), blocks);
+  const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads
+                                                               : std::max(1u, std::thread::hardware_concurrency()),
+                                                 blocks);
   std::vector<std::thread> helpers;
   for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
   std::exception_ptr stopped;  // on_summed threw (the caller stops the work): the helpers end first
@@ -179,7 +181,8 @@ class CountBatchEngine final : public EngineBase {
   // One value, every case: checked, the line set by the first, int64 residuals from the first
   // that leaves int32. values[i] names it in an error.
   void add_one(double v, std::size_t i) {
-    if (!(std::fabs(v) < 2147483648.0) || v != std::trunc(v)) throw BadValue(i, "a count must be an integer of magnitude below 2^31");
+    if (!(std::fabs(v) < 2147483648.0) || v != std::trunc(v))
+      throw BadValue(i, "a count must be an integer of magnitude below 2^31");
     const auto c = static_cast<std::int32_t>(v);
     if (counts_ == 0) slope_ = c;
     if (__builtin_add_overflow(x_, std::int64_t{c}, &x_)) throw std::range_error("the accumulated count passed 2^63 pulses");
@@ -204,13 +207,13 @@ class CountBatchEngine final : public EngineBase {
   std::vector<std::uint64_t> m_list_;
   bool keep_record_;
   std::uint64_t counts_ = 0;
-  std::int64_t x_ = 0;            // the phase reached, in pulses
-  std::int64_t slope_ = 0;        // the first count: the line the residuals are taken from
-  std::uint64_t residual_ = 0;    // x - slope * points, modulo 2^64
+  std::int64_t x_ = 0;                                     // the phase reached, in pulses
+  std::int64_t slope_ = 0;                                 // the first count: the line the residuals are taken from
+  std::uint64_t residual_ = 0;                             // x - slope * points, modulo 2^64
   std::int32_t lowest_ = INT32_MAX, highest_ = INT32_MIN;  // the counts' range: it bounds the terms
-  Held<std::int32_t> narrow_;  // the residuals while they fit in int32, x_0 first
-  Held<std::int64_t> wide_;    // all of them from the first that does not
-  std::vector<double> record_;        // the phase for the total family (keep_record)
+  Held<std::int32_t> narrow_;                              // the residuals while they fit in int32, x_0 first
+  Held<std::int64_t> wide_;                                // all of them from the first that does not
+  std::vector<double> record_;                             // the phase for the total family (keep_record)
 };
 
 // Phase or frequency with the record held: the points as the characterizer stages them (relative
@@ -221,10 +224,9 @@ class CountBatchEngine final : public EngineBase {
 // all), every tau summed by float_batch_taus(), 64 consecutive ones at a time from the cache.
 class FloatBatchEngine final : public EngineBase {
  public:
-  FloatBatchEngine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list,
-                   bool keep_record, std::uint64_t values_hint, bool prefix_sums)
-      : type_(type), stride_factor_(stride_factor), m_list_(m_list), record_(type, keep_record),
-        prefix_sums_(prefix_sums) {
+  FloatBatchEngine(DataType type, std::uint32_t stride_factor, const std::vector<std::uint64_t>& m_list, bool keep_record,
+                   std::uint64_t values_hint, bool prefix_sums)
+      : type_(type), stride_factor_(stride_factor), m_list_(m_list), record_(type, keep_record), prefix_sums_(prefix_sums) {
     x_.reserve(values_hint + 1);
     if (prefix_sums_)
       for (Held<double>* v : {&p_hi_, &p_lo_}) v->reserve(values_hint + 1);
@@ -258,17 +260,18 @@ class FloatBatchEngine final : public EngineBase {
     const unsigned kinds = sums_needed(o);  // the others' terms are not formed
     const std::vector<TauSums> sums = sum_every_tau(m_list_.size(), prefix_sums_ ? float_batch_group : phase_batch_lanes, o,
                                                     [&](std::size_t first, std::span<TauSums> out) {
-      const std::span<const std::uint64_t> m(m_list_.data() + first, out.size());
-      std::vector<std::uint64_t> stride(out.size());
-      for (std::size_t j = 0; j < out.size(); ++j) stride[j] = stride_of(m[j], stride_factor_);
-      std::vector<TauResult<double>> r(out.size());
-      std::vector<NoiseIdAccumulator> noise(out.size());
-      if (prefix_sums_)
-        float_batch_taus(held, m, stride, r, noise);
-      else
-        phase_batch_taus(x_, m, stride, r, noise, kinds);
-      for (std::size_t j = 0; j < out.size(); ++j) out[j] = tau_sums(r[j], noise[j]);
-    });
+                                                      const std::span<const std::uint64_t> m(m_list_.data() + first,
+                                                                                             out.size());
+                                                      std::vector<std::uint64_t> stride(out.size());
+                                                      for (std::size_t j = 0; j < out.size(); ++j)
+                                                        stride[j] = stride_of(m[j], stride_factor_);
+                                                      std::vector<TauResult<double>> r(out.size());
+                                                      std::vector<NoiseIdAccumulator> noise(out.size());
+                                                      if (prefix_sums_) float_batch_taus(held, m, stride, r, noise);
+                                                      else phase_batch_taus(x_, m, stride, r, noise, kinds);
+                                                      for (std::size_t j = 0; j < out.size(); ++j)
+                                                        out[j] = tau_sums(r[j], noise[j]);
+                                                    });
     read_out(a, sums, type_, o, record_.points);
     return a;
   }

@@ -35,7 +35,8 @@ void resolve_pulse_weight(const UnitOptions& o, ReportUnits& u) {
   if (!rad) refuse("--pulse-weight", "unknown angle unit '" + unit + "' (rad, mrad, urad, deg, arcsec)");
   if (!std::isnormal(value * *rad))  // 1e-320arcsec: every deviation would be 0 in the output unit
     refuse("--pulse-weight", fmt::format("{} {} is {:g} rad, below the smallest normal double (2.2e-308): the "
-                                         "deviations would underflow to 0", value, unit, value * *rad));
+                                         "deviations would underflow to 0",
+                                         value, unit, value * *rad));
   u.gyro = true;
   u.phase_unit_si = value * *rad;
   u.input = fmt::format("counts of {} {}", value, unit);

@@ -19,8 +19,8 @@ struct UnitOptions {
   std::string pulse_weight;           // --pulse-weight: "1.5arcsec", "1.5 arcsec", or "1.5" in pulse_unit
   std::string pulse_unit = "arcsec";  // --pulse-unit
   bool pulse_unit_given = false;
-  std::optional<double> nominal_hz;   // --nominal-hz: freq values in Hz around it
-  std::string rate_unit = "deg/h";    // --rate-unit
+  std::optional<double> nominal_hz;  // --nominal-hz: freq values in Hz around it
+  std::string rate_unit = "deg/h";   // --rate-unit
   bool rate_unit_given = false;
 };
 

@@ -24,7 +24,8 @@ std::uint64_t machine_budget() {
 std::uint64_t memory_budget() {
   std::uint64_t budget = machine_budget();
   rlimit limit{};
-  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) budget = std::min<std::uint64_t>(budget, limit.rlim_cur / 2);
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    budget = std::min<std::uint64_t>(budget, limit.rlim_cur / 2);
   return budget;
 }
 

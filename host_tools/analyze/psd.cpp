@@ -51,7 +51,8 @@ Psd welch_psd(std::span<const double> rate, double tau0_s, std::size_t segment, 
     mean /= static_cast<double>(L);
     for (std::size_t n = 0; n < L; ++n) in.get()[n] = (rate[start + n] - mean) * window[n];
     fftw_execute(plan);
-    for (std::size_t k = 0; k <= L / 2; ++k) sum[k] += spectrum.get()[k][0] * spectrum.get()[k][0] + spectrum.get()[k][1] * spectrum.get()[k][1];
+    for (std::size_t k = 0; k <= L / 2; ++k)
+      sum[k] += spectrum.get()[k][0] * spectrum.get()[k][0] + spectrum.get()[k][1] * spectrum.get()[k][1];
   }
   fftw_destroy_plan(plan);
   out.segments = k_segments;
@@ -71,10 +72,10 @@ Psd welch_psd(std::span<const double> rate, double tau0_s, std::size_t segment, 
 
 namespace {
 
-constexpr std::size_t lobe = 2;      // a Hann main lobe: within 2 bins of the sinusoid's frequency
-constexpr std::size_t span_half = 3; // the bins summed for a peak: its highest +- 3
+constexpr std::size_t lobe = 2;       // a Hann main lobe: within 2 bins of the sinusoid's frequency
+constexpr std::size_t span_half = 3;  // the bins summed for a peak: its highest +- 3
 constexpr std::size_t max_neighbours = 64;
-constexpr std::size_t first_bin = 7; // index 7: the 8th bin, k = 8
+constexpr std::size_t first_bin = 7;  // index 7: the 8th bin, k = 8
 
 }  // namespace
 
@@ -106,7 +107,8 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
     ++out.bins_tested;
   }
   if (out.bins_tested == 0) return out;
-  out.threshold = boost::math::quantile(boost::math::complement(chi2, false_alarm / static_cast<double>(out.bins_tested))) / nu;
+  out.threshold = boost::math::quantile(boost::math::complement(chi2, false_alarm / static_cast<double>(out.bins_tested))) /
+                  nu;
   const auto above = [&](std::size_t i) {
     return std::isfinite(out.background[i]) && psd.psd[i] > out.threshold * out.background[i];
   };
@@ -158,7 +160,8 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
     p.threshold = out.threshold;
     out.peaks.push_back(p);
   }
-  std::sort(out.peaks.begin(), out.peaks.end(), [](const SpectralPeak& a, const SpectralPeak& c) { return a.power > c.power; });
+  std::sort(out.peaks.begin(), out.peaks.end(),
+            [](const SpectralPeak& a, const SpectralPeak& c) { return a.power > c.power; });
   return out;
 }
 
@@ -221,7 +224,8 @@ void mark_pulse_lines(PeakSearch& search, const PulsePattern& pattern, double bi
   for (int k = 1; k <= last; ++k) mark(k, 0, nullptr);
   std::vector<SpectralPeak*> lines;
   for (SpectralPeak& p : search.peaks) lines.push_back(&p);
-  std::sort(lines.begin(), lines.end(), [](const SpectralPeak* a, const SpectralPeak* b) { return a->frequency_hz < b->frequency_hz; });
+  std::sort(lines.begin(), lines.end(),
+            [](const SpectralPeak* a, const SpectralPeak* b) { return a->frequency_hz < b->frequency_hz; });
   for (const SpectralPeak* line : lines) {
     if (line->pulse_harmonic != 0) continue;
     for (int k = 1; k <= last; ++k)
@@ -281,15 +285,18 @@ std::string spectrum_table(const Spectrum& s) {
   std::string out;
   auto to = std::back_inserter(out);
   const Psd& p = s.psd;
-  fmt::format_to(to, "# PSD of the rate (Welch, Hann, 50 % overlap): {} segments of {} values, bins of {:.4g} Hz from "
-                     "{:.4g} to {:.4g} Hz, EDF {:.4g} per bin, in {}\n",
+  fmt::format_to(to,
+                 "# PSD of the rate (Welch, Hann, 50 % overlap): {} segments of {} values, bins of {:.4g} Hz from "
+                 "{:.4g} to {:.4g} Hz, EDF {:.4g} per bin, in {}\n",
                  p.segments, p.segment, p.bin_hz(), p.freq_hz.front(), p.freq_hz.back(), p.edf, s.psd_unit());
   for (const double f : s.given_hz) fmt::format_to(to, "#   sinusoid offered to the fit at {:.6g} Hz (--sinusoid-hz)\n", f);
   if (!s.searched) return out;
   const PeakSearch& r = s.search;
-  fmt::format_to(to, "#   sinusoid search: {} bins tested, a peak above {:.3g} x the local background (false alarms in "
-                     "{:.2g} % of records without a sinusoid): {}\n",
-                 r.bins_tested, r.threshold, 100 * r.false_alarm, r.peaks.empty() ? "none found" : fmt::format("{} found", r.peaks.size()));
+  fmt::format_to(to,
+                 "#   sinusoid search: {} bins tested, a peak above {:.3g} x the local background (false alarms in "
+                 "{:.2g} % of records without a sinusoid): {}\n",
+                 r.bins_tested, r.threshold, 100 * r.false_alarm,
+                 r.peaks.empty() ? "none found" : fmt::format("{} found", r.peaks.size()));
   for (const SpectralPeak& q : r.peaks)
     fmt::format_to(to, "#   peak at {:.6g} +- {:.2g} Hz: amplitude {:.4g} +- {:.2g} {} (PSD {:.3g} x its background){}\n",
                    q.frequency_hz, q.frequency_uncertainty_hz, q.amplitude * s.factor, q.amplitude_uncertainty * s.factor,
@@ -297,9 +304,10 @@ std::string spectrum_table(const Spectrum& s) {
                    q.pulse_harmonic > 0
                        ? fmt::format("; a line of the pulse pattern (harmonic {} of {:.6g} Hz), not offered to the fit",
                                      q.pulse_harmonic, s.pattern ? s.pattern->rate_hz : 0.0)
-                   : q.adev_null < 0 ? ""
-                                     : fmt::format("; OADEV {} at tau = 1/f = {:.4g} s (smallest at {:.4g} s)",
-                                                   q.adev_null ? "dips" : "does not dip", 1 / q.frequency_hz, q.adev_null_tau_s));
+                   : q.adev_null < 0
+                       ? ""
+                       : fmt::format("; OADEV {} at tau = 1/f = {:.4g} s (smallest at {:.4g} s)",
+                                     q.adev_null ? "dips" : "does not dip", 1 / q.frequency_hz, q.adev_null_tau_s));
   return out;
 }
 
@@ -322,14 +330,14 @@ nlohmann::json spectrum_json(const Spectrum& s) {
   };
   json peaks = json::array();
   for (const SpectralPeak& q : s.search.peaks)
-    peaks.push_back({{"frequency", measured(q.frequency_hz, q.frequency_uncertainty_hz, "Hz")},
-                     {"amplitude", measured(q.amplitude * s.factor, q.amplitude_uncertainty * s.factor, s.unit)},
-                     {"power", q.power * k},
-                     {"ratio", q.ratio},
-                     {"threshold", q.threshold},
-                     {"adev_null", q.adev_null < 0 ? json(nullptr)
-                                                   : json{{"found", q.adev_null == 1}, {"tau", q.adev_null_tau_s}}},
-                     {"pulse_harmonic", q.pulse_harmonic > 0 ? json(q.pulse_harmonic) : json(nullptr)}});
+    peaks.push_back(
+        {{"frequency", measured(q.frequency_hz, q.frequency_uncertainty_hz, "Hz")},
+         {"amplitude", measured(q.amplitude * s.factor, q.amplitude_uncertainty * s.factor, s.unit)},
+         {"power", q.power * k},
+         {"ratio", q.ratio},
+         {"threshold", q.threshold},
+         {"adev_null", q.adev_null < 0 ? json(nullptr) : json{{"found", q.adev_null == 1}, {"tau", q.adev_null_tau_s}}},
+         {"pulse_harmonic", q.pulse_harmonic > 0 ? json(q.pulse_harmonic) : json(nullptr)}});
   return {{"unit", s.psd_unit()},
           {"segment", p.segment},
           {"segments", p.segments},

@@ -43,8 +43,8 @@ struct Psd {
   std::size_t segment = 0;   // L, values per segment
   std::size_t segments = 0;  // K
   double tau0_s = 0;
-  double edf = 0;            // nu of every bin
-  double confidence = 0;     // of the band
+  double edf = 0;                                     // nu of every bin
+  double confidence = 0;                              // of the band
   std::vector<double> freq_hz, psd, ci_low, ci_high;  // rate unit^2 / Hz
   double bin_hz() const { return segment ? 1.0 / (static_cast<double>(segment) * tau0_s) : 0.0; }
 };
@@ -63,11 +63,11 @@ Psd welch_psd(std::span<const double> rate, double tau0_s, std::size_t segment, 
 struct SpectralPeak {
   double frequency_hz = 0, frequency_uncertainty_hz = 0;
   double amplitude = 0, amplitude_uncertainty = 0;
-  double power = 0;         // excess power over the main lobe, u^2 (A^2/2)
-  double background = 0;    // the background PSD at the highest bin, u^2/Hz
-  double ratio = 0;         // highest bin's PSD over its background
-  double threshold = 0;     // the ratio a bin must exceed (Bonferroni)
-  std::size_t bin = 0;      // index of the highest bin in Psd::freq_hz
+  double power = 0;       // excess power over the main lobe, u^2 (A^2/2)
+  double background = 0;  // the background PSD at the highest bin, u^2/Hz
+  double ratio = 0;       // highest bin's PSD over its background
+  double threshold = 0;   // the ratio a bin must exceed (Bonferroni)
+  std::size_t bin = 0;    // index of the highest bin in Psd::freq_hz
   // The Allan curve's cross-check (check_adev_nulls()): -1 not made (taus not dense near 1/f),
   // 0 no dip near tau = 1/f, 1 the smallest OADEV near 1/f lies within 10 % of it; its tau.
   int adev_null = -1;
@@ -82,7 +82,7 @@ struct PeakSearch {
   std::vector<double> background;   // per bin (NaN where not estimated)
   double threshold = 0;             // ratio PSD / background a bin must exceed
   std::size_t bins_tested = 0;
-  double false_alarm = 0;           // alpha: chance of any peak in a record without a sinusoid
+  double false_alarm = 0;  // alpha: chance of any peak in a record without a sinusoid
 };
 
 /// Sinusoids in `psd` (header), at a chance `false_alarm` of finding one where there is none.
@@ -148,7 +148,7 @@ class RateRecord {
 struct Spectrum {
   Psd psd;
   std::optional<PulsePattern> pattern;  // counted pulses
-  bool searched = false;         // false: --no-sinusoid-search
+  bool searched = false;                // false: --no-sinusoid-search
   PeakSearch search;
   std::vector<double> given_hz;  // --sinusoid-hz
   double factor = 1;             // engine rate unit -> `unit`

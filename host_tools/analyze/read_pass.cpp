@@ -26,7 +26,8 @@ void InputShape::add(std::span<double> values) {
       v = (f - f0_) / f0_;
       if (f != f0_ && !std::isnormal(v))
         throw BadValue(i, fmt::format("(f - F0) / F0 of {:g} Hz with F0 = {:g} Hz is {:g}, below the smallest "
-                                      "normal double (2.2e-308)", f, f0_, v));
+                                      "normal double (2.2e-308)",
+                                      f, f0_, v));
       raw_lo_ = n_ == 0 ? f : std::min(raw_lo_, f);
       raw_hi_ = n_ == 0 ? f : std::max(raw_hi_, f);
       converted_vary_ |= n_ > 0 && v != first_;
@@ -55,7 +56,8 @@ void check_zeros(bool all_zero, const InputShape& shape, const std::string& sour
   if (!shape.straight())
     bad(source, fmt::format("every deviation is 0, but the values (from {:g} to {:g}) are not {}: the squares of their "
                             "differences underflow a double (smallest normal 2.2e-308): the values are too small; "
-                            "scale them", shape.lowest(), shape.highest(), shape.shape()));
+                            "scale them",
+                            shape.lowest(), shape.highest(), shape.shape()));
   print_error(analyze_program, "note", fmt::format("every deviation is 0: the values are {}", shape.shape()));
 }
 bool all_zero(const std::vector<AnalysisRow>& rows) {
@@ -73,8 +75,7 @@ void Progress::values(std::size_t n) {
   if (size > 0)
     std::fprintf(stderr, "\rgyrochar-analyze: reading: %5.1f %%",
                  100.0 * static_cast<double>(file_.bytes_read()) / static_cast<double>(size));
-  else
-    std::fprintf(stderr, "\rgyrochar-analyze: reading: %llu values", static_cast<unsigned long long>(values_));
+  else std::fprintf(stderr, "\rgyrochar-analyze: reading: %llu values", static_cast<unsigned long long>(values_));
 }
 
 std::function<void(std::size_t, std::size_t)> summing_progress() {

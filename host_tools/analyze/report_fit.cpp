@@ -25,8 +25,8 @@ const AnalysisRow* oadev_row(const Analysis& a, std::uint64_t m) {  // the row a
 // the phase in engine units; unit: one of them in SI. Points keep the Allan geometry and carry
 // variance_scale = the Allan estimate's EDF over their own (Greenhall's and SP 1065's formulas for
 // the identified alpha).
-void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& a, std::span<const double> x,
-                  double tau0, double unit) {
+void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& a, std::span<const double> x, double tau0,
+                  double unit) {
   const double N = static_cast<double>(x.size());
   auto allan_edf = [&](int alpha, std::uint64_t m) {
     const double md = static_cast<double>(m);
@@ -76,8 +76,8 @@ std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, do
   return points;
 }
 
-std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s,
-                                 double white_quantization_si, LongTau long_tau, const PhaseRecord& record,
+std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s, double white_quantization_si,
+                                 LongTau long_tau, const PhaseRecord& record,
                                  const std::array<double, max_sinusoids>& sinusoid_hz) {
   const std::vector<FitPoint> points = fit_points(a, units, tau0_s, long_tau, record);
   std::vector<CurveFit> fits;

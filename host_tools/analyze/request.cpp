@@ -28,7 +28,8 @@ void fail(int code, const std::string& what, const std::string& why) { throw Too
 
 namespace {
 
-constexpr const char* footer = R"(Data type and units (the type is required: for a gyro "frequency" is rate and "phase" is angle):
+constexpr const char* footer =
+    R"(Data type and units (the type is required: for a gyro "frequency" is rate and "phase" is angle):
   --type phase   phase samples: --unit s (clock phase, the default; deviations as fractional
                  frequency, TDEV in s) or an angle unit rad, mrad, urad, deg, arcsec (gyro angle)
   --type freq    frequency samples, each the average over tau0: --unit 1 (fractional, the default),
@@ -169,7 +170,8 @@ void add_options(CLI::App& app, OptionText& t, Request& r) {
   app.add_option("--pulse-unit", t.pulse_unit, "unit of --pulse-weight when it has none")->capture_default_str();
   app.add_option("--rate-unit", t.rate, "output unit of gyro data: deg/h, deg/s, rad/s")->capture_default_str();
   app.add_option("--nominal-hz", t.nominal_hz, "freq values are in Hz around this nominal frequency");
-  app.add_option("--column", r.column, "column holding the values (1-based; default: the only one, or the value of time,value)");
+  app.add_option("--column", r.column,
+                 "column holding the values (1-based; default: the only one, or the value of time,value)");
   app.add_option("--taus", t.taus, "octave, decade, all, or averaging factors m (1,10,100)")->capture_default_str();
   app.add_option("--stats", t.stats, "any of " + dev_stat_names(","))->capture_default_str();
   app.add_option("--stride-factor", t.stride, "S, a power of two, or full")->capture_default_str();
@@ -177,11 +179,13 @@ void add_options(CLI::App& app, OptionText& t, Request& r) {
                  "S of the decimated total/Theo estimators (a power of two from 2 to 2^20), or exact")
       ->capture_default_str();
   app.add_flag("--theo-decimated", t.theo_decimated,
-              "Theo1/TheoBR rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
-  app.add_flag("--total-decimated", t.total_decimated,
-               "MTOTDEV/TTOTDEV/HTOTDEV rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
+               "Theo1/TheoBR rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
+  app.add_flag(
+      "--total-decimated", t.total_decimated,
+      "MTOTDEV/TTOTDEV/HTOTDEV rows by the decimated estimator beyond 2^26 operations (the exact lag-sum one otherwise)");
   app.add_option("--confidence", t.confidence, "confidence level of the intervals")->capture_default_str();
-  app.add_option("--alpha", t.alpha, "noise exponent for the EDF: auto (identified per tau) or -4..2")->capture_default_str();
+  app.add_option("--alpha", t.alpha, "noise exponent for the EDF: auto (identified per tau) or -4..2")
+      ->capture_default_str();
   app.add_option("--fit", t.fit, "ieee952: fit Q, N, B, K, R to the oadev and mdev curves (both computed)");
   app.add_option("--fit-long-tau", t.long_tau,
                  "the fit's Allan curve at long tau: oadev, totdev or theoh (docs/metrology.md)")
@@ -202,7 +206,8 @@ void add_options(CLI::App& app, OptionText& t, Request& r) {
   app.add_flag("--no-sinusoid-search", t.no_sinusoid_search, "do not search the PSD for sinusoids to offer the fit");
   app.add_option("--sinusoid-hz", r.sinusoid_hz, "offer the fit a sinusoid at this frequency in Hz (repeatable, up to 2)")
       ->option_text("F");
-  app.add_option("--threads", t.threads, "threads summing the taus of counts at --stride-factor full and of --taus all (default: one per core)")
+  app.add_option("--threads", t.threads,
+                 "threads summing the taus of counts at --stride-factor full and of --taus all (default: one per core)")
       ->check(CLI::Range(1u, 1024u));
   app.add_option("--limits", r.limits_path, "acceptance limits: a verdict per limit (see below)")->option_text("FILE");
   app.add_option("--summary", r.summary_path, "with --limits: append the file's production summary row to FILE.csv")
@@ -242,8 +247,7 @@ std::vector<DevStat> parse_stats(const std::string& text) {
   std::stringstream ss(text);
   for (std::string item; std::getline(ss, item, ',');) {
     const auto s = parse_dev_stat(item);
-    if (!s)
-      bad("--stats", "unknown statistic '" + item + "' (" + dev_stat_names(", ") + ")");
+    if (!s) bad("--stats", "unknown statistic '" + item + "' (" + dev_stat_names(", ") + ")");
     if (std::find(stats.begin(), stats.end(), *s) != stats.end()) bad("--stats", "'" + item + "' is asked twice");
     stats.push_back(*s);
   }
@@ -323,8 +327,8 @@ void read_limits(Request& r) {
     }
     for (const Limit& l : r.limits)
       if (l.kind == Limit::Kind::term && !r.fit)
-        bad("--limits", fmt::format("{}: line {}: {} is a fitted term: add --fit ieee952", r.limits_path, l.line,
-                                    l.quantity()));
+        bad("--limits",
+            fmt::format("{}: line {}: {} is a fitted term: add --fit ieee952", r.limits_path, l.line, l.quantity()));
   }
   if (!r.summary_path.empty()) {
     if (r.limits.empty()) bad("--summary", "needs --limits (the row holds the verdicts)");
@@ -354,8 +358,7 @@ void resolve_request_units(const OptionText& t, const CLI::App& app, Request& r)
     bad(e.option(), e.what());
   }
   r.nominal_hz = t.nominal_hz;
-  if (!r.kalibr_path.empty() && !r.units.gyro)
-    bad("--kalibr", "needs gyro data: counts, or --unit with an angle or a rate");
+  if (!r.kalibr_path.empty() && !r.units.gyro) bad("--kalibr", "needs gyro data: counts, or --unit with an angle or a rate");
   if (!r.limits.empty() && !r.units.gyro)
     bad("--limits", "limits are in gyro units: needs gyro data (counts, or --unit with an angle or a rate)");
 }
@@ -379,22 +382,27 @@ DynamicSpec parse_dynamic(const std::string& text, double tau0_s) {
   if (parts.size() == 1) step_s = window_s;
   const double window_values = std::round(window_s / tau0_s), step_values = std::round(step_s / tau0_s);
   if (window_values < 4)
-    bad("--dynamic", fmt::format("a window of {} s holds {} values of tau0: at least 4 are needed", window_s, window_values));
+    bad("--dynamic",
+        fmt::format("a window of {} s holds {} values of tau0: at least 4 are needed", window_s, window_values));
   if (step_values < 1) bad("--dynamic", fmt::format("a step of {} s is shorter than tau0", step_s));
-  for (const auto& [what, seconds_asked, values] : {std::tuple{"window", window_s, window_values}, std::tuple{"step", step_s, step_values}})
+  for (const auto& [what, seconds_asked, values] :
+       {std::tuple{"window", window_s, window_values}, std::tuple{"step", step_s, step_values}})
     if (values > max_dynamic_values)
       bad("--dynamic", fmt::format("a {} of {:g} s is {:g} values of tau0 = {:g} s, more than the {:g} a window or step "
-                                   "may span", what, seconds_asked, values, tau0_s, max_dynamic_values));
+                                   "may span",
+                                   what, seconds_asked, values, tau0_s, max_dynamic_values));
   return {static_cast<std::uint64_t>(window_values), static_cast<std::uint64_t>(step_values)};
 }
 
 // The PSD, the sinusoids offered to the fit, and what --dynamic excludes.
 void check_spectrum_and_dynamic(const OptionText& t, Request& r) {
   const double tau0_s = r.options.tau0_s;
-  if (r.psd_segment != 0 && (r.psd_segment < 8 || r.psd_segment % 2 != 0)) bad("--psd-segment", "must be even and at least 8");
+  if (r.psd_segment != 0 && (r.psd_segment < 8 || r.psd_segment % 2 != 0))
+    bad("--psd-segment", "must be even and at least 8");
   if (r.sinusoid_hz.size() > max_sinusoids) bad("--sinusoid-hz", fmt::format("at most {} frequencies", max_sinusoids));
   for (const double f : r.sinusoid_hz)
-    if (!(f > 0 && f < 0.5 / tau0_s)) bad("--sinusoid-hz", fmt::format("{} Hz is not between 0 and the Nyquist frequency {} Hz", f, 0.5 / tau0_s));
+    if (!(f > 0 && f < 0.5 / tau0_s))
+      bad("--sinusoid-hz", fmt::format("{} Hz is not between 0 and the Nyquist frequency {} Hz", f, 0.5 / tau0_s));
   if (!r.sinusoid_hz.empty() && !r.fit) bad("--sinusoid-hz", "offers sinusoids to --fit ieee952");
   r.sinusoid_search = !t.no_sinusoid_search;
   // The PSD: asked for (--psd, the static --plot) or searched for sinusoids to offer the fit.
@@ -412,10 +420,11 @@ void check_spectrum_and_dynamic(const OptionText& t, Request& r) {
 }  // namespace
 
 std::optional<int> parse_request(int argc, const char* const* argv, Request& r) {
-  CLI::App app{"gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV (streamed, any length) and TOTDEV,\n"
-               "MTOTDEV, TTOTDEV, HTOTDEV, Theo1, TheoH (held in memory) of a recorded file, with EDF,\n"
-               "confidence intervals, noise identification and the IEEE-952 gyro fit.",
-               "gyrochar-analyze"};
+  CLI::App app{
+      "gyrochar-analyze: ADEV, OADEV, MDEV, TDEV, HDEV, OHDEV (streamed, any length) and TOTDEV,\n"
+      "MTOTDEV, TTOTDEV, HTOTDEV, Theo1, TheoH (held in memory) of a recorded file, with EDF,\n"
+      "confidence intervals, noise identification and the IEEE-952 gyro fit.",
+      "gyrochar-analyze"};
   app.footer(std::string(footer) + exit_code::help +
              "\nWith --limits: 5 a limit is undecided (none failed); 6 a limit failed (the analysis is written).");
   OptionText t;
@@ -429,7 +438,8 @@ std::optional<int> parse_request(int argc, const char* const* argv, Request& r) 
   // The fit uses both curves, whatever the table shows: compute them, show what was asked.
   r.shown = r.options.stats;
   for (const Limit& l : r.limits)  // limited deviations are computed, shown or not
-    if (l.kind != Limit::Kind::term) compute_too(r.options.stats, l.kind == Limit::Kind::adev ? DevStat::oadev : DevStat::mdev);
+    if (l.kind != Limit::Kind::term)
+      compute_too(r.options.stats, l.kind == Limit::Kind::adev ? DevStat::oadev : DevStat::mdev);
   if (r.fit)
     for (const DevStat s : {DevStat::oadev, DevStat::mdev}) compute_too(r.options.stats, s);
   resolve_request_units(t, app, r);

@@ -64,9 +64,9 @@ void open_input(const Request& r, RunPlan& p) {
   fail(exit_code::internal, r.source,
        fmt::format("{} values{} need {} MiB of memory with every tau up to N/4 fully overlapped (--stride-factor "
                    "full, the default), more than the {} MiB this process may use ({}): raise the limit, or give "
-                   "--stride-factor 8 (a few MiB whatever the length)", o.values_hint,
-                   r.taus == TauRule::all ? "" : " (at most, from the file's size)", std::max<std::uint64_t>(bytes >> 20, 1),
-                   p.budget >> 20, memory_budget_reason()));
+                   "--stride-factor 8 (a few MiB whatever the length)",
+                   o.values_hint, r.taus == TauRule::all ? "" : " (at most, from the file's size)",
+                   std::max<std::uint64_t>(bytes >> 20, 1), p.budget >> 20, memory_budget_reason()));
 }
 
 }  // namespace
@@ -166,7 +166,8 @@ void note_missing_taus(const Request& r, const Analysis& shown) {
   for (const std::uint64_t m : r.options.m_list) {
     std::string missing;
     for (const DevStat stat : r.shown)
-      if (std::none_of(shown.rows.begin(), shown.rows.end(), [&](const AnalysisRow& row) { return row.stat == stat && row.m == m; }))
+      if (std::none_of(shown.rows.begin(), shown.rows.end(),
+                       [&](const AnalysisRow& row) { return row.stat == stat && row.m == m; }))
         missing += (missing.empty() ? "" : ", ") + std::string(name(stat));
     if (!missing.empty())
       print_error(program, "note",
@@ -180,13 +181,13 @@ void check_output_range(const Request& r, const Analysis& shown) {
   const ReportUnits& units = r.units;
   for (const AnalysisRow& row : shown.rows) {
     if (!std::isfinite(row.dev * units.factor()) || (row.ci.valid && !std::isfinite(row.ci.high * units.factor())))
-      bad(r.source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) overflows a double",
-                                name(row.stat), row.tau_s, row.m, row.ci.valid ? row.ci.high : row.dev, units.factor(),
-                                units.unit(row.stat)));
+      bad(r.source,
+          fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) overflows a double", name(row.stat),
+                      row.tau_s, row.m, row.ci.valid ? row.ci.high : row.dev, units.factor(), units.unit(row.stat)));
     if (row.dev != 0 && !(row.dev * units.factor() >= DBL_MIN))
       bad(r.source, fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) underflows a double "
-                                "(smallest normal 2.2e-308)", name(row.stat), row.tau_s, row.m, row.dev, units.factor(),
-                                units.unit(row.stat)));
+                                "(smallest normal 2.2e-308)",
+                                name(row.stat), row.tau_s, row.m, row.dev, units.factor(), units.unit(row.stat)));
   }
 }
 
@@ -205,13 +206,16 @@ Analysis checked_result(const Request& r, const RunPlan& p, const InputShape& sh
   for (const std::uint64_t m : p.taus.not_formed)
     if (m <= a.n_phase / 2)
       bad("--taus", fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must be a "
-                                "multiple of its stride (m/S rounded up to a power of two)", m, s));
+                                "multiple of its stride (m/S rounded up to a power of two)",
+                                m, s));
   if (a.rows.empty()) bad(r.source, fmt::format("{} values are too few for any of the taus asked", a.n_values));
   check_zeros(all_zero(a.rows), shape, r.source);
   if (!p.file->layout_note().empty()) print_error(program, r.source, "values from " + p.file->layout_note());
   if (p.taus.cut_above > 0 && p.taus.cut_above <= a.n_phase / 2)
-    print_error(program, r.source, fmt::format("taus stop below m = {}: with stride factor {} more would need more than "
-                                               "{} MiB of history", p.taus.cut_above, s, p.budget >> 20));
+    print_error(program, r.source,
+                fmt::format("taus stop below m = {}: with stride factor {} more would need more than "
+                            "{} MiB of history",
+                            p.taus.cut_above, s, p.budget >> 20));
   return a;
 }
 
@@ -222,8 +226,10 @@ std::string kalibr_text(const Request& r, const Report& report) {
   if (!text) bad("--kalibr", why);
   if (!why.empty()) print_error(program, "note", r.kalibr_path + ": " + why);
   if (const std::string beyond = kalibr_left_out(report.fits.front().fit); !beyond.empty())
-    print_error(program, "note", "--kalibr: gyroscope_noise_density is the fitted white-rate N, gyroscope_random_walk the "
-                                 "fitted rate random walk K; Kalibr's model has no place for the model's " + beyond);
+    print_error(program, "note",
+                "--kalibr: gyroscope_noise_density is the fitted white-rate N, gyroscope_random_walk the "
+                "fitted rate random walk K; Kalibr's model has no place for the model's " +
+                    beyond);
   return *text;
 }
 
@@ -258,7 +264,9 @@ void run_analysis(const Request& r, RunPlan& p, RunOutcome& out) {
     std::copy_if(a.rows.begin(), a.rows.end(), std::back_inserter(out.plotted),
                  [](const AnalysisRow& row) { return row.stat == DevStat::oadev || row.stat == DevStat::mdev; });
   out.shown = std::move(a);  // (a --taus all run has millions of rows: not copied)
-  std::erase_if(out.shown.rows, [&](const AnalysisRow& row) { return std::find(r.shown.begin(), r.shown.end(), row.stat) == r.shown.end(); });
+  std::erase_if(out.shown.rows, [&](const AnalysisRow& row) {
+    return std::find(r.shown.begin(), r.shown.end(), row.stat) == r.shown.end();
+  });
   note_missing_taus(r, out.shown);
   check_output_range(r, out.shown);
   Report& report = out.report.emplace(Report{out.shown, o.type, o.tau0_s, o.confidence, r.units, std::move(fits),
@@ -284,11 +292,14 @@ void write_stdout(const Request& r, const RunOutcome& out) {
   std::string text;
   switch (r.format) {
     case OutputFormat::json: text = json_text(); break;
-    case OutputFormat::csv: text = format_csv(report) + (r.limits.empty() ? "" : acceptance_csv(r.limits, out.decisions)); break;
+    case OutputFormat::csv:
+      text = format_csv(report) + (r.limits.empty() ? "" : acceptance_csv(r.limits, out.decisions));
+      break;
     case OutputFormat::stable32: text = format_stable32(report); break;
     case OutputFormat::table: text = format_table(report) + verdicts; break;
   }
-  if (r.format == OutputFormat::stable32 && !r.limits.empty()) std::fputs(verdicts.c_str(), stderr);  // its format has no place
+  if (r.format == OutputFormat::stable32 && !r.limits.empty())
+    std::fputs(verdicts.c_str(), stderr);  // its format has no place
   std::fwrite(text.data(), 1, text.size(), stdout);
 }
 
@@ -311,7 +322,9 @@ GyroSummary summary_row(const Request& r, const RunOutcome& out) {
     for (std::size_t k = 0; k < 5; ++k) {
       const Ieee952Parameter& p = fit.p[k];
       g.terms[k] = {p.fitted, p.value / units::ieee952[k].si, p.uncertainty / units::ieee952[k].si,
-                    !p.fitted ? "not in model" : p.resolved ? "resolved" : "not resolved"};
+                    !p.fitted    ? "not in model"
+                    : p.resolved ? "resolved"
+                                 : "not resolved"};
     }
   }
   return g;

@@ -24,11 +24,11 @@ namespace gyrochar {
 /// the stride factor in the request's options, the analyzer made for them.
 struct RunPlan {
   std::unique_ptr<DataFile> file;
-  std::vector<double> kept;               // --taus all: every value, and its line
+  std::vector<double> kept;  // --taus all: every value, and its line
   std::vector<std::uint64_t> kept_lines;
-  std::uint64_t n_phase = 0;              // phase points: exact (all), an upper bound, or 0 (unknown)
+  std::uint64_t n_phase = 0;  // phase points: exact (all), an upper bound, or 0 (unknown)
   TauPlan taus;
-  std::uint64_t budget = 0;               // bytes the history may take (memory_budget())
+  std::uint64_t budget = 0;  // bytes the history may take (memory_budget())
   std::unique_ptr<Analyzer> analyzer;
 };
 /// Plans the run of `r`: fills r.options' taus and stride factor ("full" resolved, plan_taus), the
@@ -43,12 +43,12 @@ struct RunOutcome {
   RunOutcome(const RunOutcome&) = delete;
   RunOutcome& operator=(const RunOutcome&) = delete;
 
-  Analysis shown;                       // the rows of the statistics asked for
-  std::optional<Report> report;         // of `shown`
-  std::vector<AnalysisRow> plotted;     // OADEV and MDEV, shown or not (--plot, --report, --limits)
-  std::vector<Decision> decisions;      // of r.limits
-  std::string yaml;                     // --kalibr's file
-  double run_s = 0;                     // the run's length, s
+  Analysis shown;                    // the rows of the statistics asked for
+  std::optional<Report> report;      // of `shown`
+  std::vector<AnalysisRow> plotted;  // OADEV and MDEV, shown or not (--plot, --report, --limits)
+  std::vector<Decision> decisions;   // of r.limits
+  std::string yaml;                  // --kalibr's file
+  double run_s = 0;                  // the run's length, s
 };
 /// Reads the values once and analyses them, with the PSD, the fits and the verdicts, into `out`.
 void run_analysis(const Request& r, RunPlan& plan, RunOutcome& out);

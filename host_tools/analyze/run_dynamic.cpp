@@ -60,16 +60,17 @@ DynamicOutcome run_dynamic(const Request& r, DynamicPlan& p) {
   out.values = p.analyzer->values();
   if (out.windows.empty())
     bad(r.source, fmt::format("{} values are fewer than one window of {} values", out.values, r.dynamic->window));
-  check_zeros(std::all_of(out.windows.begin(), out.windows.end(), [](const WindowAnalysis& w) { return all_zero(w.analysis.rows); }),
+  check_zeros(std::all_of(out.windows.begin(), out.windows.end(),
+                          [](const WindowAnalysis& w) { return all_zero(w.analysis.rows); }),
               shape, r.source);
   return out;
 }
 
 void write_dynamic(const Request& r, const DynamicOutcome& out) {
   const AnalysisOptions& o = r.options;
-  const DynamicReport report{out.windows, o.type, o.tau0_s, o.confidence, r.units, r.dynamic->window, r.dynamic->step,
-                             out.values, o.stats};
-  const std::string text = r.format == OutputFormat::json ? dynamic_to_json(report).dump(2) + "\n"
+  const DynamicReport report{out.windows,       o.type,          o.tau0_s,   o.confidence, r.units,
+                             r.dynamic->window, r.dynamic->step, out.values, o.stats};
+  const std::string text = r.format == OutputFormat::json  ? dynamic_to_json(report).dump(2) + "\n"
                            : r.format == OutputFormat::csv ? format_dynamic_csv(report)
                                                            : format_dynamic_table(report);
   std::fwrite(text.data(), 1, text.size(), stdout);

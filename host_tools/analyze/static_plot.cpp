@@ -66,7 +66,8 @@ CurvePanel curve_panel(const Report& r, const std::vector<AnalysisRow>& rows, De
     if (lt < last_log + 0.01) continue;  // at most 100 points a decade
     last_log = lt;
     const double k = u.factor();
-    p.points.push_back({row.tau_s, row.dev * k, row.ci.valid ? Interval{row.ci.low * k, row.ci.high * k, true} : Interval{}});
+    p.points.push_back(
+        {row.tau_s, row.dev * k, row.ci.valid ? Interval{row.ci.low * k, row.ci.high * k, true} : Interval{}});
   }
   if (p.points.empty()) return p;
   p.tau_lo = p.points.front().tau_s / 2;
@@ -167,16 +168,19 @@ void draw_curve_panel(plstream& pls, const CurvePanel& p, const Report& r) {
     };
     if (ro.n.valid) {
       slope_line(ro.n.value * to_out, -0.5);
-      mark(1.0, ro.n.value * to_out, fmt::format("read-off N {:.3g} {}", ro.n.value / units::ieee952[1].si, units::ieee952[1].name));
+      mark(1.0, ro.n.value * to_out,
+           fmt::format("read-off N {:.3g} {}", ro.n.value / units::ieee952[1].si, units::ieee952[1].name));
     }
     if (ro.floor.valid)
       mark(ro.floor.tau_s, ro.floor.value * to_out,
            fmt::format("floor: B {:.3g} {}", ro.b.value / units::ieee952[2].si, units::ieee952[2].name));
     if (ro.k.valid) {
       slope_line(ro.k.value * to_out / std::sqrt(3.0), 0.5);
-      mark(3.0, ro.k.value * to_out, fmt::format("read-off K {:.3g} {}", ro.k.value / units::ieee952[3].si, units::ieee952[3].name));
+      mark(3.0, ro.k.value * to_out,
+           fmt::format("read-off K {:.3g} {}", ro.k.value / units::ieee952[3].si, units::ieee952[3].name));
     }
-    if (ro.n.valid || ro.floor.valid || ro.k.valid) legend.symbol("read-off (dotted: slopes -1/2, +1/2)", ink_colour, read_off_glyph);
+    if (ro.n.valid || ro.floor.valid || ro.k.valid)
+      legend.symbol("read-off (dotted: slopes -1/2, +1/2)", ink_colour, read_off_glyph);
   }
   for (const std::string& note : p.notes) legend.note(note);
   legend.draw(pls);
@@ -203,8 +207,10 @@ void draw_psd_panel(plstream& pls, const Report& r) {
   if (x.empty()) return draw_empty_panel(pls, title, "no positive PSD");
   const bool band = std::all_of(p.ci_low.begin(), p.ci_low.end(), [](double v) { return v > 0 && std::isfinite(v); });
   if (band) {  // the band's polygon: up along the upper bound, back along the lower
-    for (std::size_t i = 0; i < p.psd.size(); ++i) band_x.push_back(std::log10(p.freq_hz[i])), band_y.push_back(std::log10(p.ci_high[i] * k2));
-    for (std::size_t i = p.psd.size(); i-- > 0;) band_x.push_back(std::log10(p.freq_hz[i])), band_y.push_back(std::log10(p.ci_low[i] * k2));
+    for (std::size_t i = 0; i < p.psd.size(); ++i)
+      band_x.push_back(std::log10(p.freq_hz[i])), band_y.push_back(std::log10(p.ci_high[i] * k2));
+    for (std::size_t i = p.psd.size(); i-- > 0;)
+      band_x.push_back(std::log10(p.freq_hz[i])), band_y.push_back(std::log10(p.ci_low[i] * k2));
     lo = std::min(lo, *std::min_element(p.ci_low.begin(), p.ci_low.end()) * k2);
   }
   const double x_lo = std::log10(p.freq_hz.front()) - 0.1, x_hi = std::log10(p.freq_hz.back()) + 0.1;
@@ -301,8 +307,8 @@ bool write_static_plot(const std::string& prefix, const Report& report, const st
   const Ieee952Fit* fit = recommended(report);
   if (fit != nullptr && fit->n_residuals > 0 && adev.tau_lo > 0)
     panels.push_back([&](plstream& pls) { draw_residual_panel(pls, report, adev.tau_lo, adev.tau_hi); });
-  return write_figure(prefix, panels.size(), deviation_palette(), 1500, 900,
-                      [&](plstream& pls, std::size_t k) { panels[k](pls); }, why);
+  return write_figure(
+      prefix, panels.size(), deviation_palette(), 1500, 900, [&](plstream& pls, std::size_t k) { panels[k](pls); }, why);
 }
 
 }  // namespace gyrochar

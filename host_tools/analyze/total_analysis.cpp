@@ -83,9 +83,8 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
 }
 
 // TOTDEV, MTOTDEV, TTOTDEV or HTOTDEV at o.m_list: k2 is phase_scale squared.
-std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double> x, double k2,
-                                           const AnalysisOptions& o, const std::vector<AnalysisRow>& allan,
-                                           LagSumRecord& lag_sums) {
+std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double> x, double k2, const AnalysisOptions& o,
+                                           const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums) {
   std::vector<AnalysisRow> rows;
   const std::uint64_t N = x.size();
   const double n = static_cast<double>(N), tau0 = o.tau0_s;
@@ -98,10 +97,12 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
   // says which estimator ran.
   const bool hadamard = stat == DevStat::htotdev;
   const std::size_t n_fast = hadamard ? N - 1 : N, fast_size = theo1_workspace_size(n_fast) + mtotvar_scratch_size(n_fast);
-  const bool total_decimated = o.total_decimated || N < 2 || 8 * (static_cast<std::uint64_t>(fast_size) + N) > memory_budget();
+  const bool total_decimated = o.total_decimated || N < 2 ||
+                               8 * (static_cast<std::uint64_t>(fast_size) + N) > memory_budget();
   auto exact = [&](std::uint64_t m) {
     Theo1Workspace& prepared = lag_sums.prepared(x, hadamard);  // HTOTVAR: the frequencies times tau0
-    return hadamard ? htotvar_fast(prepared, lag_sums.scratch(), m, tau0) : mtotvar_fast(prepared, lag_sums.scratch(), m, tau0);
+    return hadamard ? htotvar_fast(prepared, lag_sums.scratch(), m, tau0)
+                    : mtotvar_fast(prepared, lag_sums.scratch(), m, tau0);
   };
   auto mtot_estimate = [&](std::uint64_t m) {
     if (!total_decimated) return exact(m);
@@ -183,9 +184,8 @@ std::span<double> LagSumRecord::scratch() {
   return {scratch_.get(), size};
 }
 
-std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, double phase_scale,
-                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan,
-                                    LagSumRecord& lag_sums) {
+std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, double phase_scale, const AnalysisOptions& o,
+                                    const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums) {
   const double k2 = phase_scale * phase_scale;
   if (stat == DevStat::theo1 || stat == DevStat::theoh) return theo_rows(stat, x, k2, o, allan, lag_sums);
   return total_family_rows(stat, x, k2, o, allan, lag_sums);

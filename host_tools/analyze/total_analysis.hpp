@@ -49,7 +49,6 @@ class LagSumRecord {
 /// rows; O(N) per tau for TOTDEV, O(N S) to O(N S^2 / m) for the others (docs/total.md).
 /// `lag_sums`: the run's one LagSumRecord.
 std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> phase, double phase_scale,
-                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan,
-                                    LagSumRecord& lag_sums);
+                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums);
 
 }  // namespace gyrochar

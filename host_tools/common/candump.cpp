@@ -122,8 +122,8 @@ bool parse_candump_line(std::string_view line, CandumpLine& out, std::string& wh
     }
     f.fd = true;
     return parse_bytes(payload.substr(2), f, CanFrame::max_fd_len, why) &&
-           (f.len <= 8 || f.len == 12 || f.len == 16 || f.len == 20 || f.len == 24 || f.len == 32 ||
-            f.len == 48 || f.len == 64 || (why = "CAN FD length is not a valid DLC size", false));
+           (f.len <= 8 || f.len == 12 || f.len == 16 || f.len == 20 || f.len == 24 || f.len == 32 || f.len == 48 ||
+            f.len == 64 || (why = "CAN FD length is not a valid DLC size", false));
   }
   if (!payload.empty() && (payload.front() == 'R' || payload.front() == 'r')) {
     out.remote = true;

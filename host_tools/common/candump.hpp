@@ -19,7 +19,7 @@ namespace gyrochar {
 inline constexpr std::size_t max_candump_line_bytes = 1024;
 
 struct CandumpLine {
-  double time_s = 0.0;   // timestamp in seconds (as printed)
+  double time_s = 0.0;  // timestamp in seconds (as printed)
   std::string interface;
   CanFrame frame;
   bool remote = false;

@@ -15,7 +15,7 @@ namespace gyrochar {
 /// Colour map 0 of the deviation panels (deviation_palette()); index 0 is the background.
 enum PlotColour : int {
   background_colour,
-  ink_colour,      // axes, text, read-off points
+  ink_colour,  // axes, text, read-off points
   adev_colour,
   mdev_colour,
   q_colour,
@@ -23,14 +23,14 @@ enum PlotColour : int {
   b_colour,
   k_colour,
   r_colour,
-  sum_colour,      // the fitted model's sum
+  sum_colour,  // the fitted model's sum
   grid_colour,
-  truth_colour,    // the simulated (true) model
-  markov_colour,   // Gauss-Markov terms
-  sinusoid_colour, // sinusoids, the PSD's peaks
-  filter_colour,   // the sensor's own filter
+  truth_colour,     // the simulated (true) model
+  markov_colour,    // Gauss-Markov terms
+  sinusoid_colour,  // sinusoids, the PSD's peaks
+  filter_colour,    // the sensor's own filter
   psd_colour,
-  band_colour,     // the PSD's confidence band
+  band_colour,  // the PSD's confidence band
 };
 /// The colours of PlotColour, in order.
 Palette deviation_palette();

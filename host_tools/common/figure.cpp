@@ -18,8 +18,8 @@ extern "C" const char* __lsan_default_suppressions() { return "leak:libfontconfi
 namespace gyrochar {
 namespace {
 
-bool draw(const char* device, const std::string& file, std::size_t panels, const Palette& palette, int width,
-          int height, const std::function<void(plstream&, std::size_t)>& draw_panel, std::string& why) {
+bool draw(const char* device, const std::string& file, std::size_t panels, const Palette& palette, int width, int height,
+          const std::function<void(plstream&, std::size_t)>& draw_panel, std::string& why) {
   // PLplot would end the process on a file it cannot open: check first.
   if (std::FILE* f = std::fopen(file.c_str(), "w")) {
     std::fclose(f);
@@ -72,8 +72,8 @@ void draw_empty_panel(plstream& pls, const std::string& title, const char* messa
   pls.lab("", "", title.c_str());
 }
 
-bool write_figure(const std::string& prefix, std::size_t panels, const Palette& palette, int panel_width,
-                  int panel_height, const std::function<void(plstream&, std::size_t)>& draw_panel, std::string& why) {
+bool write_figure(const std::string& prefix, std::size_t panels, const Palette& palette, int panel_width, int panel_height,
+                  const std::function<void(plstream&, std::size_t)>& draw_panel, std::string& why) {
   for (const auto& [device, extension] : {std::pair{"svgcairo", ".svg"}, std::pair{"pngcairo", ".png"}}) {
     const std::string file = prefix + extension, part = file + ".part";
     if (!draw(device, part, panels, palette, panel_width, panel_height, draw_panel, why)) return false;

@@ -27,7 +27,7 @@ void draw_empty_panel(plstream& pls, const std::string& title, const char* messa
 /// panel_height pixels, panel k drawn by draw_panel(pls, k), which starts its panel with
 /// pls.adv(0). Replaces the files atomically. Returns false and sets `why` when a file cannot be
 /// written. Allocates; the cost is the panels'.
-bool write_figure(const std::string& prefix, std::size_t panels, const Palette& palette, int panel_width,
-                  int panel_height, const std::function<void(plstream&, std::size_t)>& draw_panel, std::string& why);
+bool write_figure(const std::string& prefix, std::size_t panels, const Palette& palette, int panel_width, int panel_height,
+                  const std::function<void(plstream&, std::size_t)>& draw_panel, std::string& why);
 
 }  // namespace gyrochar

@@ -95,8 +95,9 @@ void draw_heat_map(plstream& pls, const HeatMap& map) {
 }
 
 bool write_heat_maps(const std::string& prefix, const std::vector<HeatMap>& maps, std::string& why) {
-  return write_figure(prefix, maps.size(), heat_map_palette(), 1500, 900,
-                      [&](plstream& pls, std::size_t k) { draw_heat_map(pls, maps[k]); }, why);
+  return write_figure(
+      prefix, maps.size(), heat_map_palette(), 1500, 900, [&](plstream& pls, std::size_t k) { draw_heat_map(pls, maps[k]); },
+      why);
 }
 
 }  // namespace gyrochar

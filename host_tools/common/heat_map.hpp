@@ -11,9 +11,9 @@
 namespace gyrochar {
 
 struct HeatMap {
-  std::string title;       // e.g. "node 0x10, session 0: ADEV per 600 s window"
-  std::string value_name;  // what the colour is: "ADEV", "MDEV", ...
-  std::string unit;        // its unit, e.g. "deg/h"
+  std::string title;          // e.g. "node 0x10, session 0: ADEV per 600 s window"
+  std::string value_name;     // what the colour is: "ADEV", "MDEV", ...
+  std::string unit;           // its unit, e.g. "deg/h"
   std::vector<double> tau_s;  // the rows, increasing, > 0
   struct Column {
     double start_s = 0.0, end_s = 0.0;  // the cell's extent in time (s since the start of the run)

@@ -112,8 +112,9 @@ std::string svg_log_plot(const LogPlot& plot) {
       take(p.x, p.y);
       if (p.ci.valid && p.y > 0) take(p.x, p.ci.low), take(p.x, p.ci.high);
     }
-  std::string out = fmt::format(R"(<svg class="plot" width="{}" height="{}" viewBox="0 0 {} {}" role="img" aria-label="{}">)",
-                                width, height, width, height, escape(plot.title));
+  std::string out =
+      fmt::format(R"(<svg class="plot" width="{}" height="{}" viewBox="0 0 {} {}" role="img" aria-label="{}">)", width,
+                  height, width, height, escape(plot.title));
   out += fmt::format(R"(<text x="{}" y="18" font-size="14" font-weight="bold">{}</text>)", left, escape(plot.title));
   if (!(x_hi > 0)) {
     out += fmt::format(R"(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#333"/>)", left, top, pw, ph);
@@ -135,14 +136,16 @@ std::string svg_log_plot(const LogPlot& plot) {
   for (int e = xa; e <= xb; ++e) {
     const double x = left + static_cast<double>(e - xa) / (xb - xa) * pw;
     out += fmt::format(R"(<line x1="{:.1f}" y1="{}" x2="{:.1f}" y2="{}" stroke="#ddd"/>)", x, top, x, top + ph);
-    out += fmt::format(R"(<text x="{:.1f}" y="{}" text-anchor="middle" font-size="11">10<tspan dy="-5" font-size="8">{}</tspan></text>)",
-                       x, top + ph + 15, e);
+    out += fmt::format(
+        R"(<text x="{:.1f}" y="{}" text-anchor="middle" font-size="11">10<tspan dy="-5" font-size="8">{}</tspan></text>)", x,
+        top + ph + 15, e);
   }
   for (int e = ya; e <= yb; ++e) {
     const double y = top + ph - static_cast<double>(e - ya) / (yb - ya) * ph;
     out += fmt::format(R"(<line x1="{}" y1="{:.1f}" x2="{}" y2="{:.1f}" stroke="#ddd"/>)", left, y, left + pw, y);
-    out += fmt::format(R"(<text x="{}" y="{:.1f}" text-anchor="end" font-size="11">10<tspan dy="-5" font-size="8">{}</tspan></text>)",
-                       left - 6, y + 4, e);
+    out += fmt::format(
+        R"(<text x="{}" y="{:.1f}" text-anchor="end" font-size="11">10<tspan dy="-5" font-size="8">{}</tspan></text>)",
+        left - 6, y + 4, e);
   }
   out += fmt::format(R"(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#333"/>)", left, top, pw, ph);
   out += fmt::format(R"(<text x="{}" y="{}" text-anchor="middle" font-size="12">{}</text>)", left + pw / 2, height - 10,
@@ -170,10 +173,13 @@ std::string svg_log_plot(const LogPlot& plot) {
   }
   for (const LogPlot::LimitMark& l : plot.limits) {
     if (!inside(l.tau > 0 ? l.tau : std::pow(10.0, xa), l.value)) continue;
-    const double x1 = l.tau > 0 ? std::max(left, px(l.tau) - 18) : left, x2 = l.tau > 0 ? std::min(left + pw, px(l.tau) + 18) : left + pw;
-    out += fmt::format(R"(<line x1="{:.1f}" y1="{:.1f}" x2="{:.1f}" y2="{:.1f}" stroke="#c00000" stroke-width="2" stroke-dasharray="6,3"/>)",
-                       x1, py(l.value), x2, py(l.value));
-    legend_entry("#c00000", l.label, R"(<line x1="0" y1="0" x2="16" y2="0" stroke="{}" stroke-width="2" stroke-dasharray="6,3"/>)");
+    const double x1 = l.tau > 0 ? std::max(left, px(l.tau) - 18) : left,
+                 x2 = l.tau > 0 ? std::min(left + pw, px(l.tau) + 18) : left + pw;
+    out += fmt::format(
+        R"(<line x1="{:.1f}" y1="{:.1f}" x2="{:.1f}" y2="{:.1f}" stroke="#c00000" stroke-width="2" stroke-dasharray="6,3"/>)",
+        x1, py(l.value), x2, py(l.value));
+    legend_entry("#c00000", l.label,
+                 R"(<line x1="0" y1="0" x2="16" y2="0" stroke="{}" stroke-width="2" stroke-dasharray="6,3"/>)");
   }
   for (const PlotSeries& s : plot.series) {
     const std::string c = escape(s.colour);
@@ -182,11 +188,13 @@ std::string svg_log_plot(const LogPlot& plot) {
       if (p.ci.valid && p.ci.low > 0)
         out += fmt::format(R"(<line x1="{0:.1f}" y1="{1:.1f}" x2="{0:.1f}" y2="{2:.1f}" stroke="{3}"/>)", px(p.x),
                            py(std::min(p.ci.high, std::pow(10.0, yb))), py(std::max(p.ci.low, std::pow(10.0, ya))), c);
-      out += s.square ? fmt::format(R"(<rect x="{:.1f}" y="{:.1f}" width="6" height="6" fill="{}"/>)", px(p.x) - 3, py(p.y) - 3, c)
+      out += s.square ? fmt::format(R"(<rect x="{:.1f}" y="{:.1f}" width="6" height="6" fill="{}"/>)", px(p.x) - 3,
+                                    py(p.y) - 3, c)
                       : fmt::format(R"(<circle cx="{:.1f}" cy="{:.1f}" r="3" fill="{}"/>)", px(p.x), py(p.y), c);
     }
-    legend_entry(c, s.name, s.square ? R"(<rect x="5" y="-3" width="6" height="6" fill="{}"/>)"
-                                     : R"(<circle cx="8" cy="0" r="3" fill="{}"/>)");
+    legend_entry(c, s.name,
+                 s.square ? R"(<rect x="5" y="-3" width="6" height="6" fill="{}"/>)"
+                          : R"(<circle cx="8" cy="0" r="3" fill="{}"/>)");
   }
   return out + legend + "</svg>";
 }
@@ -226,34 +234,45 @@ void Document::table(std::string_view id, std::string_view caption, const std::v
 void Document::raw(std::string_view markup) { body_ += markup; }
 
 std::string Document::finish() const {
-  return fmt::format("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n"
-                     "<style>{}</style>\n</head>\n<body>\n<h1>{}</h1>\n{}<p class=\"note\">Made by {}.</p>\n"
-                     "</body>\n</html>\n",
-                     escape(title_), style, escape(title_), body_, software_version());
+  return fmt::format(
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n"
+      "<style>{}</style>\n</head>\n<body>\n<h1>{}</h1>\n{}<p class=\"note\">Made by {}.</p>\n"
+      "</body>\n</html>\n",
+      escape(title_), style, escape(title_), body_, software_version());
 }
 
 void verdict_section(Document& doc, const std::vector<Limit>& limits, const std::vector<Decision>& decisions,
                      const std::string& id, int level) {
   doc.heading("Acceptance verdicts", level, id + "-heading");
   doc.paragraph(fmt::format("Overall: {}", name(overall(decisions))), "overall");
-  doc.paragraph("Decision rule: each bound is a one-sided 97.5 % confidence bound (the two-sided 95 % interval of "
-                "the deviation's EDF, or of the fitted term, value -+ 1.96 standard uncertainties). Pass when the "
-                "upper bound is within the limit, fail when the lower bound is beyond it, undecided otherwise or "
-                "when the term is not resolved by an accepted fit. 'Decides at' is the run length at which the "
-                "interval is expected to clear the limit if the estimate stays where it is (the interval narrows "
-                "as 1/sqrt(EDF), EDF in proportion to the run length).", "note");
+  doc.paragraph(
+      "Decision rule: each bound is a one-sided 97.5 % confidence bound (the two-sided 95 % interval of "
+      "the deviation's EDF, or of the fitted term, value -+ 1.96 standard uncertainties). Pass when the "
+      "upper bound is within the limit, fail when the lower bound is beyond it, undecided otherwise or "
+      "when the term is not resolved by an accepted fit. 'Decides at' is the run length at which the "
+      "interval is expected to clear the limit if the estimate stays where it is (the interval narrows "
+      "as 1/sqrt(EDF), EDF in proportion to the run length).",
+      "note");
   std::vector<std::vector<Cell>> rows;
   for (std::size_t i = 0; i < limits.size() && i < decisions.size(); ++i) {
     const Limit& l = limits[i];
     const Decision& d = decisions[i];
     const auto in_unit = [&](double v) { return d.estimate.usable ? number(v / l.unit_si) : Cell{}; };
-    Cell when = Cell{format_run_length(d.decide_at_s), std::isnan(d.decide_at_s) ? "" : fmt::format("{}", d.decide_at_s), {}};
-    rows.push_back({{l.quantity(), l.quantity(), "text"}, number(l.value_si / l.unit_si), {l.unit, {}, "text"},
-                    in_unit(d.estimate.value), in_unit(d.estimate.low), in_unit(d.estimate.high), verdict(d.verdict),
-                    when, {d.reason, {}, "text"}});
+    Cell when = Cell{format_run_length(d.decide_at_s),
+                     std::isnan(d.decide_at_s) ? "" : fmt::format("{}", d.decide_at_s),
+                     {}};
+    rows.push_back({{l.quantity(), l.quantity(), "text"},
+                    number(l.value_si / l.unit_si),
+                    {l.unit, {}, "text"},
+                    in_unit(d.estimate.value),
+                    in_unit(d.estimate.low),
+                    in_unit(d.estimate.high),
+                    verdict(d.verdict),
+                    when,
+                    {d.reason, {}, "text"}});
   }
-  doc.table(id, "", {"quantity", "limit", "unit", "estimate", "lower 97.5 %", "upper 97.5 %", "verdict",
-                             "decides at", "why"}, rows);
+  doc.table(id, "",
+            {"quantity", "limit", "unit", "estimate", "lower 97.5 %", "upper 97.5 %", "verdict", "decides at", "why"}, rows);
 }
 
 bool write_file_atomically(const std::string& path, std::string_view text, std::string& why) {

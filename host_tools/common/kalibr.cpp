@@ -22,8 +22,10 @@ std::string term_comment(const KalibrTerm& t, std::size_t k) {
 // model (partial), the placeholder of the accelerometer keys.
 std::string term_line(const char* key, const char* unit, const KalibrTerm& t, std::size_t k) {
   if (!t.fitted)
-    return fmt::format("#{}: ?   # {}; {} is not in the fitted model: fill it in (from a longer record, or the "
-                       "data sheet)\n", key, unit, units::ieee952[k].letter);
+    return fmt::format(
+        "#{}: ?   # {}; {} is not in the fitted model: fill it in (from a longer record, or the "
+        "data sheet)\n",
+        key, unit, units::ieee952[k].letter);
   return fmt::format("{}: {}   # {}; {}\n", key, t.value_si, unit, term_comment(t, k));
 }
 
@@ -35,8 +37,10 @@ std::optional<std::string> kalibr_imu_yaml(const KalibrTerm& n, const KalibrTerm
   if (!n.fitted && !k.fitted) partial = false;  // nothing to give
   for (const auto& [term, letter] : {std::pair{&n, "N (angle random walk)"}, std::pair{&k, "K (rate random walk)"}}) {
     if (!term->fitted && partial) {
-      why = fmt::format("{} is not in the fitted model: its key is written commented out with '?' for you to fill "
-                        "in (Kalibr needs it > 0)", letter);
+      why = fmt::format(
+          "{} is not in the fitted model: its key is written commented out with '?' for you to fill "
+          "in (Kalibr needs it > 0)",
+          letter);
       continue;
     }
     if (!term->fitted) {

@@ -41,13 +41,13 @@ struct Limit {
   // adev is the overlapping Allan deviation, as on the wire (docs/architecture.md, "Names of statistics").
   enum class Kind : unsigned char { term, adev, mdev };
   Kind kind = Kind::term;
-  std::size_t term = 1;   // Kind::term: Q N B K R = 0..4
-  double tau_s = 0;       // adev, mdev
-  double value_si = 0;    // the limit in SI: rad, rad/s^0.5, rad/s, rad/s^1.5, rad/s^2; deviations rad/s
-  std::string unit;       // the unit it was written in
-  double unit_si = 1;     // the size of that unit in SI
-  std::size_t line = 0;   // line in the file
-  std::string text;       // the limit as written (without comment and surrounding blanks)
+  std::size_t term = 1;  // Kind::term: Q N B K R = 0..4
+  double tau_s = 0;      // adev, mdev
+  double value_si = 0;   // the limit in SI: rad, rad/s^0.5, rad/s, rad/s^1.5, rad/s^2; deviations rad/s
+  std::string unit;      // the unit it was written in
+  double unit_si = 1;    // the size of that unit in SI
+  std::size_t line = 0;  // line in the file
+  std::string text;      // the limit as written (without comment and surrounding blanks)
   /// "N", "B", "adev(100 s)": the quantity, for tables and column names.
   std::string quantity() const;
 };

@@ -62,7 +62,9 @@ std::optional<PathConflict> output_conflict(const std::vector<NamedPath>& inputs
 
 std::vector<NamedPath> plot_outputs(const std::string& option, const std::string& prefix) {
   if (prefix.empty()) return {};
-  return {{option, prefix + ".svg"}, {option, prefix + ".png"}, {option, prefix + ".svg.part"},
+  return {{option, prefix + ".svg"},
+          {option, prefix + ".png"},
+          {option, prefix + ".svg.part"},
           {option, prefix + ".png.part"}};
 }
 

@@ -11,12 +11,12 @@ namespace gyrochar {
 
 namespace units {
 inline constexpr double pi = std::numbers::pi;
-inline constexpr double deg = pi / 180.0;                          // rad
-inline constexpr double arcsec = deg / 3600.0;                     // rad
-inline constexpr double deg_per_h = deg / 3600.0;                  // rad/s
-inline constexpr double deg_per_sqrt_h = deg / 60.0;               // rad/s^0.5 (sqrt(3600 s) = 60 s^0.5)
-inline constexpr double deg_per_h_sqrt_h = deg / 3600.0 / 60.0;    // rad/s^1.5
-inline constexpr double deg_per_h_per_h = deg / 3600.0 / 3600.0;   // rad/s^2
+inline constexpr double deg = pi / 180.0;                         // rad
+inline constexpr double arcsec = deg / 3600.0;                    // rad
+inline constexpr double deg_per_h = deg / 3600.0;                 // rad/s
+inline constexpr double deg_per_sqrt_h = deg / 60.0;              // rad/s^0.5 (sqrt(3600 s) = 60 s^0.5)
+inline constexpr double deg_per_h_sqrt_h = deg / 3600.0 / 60.0;   // rad/s^1.5
+inline constexpr double deg_per_h_per_h = deg / 3600.0 / 3600.0;  // rad/s^2
 
 /// An IEEE-952 parameter in the unit gyro people use: its letter, the unit's name and size in SI.
 struct Ieee952Unit {

@@ -40,8 +40,8 @@ std::string decision_fields(const Limit& limit, const Decision* d) {
 std::string summary_header(const std::vector<Limit>& limits) {
   std::string h = "source,node,run_s,samples,fit_status,chi2_per_dof";
   for (const auto& u : units::ieee952)
-    h += fmt::format(",{}",
-                     csv_field(fmt::format("{} [{}]", u.letter, u.name))) + fmt::format(",{} u,{} status", u.letter, u.letter);
+    h += fmt::format(",{}", csv_field(fmt::format("{} [{}]", u.letter, u.name))) +
+         fmt::format(",{} u,{} status", u.letter, u.letter);
   h += ",verdict";
   for (const Limit& l : limits) h += decision_columns(l);
   return h;
@@ -88,9 +88,10 @@ bool append_summary(const std::string& path, const std::vector<Limit>& limits, c
 }
 
 std::string acceptance_table(const std::vector<Limit>& limits, const std::vector<Decision>& decisions) {
-  std::string out = fmt::format("\nAcceptance: {} (each bound one-sided {:g} %: pass when the upper bound is within the "
-                                "limit, fail when the lower bound is beyond it)\n",
-                                name(overall(decisions)), 100 * (1 + decision_confidence) / 2);
+  std::string out = fmt::format(
+      "\nAcceptance: {} (each bound one-sided {:g} %: pass when the upper bound is within the "
+      "limit, fail when the lower bound is beyond it)\n",
+      name(overall(decisions)), 100 * (1 + decision_confidence) / 2);
   out += fmt::format("  {:<14} {:>12} {:<14} {:>12} {:>12} {:>12}  {:<10} {}\n", "limit", "value", "unit", "estimate",
                      "lower", "upper", "verdict", "");
   for (std::size_t i = 0; i < limits.size(); ++i) {
@@ -99,8 +100,9 @@ std::string acceptance_table(const std::vector<Limit>& limits, const std::vector
     const auto shown = [&](double v) { return d.estimate.usable ? fmt::format("{:.4g}", v / l.unit_si) : "-"; };
     std::string why = d.reason;
     if (d.verdict == Verdict::undecided && !std::isnan(d.decide_at_s))
-      why += std::isinf(d.decide_at_s) ? ": the estimate sits on the limit"
-                                       : fmt::format(": expected to decide at a run of {}", format_run_length(d.decide_at_s));
+      why += std::isinf(d.decide_at_s)
+                 ? ": the estimate sits on the limit"
+                 : fmt::format(": expected to decide at a run of {}", format_run_length(d.decide_at_s));
     out += fmt::format("  {:<14} {:>12.4g} {:<14} {:>12} {:>12} {:>12}  {:<10} {}\n", l.quantity(), l.value_si / l.unit_si,
                        l.unit, shown(d.estimate.value), shown(d.estimate.low), shown(d.estimate.high), name(d.verdict), why);
   }

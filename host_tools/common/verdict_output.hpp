@@ -23,17 +23,17 @@ std::string acceptance_csv(const std::vector<Limit>& limits, const std::vector<D
 nlohmann::json acceptance_json(const std::vector<Limit>& limits, const std::vector<Decision>& decisions);
 
 struct SummaryTerm {
-  bool known = false;       // the fit has a value for it
+  bool known = false;                 // the fit has a value for it
   double value = 0, uncertainty = 0;  // in the term's gyro unit (units::ieee952)
-  std::string status;       // "resolved", "not resolved", "not in model", "" (no fit)
+  std::string status;                 // "resolved", "not resolved", "not in model", "" (no fit)
 };
 
 struct GyroSummary {
-  std::string source;       // the input file, or "can0 node 3"
-  std::string node;         // node address; empty for a file
-  double run_s = 0;         // run length
+  std::string source;  // the input file, or "can0 node 3"
+  std::string node;    // node address; empty for a file
+  double run_s = 0;    // run length
   std::uint64_t samples = 0;
-  std::string fit_status;   // "ok", "model rejected", ...; empty: no fit
+  std::string fit_status;  // "ok", "model rejected", ...; empty: no fit
   double chi2_per_dof = 0;
   std::array<SummaryTerm, 5> terms{};  // Q N B K R
   std::vector<Decision> decisions;     // in the order of the limits

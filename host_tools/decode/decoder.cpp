@@ -135,8 +135,8 @@ void Decoder::accept(NodeView& v, Assembly& a, const Message& message) {
           v.config = msg;
           mark_slot(v, a, Slot::config, 0);
         } else if constexpr (std::is_same_v<M, Ieee952Msg>) {
-          v.ieee952[static_cast<std::size_t>(msg.term)] = {true, msg.resolved, msg.value, msg.rel_uncertainty,
-                                                           msg.fitted || msg.resolved, v.cycle()};
+          v.ieee952[static_cast<std::size_t>(msg.term)] = {
+              true, msg.resolved, msg.value, msg.rel_uncertainty, msg.fitted || msg.resolved, v.cycle()};
           mark_slot(v, a, Slot::ieee952, static_cast<std::uint8_t>(msg.term));
         } else if constexpr (std::is_same_v<M, Ieee952SummaryMsg>) {
           v.ieee952_summary = msg;

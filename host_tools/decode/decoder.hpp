@@ -21,16 +21,16 @@ namespace gyrochar {
 
 /// The latest values of one tau of one node.
 struct TauView {
-  std::uint64_t m = 0;          // averaging factor, 0 while unknown (tau info not yet received)
+  std::uint64_t m = 0;  // averaging factor, 0 while unknown (tau info not yet received)
   std::uint8_t stride_log2 = 0;
-  std::uint64_t n = 0;          // overlapping Allan terms (slow cycle), 0 while unknown
+  std::uint64_t n = 0;  // overlapping Allan terms (slow cycle), 0 while unknown
   struct Dev {
-    bool received = false;      // a value arrived in this session
-    float dev = 0.0f;           // angle unit / s
-    double edf = 0.0;           // 0: not available
+    bool received = false;  // a value arrived in this session
+    float dev = 0.0f;       // angle unit / s
+    double edf = 0.0;       // 0: not available
     protocol::NoiseType noise = protocol::NoiseType::not_identified;
     bool valid = false;
-    std::uint64_t report = 0;   // NodeView::report of the report it arrived in
+    std::uint64_t report = 0;  // NodeView::report of the report it arrived in
   };
   Dev adev, mdev;
 };
@@ -38,13 +38,13 @@ struct TauView {
 /// One IEEE-952 term of the node's latest fit.
 struct Ieee952View {
   bool received = false;
-  bool resolved = false;       // significant and dominating somewhere, in an accepted fit
-  float value = 0.0f;          // in the term's unit (protocol::Ieee952Term); 0 unless fitted
+  bool resolved = false;  // significant and dominating somewhere, in an accepted fit
+  float value = 0.0f;     // in the term's unit (protocol::Ieee952Term); 0 unless fitted
   double rel_uncertainty = 0.0;
-  bool fitted = false;         // in the fitted model: value and uncertainty are the fit's even when
-                               // not resolved (an upper-bound reading). A version-1 node sends no
-                               // Fitted flag: there it is the Resolved flag.
-  std::uint64_t cycle = 0;      // NodeView::cycle() of the report that carried it
+  bool fitted = false;      // in the fitted model: value and uncertainty are the fit's even when
+                            // not resolved (an upper-bound reading). A version-1 node sends no
+                            // Fitted flag: there it is the Resolved flag.
+  std::uint64_t cycle = 0;  // NodeView::cycle() of the report that carried it
   /// In the node's model: received and fitted (a version-1 node: resolved).
   bool in_model() const { return received && (fitted || resolved); }
 };
@@ -90,8 +90,8 @@ struct FitModelView {
 /// One window of the node's dynamic Allan deviation (protocol version 3): the window k covers the
 /// node's samples k L .. (k+1) L - 1 (L = NodeView::window_length).
 struct WindowView {
-  std::uint32_t window = 0;   // k
-  std::uint32_t gaps = 0;     // sample gaps inside it
+  std::uint32_t window = 0;        // k
+  std::uint32_t gaps = 0;          // sample gaps inside it
   std::vector<double> adev, mdev;  // per window tau, angle unit / s; 0: no estimate or not received
   std::vector<bool> received;      // per window tau: its frame arrived
   bool complete() const { return !received.empty() && std::find(received.begin(), received.end(), false) == received.end(); }
@@ -99,16 +99,16 @@ struct WindowView {
 
 /// Link health of one node: what went missing and what went wrong, since the decoder started.
 struct LinkHealth {
-  std::uint64_t frames = 0;             // frames accepted from this node
-  std::uint64_t reports_complete = 0;   // reports with every expected frame
-  std::uint64_t reports_incomplete = 0; // reports closed with missing frames
-  std::uint64_t reports_lost = 0;       // whole reports never seen (Seq gaps)
-  std::uint64_t frames_missing = 0;     // expected slots not received in closed reports
-  std::uint64_t restarts = 0;           // Seq/SampleCount/Uptime backwards, config or tau count change
-  std::uint64_t offline_events = 0;     // silences of 3 s or more
-  std::uint64_t duplicates = 0;         // a slot received twice in one report: address conflict
-  std::uint64_t not_decoded = 0;        // frames of a protocol version this decoder does not know
-  std::uint64_t window_frames_unplaced = 0;  // window tau frames whose window page was not received
+  std::uint64_t frames = 0;                                   // frames accepted from this node
+  std::uint64_t reports_complete = 0;                         // reports with every expected frame
+  std::uint64_t reports_incomplete = 0;                       // reports closed with missing frames
+  std::uint64_t reports_lost = 0;                             // whole reports never seen (Seq gaps)
+  std::uint64_t frames_missing = 0;                           // expected slots not received in closed reports
+  std::uint64_t restarts = 0;                                 // Seq/SampleCount/Uptime backwards, config or tau count change
+  std::uint64_t offline_events = 0;                           // silences of 3 s or more
+  std::uint64_t duplicates = 0;                               // a slot received twice in one report: address conflict
+  std::uint64_t not_decoded = 0;                              // frames of a protocol version this decoder does not know
+  std::uint64_t window_frames_unplaced = 0;                   // window tau frames whose window page was not received
   std::map<protocol::ProtocolError, std::uint64_t> rejected;  // frames decode() refused
 };
 
@@ -116,7 +116,7 @@ struct NodeView {
   std::uint8_t address = 0;
   bool online = false;
   double last_frame_s = 0.0;
-  std::uint32_t session = 0;            // +1 at every restart detected
+  std::uint32_t session = 0;  // +1 at every restart detected
   /// The node's latest report of this session: its number (1 for the first, 0 before any) and
   /// whether it is still being received. TauView::Dev::report says which report a value is from.
   std::uint64_t report = 0;
@@ -182,9 +182,9 @@ struct NodeView {
   /// which a version-5 layout would then call missing; it is used, not counted, until the clock page. A version-1 report then misses nothing, and a newer report opened before the
   /// clock page only leaves its newer frames uncounted.
   std::uint8_t schedule_version() const {
-    return clock            ? clock->protocol_version
+    return clock             ? clock->protocol_version
            : fit_model.model ? std::uint8_t{4}
-           : window_taus    ? std::uint8_t{3}
+           : window_taus     ? std::uint8_t{3}
            : ieee952_summary ? std::uint8_t{2}
                              : std::uint8_t{1};
   }
@@ -221,10 +221,11 @@ class Decoder {
     double start_s = 0.0;           // time of the report's first frame
     std::uint8_t lost_at_open = 0;  // reports counted lost when the current report opened
     std::uint8_t tau_count = 0;
-    std::uint8_t version = 1;  // the schedule's protocol version (NodeView::schedule_version())
-    std::uint8_t window_taus = 0;  // the node's window taus (version 3), 0 while unknown
+    std::uint8_t version = 1;         // the schedule's protocol version (NodeView::schedule_version())
+    std::uint8_t window_taus = 0;     // the node's window taus (version 3), 0 while unknown
     std::array<bool, 512> arrived{};  // by slot position in the report
-    std::array<std::int16_t, protocol::slot_kinds * protocol::max_taus> position{};  // (slot, index) -> position, -1: not in this report
+    std::array<std::int16_t, protocol::slot_kinds * protocol::max_taus>
+        position{};  // (slot, index) -> position, -1: not in this report
 
     /// True when the frame of (slot, index) arrived in this report; false for a frame the report's
     /// schedule does not have. O(1).
@@ -278,7 +279,7 @@ class Decoder {
   double offline_after_s_;
   std::map<std::uint8_t, NodeView> nodes_;
   std::map<std::uint8_t, Assembly> assembly_;  // the report being received, per node
-  double now_s_ = 0.0;                          // time of the frame being fed
+  double now_s_ = 0.0;                         // time of the frame being fed
   std::uint64_t other_frames_ = 0;
   std::uint64_t rejected_ = 0;
 };

@@ -21,9 +21,7 @@ namespace gyrochar::web {
 
 namespace {
 
-double steady_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double steady_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 const char* reason(int status) {
   switch (status) {
@@ -149,8 +147,8 @@ HttpServer::HttpServer(const ListenAddress& address, std::span<const Asset> asse
   hints.ai_socktype = SOCK_STREAM;
   hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV | (address.host == "localhost" ? 0 : AI_NUMERICHOST);
   addrinfo* found = nullptr;
-  const std::string where = (address.host.find(':') != std::string::npos ? "[" + address.host + "]" : address.host) +
-                            ":" + std::to_string(address.port);
+  const std::string where = (address.host.find(':') != std::string::npos ? "[" + address.host + "]" : address.host) + ":" +
+                            std::to_string(address.port);
   if (const int e = ::getaddrinfo(address.host.c_str(), std::to_string(address.port).c_str(), &hints, &found); e != 0)
     throw ListenError(where + ": " + ::gai_strerror(e));
   std::unique_ptr<addrinfo, void (*)(addrinfo*)> list(found, ::freeaddrinfo);

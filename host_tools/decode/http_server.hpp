@@ -42,23 +42,23 @@ struct Asset {
 };
 
 struct ServerLimits {
-  std::size_t max_connections = 256;      // more are answered 503 and closed at once
-  std::size_t max_request_bytes = 8192;   // request line and headers: 414 / 431 beyond
-  double request_timeout_s = 5.0;         // the whole request head must arrive within (slowloris): 408
-  double write_stall_s = 10.0;            // queued output and nothing taken for that long: dropped
-  double keepalive_s = 15.0;              // an idle event stream gets a comment line this often
+  std::size_t max_connections = 256;     // more are answered 503 and closed at once
+  std::size_t max_request_bytes = 8192;  // request line and headers: 414 / 431 beyond
+  double request_timeout_s = 5.0;        // the whole request head must arrive within (slowloris): 408
+  double write_stall_s = 10.0;           // queued output and nothing taken for that long: dropped
+  double keepalive_s = 15.0;             // an idle event stream gets a comment line this often
 };
 
 /// What the server has done, for the tests and the benchmark (read while it runs).
 struct ServerCounters {
-  std::atomic<std::uint64_t> accepted{0};       // connections taken
-  std::atomic<std::uint64_t> refused{0};        // answered 503: max_connections open
-  std::atomic<std::uint64_t> requests{0};       // requests answered (any status)
-  std::atomic<std::uint64_t> errors{0};         // answered 4xx or 5xx
-  std::atomic<std::uint64_t> timed_out{0};      // request head not complete in time (408)
-  std::atomic<std::uint64_t> dropped_slow{0};   // clients that took nothing for write_stall_s
-  std::atomic<std::uint64_t> events_sent{0};    // snapshots queued to event streams
-  std::atomic<std::uint64_t> open{0};           // connections open now
+  std::atomic<std::uint64_t> accepted{0};      // connections taken
+  std::atomic<std::uint64_t> refused{0};       // answered 503: max_connections open
+  std::atomic<std::uint64_t> requests{0};      // requests answered (any status)
+  std::atomic<std::uint64_t> errors{0};        // answered 4xx or 5xx
+  std::atomic<std::uint64_t> timed_out{0};     // request head not complete in time (408)
+  std::atomic<std::uint64_t> dropped_slow{0};  // clients that took nothing for write_stall_s
+  std::atomic<std::uint64_t> events_sent{0};   // snapshots queued to event streams
+  std::atomic<std::uint64_t> open{0};          // connections open now
 };
 
 /// Thrown by the constructor when the address cannot be listened on; what() names the address and

@@ -34,7 +34,7 @@ Json line_json(const PlotLine& l, const char* kind) {
 Json plot_json(const NodePlot& p) {
   Json lines = Json::array();
   for (const PlotLine& l : p.terms)
-    lines.push_back(line_json(l, l.term ? units::ieee952[static_cast<std::size_t>(*l.term)].letter
+    lines.push_back(line_json(l, l.term     ? units::ieee952[static_cast<std::size_t>(*l.term)].letter
                                  : l.markov ? "markov"
                                             : "model"));
   if (p.truth) lines.push_back(line_json(*p.truth, "truth"));
@@ -48,9 +48,8 @@ Json plot_json(const NodePlot& p) {
       columns.push_back(Json{{"start_s", c.start_s}, {"end_s", c.end_s}, {"value", numbers(c.value)}});
     heat = Json{{"title", p.dynamic->title}, {"unit", p.dynamic->unit}, {"tau_s", p.dynamic->tau_s}, {"columns", columns}};
   }
-  return Json{{"title", p.title},        {"rate_unit", p.rate_name}, {"tau_min_s", p.tau_min_s},
-              {"tau_max_s", p.tau_max_s}, {"lines", lines},          {"notes", p.notes},
-              {"read_offs", read_offs},   {"heat", heat}};
+  return Json{{"title", p.title}, {"rate_unit", p.rate_name}, {"tau_min_s", p.tau_min_s}, {"tau_max_s", p.tau_max_s},
+              {"lines", lines},   {"notes", p.notes},         {"read_offs", read_offs},   {"heat", heat}};
 }
 
 // The simulated gyro's terms in the units the node's fit is shown in; null where unknown.
@@ -60,7 +59,8 @@ Json truth_json(const NodeView& v, const Units& u, const TrueTerms* t) {
   Json j = Json::object();
   for (std::size_t k = 0; k < 5; ++k) j[units::ieee952[k].letter] = number(t->qnbkr[k] * *per_si * u.ieee[k]);
   Json markov = Json::array();
-  for (const auto& [sigma, tc] : t->markov) markov.push_back(Json{{"sigma", number(sigma * *per_si * u.rate)}, {"tc_s", tc}});
+  for (const auto& [sigma, tc] : t->markov)
+    markov.push_back(Json{{"sigma", number(sigma * *per_si * u.rate)}, {"tc_s", tc}});
   j["markov"] = markov;
   return j;
 }

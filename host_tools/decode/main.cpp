@@ -37,9 +37,7 @@ using namespace gyrochar::decoding;
 constexpr const char* program = "gyrochar-decode";
 constexpr std::uint64_t malformed_reported = 10;  // malformed lines reported one by one, then counted
 
-[[noreturn]] void fail(int code, const std::string& what, const std::string& why) {
-  exit_with(code, program, what, why);
-}
+[[noreturn]] void fail(int code, const std::string& what, const std::string& why) { exit_with(code, program, what, why); }
 
 volatile std::sig_atomic_t stop_requested = 0;
 extern "C" void request_stop(int) { stop_requested = 1; }
@@ -71,7 +69,7 @@ struct Options {
   std::string limits_path, report, summary;  // --limits, --report, --summary
   std::vector<Limit> limits;
   std::string command;  // for the report's provenance
-  std::string http;  // [ADDR:]PORT of the live web page; empty: none
+  std::string http;     // [ADDR:]PORT of the live web page; empty: none
 };
 
 std::FILE* open_output(const std::string& path) {
@@ -148,8 +146,8 @@ class Presenter {
 
  private:
   void show() {
-    const std::string text =
-        format_view(session_.decoder(), session_.input(), session_.options().shown, rate_unit_, session_.intervals());
+    const std::string text = format_view(session_.decoder(), session_.input(), session_.options().shown, rate_unit_,
+                                         session_.intervals());
     if (view_ == View::live && tty_) std::fputs("\033[H\033[J", stdout);  // home, clear screen
     std::fputs(text.c_str(), stdout);
     std::fflush(stdout);
@@ -277,9 +275,8 @@ int decode_log(const Options& o, Session& session, Presenter& presenter) {
 std::string bus_text(const std::string& interface, const hal::CanBus& bus) {
   static constexpr const char* states[] = {"error active", "error warning", "error passive", "bus-off", "down"};
   const hal::CanCounters& c = bus.counters();
-  return fmt::format("{}: {}; received {}, dropped in the socket queue {}, error frames {}, bus-off events {}",
-                     interface, states[static_cast<int>(bus.state())], c.received, c.rx_dropped, c.error_frames,
-                     c.bus_off_events);
+  return fmt::format("{}: {}; received {}, dropped in the socket queue {}, error frames {}, bus-off events {}", interface,
+                     states[static_cast<int>(bus.state())], c.received, c.rx_dropped, c.error_frames, c.bus_off_events);
 }
 
 int decode_live(const Options& o, Session& session, Presenter& presenter) {
@@ -339,7 +336,8 @@ std::string help_footer() {
          "  candump -L can0 | gyrochar-decode - --duration 3600 --plot hour\n\n"
          "The table shows one report per row: a value whose frame that report lost reads 'missing', as in\n"
          "the CSV (one still awaited 'pending'), never the report before's.\n"
-         "Malformed lines (lines longer than " + std::to_string(max_candump_line_bytes) +
+         "Malformed lines (lines longer than " +
+         std::to_string(max_candump_line_bytes) +
          " bytes among them), remote request (RTR) frames and\n"
          "rejected frames are counted and reported, not fatal. A log that is missing, unreadable, empty or\n"
          "without any candump line is bad input, and so is an output (--csv, --jsonl, --kalibr, --plot's\n"
@@ -364,8 +362,7 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("log", o.log, "candump log file, or '-' for stdin")->option_text("LOG");
   app.add_option("-i,--interface", o.interface, "live SocketCAN interface, e.g. can0, vcan0")->option_text("IF");
   app.add_option("--csv", o.csv, "write one row per node, closed report and tau to this CSV file")->option_text("FILE");
-  app.add_option("--jsonl", o.jsonl, "write the same rows, per-report status and events as JSON lines")
-      ->option_text("FILE");
+  app.add_option("--jsonl", o.jsonl, "write the same rows, per-report status and events as JSON lines")->option_text("FILE");
   app.add_option("--plot", o.plot, "write PREFIX.svg and PREFIX.png at the end")->option_text("PREFIX");
   app.add_option("--kalibr", o.kalibr, "write the node's N and K as a Kalibr imu.yaml at the end (one node: --node)")
       ->option_text("FILE");
@@ -387,8 +384,7 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--rate-unit", o.rate_unit, "deg/h, deg/s, rad/s or native (the node's angle unit per s)")
       ->capture_default_str();
   app.add_option("--confidence", o.confidence, "level of the confidence intervals, in (0, 1)")->capture_default_str();
-  app.add_option("--duration", o.duration_s, "stop after S seconds of decoder time (log time for a log)")
-      ->option_text("S");
+  app.add_option("--duration", o.duration_s, "stop after S seconds of decoder time (log time for a log)")->option_text("S");
   app.add_option("--node", o.nodes, "show and record only this node address (repeatable; 16 or 0x10)")
       ->option_text("ADDRESS");
   app.add_option("--http", o.http,
@@ -401,7 +397,8 @@ void add_options(CLI::App& app, Options& o) {
 
 std::optional<web::ListenAddress> check_http(const Options& o) {
   std::optional<web::ListenAddress> http;
-  if (std::string why; !o.http.empty() && !(http = web::parse_listen_address(o.http, why))) fail(exit_code::bad_input, "--http", why);
+  if (std::string why; !o.http.empty() && !(http = web::parse_listen_address(o.http, why)))
+    fail(exit_code::bad_input, "--http", why);
   return http;
 }
 
@@ -448,14 +445,10 @@ void read_limits(Options& o) {
 View choose_view(const Options& o) {
   if (!(o.refresh_s > 0)) fail(exit_code::bad_input, "--refresh", "must be > 0");
   View view = isatty(STDOUT_FILENO) ? View::live : View::none;
-  if (o.view == "live")
-    view = View::live;
-  else if (o.view == "final")
-    view = View::final;
-  else if (o.view == "none")
-    view = View::none;
-  else if (!o.view.empty())
-    fail(exit_code::bad_input, "--view", "'" + o.view + "' is not live, final or none");
+  if (o.view == "live") view = View::live;
+  else if (o.view == "final") view = View::final;
+  else if (o.view == "none") view = View::none;
+  else if (!o.view.empty()) fail(exit_code::bad_input, "--view", "'" + o.view + "' is not live, final or none");
   return view;
 }
 
@@ -464,7 +457,8 @@ View choose_view(const Options& o) {
 void check_outputs(const Options& o) {
   std::vector<NamedPath> outputs = plot_outputs("--plot", o.plot);
   outputs.insert(outputs.begin(), {{"--csv", o.csv}, {"--jsonl", o.jsonl}, {"--kalibr", o.kalibr}});
-  outputs.insert(outputs.end(), {{"--report", o.report}, {"--report", o.report.empty() ? "" : o.report + ".part"},
+  outputs.insert(outputs.end(), {{"--report", o.report},
+                                 {"--report", o.report.empty() ? "" : o.report + ".part"},
                                  {"--summary", o.summary}});
   if (const auto conflict = output_conflict({{"LOG", o.log}, {"--limits", o.limits_path}}, outputs))
     fail(exit_code::bad_input, conflict->what, conflict->why);

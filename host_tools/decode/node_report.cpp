@@ -81,7 +81,10 @@ html::LogPlot node_plot(const NodePlot& p) {
   // Q N B K R, a Markov term, the model's sum.
   static constexpr const char* term_colours[] = {"#8c564b", "#2a8a2a", "#9467bd", "#d62728", "#e377c2"};
   for (const PlotLine& l : p.terms)
-    plot.lines.push_back({l.label, l.term ? term_colours[static_cast<int>(*l.term)] : l.markov ? "#17becf" : "#222222",
+    plot.lines.push_back({l.label,
+                          l.term     ? term_colours[static_cast<int>(*l.term)]
+                          : l.markov ? "#17becf"
+                                     : "#222222",
                           false, l.tau_s, l.dev});
   if (p.truth) plot.lines.push_back({p.truth->label, "#7a3fa0", true, p.truth->tau_s, p.truth->dev});
   return plot;
@@ -182,7 +185,9 @@ GyroSummary node_summary(const NodeView& node, const std::string& source, const 
       if (!t.received) continue;
       const double v = static_cast<double>(t.value) / *wire_si / units::ieee952[k].si;
       g.terms[k] = {t.in_model(), v, v * t.rel_uncertainty,
-                    !t.in_model() ? "not in model" : t.resolved ? "resolved" : "not resolved"};
+                    !t.in_model() ? "not in model"
+                    : t.resolved  ? "resolved"
+                                  : "not resolved"};
     }
   g.decisions = node_decisions(node, limits);
   return g;
@@ -204,11 +209,13 @@ void model_table(html::Document& doc, const NodeView& node, const Units& u, cons
     return;
   }
   std::vector<std::vector<Cell>> rows;
-  const auto add_row = [&](const std::string& term, protocol::FitParameter kind, std::uint8_t j,
-                           const std::string& unit, bool with_status) {
+  const auto add_row = [&](const std::string& term, protocol::FitParameter kind, std::uint8_t j, const std::string& unit,
+                           bool with_status) {
     const FitModelRow::Parameter& q = m->parameters[protocol::fit_parameter_position(kind, j)];
-    rows.push_back({{term, {}, "text"}, number(q.value),
-                    q.rel_uncertainty > 0 ? number(q.value * q.rel_uncertainty) : Cell{}, {unit, {}, "text"},
+    rows.push_back({{term, {}, "text"},
+                    number(q.value),
+                    q.rel_uncertainty > 0 ? number(q.value * q.rel_uncertainty) : Cell{},
+                    {unit, {}, "text"},
                     {with_status ? (q.resolved ? "resolved" : "not resolved") : "", {}, "text"}});
   };
   using protocol::FitParameter;
@@ -227,10 +234,8 @@ void model_table(html::Document& doc, const NodeView& node, const Units& u, cons
   if (const auto& r = m->runner_up)
     title += fmt::format("; runner-up: {} Markov, {} sinusoids{}, criterion {:+.3g}", r->runner_up_markov,
                          r->runner_up_sinusoids, r->runner_up_bandwidth ? ", filter" : "", r->criterion_margin);
-  if (rows.empty())
-    doc.paragraph(title, "model");
-  else
-    doc.table(id + "-model", title, {"term", "value", "standard uncertainty", "unit", "status"}, rows);
+  if (rows.empty()) doc.paragraph(title, "model");
+  else doc.table(id + "-model", title, {"term", "value", "standard uncertainty", "unit", "status"}, rows);
 }
 
 // The dynamic Allan deviation: the latest window's ADEV at each window tau, as the terminal view.
@@ -249,9 +254,8 @@ void window_table(html::Document& doc, const NodeView& node, const Units& u, con
 
 }  // namespace
 
-std::string decode_html(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown,
-                        const DisplayRate& rate, ConfidenceIntervals& intervals, const std::vector<Limit>& limits,
-                        const std::string& command) {
+std::string decode_html(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown, const DisplayRate& rate,
+                        ConfidenceIntervals& intervals, const std::vector<Limit>& limits, const std::string& command) {
   html::Document doc("gyrochar report: " + input.source);
   doc.heading("Provenance", 2, "provenance");
   doc.facts({{"input", input.source},
@@ -268,26 +272,23 @@ std::string decode_html(const Decoder& decoder, const InputCounters& input, cons
     const std::string id = fmt::format("node-{:02x}", address);
     doc.heading(node_name(node), 2, id);
     const LinkHealth& h = node.health;
-    doc.facts({{"node", fmt::format("0x{:02X}, session {}", address, node.session)},
-               {"configuration",
-                node.config ? fmt::format("hash 0x{:08X}, report every {} ms", node.config->config_hash,
-                                          node.config->report_period_ms)
-                            : "not received"},
-               {"tau0", node.sampling ? fmt::format("{:g} s, stride factor {}", node.sampling->tau0_s,
-                                                    node.sampling->stride_factor)
-                                      : "not received"},
-               {"scale", node.scale ? fmt::format("{:g} {} a pulse, input {}", node.scale->angle_per_pulse,
-                                                  protocol::name(node.scale->angle_unit),
-                                                  protocol::name(node.scale->input_source))
-                                    : "not received"},
-               {"samples", node.have_status ? fmt::format("{} ({})", node.status.sample_count,
-                                                          format_run_length(run_s_of(node)))
-                                            : "no status yet"},
-               {"gaps", fmt::format("{} sample gaps, {} lost edges", node.faults.sample_gaps, node.faults.lost_edges)},
-               {"link", fmt::format("{} reports complete, {} incomplete, {} lost; {} frames missing; {} restarts",
-                                    h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing,
-                                    h.restarts)}},
-              id + "-provenance");
+    doc.facts(
+        {{"node", fmt::format("0x{:02X}, session {}", address, node.session)},
+         {"configuration", node.config ? fmt::format("hash 0x{:08X}, report every {} ms", node.config->config_hash,
+                                                     node.config->report_period_ms)
+                                       : "not received"},
+         {"tau0", node.sampling
+                      ? fmt::format("{:g} s, stride factor {}", node.sampling->tau0_s, node.sampling->stride_factor)
+                      : "not received"},
+         {"scale", node.scale ? fmt::format("{:g} {} a pulse, input {}", node.scale->angle_per_pulse,
+                                            protocol::name(node.scale->angle_unit), protocol::name(node.scale->input_source))
+                              : "not received"},
+         {"samples", node.have_status ? fmt::format("{} ({})", node.status.sample_count, format_run_length(run_s_of(node)))
+                                      : "no status yet"},
+         {"gaps", fmt::format("{} sample gaps, {} lost edges", node.faults.sample_gaps, node.faults.lost_edges)},
+         {"link", fmt::format("{} reports complete, {} incomplete, {} lost; {} frames missing; {} restarts",
+                              h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing, h.restarts)}},
+        id + "-provenance");
     if (!limits.empty()) html::verdict_section(doc, limits, node_decisions(node, limits), id + "-verdicts", 3);
     const NodePlot p = plot_data(node, rate, intervals);
     html::LogPlot plot = node_plot(p);
@@ -311,23 +312,34 @@ std::string decode_html(const Decoder& decoder, const InputCounters& input, cons
         }
         const double v = static_cast<double>(d->dev) * u.rate;
         const Interval ci = intervals(v, d->edf);
-        row.insert(row.end(), {number(v), ci.valid ? number(ci.low) : Cell{}, ci.valid ? number(ci.high) : Cell{},
-                               d->edf > 0 ? number(d->edf) : Cell{}, {protocol::name(d->noise), {}, "text"}});
+        row.insert(row.end(), {number(v),
+                               ci.valid ? number(ci.low) : Cell{},
+                               ci.valid ? number(ci.high) : Cell{},
+                               d->edf > 0 ? number(d->edf) : Cell{},
+                               {protocol::name(d->noise), {}, "text"}});
       }
       rows.push_back(std::move(row));
     }
-    doc.table(id + "-taus", fmt::format("ADEV and MDEV [{}], intervals at {:g} %", u.rate_name, 100 * intervals.confidence()),
-              {"tau [s]", "m", "n", "adev", "ci low", "ci high", "edf", "noise", "mdev", "ci low", "ci high", "edf", "noise"},
+    doc.table(id + "-taus",
+              fmt::format("ADEV and MDEV [{}], intervals at {:g} %", u.rate_name, 100 * intervals.confidence()),
+              {"tau [s]", "m", "n", "adev", "ci low", "ci high", "edf", "noise", "mdev", "ci low", "ci high", "edf",
+               "noise"},
               rows);
     // The fit.
     std::vector<std::vector<Cell>> terms;
     for (std::size_t k = 0; k < 5; ++k) {
       const Ieee952View& t = node.ieee952[k];
       const double v = static_cast<double>(t.value) * u.ieee[k];
-      terms.push_back({{units::ieee952[k].letter, {}, "text"}, t.in_model() ? number(v) : Cell{},
-                       t.in_model() ? number(v * t.rel_uncertainty) : Cell{}, {u.ieee_name[k], {}, "text"},
-                       {!t.received ? "not received" : !t.in_model() ? "not in model" : t.resolved ? "resolved" : "not resolved",
-                        {}, "text"}});
+      terms.push_back({{units::ieee952[k].letter, {}, "text"},
+                       t.in_model() ? number(v) : Cell{},
+                       t.in_model() ? number(v * t.rel_uncertainty) : Cell{},
+                       {u.ieee_name[k], {}, "text"},
+                       {!t.received     ? "not received"
+                        : !t.in_model() ? "not in model"
+                        : t.resolved    ? "resolved"
+                                        : "not resolved",
+                        {},
+                        "text"}});
     }
     const auto& s = node.ieee952_summary;
     doc.table(id + "-fit",

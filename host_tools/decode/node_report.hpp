@@ -55,8 +55,7 @@ GyroSummary node_summary(const NodeView& node, const std::string& source, const 
 /// The HTML report of every shown node: per node its provenance (input, node, configuration, sample
 /// count, gaps, link health), the ADEV/MDEV plot with intervals and the fitted model, the tau table
 /// with intervals, the fit's terms and status, and the verdicts. O(nodes x taus).
-std::string decode_html(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown,
-                        const DisplayRate& rate, ConfidenceIntervals& intervals, const std::vector<Limit>& limits,
-                        const std::string& command);
+std::string decode_html(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown, const DisplayRate& rate,
+                        ConfidenceIntervals& intervals, const std::vector<Limit>& limits, const std::string& command);
 
 }  // namespace gyrochar::decoding

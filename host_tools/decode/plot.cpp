@@ -47,7 +47,9 @@ void draw_panel(plstream& pls, const NodePlot& p, double confidence) {
   };
   for (const PlotLine& line : p.terms) {
     const bool sum = !line.term && !line.markov;
-    const PlotColour colour = sum ? sum_colour : line.markov ? markov_colour : term_colour(static_cast<std::size_t>(*line.term));
+    const PlotColour colour = sum           ? sum_colour
+                              : line.markov ? markov_colour
+                                            : term_colour(static_cast<std::size_t>(*line.term));
     draw_line(line, colour, sum ? 1 : 2, sum ? 2.0 : 1.5);
   }
   if (p.truth) draw_line(*p.truth, truth_colour, 3, 2.0);  // long dashes: told apart from the terms'
@@ -71,15 +73,14 @@ bool write_plot(const std::string& prefix, const std::vector<NodePlot>& panels, 
     order.emplace_back(&p, false);
     if (p.dynamic) order.emplace_back(&p, true);
   }
-  return write_figure(prefix, order.size(), deviation_palette(), 1500, 900,
-                      [&](plstream& pls, std::size_t k) {
-                        pls.schr(0, plot_text_scale);
-                        if (order[k].second)
-                          draw_heat_map(pls, *order[k].first->dynamic);
-                        else
-                          draw_panel(pls, *order[k].first, confidence);
-                      },
-                      why);
+  return write_figure(
+      prefix, order.size(), deviation_palette(), 1500, 900,
+      [&](plstream& pls, std::size_t k) {
+        pls.schr(0, plot_text_scale);
+        if (order[k].second) draw_heat_map(pls, *order[k].first->dynamic);
+        else draw_panel(pls, *order[k].first, confidence);
+      },
+      why);
 }
 
 }  // namespace gyrochar::decoding

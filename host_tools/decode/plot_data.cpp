@@ -103,8 +103,11 @@ std::optional<PlotLine> truth_line(const NodeView& node, const TrueTerms& truth,
       f.sinusoids[f.n_sinusoids].amplitude.value = amplitude * *to_wire, f.sinusoids[f.n_sinusoids++].frequency_hz = hz;
   const bool beyond = (f.n_markov > 0 || f.n_sinusoids > 0) && node.sampling;
   const double tau0_s = node.sampling ? static_cast<double>(node.sampling->tau0_s) : 0.0;
-  PlotLine line{std::nullopt, false, "simulated gyro (truth)",
-                beyond ? log_grid(std::max(p.tau_min_s, tau0_s), p.tau_max_s) : grid, {}};
+  PlotLine line{std::nullopt,
+                false,
+                "simulated gyro (truth)",
+                beyond ? log_grid(std::max(p.tau_min_s, tau0_s), p.tau_max_s) : grid,
+                {}};
   for (const double tau : line.tau_s)
     line.dev.push_back(beyond ? fit_adev(f, tau, tau0_s, u.rate) : model_adev(wire, tau, u.rate));
   return line;
@@ -120,9 +123,8 @@ bool fit_notes(const NodeView& node, NodePlot& p) {
     return false;
   }
   if (fit && fit->status != Ieee952Status::ok) {
-    p.notes.push_back(fmt::format("no IEEE-952 fit: {}", fit->status == Ieee952Status::too_few_points
-                                                              ? "too few points"
-                                                              : "singular"));
+    p.notes.push_back(
+        fmt::format("no IEEE-952 fit: {}", fit->status == Ieee952Status::too_few_points ? "too few points" : "singular"));
     return false;
   }
   if (fit && !fit->quantization_white) {
@@ -159,7 +161,8 @@ std::size_t add_term_lines(const NodeView& node, const Units& u, const std::vect
     if (!t.resolved) continue;
     std::array<double, 5> one{};
     one[k] = t.value;
-    PlotLine line{static_cast<Ieee952Term>(k), false,
+    PlotLine line{static_cast<Ieee952Term>(k),
+                  false,
                   fmt::format("{} {:.3g} {} (±{:.2g}%)", units::ieee952[k].letter, t.value * u.ieee[k], u.ieee_name[k],
                               100.0 * t.rel_uncertainty),
                   grid,
@@ -227,7 +230,8 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
       one.parameters[fit_parameter_position(FitParameter::markov_tc, 0)] =
           beyond->parameters[fit_parameter_position(FitParameter::markov_tc, j)];
       const Ieee952Fit f = wire_fit({}, one, u.rate);
-      PlotLine line{std::nullopt, true,
+      PlotLine line{std::nullopt,
+                    true,
                     fmt::format("Markov {:.3g} {} (±{:.2g}%), Tc {:.3g} s", sigma.value, u.rate_name,
                                 100.0 * sigma.rel_uncertainty, f.markov[0].tc_s),
                     sampled_grid,
@@ -239,7 +243,8 @@ NodePlot plot_data(const NodeView& node, const DisplayRate& rate, ConfidenceInte
   if (fitted == 0 && !extra) return p;
   if (fit && !fit->quantization_white && !node.ieee952[0].in_model() && node.scale)
     model[0] = static_cast<double>(node.scale->angle_per_pulse) / std::sqrt(12.0);  // Q held there
-  PlotLine sum{std::nullopt, false,
+  PlotLine sum{std::nullopt,
+               false,
                fit ? fmt::format("IEEE-952 model, chi2/dof {:.2g}", fit->chi2_per_dof) : "IEEE-952 model (sum)",
                grid,
                {}};

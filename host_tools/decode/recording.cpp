@@ -168,7 +168,8 @@ Json candidate_json(unsigned markov, unsigned sinusoids, bool bandwidth) {
 
 /// A parameter as the analyzer's JSON has it: value, uncertainty (absolute), unit (and resolved).
 Json parameter_json(const FitModelRow::Parameter& p, const std::string& unit, bool with_resolved) {
-  Json j{{"value", p.value}, {"uncertainty", p.rel_uncertainty > 0 ? Json(p.rel_uncertainty * p.value) : Json(nullptr)},
+  Json j{{"value", p.value},
+         {"uncertainty", p.rel_uncertainty > 0 ? Json(p.rel_uncertainty * p.value) : Json(nullptr)},
          {"unit", unit}};
   if (with_resolved) j["resolved"] = p.resolved;
   return j;
@@ -185,9 +186,7 @@ void add_model_json(Json& fit, const std::optional<FitModelRow>& model, const Un
       fit[key] = nullptr;
     return;
   }
-  const auto page = [&](FitParameter p, std::uint8_t index) {
-    return model->parameters[fit_parameter_position(p, index)];
-  };
+  const auto page = [&](FitParameter p, std::uint8_t index) { return model->parameters[fit_parameter_position(p, index)]; };
   Json markov = Json::array(), sinusoids = Json::array();
   for (std::uint8_t j = 0; j < model->markov; ++j)
     markov.push_back({{"sigma", parameter_json(page(FitParameter::markov_sigma, j), units.rate_name, true)},
@@ -230,10 +229,8 @@ Json health_json(const LinkHealth& h) {
 
 template <class T>
 void JsonlWriter::member(const char* key, bool known, T value) {
-  if (known)
-    fmt::format_to(fmt::appender(line_), FMT_COMPILE(",\"{}\":{}"), key, value);
-  else
-    fmt::format_to(fmt::appender(line_), FMT_COMPILE(",\"{}\":null"), key);
+  if (known) fmt::format_to(fmt::appender(line_), FMT_COMPILE(",\"{}\":{}"), key, value);
+  else fmt::format_to(fmt::appender(line_), FMT_COMPILE(",\"{}\":null"), key);
 }
 
 // The tau rows are the bulk of a recording: written with fmt, not built as JSON objects (5x faster).
@@ -242,9 +239,9 @@ void JsonlWriter::member(const char* key, bool known, T value) {
 void JsonlWriter::row(const TauRow& r, const Units& units) {
   line_.clear();
   const auto out = fmt::appender(line_);
-  fmt::format_to(
-      out, FMT_COMPILE("{{\"type\":\"tau\",\"time_s\":{:.6f},\"node\":{},\"session\":{},\"seq\":{},\"tau_index\":{}"),
-      r.time_s, r.node, r.session, r.seq, r.tau_index);
+  fmt::format_to(out,
+                 FMT_COMPILE("{{\"type\":\"tau\",\"time_s\":{:.6f},\"node\":{},\"session\":{},\"seq\":{},\"tau_index\":{}"),
+                 r.time_s, r.node, r.session, r.seq, r.tau_index);
   member("m", r.m != 0, r.m);
   member("tau_s", r.tau_s > 0, static_cast<float>(r.tau_s));  // as in the CSV
   member("n", r.n != 0, r.n);
@@ -255,10 +252,8 @@ void JsonlWriter::row(const TauRow& r, const Units& units) {
     member("low", c->ci.valid, c->ci.low);
     member("high", c->ci.valid, c->ci.high);
     member("edf", c->edf > 0, c->edf);
-    if (c->status != DevCell::Status::missing)
-      fmt::format_to(out, FMT_COMPILE(",\"noise\":\"{}\"}}"), name(c->noise));
-    else
-      fmt::format_to(out, FMT_COMPILE(",\"noise\":null}}"));
+    if (c->status != DevCell::Status::missing) fmt::format_to(out, FMT_COMPILE(",\"noise\":\"{}\"}}"), name(c->noise));
+    else fmt::format_to(out, FMT_COMPILE(",\"noise\":null}}"));
   }
   fmt::format_to(out, FMT_COMPILE("}}\n"));
   std::fwrite(line_.data(), 1, line_.size(), out_);
@@ -305,18 +300,18 @@ void JsonlWriter::report(double time_s, const NodeView& node, std::uint8_t seq, 
     const Ieee952View& p = node.ieee952[k];
     const bool fitted = p.in_model();
     ieee[units::ieee952[k].letter] = !p.received ? Json(nullptr)
-                                        : Json{{"fitted", fitted},
-                                               {"resolved", p.resolved},
-                                               {"value", json_or_null(fitted, p.value * units.ieee[k])},
-                                               {"unit", units.ieee_name[k]},
-                                               {"rel_uncertainty", json_or_null(fitted, p.rel_uncertainty)}};
+                                                 : Json{{"fitted", fitted},
+                                                        {"resolved", p.resolved},
+                                                        {"value", json_or_null(fitted, p.value * units.ieee[k])},
+                                                        {"unit", units.ieee_name[k]},
+                                                        {"rel_uncertainty", json_or_null(fitted, p.rel_uncertainty)}};
     // What a verdict judges, as gyrochar-analyze's JSON gives it (protocol version 5): the estimate
     // (0 where the unconstrained square is negative) and, signed, the root the node sent.
     if (const Ieee952UnconstrainedMsg* u = node.unconstrained_estimate(k))
-      ieee[units::ieee952[k].letter]["unconstrained"] = {
-          {"value", std::max(static_cast<double>(u->value), 0.0) * units.ieee[k]},
-          {"uncertainty", u->uncertainty * units.ieee[k]},
-          {"signed", static_cast<double>(u->value) * units.ieee[k]}};
+      ieee[units::ieee952[k].letter]["unconstrained"] = {{"value",
+                                                          std::max(static_cast<double>(u->value), 0.0) * units.ieee[k]},
+                                                         {"uncertainty", u->uncertainty * units.ieee[k]},
+                                                         {"signed", static_cast<double>(u->value) * units.ieee[k]}};
   }
   Json fit(nullptr);
   if (const auto& f = node.ieee952_summary) {
@@ -352,9 +347,8 @@ void JsonlWriter::report(double time_s, const NodeView& node, std::uint8_t seq, 
 }
 
 void JsonlWriter::event(double time_s, DecoderEvent e, const NodeView& node) {
-  line(
-      Json{{"type", "event"}, {"time_s", time_s}, {"node", node.address}, {"event", name(e)}, {"session", node.session}}
-          .dump());
+  line(Json{{"type", "event"}, {"time_s", time_s}, {"node", node.address}, {"event", name(e)}, {"session", node.session}}
+           .dump());
 }
 
 void JsonlWriter::summary(const Decoder& decoder, const InputCounters& input, const NodeFilter& shown) {

@@ -29,7 +29,7 @@ class CsvWriter {
 
  private:
   template <class T>
-  void field(bool known, T value);  // the value (or nothing) and a comma
+  void field(bool known, T value);                             // the value (or nothing) and a comma
   void model_fields(const std::optional<FitModelRow>& model);  // the fit_model columns, each with its comma
   void begin(double time_s, std::uint8_t node, std::uint8_t seq, std::uint8_t tau_index, std::uint64_t m, double tau_s);
   std::FILE* out_;

@@ -48,7 +48,7 @@ const char* name(Viewed v) {
 std::optional<FitModelRow> fit_model_row(const NodeView& node, const Units& units) {
   if (!node.ieee952_summary || node.schedule_version() < 4) return std::nullopt;
   const std::uint64_t cycle = node.ieee952_summary_cycle;
-  const FitModelView* pages = node.fit_model.cycle == cycle           ? &node.fit_model
+  const FitModelView* pages = node.fit_model.cycle == cycle            ? &node.fit_model
                               : node.previous_fit_model.cycle == cycle ? &node.previous_fit_model
                                                                        : nullptr;
   FitModelRow row;
@@ -63,11 +63,10 @@ std::optional<FitModelRow> fit_model_row(const NodeView& node, const Units& unit
   row.markov = m.markov;
   row.sinusoids = m.sinusoids;
   row.bandwidth = m.bandwidth;
-  if (m.bandwidth_excluded_below_log2_m == 0)
-    row.bandwidth_excluded_below_tau_s = 0.0;
+  if (m.bandwidth_excluded_below_log2_m == 0) row.bandwidth_excluded_below_tau_s = 0.0;
   else if (node.sampling)
-    row.bandwidth_excluded_below_tau_s =
-        static_cast<double>(node.sampling->tau0_s) * std::ldexp(1.0, m.bandwidth_excluded_below_log2_m);
+    row.bandwidth_excluded_below_tau_s = static_cast<double>(node.sampling->tau0_s) *
+                                         std::ldexp(1.0, m.bandwidth_excluded_below_log2_m);
   if (m.runner_up) row.runner_up = m;
   for (std::size_t k = 0; k < fit_parameter_pages; ++k) {
     if (!pages->in_model(k)) continue;

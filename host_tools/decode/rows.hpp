@@ -78,7 +78,7 @@ struct FitModelRow {
     bool resolved = false;
   };
   std::array<Parameter, protocol::fit_parameter_pages> parameters{};  // protocol::fit_parameter_slot order
-  std::optional<protocol::Ieee952ModelMsg> runner_up;  // the model page, when it names a runner-up
+  std::optional<protocol::Ieee952ModelMsg> runner_up;                 // the model page, when it names a runner-up
 };
 /// Empty for a node that follows a schedule before version 4 or whose summary has not arrived.
 /// O(1).

@@ -99,9 +99,9 @@ class Session {
   CandumpLine parsed_;
   std::vector<TauRow> rows_;
   std::vector<WindowRow> window_rows_;
-  std::vector<Decision> decisions_;                             // of the node whose report closed last
+  std::vector<Decision> decisions_;                                // of the node whose report closed last
   std::map<std::uint8_t, std::vector<Verdict>> verdicts_written_;  // per node, in its last acceptance record
-  Decoder decoder_;  // last: its listener uses the members above
+  Decoder decoder_;                                                // last: its listener uses the members above
 };
 
 }  // namespace gyrochar::decoding

@@ -25,11 +25,10 @@ std::string health_text(const LinkHealth& h) {
   return fmt::format(
       "frames {}; reports {} complete, {} incomplete, {} lost; frames missing {}; restarts {}; "
       "offline {}; duplicates {}; rejected {}{}{}",
-      h.frames, h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing, h.restarts,
-      h.offline_events, h.duplicates, rejected_text(h),
+      h.frames, h.reports_complete, h.reports_incomplete, h.reports_lost, h.frames_missing, h.restarts, h.offline_events,
+      h.duplicates, rejected_text(h),
       h.not_decoded ? fmt::format("; not decoded {} (unknown protocol version)", h.not_decoded) : "",
-      h.window_frames_unplaced ? fmt::format("; window frames without their window page {}", h.window_frames_unplaced)
-                               : "");
+      h.window_frames_unplaced ? fmt::format("; window frames without their window page {}", h.window_frames_unplaced) : "");
 }
 
 std::string input_text(const Decoder& decoder, const InputCounters& in) {
@@ -84,8 +83,7 @@ void ieee952_view(std::string& s, const NodeView& v, const Units& u, const TrueT
       if (v.scale)
         fmt::format_to(out, "  Q held at {:.4g} {} (pulse weight/sqrt(12))",
                        static_cast<double>(v.scale->angle_per_pulse) / std::sqrt(12.0) * shown, u.ieee_name[k]);
-      else
-        s += "  Q held at pulse weight/sqrt(12)";
+      else s += "  Q held at pulse weight/sqrt(12)";
     } else {
       fmt::format_to(out, "  {} {}", units::ieee952[k].letter, fit ? "not fitted" : "not resolved");
     }
@@ -98,7 +96,8 @@ void ieee952_view(std::string& s, const NodeView& v, const Units& u, const TrueT
     const auto [avar, mvar] = fit->excluded_below_log2_m;
     s += "  quantization not white: short taus left out";
     if (avar != 0) fmt::format_to(out, " (AVAR below {}", seconds_text(fit_excluded_below_tau_s(v, 0), avar));
-    if (mvar != 0) fmt::format_to(out, "{}MVAR below {}", avar != 0 ? ", " : " (", seconds_text(fit_excluded_below_tau_s(v, 1), mvar));
+    if (mvar != 0)
+      fmt::format_to(out, "{}MVAR below {}", avar != 0 ? ", " : " (", seconds_text(fit_excluded_below_tau_s(v, 1), mvar));
     if (avar != 0 || mvar != 0) s += ')';
     s += ", Q held at pulse weight/sqrt(12)\n";
   }
@@ -130,7 +129,8 @@ void model_view(std::string& s, const NodeView& v, const Units& u) {
   const std::string rate = u.rate_name;
   if (m->markov == 0 && m->sinusoids == 0 && !m->bandwidth) s += " the five terms";
   for (std::uint8_t j = 0; j < m->markov; ++j)
-    fmt::format_to(out, "  Markov {}: sigma {}, Tc {}", j + 1, parameter_text(page(FitParameter::markov_sigma, j), rate.c_str(), true),
+    fmt::format_to(out, "  Markov {}: sigma {}, Tc {}", j + 1,
+                   parameter_text(page(FitParameter::markov_sigma, j), rate.c_str(), true),
                    parameter_text(page(FitParameter::markov_tc, j), "s", false));
   if (m->bandwidth)
     fmt::format_to(out, "  sensor filter: Tf {}", parameter_text(page(FitParameter::filter_tf, 0), "s", false));
@@ -152,10 +152,8 @@ void window_view(std::string& s, const NodeView& v, const Units& u) {
   auto out = std::back_inserter(s);
   const double length_s = v.sampling ? static_cast<double>(v.window_length) * static_cast<double>(v.sampling->tau0_s) : 0.0;
   fmt::format_to(out, "  dynamic ADEV: {} window taus, ", v.window_taus);
-  if (length_s > 0)
-    fmt::format_to(out, "windows of {:.4g} s", length_s);
-  else
-    s += "window length not received yet";
+  if (length_s > 0) fmt::format_to(out, "windows of {:.4g} s", length_s);
+  else s += "window length not received yet";
   std::size_t complete = 0;
   for (const auto& [k, w] : v.windows) complete += w.complete() ? 1 : 0;
   fmt::format_to(out, "; {} windows received, {} complete", v.windows.size(), complete);
@@ -178,11 +176,12 @@ void node_view(std::string& s, const NodeView& v, const DisplayRate& rate, Confi
   if (v.clock)
     fmt::format_to(out, "  uptime {:.1f} s  protocol {}", static_cast<double>(v.clock->uptime_ms) / 1000.0,
                    v.clock->protocol_version);
-  if (v.config)
-    fmt::format_to(out, "  config 0x{:08X}  report {} ms", v.config->config_hash, v.config->report_period_ms);
+  if (v.config) fmt::format_to(out, "  config 0x{:08X}  report {} ms", v.config->config_hash, v.config->report_period_ms);
   if (v.unknown_version != 0)
-    fmt::format_to(out, "\n  NOT DECODED: the node speaks protocol version {}, this decoder knows 1 to {} "
-                   "(values below are from before)", v.unknown_version, protocol::version);
+    fmt::format_to(out,
+                   "\n  NOT DECODED: the node speaks protocol version {}, this decoder knows 1 to {} "
+                   "(values below are from before)",
+                   v.unknown_version, protocol::version);
   s += "\n ";
   if (v.sampling) fmt::format_to(out, " tau0 {} s  S {} ", v.sampling->tau0_s, v.sampling->stride_factor);
   if (v.scale) {
@@ -197,8 +196,8 @@ void node_view(std::string& s, const NodeView& v, const DisplayRate& rate, Confi
   fmt::format_to(out, "  node faults: lost edges {}, sample gaps {}, tx dropped frames {}, bus-off events {}\n",
                  v.faults.lost_edges, v.faults.sample_gaps, v.faults.tx_dropped_frames, v.faults.bus_off_events);
   const std::string level = fmt::format("({:.1f}% CI)", 100.0 * intervals.confidence());
-  fmt::format_to(out, "  {:>11} {:>13}  {:>11}  {:24}  {:>11}  {:24}  {:>9}  {}\n", "tau [s]", "n", "ADEV", level,
-                 "MDEV", level, "EDF MDEV", "noise");
+  fmt::format_to(out, "  {:>11} {:>13}  {:>11}  {:24}  {:>11}  {:24}  {:>9}  {}\n", "tau [s]", "n", "ADEV", level, "MDEV",
+                 level, "EDF MDEV", "noise");
   for (std::size_t i = 0; i < v.status.tau_count && i < max_taus; ++i) {
     const TauView& t = v.taus[i];
     const ViewedRow viewed = viewed_row(v, i);
@@ -244,8 +243,7 @@ std::string format_summary(const Decoder& decoder, const InputCounters& input, c
   if (!input.bus.empty()) s += fmt::format("{}: {}\n", program, input.bus);
   for (const auto& [address, v] : decoder.nodes()) {
     if (!shown[address]) continue;
-    s += fmt::format("{}: node 0x{:02X}{}: {}\n", program, address, v.online ? "" : " (offline)",
-                     health_text(v.health));
+    s += fmt::format("{}: node 0x{:02X}{}: {}\n", program, address, v.online ? "" : " (offline)", health_text(v.health));
   }
   return s;
 }

@@ -55,8 +55,7 @@ extern "C" void request_stop(int) { stop_requested = 1; }
 // One simulated gyro board on the bus.
 struct Node {
   Node(const firmware::Config& c, const GyroParameters& g, hal::FakeCanBus& bus, const hal::FakeClock& clock)
-      : gyro(g), can(bus.attach()), timer(clock),
-        board(c, firmware::BoardIo{*can, &source, clock, timer}) {}
+      : gyro(g), can(bus.attach()), timer(clock), board(c, firmware::BoardIo{*can, &source, clock, timer}) {}
   GyroSimulator gyro;
   std::unique_ptr<hal::FakeCanNode> can;
   hal::FakeTimer timer;
@@ -73,15 +72,16 @@ struct DemoOptions {
 };
 
 void add_options(CLI::App& app, DemoOptions& d) {
-  app.footer("Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n"
-             "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n"
-             "  gyrochar-demo --nodes 8 --http 8080 --speed 600   # then open http://127.0.0.1:8080/\n\n"
-             "With --http the live page is served during the run and, after it, until Ctrl-C (SIGINT or\n"
-             "SIGTERM, which also end the run early, its outputs written). An address that cannot be listened\n"
-             "on (port in use) is an output that cannot be opened (4).\n\n"
-             "Two outputs (--csv, --candump, --plot's files) that are the same file, through links too, are\n"
-             "refused (bad input) before anything is written.\n" +
-             std::string(exit_code::help));
+  app.footer(
+      "Examples:\n  gyrochar-demo\n  gyrochar-demo --hours 24 --nodes 3 --loss 0.001 --csv decoded.csv --plot adev\n"
+      "  gyrochar-demo --hours 2 --window 10   # a heat map of 12 windows per node\n"
+      "  gyrochar-demo --nodes 8 --http 8080 --speed 600   # then open http://127.0.0.1:8080/\n\n"
+      "With --http the live page is served during the run and, after it, until Ctrl-C (SIGINT or\n"
+      "SIGTERM, which also end the run early, its outputs written). An address that cannot be listened\n"
+      "on (port in use) is an output that cannot be opened (4).\n\n"
+      "Two outputs (--csv, --candump, --plot's files) that are the same file, through links too, are\n"
+      "refused (bad input) before anything is written.\n" +
+      std::string(exit_code::help));
   app.add_option("--hours", d.hours, "gyro hours to simulate")->capture_default_str();
   app.add_option("--nodes", d.nodes, "gyro boards on the bus (1..8)")->capture_default_str();
   app.add_option("--tau0", d.tau0, "sample interval in seconds")->capture_default_str();
@@ -91,15 +91,15 @@ void add_options(CLI::App& app, DemoOptions& d) {
       ->capture_default_str();
   app.add_option("--view-every", d.view_every_min, "show the table every N gyro minutes (0: only at the end)")
       ->capture_default_str();
-  app.add_option("--csv", d.csv_path, "decoded reports as CSV (one row per node, report and tau; empty: none)")->capture_default_str();
+  app.add_option("--csv", d.csv_path, "decoded reports as CSV (one row per node, report and tau; empty: none)")
+      ->capture_default_str();
   app.add_option("--plot", d.plot_prefix, "ADEV/MDEV plot written to PREFIX.svg and PREFIX.png (empty: none)")
       ->capture_default_str();
   app.add_option("--candump", d.candump_path, "also record the bus as a candump log (canplayer replays it)");
   app.add_option("--http", d.http_text, "serve the live web page on [ADDR:]PORT (address 127.0.0.1 unless given)")
       ->option_text("[ADDR:]PORT");
   app.add_option("--speed", d.speed, "gyro seconds per wall-clock second (0: as fast as it can)")->capture_default_str();
-  app.add_option("--refresh", d.refresh_s, "wall-clock seconds between updates of the live web page")
-      ->capture_default_str();
+  app.add_option("--refresh", d.refresh_s, "wall-clock seconds between updates of the live web page")->capture_default_str();
   app.add_option("--limits", d.limits_path,
                  "acceptance limits (gyrochar-analyze --help): each node's verdicts on the live page (--http) and in "
                  "the CSV's verdict columns, as gyrochar-decode --limits gives them");
@@ -122,8 +122,10 @@ void check_options(const DemoOptions& d, std::optional<web::ListenAddress>& http
     }
   }
   // Each rule its own message: the option, what it must be, and what was given.
-  if (!(d.hours > 0) || !std::isfinite(d.hours)) bad("--hours", fmt::format("must be a positive number of hours, not {}", d.hours));
-  if (!(d.tau0 > 0) || !std::isfinite(d.tau0)) bad("--tau0", fmt::format("must be a positive number of seconds, not {}", d.tau0));
+  if (!(d.hours > 0) || !std::isfinite(d.hours))
+    bad("--hours", fmt::format("must be a positive number of hours, not {}", d.hours));
+  if (!(d.tau0 > 0) || !std::isfinite(d.tau0))
+    bad("--tau0", fmt::format("must be a positive number of seconds, not {}", d.tau0));
   if (d.hours * 3600 / d.tau0 > 1e12) bad("--hours", "more than 10^12 samples per node");
   if (d.nodes < 1 || d.nodes > 8) bad("--nodes", fmt::format("must be 1..8, not {}", d.nodes));
   if (d.octaves < 1 || d.octaves > 40) bad("--octaves", fmt::format("must be 1..40, not {}", d.octaves));
@@ -215,9 +217,9 @@ void run_clock(const DemoOptions& d, Rig& rig) {
   const auto wall_start = std::chrono::steady_clock::now();
   while (clock.now_ns() < end_ns && !stop_requested) {
     if (d.speed > 0)  // hold the virtual clock to `speed` gyro seconds per wall-clock second
-      std::this_thread::sleep_until(wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                     std::chrono::duration<double>(
-                                                         static_cast<double>(clock.now_ns() - start_ns) * 1e-9 / d.speed)));
+      std::this_thread::sleep_until(
+          wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                           std::chrono::duration<double>(static_cast<double>(clock.now_ns() - start_ns) * 1e-9 / d.speed)));
     clock.advance(step_ns);
     const std::uint64_t n = (clock.now_ns() - scripted_ns) / tau0_ns;
     for (auto& node : rig.gyros) {
@@ -261,9 +263,10 @@ bool write_demo_plot(const std::string& prefix, const Rig& rig) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"gyrochar-demo: simulated gyros -> the board program (on HAL fakes) -> virtual CAN bus -> decoder,\n"
-               "on a virtual clock.",
-               "gyrochar-demo"};
+  CLI::App app{
+      "gyrochar-demo: simulated gyros -> the board program (on HAL fakes) -> virtual CAN bus -> decoder,\n"
+      "on a virtual clock.",
+      "gyrochar-demo"};
   DemoOptions d;
   add_options(app, d);
   if (const auto code = parse_command_line(app, argc, argv, program)) return finish(program, *code);

@@ -36,21 +36,23 @@ namespace {
 class Values {
  public:
   explicit Values(const py::buffer& b) : info_(b.request()) {
-    if (info_.ndim != 1) throw py::value_error(fmt::format("values must be one-dimensional, not {}-dimensional", info_.ndim));
+    if (info_.ndim != 1)
+      throw py::value_error(fmt::format("values must be one-dimensional, not {}-dimensional", info_.ndim));
     const std::string& f = info_.format;
     is_double_ = f == py::format_descriptor<double>::format();
     is_int64_ = info_.itemsize == 8 && (f == "q" || f == "l" || f == "<q" || f == "<l" || f == "=q" || f == "=l");
     if (!is_double_ && !is_int64_)
-      throw py::type_error(fmt::format("values must be float64 or int64 (buffer format '{}'): convert them with "
-                                       "numpy.asarray(values, dtype=float)", f));
+      throw py::type_error(
+          fmt::format("values must be float64 or int64 (buffer format '{}'): convert them with "
+                      "numpy.asarray(values, dtype=float)",
+                      f));
     stride_ = info_.strides.empty() ? info_.itemsize : info_.strides[0];
   }
   std::size_t size() const { return static_cast<std::size_t>(info_.shape[0]); }
   /// Values [begin, begin + n) as a span valid until the next call (n <= block).
   std::span<const double> block(std::size_t begin, std::size_t n) {
     const auto* base = static_cast<const char*>(info_.ptr);
-    if (is_double_ && stride_ == sizeof(double))
-      return {reinterpret_cast<const double*>(base) + begin, n};
+    if (is_double_ && stride_ == sizeof(double)) return {reinterpret_cast<const double*>(base) + begin, n};
     buffer_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       const char* p = base + static_cast<std::ptrdiff_t>(begin + i) * stride_;
@@ -151,8 +153,8 @@ struct Setup {
 // --rate-unit (empty: not given).
 Setup make_setup(double tau0, const std::string& type_text, const std::string& unit, const std::string& pulse_weight,
                  const std::string& pulse_unit, const std::string& rate_unit, const std::vector<std::string>& stat_names,
-                 std::uint32_t stride_factor, std::uint32_t total_stride_factor, double confidence,
-                 std::optional<int> alpha, bool fit, unsigned threads, bool identify_noise) {
+                 std::uint32_t stride_factor, std::uint32_t total_stride_factor, double confidence, std::optional<int> alpha,
+                 bool fit, unsigned threads, bool identify_noise) {
   Setup s;
   AnalysisOptions& o = s.o;
   o.type = data_type(type_text);
@@ -203,9 +205,10 @@ std::unique_ptr<Analyzer> planned_analyzer(Setup& s, const std::string& taus, co
   if (o.m_list.empty()) throw py::value_error(fmt::format("{} phase points are too few for any tau", n_phase / 2));
   s.not_formed = plan.not_formed;  // refused once the data reaches them (results()), as the program does
   if (!plan.held && history_bytes(o.type, o.stride_factor, o.m_list.back()) > memory_budget())
-    throw py::value_error(fmt::format("stride factor {} with taus up to {} needs more memory than this process may use "
-                                      "({}): give a smaller stride factor or fewer taus", o.stride_factor,
-                                      o.m_list.back(), memory_budget_reason()));
+    throw py::value_error(
+        fmt::format("stride factor {} with taus up to {} needs more memory than this process may use "
+                    "({}): give a smaller stride factor or fewer taus",
+                    o.stride_factor, o.m_list.back(), memory_budget_reason()));
   // The sums of a held record (taus "all", counts of a known length) may take minutes: between
   // blocks of taus a pending KeyboardInterrupt stops them (results()).
   o.on_summed = [](std::size_t, std::size_t) {
@@ -268,18 +271,22 @@ py::dict results(const Analyzer& analyzer, const Setup& s) {
   if (interrupted) throw py::error_already_set();  // the KeyboardInterrupt PyErr_CheckSignals raised
   for (const std::uint64_t m : s.not_formed)
     if (m <= a.n_phase / 2)
-      throw py::value_error(fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must "
-                                        "be a multiple of its stride (m/S rounded up to a power of two)", m,
-                                        a.stride_factor));
-  const auto shown = [&](const AnalysisRow& r) { return std::find(s.shown.begin(), s.shown.end(), r.stat) != s.shown.end(); };
+      throw py::value_error(
+          fmt::format("averaging factor {} cannot be formed with stride factor {}: above S it must "
+                      "be a multiple of its stride (m/S rounded up to a power of two)",
+                      m, a.stride_factor));
+  const auto shown = [&](const AnalysisRow& r) {
+    return std::find(s.shown.begin(), s.shown.end(), r.stat) != s.shown.end();
+  };
   if (std::none_of(a.rows.begin(), a.rows.end(), shown))
     throw py::value_error(fmt::format("{} values are too few for any of the taus asked", a.n_values));
   for (const AnalysisRow& r : a.rows)  // the output unit must not take a value out of range
-    if (shown(r) &&
-        (!std::isfinite(r.dev * units.factor()) || (r.dev != 0 && !(std::fabs(r.dev * units.factor()) >= 2.2250738585072014e-308))))
-      throw py::value_error(fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) leaves a "
-                                        "double's range", name(r.stat), r.tau_s, r.m, r.dev, units.factor(),
-                                        units.unit(r.stat)));
+    if (shown(r) && (!std::isfinite(r.dev * units.factor()) ||
+                     (r.dev != 0 && !(std::fabs(r.dev * units.factor()) >= 2.2250738585072014e-308))))
+      throw py::value_error(
+          fmt::format("{} at tau = {:g} s (m = {}): {:g} times the unit factor {:g} ({}) leaves a "
+                      "double's range",
+                      name(r.stat), r.tau_s, r.m, r.dev, units.factor(), units.unit(r.stat)));
   py::dict out;
   out["n_values"] = a.n_values;
   out["n_phase"] = a.n_phase;
@@ -290,8 +297,8 @@ py::dict results(const Analyzer& analyzer, const Setup& s) {
   out["stats"] = stats;
   if (s.fit) {
     // The fit's part of gyrochar-analyze's JSON report, as text for json.loads.
-    const Report report{a, s.o.type, s.o.tau0_s, s.o.confidence, units, std::move(fits), std::nullopt, "values", DataRange{},
-                        std::nullopt, std::nullopt};
+    const Report report{a,        s.o.type,    s.o.tau0_s,   s.o.confidence, units, std::move(fits), std::nullopt,
+                        "values", DataRange{}, std::nullopt, std::nullopt};
     out["fit_json"] = to_json(report)["fit"].dump();
   }
   return out;

@@ -47,7 +47,8 @@ GyroSimulator::GyroSimulator(const GyroParameters& p)
   // sinusoid's phase.
   for (const MarkovRate& m : p.markov) {  // 1 - phi^2 from expm1: accurate also when Tc spans many samples
     const double a = p.tau0_s / m.tc_s, z = terms_normal_(terms_rng_);
-    markov_.push_back(Markov::stationary(m.sigma_rad_s, std::exp(-a), -std::expm1(-2.0 * a), z, 1.0 / (2.0 * units::pi * m.tc_s)));
+    markov_.push_back(
+        Markov::stationary(m.sigma_rad_s, std::exp(-a), -std::expm1(-2.0 * a), z, 1.0 / (2.0 * units::pi * m.tc_s)));
   }
   std::uniform_real_distribution<double> phase(0.0, 2.0 * units::pi);
   for (const SinusoidRate& s : p.sinusoids) {
@@ -108,11 +109,12 @@ std::int64_t GyroSimulator::next_count() {
   if (p_.dither_amplitude_rad != 0)
     observed += p_.dither_amplitude_rad * std::sin(2.0 * units::pi * p_.dither_frequency_hz * static_cast<double>(k_) * dt);
   const double pulses = std::floor(observed / p_.pulse_weight_rad);
-  if (!(std::fabs(pulses) <= max_pulse_total))
-  {
+  if (!(std::fabs(pulses) <= max_pulse_total)) {
     char why[160];
-    std::snprintf(why, sizeof why, "sample %llu: the angle reached %.4g pulses, beyond the simulator's 2^53 (counts "
-                  "exact in a double)", static_cast<unsigned long long>(k_), pulses);
+    std::snprintf(why, sizeof why,
+                  "sample %llu: the angle reached %.4g pulses, beyond the simulator's 2^53 (counts "
+                  "exact in a double)",
+                  static_cast<unsigned long long>(k_), pulses);
     throw std::overflow_error(why);
   }
   const auto total = static_cast<std::int64_t>(pulses);

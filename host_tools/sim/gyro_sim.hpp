@@ -86,10 +86,9 @@ struct GyroParameters {
   double dither_amplitude_rad = 0.0;
   double dither_frequency_hz = 0.0;
   std::uint64_t seed = 1;
-  std::vector<MarkovRate> markov;        // Gauss-Markov rates: tc_s > 0, sigma_rad_s >= 0
-  std::vector<SinusoidRate> sinusoids;   // sinusoidal rates: 0 < frequency_hz < 1 / (2 tau0)
+  std::vector<MarkovRate> markov;       // Gauss-Markov rates: tc_s > 0, sigma_rad_s >= 0
+  std::vector<SinusoidRate> sinusoids;  // sinusoidal rates: 0 < frequency_hz < 1 / (2 tau0)
 };
-
 
 class GyroSimulator {
  public:
@@ -116,9 +115,9 @@ class GyroSimulator {
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   std::uint64_t k_ = 0;
-  double angle_ = 0.0;         // integrated rate (rad)
-  double rrw_rate_ = 0.0;      // rate random walk state (rad/s)
-  double arw_step_rad_ = 0.0;  // N sqrt(tau0)
+  double angle_ = 0.0;           // integrated rate (rad)
+  double rrw_rate_ = 0.0;        // rate random walk state (rad/s)
+  double arw_step_rad_ = 0.0;    // N sqrt(tau0)
   double rrw_step_rad_s_ = 0.0;  // K sqrt(tau0)
   // A stationary AR(1) rate: state = decay state + drive z, started at sigma z.
   struct Markov {
@@ -129,16 +128,16 @@ class GyroSimulator {
   // A sinusoidal rate's mean over an interval: mean_amplitude sin(2 pi cycles + phase), cycles =
   // (interval index + 1/2) cycles_per_sample, reduced modulo 1 in long double.
   struct Sinusoid {
-    double mean_amplitude_rad_s = 0;  // A sin(pi f tau0) / (pi f tau0)
+    double mean_amplitude_rad_s = 0;    // A sin(pi f tau0) / (pi f tau0)
     long double cycles_per_sample = 0;  // f tau0
     double phase_rad = 0;
   };
   std::vector<Markov> flicker_;  // bias instability processes
   std::mt19937_64 terms_rng_;    // the Gauss-Markov and sinusoidal terms' own stream
   std::normal_distribution<double> terms_normal_{0.0, 1.0};
-  std::vector<Markov> markov_;         // Gauss-Markov rate terms
-  std::vector<Sinusoid> sinusoids_;    // sinusoidal rate terms
-  std::int64_t pulses_ = 0;    // pulses emitted so far
+  std::vector<Markov> markov_;       // Gauss-Markov rate terms
+  std::vector<Sinusoid> sinusoids_;  // sinusoidal rate terms
+  std::int64_t pulses_ = 0;          // pulses emitted so far
 };
 
 }  // namespace gyrochar

@@ -54,11 +54,8 @@ class CounterInputSender {
     ++frames_;
     for (int attempt = 0; attempt < 1000; ++attempt) {
       switch (bus_.send(frame)) {
-        case hal::SendResult::sent:
-          return;
-        case hal::SendResult::bus_down:
-          ++lost_down_;
-          return;
+        case hal::SendResult::sent: return;
+        case hal::SendResult::bus_down: ++lost_down_; return;
         case hal::SendResult::queue_full:
           ++queue_full_waits_;
           sleep_ns(1000000);
@@ -99,7 +96,8 @@ class CounterInputSender {
   std::uint64_t frames_ = 0, late_ = 0, queue_full_waits_ = 0, lost_down_ = 0, lost_queue_full_ = 0;
 };
 
-constexpr const char* footer = R"(Parameters are in the units gyro data sheets use; the quantization noise follows from the pulse
+constexpr const char* footer =
+    R"(Parameters are in the units gyro data sheets use; the quantization noise follows from the pulse
 weight (Q = pulse weight / sqrt(12), white only when the angle moves at random by a pulse or more
 per sample, or a dither moves it). Bias instability is flicker rate noise (ADEV floor 0.664 B)
 over the band from 1/(2 pi --bias-time) up to 0.34 / tau0. docs/metrology.md gives each term's
@@ -189,7 +187,8 @@ void add_options(CLI::App& app, SimCli& c) {
       ->option_text("T:NAME=VALUE");
   app.add_option("--markov", c.markov, "Gauss-Markov rate: stationary sigma in deg/h, correlation time in s (up to 4)")
       ->option_text("SIGMA,TC");
-  app.add_option("--sinusoid", c.sinusoids, "sinusoidal rate: amplitude in deg/h, frequency in Hz below 1/(2 tau0) (up to 4)")
+  app.add_option("--sinusoid", c.sinusoids,
+                 "sinusoidal rate: amplitude in deg/h, frequency in Hz below 1/(2 tau0) (up to 4)")
       ->option_text("AMP,FREQ");
   app.add_option("--out", c.out, "output file, '-' for standard output")->capture_default_str();
   app.add_option("--can", c.can_interface, "also send the counts as CounterInput frames on this SocketCAN interface")
@@ -256,8 +255,7 @@ void simulate(const SimOptions& o, FILE* f, CounterInputSender* sender) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"gyrochar-sim: pulse counts of a simulated ring laser gyro with known parameters.",
-               "gyrochar-sim"};
+  CLI::App app{"gyrochar-sim: pulse counts of a simulated ring laser gyro with known parameters.", "gyrochar-sim"};
   app.footer(std::string(footer) + std::string(exit_code::help));
   SimCli c;
   add_options(app, c);
@@ -269,7 +267,8 @@ int main(int argc, char** argv) {
   std::unique_ptr<CounterInputSender> sender;
   if (!c.can_interface.empty()) {
     try {
-      sender = std::make_unique<CounterInputSender>(c.can_interface, static_cast<std::uint8_t>(c.can_node), p.tau0_s / c.speed);
+      sender = std::make_unique<CounterInputSender>(c.can_interface, static_cast<std::uint8_t>(c.can_node),
+                                                    p.tau0_s / c.speed);
     } catch (const std::exception& e) {
       exit_with(exit_code::no_hardware, program, e.what());  // "vcan0: why": the interface first
     }

@@ -71,16 +71,15 @@ struct TermKeys {
   std::array<std::pair<std::string_view, double Term::*>, 2> fields;
   std::vector<Term> SimOptions::*list;
 };
-constexpr TermKeys<SimMarkov> markov_keys{
-    "markov",
-    "markov_terms",
-    {{{"sigma_deg_per_h", &SimMarkov::sigma_deg_per_h}, {"tc_s", &SimMarkov::tc_s}}},
-    &SimOptions::markov};
-constexpr TermKeys<SimSinusoid> sinusoid_keys{
-    "sinusoid",
-    "sinusoid_terms",
-    {{{"amplitude_deg_per_h", &SimSinusoid::amplitude_deg_per_h}, {"frequency_hz", &SimSinusoid::frequency_hz}}},
-    &SimOptions::sinusoids};
+constexpr TermKeys<SimMarkov> markov_keys{"markov",
+                                          "markov_terms",
+                                          {{{"sigma_deg_per_h", &SimMarkov::sigma_deg_per_h}, {"tc_s", &SimMarkov::tc_s}}},
+                                          &SimOptions::markov};
+constexpr TermKeys<SimSinusoid> sinusoid_keys{"sinusoid",
+                                              "sinusoid_terms",
+                                              {{{"amplitude_deg_per_h", &SimSinusoid::amplitude_deg_per_h},
+                                                {"frequency_hz", &SimSinusoid::frequency_hz}}},
+                                              &SimOptions::sinusoids};
 
 void append_number(std::string& out, double v) {
   char buf[64];
@@ -115,8 +114,8 @@ std::optional<ParameterProblem> check_parameters(const SimOptions& o) {
   if (!std::isfinite(o.rate_deg_per_h) || std::fabs(o.rate_deg_per_h) > 1e9)
     return ParameterProblem{"--rate", "must be a finite rate in deg/h"};
   if (!(o.pulse_arcsec > 0) || !std::isfinite(o.pulse_arcsec)) return ParameterProblem{"--pulse-weight", "must be positive"};
-  for (double v : {o.white_angle_arcsec, o.arw_deg_per_sqrt_h, o.rrw_deg_per_h_sqrt_h, o.ramp_deg_per_h2,
-                   o.bias_deg_per_h, o.dither_arcsec, o.dither_hz})
+  for (double v : {o.white_angle_arcsec, o.arw_deg_per_sqrt_h, o.rrw_deg_per_h_sqrt_h, o.ramp_deg_per_h2, o.bias_deg_per_h,
+                   o.dither_arcsec, o.dither_hz})
     if (!(v >= 0) || !std::isfinite(v)) return ParameterProblem{"noise parameters", "must be finite and >= 0"};
   if (o.bias_deg_per_h > 0 && !(o.bias_time_s > o.tau0_s && o.bias_time_s <= 1e15 * o.tau0_s))
     return ParameterProblem{"--bias-time", "must exceed tau0 (and stay within 10^15 tau0) for bias instability"};
@@ -144,10 +143,10 @@ std::optional<ParameterProblem> check_parameters(const SimOptions& o) {
     if (!(g.start_s >= o.tau0_s && g.start_s < o.duration_s && g.start_s > previous_s))
       return ParameterProblem{"--segment", "segments must start in increasing order, at tau0 or later, before the end"};
     previous_s = g.start_s;
-    if (std::none_of(segment_keys.begin(), segment_keys.end(), [&](const SegmentKey& k) { return (g.*k.field).has_value(); }))
+    if (std::none_of(segment_keys.begin(), segment_keys.end(),
+                     [&](const SegmentKey& k) { return (g.*k.field).has_value(); }))
       return ParameterProblem{"--segment", "a segment must change something"};
-    if (const auto problem = check_parameters(segment_options(o, i + 1)))
-      return ParameterProblem{"--segment", problem->why};
+    if (const auto problem = check_parameters(segment_options(o, i + 1))) return ParameterProblem{"--segment", problem->why};
   }
   if (const PulseReach reach = worst_case_pulses(o); !(reach.total <= max_pulse_total)) {
     char why[400];
@@ -238,8 +237,8 @@ bool quantization_expected_white(const SimOptions& o) {
   for (std::size_t i = 1; i <= o.segments.size(); ++i)
     if (!quantization_expected_white(segment_options(o, i))) return false;
   const double arw_arcsec = o.arw_deg_per_sqrt_h * units::deg_per_sqrt_h / units::arcsec;  // arcsec/sqrt(s)
-  const double random_step_arcsec =
-      std::sqrt(arw_arcsec * arw_arcsec * o.tau0_s + 2.0 * o.white_angle_arcsec * o.white_angle_arcsec);
+  const double random_step_arcsec = std::sqrt(arw_arcsec * arw_arcsec * o.tau0_s +
+                                              2.0 * o.white_angle_arcsec * o.white_angle_arcsec);
   // A dither of angle amplitude A moves the angle by up to 2 A |sin(pi f tau0)| per sample; so does a
   // sinusoidal rate, whose angle amplitude is A_rate / (2 pi f) (deg/h = arcsec/s).
   const auto dither_step_arcsec = [&o](double amplitude_arcsec, double f) {
@@ -271,9 +270,9 @@ std::string format_sim_description_line(const SimOptions& o) {
                 "# gyrochar-sim counts: tau0 %g s, pulse weight %g arcsec, rate %g deg/h, white angle %g arcsec, "
                 "ARW %g deg/sqrt(h), bias instability %g deg/h (band down to 1/(2 pi %g s)), RRW %g deg/h/sqrt(h), "
                 "ramp %g deg/h/h, dither %g arcsec at %g Hz, seed %llu",
-                o.tau0_s, o.pulse_arcsec, o.rate_deg_per_h, o.white_angle_arcsec, o.arw_deg_per_sqrt_h,
-                o.bias_deg_per_h, o.bias_time_s, o.rrw_deg_per_h_sqrt_h, o.ramp_deg_per_h2, o.dither_arcsec,
-                o.dither_hz, static_cast<unsigned long long>(o.seed));
+                o.tau0_s, o.pulse_arcsec, o.rate_deg_per_h, o.white_angle_arcsec, o.arw_deg_per_sqrt_h, o.bias_deg_per_h,
+                o.bias_time_s, o.rrw_deg_per_h_sqrt_h, o.ramp_deg_per_h2, o.dither_arcsec, o.dither_hz,
+                static_cast<unsigned long long>(o.seed));
   std::string out = buf;
   for (const SimMarkov& m : o.markov) {
     std::snprintf(buf, sizeof buf, ", Gauss-Markov rate %g deg/h over %g s", m.sigma_deg_per_h, m.tc_s);
@@ -508,8 +507,8 @@ std::optional<SimTruth> parse_sim_truth_line(std::string_view line) {
     }
     // Any other key belongs to a later format: ignored.
   }
-  if (seen != all || format != (has_segments ? segmented_format : truth_format) ||
-      r.options.segments.size() != segments || !markov.complete() || !sinusoids.complete() || check_parameters(r.options))
+  if (seen != all || format != (has_segments ? segmented_format : truth_format) || r.options.segments.size() != segments ||
+      !markov.complete() || !sinusoids.complete() || check_parameters(r.options))
     return std::nullopt;
   const GyroParameters p = gyro_parameters(r.options);  // the terms' truth: as written, in SI
   r.truth.markov = p.markov;

@@ -87,9 +87,9 @@ struct SimOptions {
   double dither_arcsec = 0;
   double dither_hz = 0;
   std::uint64_t seed = 1;
-  std::vector<SimSegment> segments;  // in increasing start_s; empty: the gyro never changes
-  std::vector<SimMarkov> markov;      // Gauss-Markov rate terms, for the whole run
-  std::vector<SimSinusoid> sinusoids; // sinusoidal rate terms, for the whole run
+  std::vector<SimSegment> segments;    // in increasing start_s; empty: the gyro never changes
+  std::vector<SimMarkov> markov;       // Gauss-Markov rate terms, for the whole run
+  std::vector<SimSinusoid> sinusoids;  // sinusoidal rate terms, for the whole run
 };
 
 /// The options in force in segment i of `o` (0: before the first change, up to o.segments.size()),
@@ -98,14 +98,14 @@ SimOptions segment_options(const SimOptions& o, std::size_t i);
 
 /// The IEEE-952 truth of a simulation, SI units (rad, s).
 struct Ieee952Truth {
-  double q_rad = 0;            // total white angle noise sqrt(q^2 + pulse^2 / 12)
-  double n_rad_sqrt_s = 0;     // angle random walk
-  double b_rad_s = 0;          // bias instability (ADEV floor / 0.664)
-  double k_rad_s_sqrt_s = 0;   // rate random walk
-  double r_rad_s2 = 0;         // rate ramp
-  bool quantization_white = false;  // the pulse quantization is expected to be white (below)
-  std::vector<MarkovRate> markov;         // Gauss-Markov rate terms (sigma rad/s, tc s)
-  std::vector<SinusoidRate> sinusoids;    // sinusoidal rate terms (amplitude rad/s, frequency Hz)
+  double q_rad = 0;                     // total white angle noise sqrt(q^2 + pulse^2 / 12)
+  double n_rad_sqrt_s = 0;              // angle random walk
+  double b_rad_s = 0;                   // bias instability (ADEV floor / 0.664)
+  double k_rad_s_sqrt_s = 0;            // rate random walk
+  double r_rad_s2 = 0;                  // rate ramp
+  bool quantization_white = false;      // the pulse quantization is expected to be white (below)
+  std::vector<MarkovRate> markov;       // Gauss-Markov rate terms (sigma rad/s, tc s)
+  std::vector<SinusoidRate> sinusoids;  // sinusoidal rate terms (amplitude rad/s, frequency Hz)
 };
 
 struct SimTruth {
@@ -138,8 +138,8 @@ std::optional<ParameterProblem> check_parameters(const SimOptions& o);
 /// instability's rate times T (its octave processes' summed variance) and each Gauss-Markov
 /// term's, sigma T; each sinusoid's angle amplitude A / (pi f). T = samples x tau0.
 struct PulseReach {
-  double total = 0;              // the sum of the terms, in pulses
-  double largest = 0;            // the largest term, in pulses
+  double total = 0;               // the sum of the terms, in pulses
+  double largest = 0;             // the largest term, in pulses
   const char* largest_what = "";  // its option ("--rate", "--arw", ...)
 };
 /// Standard deviations of reach for the random terms: a normal draw exceeds 10 sigma with

@@ -147,7 +147,8 @@ std::map<unsigned, std::vector<Report>> read_reports(const std::string& path) {
     } else if (type == "report") {
       const auto node = j.at("node").get<unsigned>();
       std::vector<Report>& reports = nodes[node];
-      const std::uint64_t before = reports.empty() ? 0 : reports.back().line["health"]["reports_complete"].get<std::uint64_t>();
+      const std::uint64_t before = reports.empty() ? 0
+                                                   : reports.back().line["health"]["reports_complete"].get<std::uint64_t>();
       Report& r = reports.emplace_back();
       r.complete = j["health"]["reports_complete"].get<std::uint64_t>() > before;
       r.line = std::move(j);
@@ -170,10 +171,10 @@ std::string link_text(const Json& r) {
   return std::to_string(health(r, "reports_complete")) + " complete, " + std::to_string(health(r, "reports_incomplete")) +
          " incomplete, " + std::to_string(health(r, "reports_lost")) + " lost, " +
          std::to_string(health(r, "frames_missing")) + " frames missing, " + std::to_string(health(r, "restarts")) +
-         " restarts, " + std::to_string(health(r, "offline_events")) + " offline events, " +
-         std::to_string(rejected(r)) + " rejected; node faults: " + std::to_string(fault(r, "sample_gaps")) +
-         " sample gaps, " + std::to_string(fault(r, "lost_edges")) + " lost edges, " +
-         std::to_string(fault(r, "tx_dropped_frames")) + " tx dropped frames";
+         " restarts, " + std::to_string(health(r, "offline_events")) + " offline events, " + std::to_string(rejected(r)) +
+         " rejected; node faults: " + std::to_string(fault(r, "sample_gaps")) + " sample gaps, " +
+         std::to_string(fault(r, "lost_edges")) + " lost edges, " + std::to_string(fault(r, "tx_dropped_frames")) +
+         " tx dropped frames";
 }
 
 int check_link(const std::string& jsonl, const std::vector<unsigned>& wanted, bool expect_gap, unsigned min_reports,
@@ -225,12 +226,12 @@ int check_link(const std::string& jsonl, const std::vector<unsigned>& wanted, bo
     }
     std::size_t after = 0;
     for (std::size_t k = gap; k + 1 < reports.size(); ++k) after += reports[k].complete ? 1 : 0;
-    std::printf("node %u: gap at report %zu of %zu (%.3f s after the first): %llu reports lost, %llu offline events; "
-                "%zu complete reports after it\n",
-                node, gap + 1, reports.size(),
-                reports[gap].line["time_s"].get<double>() - reports[0].line["time_s"].get<double>(),
-                static_cast<unsigned long long>(health(last, "reports_lost")),
-                static_cast<unsigned long long>(health(last, "offline_events")), after);
+    std::printf(
+        "node %u: gap at report %zu of %zu (%.3f s after the first): %llu reports lost, %llu offline events; "
+        "%zu complete reports after it\n",
+        node, gap + 1, reports.size(), reports[gap].line["time_s"].get<double>() - reports[0].line["time_s"].get<double>(),
+        static_cast<unsigned long long>(health(last, "reports_lost")),
+        static_cast<unsigned long long>(health(last, "offline_events")), after);
     if (after < min_reports) problem(node, "did not resume: " + std::to_string(after) + " complete reports after the gap");
   }
   return result;
@@ -295,19 +296,20 @@ int check_estimates(const std::string& jsonl, const std::string& csv, unsigned n
     const float want = static_cast<float>(oracle_arcsec_s);
     worst = std::max(worst, std::fabs(decoded - oracle_arcsec_s) / oracle_arcsec_s);
     if (static_cast<float>(decoded) != want || static_cast<double>(static_cast<float>(decoded)) != decoded) {
-      std::fprintf(stderr, "gyrochar-bench: node %u: %s m=%llu: decoded %.9g arcsec/s, gyrochar-analyze %.9g (float32 %.9g)\n",
-                   node, stat.c_str(), static_cast<unsigned long long>(m), decoded, oracle_arcsec_s,
-                   static_cast<double>(want));
+      std::fprintf(stderr,
+                   "gyrochar-bench: node %u: %s m=%llu: decoded %.9g arcsec/s, gyrochar-analyze %.9g (float32 %.9g)\n", node,
+                   stat.c_str(), static_cast<unsigned long long>(m), decoded, oracle_arcsec_s, static_cast<double>(want));
       result = exit_disagree;
     }
     ++compared;
     m_max = std::max(m_max, m);
   }
   if (compared == 0) bad_input(analyzed, "no oadev or mdev row");
-  std::printf("node %u: report seq %u with %llu samples: %zu ADEV/MDEV values (m = 1..%llu) %s gyrochar-analyze's in float32 "
-              "(largest relative difference before rounding %.2g); the CSV holds the same values\n",
-              node, seq, static_cast<unsigned long long>(samples), compared, static_cast<unsigned long long>(m_max),
-              result == exit_agree ? "equal" : "differ from", worst);
+  std::printf(
+      "node %u: report seq %u with %llu samples: %zu ADEV/MDEV values (m = 1..%llu) %s gyrochar-analyze's in float32 "
+      "(largest relative difference before rounding %.2g); the CSV holds the same values\n",
+      node, seq, static_cast<unsigned long long>(samples), compared, static_cast<unsigned long long>(m_max),
+      result == exit_agree ? "equal" : "differ from", worst);
   return result;
 }
 
@@ -433,7 +435,8 @@ std::int64_t wait_for_request(const PlaybackOptions& o) {
   if (fd < 0) bad_input(o.chip, std::strerror(errno));
   gpio_v2_line_info info{};
   info.offset = o.line_a;
-  if (ioctl(fd, GPIO_V2_GET_LINEINFO_WATCH_IOCTL, &info) < 0) bad_input(o.chip, std::string("line info watch: ") + std::strerror(errno));
+  if (ioctl(fd, GPIO_V2_GET_LINEINFO_WATCH_IOCTL, &info) < 0)
+    bad_input(o.chip, std::string("line info watch: ") + std::strerror(errno));
   std::printf("gyrochar-bench: watching line %u of %s for its request\n", o.line_a, o.chip.c_str());
   std::fflush(stdout);
   for (;;) {
@@ -508,8 +511,7 @@ int play_quadrature(const PlaybackOptions& o) {
       // Once gyrochard has read every earlier event (it sleeps); if it is still busy at 35 % of
       // the interval, the burst waits for the next interval.
       sleep_until_ns(start_ns + 28 * tau_ns / 100);
-      while (!sleeping(reader) && monotonic_ns() < start_ns + 35 * tau_ns / 100)
-        sleep_until_ns(monotonic_ns() + 1000000);
+      while (!sleeping(reader) && monotonic_ns() < start_ns + 35 * tau_ns / 100) sleep_until_ns(monotonic_ns() + 1000000);
       if (sleeping(reader)) {
         const std::int64_t burst_ns = monotonic_ns();
         for (int i = 0; i < 16; ++i) edge(0, true);  // no sleep: gyrochard cannot read in between,
@@ -528,20 +530,21 @@ int play_quadrature(const PlaybackOptions& o) {
   // intervals before the first edge are delivered as zeros, those after the last one are not).
   std::FILE* f = std::fopen(o.expected.c_str(), "w");
   if (f == nullptr) bad_input(o.expected, std::strerror(errno));
-  std::fprintf(f, "# counts gyrochard must deliver: the edges played from %s, by interval of its grid\n",
-               o.counts.c_str());
+  std::fprintf(f, "# counts gyrochard must deliver: the edges played from %s, by interval of its grid\n", o.counts.c_str());
   for (const std::int64_t c : ledger.counts()) std::fprintf(f, "%lld\n", static_cast<long long>(c));
   if (std::fclose(f) != 0) bad_input(o.expected, "write failed");
-  std::printf("gyrochar-bench: played %zu intervals of %g s from interval %lld of gyrochard's grid: %llu edges seen, "
-              "%llu overflow bursts (one lost edge each, longest %.1f ms), %llu intervals ended late (stalls), "
-              "%llu edges ambiguous; %zu samples expected\n",
-              counts.size(), o.tau0_s, static_cast<long long>(first), static_cast<unsigned long long>(ledger.edges()),
-              static_cast<unsigned long long>(bursts), static_cast<double>(longest_burst_ns) / 1e6,
-              static_cast<unsigned long long>(late),
-              static_cast<unsigned long long>(ledger.ambiguous()), ledger.counts().size());
+  std::printf(
+      "gyrochar-bench: played %zu intervals of %g s from interval %lld of gyrochard's grid: %llu edges seen, "
+      "%llu overflow bursts (one lost edge each, longest %.1f ms), %llu intervals ended late (stalls), "
+      "%llu edges ambiguous; %zu samples expected\n",
+      counts.size(), o.tau0_s, static_cast<long long>(first), static_cast<unsigned long long>(ledger.edges()),
+      static_cast<unsigned long long>(bursts), static_cast<double>(longest_burst_ns) / 1e6,
+      static_cast<unsigned long long>(late), static_cast<unsigned long long>(ledger.ambiguous()), ledger.counts().size());
   if (ledger.ambiguous() != 0) {
-    std::fprintf(stderr, "gyrochar-bench: quadrature: %llu edges were played so near an interval's end that their "
-                 "interval is not known (the emulator stalled)\n", static_cast<unsigned long long>(ledger.ambiguous()));
+    std::fprintf(stderr,
+                 "gyrochar-bench: quadrature: %llu edges were played so near an interval's end that their "
+                 "interval is not known (the emulator stalled)\n",
+                 static_cast<unsigned long long>(ledger.ambiguous()));
     return exit_disagree;
   }
   return exit_agree;

@@ -29,33 +29,22 @@ constexpr int nodes = 4;
 Message message(std::uint8_t node, std::uint8_t seq, ReportSlot s, std::uint64_t report) {
   const auto value = static_cast<float>(node) / static_cast<float>(1 + s.index) + 1e-3f * static_cast<float>(seq);
   switch (s.slot) {
-    case Slot::status:
-      return StatusMsg{seq, NodeState::running, taus, 100 * (report + 1)};
-    case Slot::faults:
-      return StatusFaultsMsg{seq, 0, 0, 0, 0};
-    case Slot::adev:
-      return TauDevMsg{seq, s.index, DevKind::adev, value, 10.0 + s.index, NoiseType::white_fm, true};
-    case Slot::mdev:
-      return TauDevMsg{seq, s.index, DevKind::mdev, value / 2, 9.0 + s.index, NoiseType::white_fm, true};
-    case Slot::terms:
-      return TauTermsMsg{seq, s.index, 100 * (report + 1)};
-    case Slot::tau_info:
-      return TauInfoMsg{seq, s.index, std::uint64_t{1} << s.index, 0};
-    case Slot::sampling:
-      return MetaSamplingMsg{seq, 0.01f, 8};
-    case Slot::clock:
-      return MetaClockMsg{seq, 1000 * (report + 1), version};
-    case Slot::scale:
-      return MetaScaleMsg{seq, 1.0f, AngleUnit::arcsec, InputSource::simulated};
-    case Slot::config:
-      return MetaConfigMsg{seq, 7, 1000};
+    case Slot::status: return StatusMsg{seq, NodeState::running, taus, 100 * (report + 1)};
+    case Slot::faults: return StatusFaultsMsg{seq, 0, 0, 0, 0};
+    case Slot::adev: return TauDevMsg{seq, s.index, DevKind::adev, value, 10.0 + s.index, NoiseType::white_fm, true};
+    case Slot::mdev: return TauDevMsg{seq, s.index, DevKind::mdev, value / 2, 9.0 + s.index, NoiseType::white_fm, true};
+    case Slot::terms: return TauTermsMsg{seq, s.index, 100 * (report + 1)};
+    case Slot::tau_info: return TauInfoMsg{seq, s.index, std::uint64_t{1} << s.index, 0};
+    case Slot::sampling: return MetaSamplingMsg{seq, 0.01f, 8};
+    case Slot::clock: return MetaClockMsg{seq, 1000 * (report + 1), version};
+    case Slot::scale: return MetaScaleMsg{seq, 1.0f, AngleUnit::arcsec, InputSource::simulated};
+    case Slot::config: return MetaConfigMsg{seq, 7, 1000};
     case Slot::ieee952:
       if (s.index == ieee952_summary_page) return Ieee952SummaryMsg{seq, Ieee952Status::ok, 0.9f, 15, true, {}};
       return Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.01f, 0.1, true};
     case Slot::window:  // no window taus
     case Slot::window_length:
-    case Slot::window_dev:
-      break;
+    case Slot::window_dev: break;
   }
   return {};
 }
@@ -77,8 +66,8 @@ void write_log(const std::string& path, long lines) {
       for (std::size_t k = 0; k < frames; ++k) {
         CanFrame f;
         encode(message(node, seq, report_slot(seq, taus, k), report), node, f);
-        const double t =
-            1.7e9 + static_cast<double>(report) + (static_cast<double>(k) + 0.25 * n) / static_cast<double>(frames);
+        const double t = 1.7e9 + static_cast<double>(report) +
+                         (static_cast<double>(k) + 0.25 * n) / static_cast<double>(frames);
         second.emplace_back(t, format_candump_line(t, "can0", f));
       }
     }

@@ -43,7 +43,8 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 double cpu_seconds() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 long peak_rss_kib() {
@@ -68,7 +69,8 @@ std::vector<double> read_phase(const char* file, bool frequency_hz) {
   std::vector<double> x;
   if (frequency_hz) x.push_back(0.0);
   for (std::string line; std::getline(in, line);)
-    if (!line.empty() && line[0] != '#') x.push_back(frequency_hz ? x.back() + (std::stod(line) - 1e7) / 1e7 : std::stod(line));
+    if (!line.empty() && line[0] != '#')
+      x.push_back(frequency_hz ? x.back() + (std::stod(line) - 1e7) / 1e7 : std::stod(line));
   return x;
 }
 
@@ -162,7 +164,8 @@ int lag_sums(std::uint64_t n, std::uint32_t S) {
   const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   const double prepare = seconds_since(t0), prepare_cpu = cpu_seconds() - c0;
-  std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace)\n", prepare, prepare_cpu, 8e-6 * static_cast<double>(size));
+  std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace)\n", prepare, prepare_cpu,
+              8e-6 * static_cast<double>(size));
   c0 = cpu_seconds();
   const double taus = lag_sum_octaves(w), taus_cpu = cpu_seconds() - c0;
   std::printf("theo1 exact: every octave m in %.2f s (CPU %.2f s) after prepare; in all %.2f s, CPU %.2f s\n", taus,
@@ -295,7 +298,9 @@ int main(int argc, char** argv) {
   if (argc == 3 && mode == "mtotlagsums") return mtot_lag_sums(std::stoull(argv[2]));
   if ((argc == 4 || argc == 5) && mode == "decimation")
     return decimation(argv[2], static_cast<std::uint32_t>(std::stoul(argv[3])), argc == 5 && std::string(argv[4]) == "freq");
-  std::fprintf(stderr, "usage: bench_total octave FILE S | bench_total long N S | bench_total lagsums N S | bench_total mtotlagsums N | "
-                       "bench_total decimation FILE S [freq]\n");
+  std::fprintf(
+      stderr,
+      "usage: bench_total octave FILE S | bench_total long N S | bench_total lagsums N S | bench_total mtotlagsums N | "
+      "bench_total decimation FILE S [freq]\n");
   return 2;
 }

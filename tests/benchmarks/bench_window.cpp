@@ -62,8 +62,8 @@ void BoardSamplePath(benchmark::State& state) {
   benchmark::DoNotOptimize(board.window->latest());
   state.SetItemsProcessed(state.iterations());
   state.counters["window_taus"] = board.window_taus;
-  state.counters["state_bytes"] =
-      static_cast<double>(sizeof(BoardCharacterizer) + (board.length ? sizeof(DynamicWindow) : 0));
+  state.counters["state_bytes"] = static_cast<double>(sizeof(BoardCharacterizer) +
+                                                      (board.length ? sizeof(DynamicWindow) : 0));
 }
 BENCHMARK(BoardSamplePath)->Arg(0)->Arg(21)->Arg(31)->MinTime(1.0);
 

@@ -67,17 +67,19 @@ bool write_csv(std::FILE* f, const std::vector<CoverageCell>& cells) {
 
 void print_markdown(const StudySettings& s, const std::vector<CoverageCell>& cells, double wall_s, double cpu_s) {
   const double se = coverage_standard_error(nominal, s.runs);
-  std::printf("%zu runs per cell (independent realizations; the same realization serves every stride factor,\n"
-              "statistic and m of its noise type and length). Binomial standard error of a coverage of 68.3 %%\n"
-              "over %zu runs: %.1f points. Wall time %.0f s with %u workers, %.0f s of CPU time (the machine\n"
-              "may be shared with other jobs, so the wall time is indicative).\n\n",
-              s.runs, s.runs, 100.0 * se, wall_s, s.workers, cpu_s);
-  std::printf("Each cell: coverage (%%) of the 68.3 %% interval with alpha identified by the engine / coverage\n"
-              "with the true alpha given to the engine / runs in which the engine identified alpha right (%%).\n"
-              "**Bold**: coverage outside 68.3 +- %.0f points. Same estimate both ways: only the EDF, and so the\n"
-              "interval, differs; the CSV also holds the stated EDFs, the Monte Carlo EDF (2 mean^2 / variance of\n"
-              "the variance estimates) and the mean of estimate / truth.\n\n",
-              flag_points);
+  std::printf(
+      "%zu runs per cell (independent realizations; the same realization serves every stride factor,\n"
+      "statistic and m of its noise type and length). Binomial standard error of a coverage of 68.3 %%\n"
+      "over %zu runs: %.1f points. Wall time %.0f s with %u workers, %.0f s of CPU time (the machine\n"
+      "may be shared with other jobs, so the wall time is indicative).\n\n",
+      s.runs, s.runs, 100.0 * se, wall_s, s.workers, cpu_s);
+  std::printf(
+      "Each cell: coverage (%%) of the 68.3 %% interval with alpha identified by the engine / coverage\n"
+      "with the true alpha given to the engine / runs in which the engine identified alpha right (%%).\n"
+      "**Bold**: coverage outside 68.3 +- %.0f points. Same estimate both ways: only the EDF, and so the\n"
+      "interval, differs; the CSV also holds the stated EDFs, the Monte Carlo EDF (2 mean^2 / variance of\n"
+      "the variance estimates) and the mean of estimate / truth.\n\n",
+      flag_points);
   // Group: length, stride factor, statistic; rows m; columns alpha.
   std::map<std::tuple<std::size_t, std::uint32_t, int>, std::map<std::uint64_t, std::map<int, const CoverageCell*>>> tables;
   std::map<std::tuple<std::size_t, std::uint32_t, int>, std::map<std::uint64_t, std::uint64_t>> terms;
@@ -102,8 +104,7 @@ void print_markdown(const StudySettings& s, const std::vector<CoverageCell>& cel
         std::printf("\n");
         std::size_t table_auto = 0, table_true = 0, table_cells = 0;
         for (const auto& [m, by_alpha] : it->second) {
-          std::printf("| %llu | %llu |", static_cast<unsigned long long>(m),
-                      static_cast<unsigned long long>(terms[key][m]));
+          std::printf("| %llu | %llu |", static_cast<unsigned long long>(m), static_cast<unsigned long long>(terms[key][m]));
           for (const int a : s.alphas) {
             const auto c = by_alpha.find(a);
             if (c == by_alpha.end()) {
@@ -126,9 +127,10 @@ void print_markdown(const StudySettings& s, const std::vector<CoverageCell>& cel
         summary.push_back(fmt::format("| {} | {} | {} | {} | {} | {} |", length, stride_name(stride),
                                       stat == Statistic::oadev ? "OADEV" : "MDEV", table_cells, table_auto, table_true));
       }
-  std::printf("### Cells outside 68.3 +- %.0f points\n\n| N | stride factor | statistic | cells | auto alpha | true alpha |\n"
-              "|---:|---|---|---:|---:|---:|\n",
-              flag_points);
+  std::printf(
+      "### Cells outside 68.3 +- %.0f points\n\n| N | stride factor | statistic | cells | auto alpha | true alpha |\n"
+      "|---:|---|---|---:|---:|---:|\n",
+      flag_points);
   for (const auto& line : summary) std::printf("%s\n", line.c_str());
   std::printf("| all | | | %zu | %zu | %zu |\n", total, out_auto, out_true);
 }

@@ -20,8 +20,9 @@ namespace {
 
 using namespace gyrochar::test_support;
 
-
-std::string share(std::size_t k, std::size_t n) { return n ? fmt::format("{:.1f}", 100.0 * static_cast<double>(k) / static_cast<double>(n)) : "-"; }
+std::string share(std::size_t k, std::size_t n) {
+  return n ? fmt::format("{:.1f}", 100.0 * static_cast<double>(k) / static_cast<double>(n)) : "-";
+}
 
 // Binomial standard error of a fraction p over n runs, in points.
 std::string error_of(double p, std::size_t n) {
@@ -35,7 +36,8 @@ std::string describe(const gyrochar::SimOptions& o) {
   if (o.bias_deg_per_h > 0) s += fmt::format(", B {:g} deg/h", o.bias_deg_per_h);
   if (o.rrw_deg_per_h_sqrt_h > 0) s += fmt::format(", K {:g} deg/h/sqrt(h)", o.rrw_deg_per_h_sqrt_h);
   if (o.ramp_deg_per_h2 > 0) s += fmt::format(", R {:g} deg/h/h", o.ramp_deg_per_h2);
-  for (const gyrochar::SimMarkov& m : o.markov) s += fmt::format(", Markov {:g} deg/h at Tc {:g} s", m.sigma_deg_per_h, m.tc_s);
+  for (const gyrochar::SimMarkov& m : o.markov)
+    s += fmt::format(", Markov {:g} deg/h at Tc {:g} s", m.sigma_deg_per_h, m.tc_s);
   for (const gyrochar::SimSinusoid& w : o.sinusoids)
     s += fmt::format(", sinusoid {:g} deg/h at {:g} Hz", w.amplitude_deg_per_h, w.frequency_hz);
   return s;
@@ -88,7 +90,8 @@ Examples:
 
   std::string out;
   auto to = std::back_inserter(out);
-  fmt::format_to(to, "{} runs per scenario, independent seeds. Wall time {:.0f} s with {} workers, {:.0f} s of CPU time.\n\n",
+  fmt::format_to(to,
+                 "{} runs per scenario, independent seeds. Wall time {:.0f} s with {} workers, {:.0f} s of CPU time.\n\n",
                  s.runs, wall, s.workers, cpu);
   // Pooled over the scenarios: every resolved term with a non-zero truth, every term with a zero one.
   std::size_t resolved_present = 0, within1 = 0, within2 = 0, absent = 0, false_resolved = 0;
@@ -114,8 +117,9 @@ Examples:
 
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const RecoveryCell& c = cells[i];
-    fmt::format_to(to, "### {}\n\n{}. Fits: {} ok, {} rejected, {} too few points, {} singular; quantization found white "
-                       "in {} % of the runs; mean chi2/dof {:.2f}.\n\n",
+    fmt::format_to(to,
+                   "### {}\n\n{}. Fits: {} ok, {} rejected, {} too few points, {} singular; quantization found white "
+                   "in {} % of the runs; mean chi2/dof {:.2f}.\n\n",
                    c.scenario, describe(s.scenarios[i].sim), c.ok, c.rejected, c.too_few, c.singular,
                    share(c.quantization_white, c.runs), c.mean_chi2_per_dof);
     fmt::format_to(to, "| term | truth | resolved (%) | within 1 sigma (%) | within 2 sigma (%) | false resolved (%) |\n");
@@ -140,21 +144,24 @@ Examples:
                      share(sinusoid.fitted, sinusoid.runs));
     fmt::format_to(to, "\n");
     if (!c.long_tau) continue;
-    fmt::format_to(to, "The same runs fitted with the Allan curve's long taus from the total family (docs/total.md): "
-                       "statistics over the runs where the term is resolved.");
+    fmt::format_to(to,
+                   "The same runs fitted with the Allan curve's long taus from the total family (docs/total.md): "
+                   "statistics over the runs where the term is resolved.");
     for (std::size_t in = 0; in < c.by_long_tau.size(); ++in)
       fmt::format_to(to, " {}: {} of {} fits ok, mean chi2/dof {:.2f}.", long_tau_names[in], c.long_tau_ok[in], c.runs,
                      c.long_tau_chi2[in]);
     fmt::format_to(to, "\n\n");
-    fmt::format_to(to, "| term | long taus from | resolved (%) | within 1 sigma (%) | within 2 sigma (%) | mean stated sigma / truth | rms error / truth |\n");
+    fmt::format_to(to,
+                   "| term | long taus from | resolved (%) | within 1 sigma (%) | within 2 sigma (%) | mean stated sigma / "
+                   "truth | rms error / truth |\n");
     fmt::format_to(to, "|---|---|---:|---:|---:|---:|---:|\n");
     for (std::size_t k = 2; k < 5; ++k)
       for (std::size_t in = 0; in < c.by_long_tau.size(); ++in) {
         const TermTally& t = c.by_long_tau[in][k];
         const std::size_t real = t.resolved - t.false_resolved;
         const double n = static_cast<double>(real);
-        fmt::format_to(to, "| {} | {} | {} | {} | {} | {} | {} |\n", tallied_names[k], long_tau_names[in], share(t.resolved, t.runs),
-                       share(t.within1, real), share(t.within2, real),
+        fmt::format_to(to, "| {} | {} | {} | {} | {} | {} | {} |\n", tallied_names[k], long_tau_names[in],
+                       share(t.resolved, t.runs), share(t.within1, real), share(t.within2, real),
                        real ? fmt::format("{:.3f}", t.sum_relative_uncertainty / n) : "-",
                        real ? fmt::format("{:.3f}", std::sqrt(t.sum_squared_relative_error / n)) : "-");
       }

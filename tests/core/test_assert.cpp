@@ -27,10 +27,10 @@ using namespace gyrochar;
 // Death tests need the handler mode and a native run: under qemu-user (the aarch64 preset's
 // tests) the forked child hangs or dies without its stderr, so there they skip, saying so; they
 // run natively in the host and sanitizer builds.
-#define REQUIRE_DEATH_TESTS()                                                                           \
-  do {                                                                                                  \
+#define REQUIRE_DEATH_TESTS()                                                                             \
+  do {                                                                                                    \
     if (GYROCHAR_ASSERT_MODE != 2) GTEST_SKIP() << "GYROCHAR_ASSERT_MODE is not 'handler' in this build"; \
-    if (emulated) GTEST_SKIP() << "death tests do not work under qemu-user; they run natively";         \
+    if (emulated) GTEST_SKIP() << "death tests do not work under qemu-user; they run natively";           \
   } while (false)
 #ifdef GYROCHAR_EMULATED
 constexpr bool emulated = true;

@@ -138,7 +138,8 @@ TEST_P(BatchProperty, EqualsTheCharacterizerBitForBitAndBruteForce) {
       EXPECT_TRUE(trial == 2 ? !narrow : trial == 0 ? narrow : true);
       if (i % 7 != 0) continue;  // brute force on some taus
       Exact want;
-      for (std::size_t k = 0; k < counts.size(); ++k) want += brute_force(held.x[k], m, stride, false, held.seg64[k].first_e);
+      for (std::size_t k = 0; k < counts.size(); ++k)
+        want += brute_force(held.x[k], m, stride, false, held.seg64[k].first_e);
       for (std::size_t k = 0; k < 3; ++k) {
         EXPECT_TRUE(to_u128(b64.result().sum[k]) == want.sum[k]) << "m=" << m << " stat " << k;
         EXPECT_EQ(b64.result().n[k], want.n[k]) << "m=" << m << " stat " << k;
@@ -159,7 +160,8 @@ TEST(Batch, LargeTermsOfInt32ResidualsAreSummedTermByTermAsTheCharacterizerDoes)
   for (std::size_t k = 0; k < counts.size(); ++k) {
     std::int64_t r = 0;
     for (std::size_t j = 0; j < 1001 + 2 * k; ++j) {
-      const std::int32_t c = (rng() % 2 == 0 && r < (std::int64_t{1} << 30)) || r <= -(std::int64_t{1} << 30) ? (1 << 29) : -(1 << 29);
+      const std::int32_t c = (rng() % 2 == 0 && r < (std::int64_t{1} << 30)) || r <= -(std::int64_t{1} << 30) ? (1 << 29)
+                                                                                                              : -(1 << 29);
       r += c;
       counts[k].push_back(j == 0 ? 0 : c);
     }
@@ -176,8 +178,10 @@ TEST(Batch, LargeTermsOfInt32ResidualsAreSummedTermByTermAsTheCharacterizerDoes)
     }
     expect_same(heap.c, i, b, "int32");
     Exact want;
-    for (std::size_t k = 0; k < counts.size(); ++k) want += brute_force(held.x[k], m_list[i], 1, false, held.seg64[k].first_e);
-    for (std::size_t k = 0; k < 3; ++k) EXPECT_TRUE(to_u128(b.result().sum[k]) == want.sum[k]) << "m=" << m_list[i] << " stat " << k;
+    for (std::size_t k = 0; k < counts.size(); ++k)
+      want += brute_force(held.x[k], m_list[i], 1, false, held.seg64[k].first_e);
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_TRUE(to_u128(b.result().sum[k]) == want.sum[k]) << "m=" << m_list[i] << " stat " << k;
   }
 }
 

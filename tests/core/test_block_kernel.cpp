@@ -67,7 +67,8 @@ TEST_P(BlockKernelProperty, AnyBlocksEqualOnePointAtATimeAndBruteForce) {
       std::vector<std::int32_t> v(500 + rng() % 2500);
       for (auto& c : v) {
         const bool wide = trial == 2 || (trial == 1 && seg == 1);
-        c = wide ? static_cast<std::int32_t>(rng() % 4294967295u - 2147483647u) : 1000000 + static_cast<std::int32_t>(rng() % 64);
+        c = wide ? static_cast<std::int32_t>(rng() % 4294967295u - 2147483647u)
+                 : 1000000 + static_cast<std::int32_t>(rng() % 64);
       }
       segments.push_back(v);
     }
@@ -206,8 +207,7 @@ TEST(BlockKernel, ProvedKernelsEqualTheTermsThemselves) {
       const auto pt = [&](std::size_t age) { return p.data() + back - age; };
       const ProvedSums direct = proved_terms(n, at(0), at(m), at(2 * m), at(3 * m), pt(0), pt(m), pt(2 * m), pt(3 * m),
                                              a.data(), h.data());
-      const ProvedSums running =
-          proved_running_terms(n, at(0), at(m), at(2 * m), at(3 * m), t_first, a2.data(), h2.data());
+      const ProvedSums running = proved_running_terms(n, at(0), at(m), at(2 * m), at(3 * m), t_first, a2.data(), h2.data());
       for (const ProvedSums& s : {direct, running}) {
         EXPECT_TRUE(u128{s.avar} == want_a && u128{s.hvar} == want_h && u128{s.mvar} == want_t) << "m=" << m << " n=" << n;
       }
@@ -259,7 +259,8 @@ TEST(BlockKernel, LevelZeroTausBeyondTwoToTheFifteenAreCheckedByTheIncrementRang
       x.push_back(x.back() + c);
     }
     const Exact want = brute_force(x, m, 1);
-    for (std::size_t k = 0; k < 3; ++k) EXPECT_TRUE(to_u128(h.c.result(1).sum[k]) == want.sum[k] && h.c.result(1).n[k] == want.n[k]);
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_TRUE(to_u128(h.c.result(1).sum[k]) == want.sum[k] && h.c.result(1).n[k] == want.n[k]);
   }
   Heap h(1u << 17, m_list);
   const std::int32_t v = 2147483647;

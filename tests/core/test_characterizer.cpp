@@ -223,7 +223,11 @@ TEST(Characterizer, FloatPhaseMatchesLongDoubleDefinition) {
     for (std::size_t k = 0; k < x.size(); ++k) p[k + 1] = p[k] + (static_cast<long double>(x[k]) - x[0]);
     for (std::uint64_t e = 0; e < x.size(); ++e) {
       auto xr = [&](std::uint64_t k) { return static_cast<long double>(x[k]) - x[0]; };
-      if (e >= 2 * m) { const long double a = xr(e) - 2 * xr(e - m) + xr(e - 2 * m); sum[0] += a * a; ++n[0]; }
+      if (e >= 2 * m) {
+        const long double a = xr(e) - 2 * xr(e - m) + xr(e - 2 * m);
+        sum[0] += a * a;
+        ++n[0];
+      }
       if (e + 1 >= 3 * m) {
         const long double t = p[e + 1] - 3 * p[e + 1 - m] + 3 * p[e + 1 - 2 * m] - p[e + 1 - 3 * m];
         sum[1] += t * t;

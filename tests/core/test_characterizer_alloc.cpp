@@ -49,7 +49,7 @@ TEST(CharacterizerAllocation, AccumulationAndReadOutAllocateNothing) {
   }
   EXPECT_EQ(allocations.load() - before, 0u);
   EXPECT_GT(c.result(10).n[0], 0u);  // it did accumulate
-  EXPECT_GT(edf_sum, 0.0);            // and read out
+  EXPECT_GT(edf_sum, 0.0);           // and read out
 }
 
 TEST(CharacterizerAllocation, StateSizeForFortyOctavesStrideEight) {
@@ -60,8 +60,9 @@ TEST(CharacterizerAllocation, StateSizeForFortyOctavesStrideEight) {
   using C = StaticCharacterizer<CountArith, 40, 8>;
   const std::size_t history = CharacterizerStorage<CountArith, 40, 8, 40>::history_capacity() * sizeof(CountArith::Entry);
   const std::size_t taus = 40 * sizeof(Characterizer<CountArith>::TauState);
-  std::printf("sizeof(StaticCharacterizer<CountArith, 40, 8>) = %zu bytes: history %zu, 40 taus %zu (of which noise sums %zu)\n",
-              sizeof(C), history, taus, 40 * sizeof(CountArith::NoiseSums));
+  std::printf(
+      "sizeof(StaticCharacterizer<CountArith, 40, 8>) = %zu bytes: history %zu, 40 taus %zu (of which noise sums %zu)\n",
+      sizeof(C), history, taus, 40 * sizeof(CountArith::NoiseSums));
   EXPECT_LE(sizeof(C), 36u * 1024u);
 }
 

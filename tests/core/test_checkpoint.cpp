@@ -187,11 +187,11 @@ TEST(CheckpointFields, EachBrokenInvariantIsRefusedNamingTheField) {
     const char* what;
     std::size_t at;
     std::uint64_t value;
-    unsigned bytes;  // 1, 4 or 8
+    unsigned bytes;     // 1, 4 or 8
     const char* field;  // the prefix restore_field() must start with
   };
   const auto run_at = [&](const auto& member) { return run + Layout::offset(r0, member); };
-  const std::size_t tau3 = Layout::tau(*board, 3);  // m = 8 (S = 8: level 0, stride 1)
+  const std::size_t tau3 = Layout::tau(*board, 3);    // m = 8 (S = 8: level 0, stride 1)
   const std::size_t tau19 = Layout::tau(*board, 19);  // m = 2^19: no terms yet in 10^4 points
   const Layout::Tau t0{};
   const auto tau_at = [&](std::size_t tau, const auto& member) { return tau + Layout::offset(t0, member); };

@@ -262,7 +262,9 @@ Definition definition(const std::vector<double>& x, std::size_t m, std::size_t s
   const L u = 0x1p-53L;
   const std::size_t size = x.size();
   L big_a = 0, big_t = 0;
-  const auto second = [&](std::size_t e) { return static_cast<L>(x[e]) - 2 * static_cast<L>(x[e - m]) + static_cast<L>(x[e - 2 * m]); };
+  const auto second = [&](std::size_t e) {
+    return static_cast<L>(x[e]) - 2 * static_cast<L>(x[e - m]) + static_cast<L>(x[e - 2 * m]);
+  };
   // The rounding bound of the AVAR term at e (as below), and of the sum of m of them ending at e.
   const auto avar_bound = [&](std::size_t e) {
     const L d1 = static_cast<L>(x[e]) - x[e - m], d2 = static_cast<L>(x[e - m]) - x[e - 2 * m];
@@ -320,9 +322,9 @@ TEST(PhaseBatch, SumsAreTheDefinitionsWithinTheirRoundingBounds) {
   std::vector<std::vector<double>> records(3);
   double walk = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    records[0].push_back(1e-9 * g(rng));                              // random (white phase)
+    records[0].push_back(1e-9 * g(rng));  // random (white phase)
     walk += g(rng);
-    records[1].push_back(3.0e4 + walk);                              // random walk far from 0
+    records[1].push_back(3.0e4 + walk);                                            // random walk far from 0
     records[2].push_back(0.125 + 0.37 * static_cast<double>(k) + 1e-12 * g(rng));  // ramp: terms ~ 0
   }
   const std::vector<std::uint64_t> m{1, 2, 3, 5, 8, 13, 64, 100, 250, 333, 400, 499, 500, 700, 750};
@@ -334,7 +336,8 @@ TEST(PhaseBatch, SumsAreTheDefinitionsWithinTheirRoundingBounds) {
     for (std::size_t i = 0; i < m.size(); ++i) {
       const Definition want = definition(records[r], m[i], stride[i]);
       for (std::size_t k = 0; k < 3; ++k) {
-        const std::string where = "record " + std::to_string(r) + " m=" + std::to_string(m[i]) + " kind " + std::to_string(k);
+        const std::string where = "record " + std::to_string(r) + " m=" + std::to_string(m[i]) + " kind " +
+                                  std::to_string(k);
         EXPECT_EQ(got[i].n[k], want.n[k]) << where;
         EXPECT_LE(std::fabs(static_cast<long double>(got[i].sum[k]) - want.sum[k]), want.tolerance[k])
             << where << ": " << got[i].sum[k] << " vs " << static_cast<double>(want.sum[k]);
@@ -393,7 +396,8 @@ TEST(PhaseBatch, OnlyTheSumsAskedForEachWithTheSameBits) {
     phase_batch_taus(x, m, stride, got, noise, kinds);
     for (std::size_t i = 0; i < m.size(); ++i) {
       for (std::size_t k = 0; k < sum_kinds; ++k) {
-        const std::string where = "kinds " + std::to_string(kinds) + " m=" + std::to_string(m[i]) + " kind " + std::to_string(k);
+        const std::string where = "kinds " + std::to_string(kinds) + " m=" + std::to_string(m[i]) + " kind " +
+                                  std::to_string(k);
         const bool formed = (kinds & sum_bit(static_cast<SumKind>(k))) != 0;
         EXPECT_EQ(got[i].n[k], formed ? all[i].n[k] : 0u) << where;
         EXPECT_EQ(std::bit_cast<std::uint64_t>(got[i].sum[k]), std::bit_cast<std::uint64_t>(formed ? all[i].sum[k] : 0.0))

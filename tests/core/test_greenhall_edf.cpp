@@ -77,8 +77,8 @@ TEST(GreenhallEdf, StridedEstimatorMatchesBasicSum) {
 }
 
 TEST(GreenhallEdf, NotAvailableOutsideTheDomain) {
-  EXPECT_EQ(edf_greenhall({-1, 1, 4, false, 1, 1000}), 0.0);  // d = 1 not supported here
-  EXPECT_EQ(edf_greenhall({-3, 2, 4, false, 1, 1000}), 0.0);  // alpha + 2d <= 1
+  EXPECT_EQ(edf_greenhall({-1, 1, 4, false, 1, 1000}), 0.0);   // d = 1 not supported here
+  EXPECT_EQ(edf_greenhall({-3, 2, 4, false, 1, 1000}), 0.0);   // alpha + 2d <= 1
   EXPECT_EQ(edf_greenhall({0, 2, 600, false, 1, 1000}), 0.0);  // N < L = 1 + 2m: not a single term
 }
 

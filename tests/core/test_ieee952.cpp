@@ -34,8 +34,7 @@ std::vector<FitPoint> exact_points(const std::array<double, 5>& p) {
   return pts;
 }
 
-Ieee952Fit fit(const std::vector<FitPoint>& pts, FitCurve curve, double white_quantization = 0,
-               double model_spread = 0.01) {
+Ieee952Fit fit(const std::vector<FitPoint>& pts, FitCurve curve, double white_quantization = 0, double model_spread = 0.01) {
   std::vector<double> workspace(ieee952_workspace_doubles(pts.size()));
   return fit_ieee952(pts, {tau0, n_phase, white_quantization, model_spread}, curve, workspace);
 }
@@ -148,7 +147,8 @@ TEST(Ieee952, ANegativeUnconstrainedSquareKeepsItsSignInTheSignedRoot) {
 // truth (pair_sums() over the unbroken grids, 2 sum c_t c_u h_t h_u / (n n' norm norm')).
 class Draw {
  public:
-  Draw(const std::vector<FitPoint>& pts, const std::array<double, 5>& truth) : pts_(pts), n_(pts.size()), chol_(n_ * n_, 0.0) {
+  Draw(const std::vector<FitPoint>& pts, const std::array<double, 5>& truth)
+      : pts_(pts), n_(pts.size()), chol_(n_ * n_, 0.0) {
     NoiseSet set;
     set.alpha = {2, 0, -1, -2};
     set.count = 4;
@@ -168,7 +168,8 @@ class Draw {
         double v = 0;
         for (std::size_t t = 0; t < 4; ++t)
           for (std::size_t u = 0; u < 4; ++u) v += 2 * h[t] * h[u] * s.cc[t][u];
-        sigma[i * n_ + j] = sigma[j * n_ + i] = v / (static_cast<double>(a.n) * static_cast<double>(b.n) * norm(a) * norm(b));
+        sigma[i * n_ + j] = sigma[j * n_ + i] = v /
+                                                (static_cast<double>(a.n) * static_cast<double>(b.n) * norm(a) * norm(b));
       }
     for (std::size_t j = 0; j < n_; ++j) {  // Cholesky
       double d = sigma[j * n_ + j];

@@ -53,7 +53,8 @@ TEST(MarkovTerms, CovarianceMatchesBruteForceFromShortToVeryLongCorrelation) {
         const long double want = brute_covariance(a, s, m, s, m, 0);
         // Rounding grows as 1e-16 / (a m)^2 where Tc >> tau (docs/metrology.md): 1e-6 relative at a = 1e-6, m = 2.
         const double tolerance = a < 1e-5 ? 1e-6 : 1e-9;
-        EXPECT_NEAR(markov_term_covariance(a, s, m, s, m, 0), static_cast<double>(want), tolerance * std::fabs(static_cast<double>(want)))
+        EXPECT_NEAR(markov_term_covariance(a, s, m, s, m, 0), static_cast<double>(want),
+                    tolerance * std::fabs(static_cast<double>(want)))
             << "a " << a << " m " << m;
       }
   // Different taus, statistics and lags (the covariance of two estimates' terms).
@@ -94,12 +95,14 @@ TEST(MarkovTerms, PairSumsMatchTheDoubleSumOverEveryPairOfTerms) {
     std::map<std::int64_t, double> pairs;
     for (std::uint64_t i = 0; i < ga.n; ++i)
       for (std::uint64_t j = 0; j < gb.n; ++j)
-        pairs[static_cast<std::int64_t>(ga.first + i * ga.stride) - static_cast<std::int64_t>(gb.first + j * gb.stride)] += 1;
+        pairs[static_cast<std::int64_t>(ga.first + i * ga.stride) - static_cast<std::int64_t>(gb.first + j * gb.stride)] +=
+            1;
     MarkovPairSums want;
     for (const auto& [lag, count] : pairs) {
       double cm[2], ct[4];
       for (int r = 0; r < 2; ++r) cm[r] = markov_term_covariance(rates[r], c.sa, c.ma, c.sb, c.mb, lag);
-      for (int t = 0; t < 4; ++t) ct[t] = term_covariance(set.alpha[static_cast<std::size_t>(t)], c.sa, c.ma, c.sb, c.mb, lag);
+      for (int t = 0; t < 4; ++t)
+        ct[t] = term_covariance(set.alpha[static_cast<std::size_t>(t)], c.sa, c.ma, c.sb, c.mb, lag);
       for (std::size_t r = 0; r < 2; ++r) {
         want.c[r] += count * cm[r];
         for (std::size_t t = 0; t < 4; ++t) want.cm[r][t] += count * cm[r] * ct[t];
@@ -156,7 +159,9 @@ TEST(MarkovTerms, SinusoidVariancesAreThePhaseMeanOfTheSampledEstimator) {
       constexpr int phases = 64;
       for (int k = 0; k < phases; ++k) {
         const double p = 2 * 3.141592653589793 * k / phases;
-        auto x = [&](double i) { return -A * std::cos(2 * 3.141592653589793 * hz * i * tau0 + p) / (2 * 3.141592653589793 * hz); };
+        auto x = [&](double i) {
+          return -A * std::cos(2 * 3.141592653589793 * hz * i * tau0 + p) / (2 * 3.141592653589793 * hz);
+        };
         const double mm = static_cast<double>(m);
         double t = 0;
         const int terms = s == Stat::avar ? 1 : static_cast<int>(m);
@@ -227,7 +232,8 @@ TEST(MarkovTerms, SinusoidPairSumsMatchTheDoubleSumOverEveryPairOfTerms) {
     std::map<std::int64_t, double> pairs;
     for (std::uint64_t i = 0; i < ga.n; ++i)
       for (std::uint64_t j = 0; j < gb.n; ++j)
-        pairs[static_cast<std::int64_t>(ga.first + i * ga.stride) - static_cast<std::int64_t>(gb.first + j * gb.stride)] += 1;
+        pairs[static_cast<std::int64_t>(ga.first + i * ga.stride) - static_cast<std::int64_t>(gb.first + j * gb.stride)] +=
+            1;
     SinusoidPairSums want;
     std::array<double, 2> own{};  // sum c_s^2: the scale of each sinusoid's sums
     for (const auto& [lag, count] : pairs)

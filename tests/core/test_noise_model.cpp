@@ -115,9 +115,9 @@ TEST(NoiseModel, PairSumsEqualTheSumOverEveryPair) {
       double tolerance;
     };
     const Case cases[] = {
-        {Stat::avar, Stat::avar, 4, 4, 1, 1, 2000, 1e-11},   {Stat::mvar, Stat::mvar, 64, 64, 8, 8, 3000, 1e-11},
-        {Stat::hvar, Stat::hvar, 16, 16, 2, 2, 2000, 1e-11}, {Stat::avar, Stat::mvar, 32, 32, 4, 4, 3000, 1e-9},
-        {Stat::avar, Stat::avar, 32, 64, 4, 8, 3000, 1e-9},  {Stat::avar, Stat::avar, 1024, 1024, 1, 1, 5500, 3e-4},
+        {Stat::avar, Stat::avar, 4, 4, 1, 1, 2000, 1e-11},       {Stat::mvar, Stat::mvar, 64, 64, 8, 8, 3000, 1e-11},
+        {Stat::hvar, Stat::hvar, 16, 16, 2, 2, 2000, 1e-11},     {Stat::avar, Stat::mvar, 32, 32, 4, 4, 3000, 1e-9},
+        {Stat::avar, Stat::avar, 32, 64, 4, 8, 3000, 1e-9},      {Stat::avar, Stat::avar, 1024, 1024, 1, 1, 5500, 3e-4},
         {Stat::mvar, Stat::mvar, 3000, 3000, 1, 1, 11500, 3e-4},
     };
     for (const Case& k : cases) {
@@ -150,7 +150,7 @@ TEST(NoiseModel, TwoPairSumsInOnePassAreTheSumsOfEach) {
     std::uint64_t m_a, m_b, stride_a, stride_b, n1, n2;
   };
   const Case cases[] = {
-      {Stat::avar, Stat::avar, 64, 64, 1, 1, 3000, 9000},    {Stat::avar, Stat::mvar, 16, 256, 1, 1, 7000, 20000},
+      {Stat::avar, Stat::avar, 64, 64, 1, 1, 3000, 9000},     {Stat::avar, Stat::mvar, 16, 256, 1, 1, 7000, 20000},
       {Stat::mvar, Stat::mvar, 1024, 32, 1, 1, 40000, 90000}, {Stat::avar, Stat::avar, 512, 128, 8, 4, 30000, 31000},
       {Stat::mvar, Stat::avar, 8, 8, 1, 1, 100, 100},         {Stat::avar, Stat::avar, 4, 4, 1, 1, 5, 6000},
   };
@@ -294,7 +294,8 @@ TEST(NoiseModel, TheRoundingEstimateSaysWhereTheClosedFormsLoseTheirDigits) {
       const double rounding = pair_sums_rounding(alpha, a, b);
       if (rounding > 1e-3) continue;
       ++checked;
-      const double got = pair_sums(set, a, b).cc[0][0] / std::sqrt(pair_sums(set, a, a).cc[0][0] * pair_sums(set, b, b).cc[0][0]);
+      const double got = pair_sums(set, a, b).cc[0][0] /
+                         std::sqrt(pair_sums(set, a, a).cc[0][0] * pair_sums(set, b, b).cc[0][0]);
       EXPECT_NEAR(got, exact_correlation(alpha, k.a, k.m_a, k.b, k.m_b, n_phase), 1e-3)
           << "alpha " << alpha << " m " << k.m_a << "/" << k.m_b << ", rounding " << rounding;
     }
@@ -313,10 +314,10 @@ TEST(NoiseModel, TheRoundingEstimateSaysWhereTheClosedFormsLoseTheirDigits) {
 }
 
 TEST(NoiseModel, OutsideTheDomainThereIsNoEdf) {
-  EXPECT_EQ(exact_edf(-3, unbroken_grid(Stat::avar, 4, 1, 1000)), 0.0);  // AVAR diverges for alpha <= -3
-  EXPECT_GT(exact_edf(-3, unbroken_grid(Stat::hvar, 4, 1, 1000)), 0.0);  // Hadamard does not
-  EXPECT_EQ(exact_edf(0, unbroken_grid(Stat::avar, 600, 1, 1000)), 0.0); // no term fits
-  EXPECT_EQ(unbroken_grid(Stat::mvar, 4, 1, 11).n, 0u);                 // first MVAR term at e = 3m - 1 = 11
+  EXPECT_EQ(exact_edf(-3, unbroken_grid(Stat::avar, 4, 1, 1000)), 0.0);   // AVAR diverges for alpha <= -3
+  EXPECT_GT(exact_edf(-3, unbroken_grid(Stat::hvar, 4, 1, 1000)), 0.0);   // Hadamard does not
+  EXPECT_EQ(exact_edf(0, unbroken_grid(Stat::avar, 600, 1, 1000)), 0.0);  // no term fits
+  EXPECT_EQ(unbroken_grid(Stat::mvar, 4, 1, 11).n, 0u);                   // first MVAR term at e = 3m - 1 = 11
   EXPECT_EQ(unbroken_grid(Stat::mvar, 4, 1, 12).n, 1u);
 }
 

@@ -220,8 +220,8 @@ TEST(ProtocolRoundTrip, EveryFieldAtItsLimits) {
       Ieee952ModelMsg{0, 0, 0, false, 0, false, 0, 0, false, 0.0f},
       Ieee952ModelMsg{255, 2, 2, true, 31, true, 2, 2, true, FLT_MAX},
       Ieee952ModelMsg{1, 0, 2, false, 0, true, 0, 0, false, -FLT_MAX},
-      Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 0.0f, 0.0},  // no estimate
-      Ieee952UnconstrainedMsg{255, Ieee952Term::rate_ramp, -FLT_MAX, std::exp2(128.0 - 1.0 / 256)},  // code 65535
+      Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 0.0f, 0.0},                                // no estimate
+      Ieee952UnconstrainedMsg{255, Ieee952Term::rate_ramp, -FLT_MAX, std::exp2(128.0 - 1.0 / 256)},    // code 65535
       Ieee952UnconstrainedMsg{1, Ieee952Term::bias_instability, FLT_MAX, std::exp2(1.0 / 256 - 128)},  // code 1
       Ieee952UnconstrainedMsg{2, Ieee952Term::rate_random_walk, -FLT_TRUE_MIN, 1.0},
   };
@@ -295,7 +295,8 @@ TEST(ProtocolQuantization, EdfIsWithinHalfAStepOfLog2) {
   const double half_step = std::exp2(1.0 / 128) * (1 + 1e-12);
   for (double log2_edf = -3.9; log2_edf < 59.9; log2_edf += 0.0137) {
     const double edf = std::exp2(log2_edf);
-    const double back = std::get<TauDevMsg>(round_trip(TauDevMsg{1, 1, DevKind::adev, 1.0f, edf, NoiseType::white_fm, true})).edf;
+    const double back =
+        std::get<TauDevMsg>(round_trip(TauDevMsg{1, 1, DevKind::adev, 1.0f, edf, NoiseType::white_fm, true})).edf;
     EXPECT_LE(back / edf, half_step) << edf;
     EXPECT_GE(back / edf, 1 / half_step) << edf;
   }
@@ -380,12 +381,14 @@ TEST(ProtocolQuantization, UnconstrainedEstimateSignedAndItsUncertaintyWithinHal
   for (int k = 0; k < 10000; ++k) {
     const double u = std::exp2(log2_u(rng));
     const float value = (k % 2 ? -1.0f : 1.0f) * static_cast<float>(u) * 0.75f;
-    const auto back = std::get<Ieee952UnconstrainedMsg>(round_trip(Ieee952UnconstrainedMsg{1, Ieee952Term::rate_random_walk, value, u}));
+    const auto back = std::get<Ieee952UnconstrainedMsg>(
+        round_trip(Ieee952UnconstrainedMsg{1, Ieee952Term::rate_random_walk, value, u}));
     EXPECT_EQ(back.value, value);  // the sign too: a negative unconstrained square
     EXPECT_LE(std::abs(std::log2(back.uncertainty) - std::log2(u)), 1.0 / 512 + 1e-12) << u;
   }
   const auto saturated = [](double u) {
-    return std::get<Ieee952UnconstrainedMsg>(round_trip(Ieee952UnconstrainedMsg{3, Ieee952Term::rate_ramp, -1.0f, u})).uncertainty;
+    return std::get<Ieee952UnconstrainedMsg>(round_trip(Ieee952UnconstrainedMsg{3, Ieee952Term::rate_ramp, -1.0f, u}))
+        .uncertainty;
   };
   EXPECT_EQ(saturated(1e300), std::exp2(65535.0 / 256 - 128));
   EXPECT_EQ(saturated(DBL_MAX), std::exp2(65535.0 / 256 - 128));
@@ -405,9 +408,11 @@ TEST(ProtocolDecode, UnconstrainedFramesOutOfRangeOrWithUnknownTermsAreRefused) 
   EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, 0.0}, 1, f), ProtocolError::out_of_range)
       << "a value without an uncertainty";
   EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, NAN, 1.0}, 1, f), ProtocolError::out_of_range);
-  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, -INFINITY, 1.0}, 1, f), ProtocolError::out_of_range);
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, -INFINITY, 1.0}, 1, f),
+            ProtocolError::out_of_range);
   EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, -1.0}, 1, f), ProtocolError::out_of_range);
-  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, INFINITY}, 1, f), ProtocolError::out_of_range);
+  EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, INFINITY}, 1, f),
+            ProtocolError::out_of_range);
   EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, 1.0f, NAN}, 1, f), ProtocolError::out_of_range);
   EXPECT_EQ(encode(Ieee952UnconstrainedMsg{0, static_cast<Ieee952Term>(5), 1.0f, 1.0}, 1, f), ProtocolError::out_of_range);
   const CanFrame good = encoded(Ieee952UnconstrainedMsg{4, Ieee952Term::rate_ramp, -3.0f, 0.5}, 7);
@@ -479,9 +484,9 @@ TEST(ProtocolEncode, RejectsWhatTheWireCannotCarryAndLeavesTheFrameAlone) {
   m.noise = static_cast<NoiseType>(8);
   EXPECT_EQ(rejects(m), range);
   EXPECT_EQ(rejects(TauTermsMsg{1, max_taus, 1}), range);
-  EXPECT_EQ(rejects(TauInfoMsg{1, 1, 0, 0}), range);                 // m = 0
-  EXPECT_EQ(rejects(TauInfoMsg{1, 1, max40 + 1, 0}), range);         // m >= 2^40
-  EXPECT_EQ(rejects(TauInfoMsg{1, 1, 96, 6}), range);                // 64 does not divide 96
+  EXPECT_EQ(rejects(TauInfoMsg{1, 1, 0, 0}), range);          // m = 0
+  EXPECT_EQ(rejects(TauInfoMsg{1, 1, max40 + 1, 0}), range);  // m >= 2^40
+  EXPECT_EQ(rejects(TauInfoMsg{1, 1, 96, 6}), range);         // 64 does not divide 96
   EXPECT_EQ(rejects(TauInfoMsg{1, 1, 1, 40}), range);
   EXPECT_EQ(rejects(TauInfoMsg{1, max_taus, 1, 0}), range);
   EXPECT_EQ(rejects(MetaSamplingMsg{1, 0.0f, 8}), range);
@@ -524,7 +529,7 @@ TEST(ProtocolEncode, RejectsWhatTheWireCannotCarryAndLeavesTheFrameAlone) {
   EXPECT_EQ(rejects(Ieee952ParameterMsg{1, static_cast<FitParameter>(5), 0, false, 1.0f, 0.1}), range);
   for (FitParameter p : {FitParameter::markov_sigma, FitParameter::markov_tc, FitParameter::sinusoid_amplitude,
                          FitParameter::sinusoid_frequency})
-    EXPECT_EQ(rejects(Ieee952ParameterMsg{1, p, 2, false, 1.0f, 0.1}), range) << name(p);  // two terms: index 0, 1
+    EXPECT_EQ(rejects(Ieee952ParameterMsg{1, p, 2, false, 1.0f, 0.1}), range) << name(p);           // two terms: index 0, 1
   EXPECT_EQ(rejects(Ieee952ParameterMsg{1, FitParameter::filter_tf, 1, false, 1.0f, 0.1}), range);  // one filter
   for (FitParameter p : {FitParameter::markov_tc, FitParameter::filter_tf, FitParameter::sinusoid_frequency})
     EXPECT_EQ(rejects(Ieee952ParameterMsg{1, p, 0, true, 1.0f, 0.1}), range) << name(p);  // no Resolved there
@@ -549,9 +554,9 @@ TEST(ProtocolEncode, RejectsWhatTheWireCannotCarryAndLeavesTheFrameAlone) {
     mutate(b);
     EXPECT_EQ(rejects(b), range);
   }
-  EXPECT_EQ(rejects(WindowMsg{1, 0, true, 1, 0}), range);          // no window taus
-  EXPECT_EQ(rejects(WindowMsg{1, max_taus, true, 1, 0}), range);   // 6 bits
-  EXPECT_EQ(rejects(WindowMsg{1, 3, false, 1, 0}), range);         // no window completed, yet a number
+  EXPECT_EQ(rejects(WindowMsg{1, 0, true, 1, 0}), range);         // no window taus
+  EXPECT_EQ(rejects(WindowMsg{1, max_taus, true, 1, 0}), range);  // 6 bits
+  EXPECT_EQ(rejects(WindowMsg{1, 3, false, 1, 0}), range);        // no window completed, yet a number
   EXPECT_EQ(rejects(WindowMsg{1, 3, false, 0, 1}), range);
   EXPECT_EQ(rejects(WindowLengthMsg{1, 3}), range);
   EXPECT_EQ(rejects(WindowLengthMsg{1, max40 + 1}), range);
@@ -596,9 +601,9 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
   // Envelope, in the order decode() checks it.
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.error = true; }), ProtocolError::error_frame);
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.extended = false; }), ProtocolError::not_extended);
-  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x14FF4411; }), ProtocolError::unknown_id);  // PGN
-  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x18FF4011; }), ProtocolError::unknown_id);  // priority
-  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id |= 0x20000000; }), ProtocolError::unknown_id); // > 29 bits
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x14FF4411; }), ProtocolError::unknown_id);   // PGN
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x18FF4011; }), ProtocolError::unknown_id);   // priority
+  EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id |= 0x20000000; }), ProtocolError::unknown_id);  // > 29 bits
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.id = 0x14FF40FE; }), ProtocolError::bad_address);
   EXPECT_EQ(decode_mutated(counter, [](CanFrame& f) { f.id = 0x0CFF50FF; }), ProtocolError::bad_address);
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.fd = true; }), ProtocolError::fd_frame);
@@ -622,15 +627,19 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
 
   // Reserved bits.
   for (std::uint8_t bit = 4; bit < 8; ++bit) {
-    EXPECT_EQ(decode_mutated(status, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    EXPECT_EQ(decode_mutated(status, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }),
+              ProtocolError::reserved_bits);
     if (bit == 4) continue;  // Fitted since version 2
-    EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }),
+              ProtocolError::reserved_bits);
   }
   for (std::uint8_t bit = 2; bit < 8; ++bit) {
     for (const Message& meta : {sampling, clock, scale, config}) {
-      EXPECT_EQ(decode_mutated(meta, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+      EXPECT_EQ(decode_mutated(meta, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }),
+                ProtocolError::reserved_bits);
     }
-    EXPECT_EQ(decode_mutated(counter, [&](CanFrame& f) { f.data[5] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    EXPECT_EQ(decode_mutated(counter, [&](CanFrame& f) { f.data[5] |= std::uint8_t(1u << bit); }),
+              ProtocolError::reserved_bits);
     EXPECT_EQ(decode_mutated(window_length, [&](CanFrame& f) { f.data[0] |= std::uint8_t(1u << bit); }),
               ProtocolError::reserved_bits);
   }
@@ -638,13 +647,15 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
     EXPECT_EQ(decode_mutated(window_length, [&](CanFrame& f) { f.data[7] |= std::uint8_t(1u << bit); }),
               ProtocolError::reserved_bits);
     if (bit == 7) continue;  // Complete
-    EXPECT_EQ(decode_mutated(window, [&](CanFrame& f) { f.data[7] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    EXPECT_EQ(decode_mutated(window, [&](CanFrame& f) { f.data[7] |= std::uint8_t(1u << bit); }),
+              ProtocolError::reserved_bits);
   }
 
   const Message parameter = Ieee952ParameterMsg{1, FitParameter::filter_tf, 0, false, 0.01f, 0.1};
   const Message model = Ieee952ModelMsg{1, 1, 0, false, 0, false, 0, 0, false, 0.0f};
   for (std::uint8_t bit = 3; bit < 8; ++bit)  // byte 3 bits 3-7 of the model page
-    EXPECT_EQ(decode_mutated(model, [&](CanFrame& f) { f.data[3] |= std::uint8_t(1u << bit); }), ProtocolError::reserved_bits);
+    EXPECT_EQ(decode_mutated(model, [&](CanFrame& f) { f.data[3] |= std::uint8_t(1u << bit); }),
+              ProtocolError::reserved_bits);
 
   // Values out of range.
   constexpr auto range = ProtocolError::out_of_range;
@@ -655,15 +666,16 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
   EXPECT_EQ(decode_mutated(parameter, [](CanFrame& f) { put_float(f, -1.0f); }), range);
   EXPECT_EQ(decode_mutated(model, [](CanFrame& f) { f.data[0] |= 3u << 3; }), range);  // 3 Markov terms
   EXPECT_EQ(decode_mutated(model, [](CanFrame& f) { f.data[0] |= 3u << 5; }), range);  // 3 sinusoids
-  EXPECT_EQ(decode_mutated(model, [](CanFrame& f) { f.data[3] = 4; }), range);          // runner-up field, no runner-up
-  EXPECT_EQ(decode_mutated(model, [](CanFrame& f) { f.data[2] = 0x20, f.data[7] = 0x7F, f.data[6] = 0x80; }), range);  // margin inf
+  EXPECT_EQ(decode_mutated(model, [](CanFrame& f) { f.data[3] = 4; }), range);         // runner-up field, no runner-up
+  EXPECT_EQ(decode_mutated(model, [](CanFrame& f) { f.data[2] = 0x20, f.data[7] = 0x7F, f.data[6] = 0x80; }),
+            range);                                                                 // margin inf
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[0] = 0x0C; }), range);  // state 3
   EXPECT_EQ(decode_mutated(status, [](CanFrame& f) { f.data[2] = max_taus + 1; }), range);
   for (float bad : {nan_f, inf_f, -inf_f, -1.0f}) {
     EXPECT_EQ(decode_mutated(adev, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
   }
   EXPECT_EQ(decode_mutated(info, [](CanFrame& f) { f.data[2] = f.data[3] = 0; }), range);  // m = 0
-  EXPECT_EQ(decode_mutated(info, [](CanFrame& f) { f.data[7] = 6; }), range);  // 2^6 does not divide 96
+  EXPECT_EQ(decode_mutated(info, [](CanFrame& f) { f.data[7] = 6; }), range);              // 2^6 does not divide 96
   EXPECT_EQ(decode_mutated(info, [](CanFrame& f) { f.data[7] = 200; }), range);
   for (float bad : {0.0f, -1e-3f, nan_f, inf_f}) {
     EXPECT_EQ(decode_mutated(sampling, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
@@ -680,10 +692,10 @@ TEST(ProtocolDecode, RejectsMalformedFramesWithTheRightReason) {
     EXPECT_EQ(decode_mutated(ieee, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;
     EXPECT_EQ(decode_mutated(summary, [&](CanFrame& f) { put_float(f, bad); }), range) << bad;  // chi2/dof
   }
-  EXPECT_EQ(decode_mutated(window, [](CanFrame& f) { f.data[0] = 0; }), range);                    // no window taus
-  EXPECT_EQ(decode_mutated(window, [](CanFrame& f) { f.data[7] = 0; }), range);                    // incomplete, number 3
+  EXPECT_EQ(decode_mutated(window, [](CanFrame& f) { f.data[0] = 0; }), range);  // no window taus
+  EXPECT_EQ(decode_mutated(window, [](CanFrame& f) { f.data[7] = 0; }), range);  // incomplete, number 3
   EXPECT_EQ(decode_mutated(window_length, [](CanFrame& f) { f.data[2] = 3, f.data[3] = 0; }), range);  // length 3
-  EXPECT_EQ(decode_mutated(window_dev, [](CanFrame& f) { f.data[2] = 0xFF; }), ProtocolError::none);  // any code
+  EXPECT_EQ(decode_mutated(window_dev, [](CanFrame& f) { f.data[2] = 0xFF; }), ProtocolError::none);   // any code
   // White quantization with points left out.
   EXPECT_EQ(decode_mutated(summary, [](CanFrame& f) { f.data[0] |= 1u << 3; }), range);
   EXPECT_EQ(decode_mutated(summary, [](CanFrame& f) { f.data[7] |= 1u; }), range);
@@ -700,7 +712,8 @@ TEST(ProtocolDecode, VersionOneIeee952FramesStillDecode) {
   std::copy(resolved.begin(), resolved.end(), f.data.begin());
   Decoded d = decode(f);
   ASSERT_EQ(d.error, ProtocolError::none) << name(d.error);
-  EXPECT_EQ(std::get<Ieee952Msg>(d.message), (Ieee952Msg{0x21, Ieee952Term::angle_random_walk, true, 3.0e-5f, 0.0125, false}));
+  EXPECT_EQ(std::get<Ieee952Msg>(d.message),
+            (Ieee952Msg{0x21, Ieee952Term::angle_random_walk, true, 3.0e-5f, 0.0125, false}));
   const std::array<std::uint8_t, 8> unresolved{0x04, 0x21, 0, 0, 0, 0, 0, 0};
   std::copy(unresolved.begin(), unresolved.end(), f.data.begin());
   d = decode(f);
@@ -762,9 +775,9 @@ TEST(ProtocolNames, AlphaAndNoiseTypeAreInverse) {
   }
   EXPECT_EQ(noise_type(3), NoiseType::not_identified);
   EXPECT_EQ(noise_type(-5), NoiseType::not_identified);
-  EXPECT_EQ(alpha(NoiseType::white_fm), 0);       // angle random walk
-  EXPECT_EQ(alpha(NoiseType::flicker_fm), -1);    // bias instability
-  EXPECT_EQ(alpha(NoiseType::white_pm), 2);       // quantization
+  EXPECT_EQ(alpha(NoiseType::white_fm), 0);     // angle random walk
+  EXPECT_EQ(alpha(NoiseType::flicker_fm), -1);  // bias instability
+  EXPECT_EQ(alpha(NoiseType::white_pm), 2);     // quantization
 }
 
 TEST(ProtocolNames, EveryValueHasItsOwnName) {
@@ -842,7 +855,8 @@ TEST(ProtocolSchedule, FastFramesEveryReportSlowListOncePerCycle) {
         ASSERT_EQ(report_frame_count(s, taus, protocol_version), report_frame_count(s % 4, taus, protocol_version));
         const std::size_t last = report_frame_count(s, taus, protocol_version) - 1;
         EXPECT_EQ(report_slot(s, taus, last, protocol_version).slot, report_slot(s % 4, taus, last, protocol_version).slot);
-        EXPECT_EQ(report_slot(s, taus, last, protocol_version).index, report_slot(s % 4, taus, last, protocol_version).index);
+        EXPECT_EQ(report_slot(s, taus, last, protocol_version).index,
+                  report_slot(s % 4, taus, last, protocol_version).index);
       }
     }
   }
@@ -927,7 +941,8 @@ TEST(ProtocolSchedule, VersionFourAppendsTheModelListToEveryReport) {
       std::map<std::pair<Slot, int>, int> count;
       std::size_t longest_tail = 0;
       for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) {
-        const std::size_t v3 = report_frame_count(seq, taus, 3, window_taus), v4 = report_frame_count(seq, taus, 4, window_taus);
+        const std::size_t v3 = report_frame_count(seq, taus, 3, window_taus),
+                          v4 = report_frame_count(seq, taus, 4, window_taus);
         ASSERT_GE(v4, v3);
         longest_tail = std::max(longest_tail, v4 - v3);
         for (std::size_t p = 0; p < v4; ++p) {
@@ -948,7 +963,8 @@ TEST(ProtocolSchedule, VersionFourAppendsTheModelListToEveryReport) {
       }
       ASSERT_EQ(count.size(), 1 + fit_parameter_pages);
       EXPECT_EQ((count[{Slot::fit_model, 0}]), 1);
-      for (std::size_t k = 0; k < fit_parameter_pages; ++k) EXPECT_EQ((count[{Slot::fit_parameter, static_cast<int>(k)}]), 1) << k;
+      for (std::size_t k = 0; k < fit_parameter_pages; ++k)
+        EXPECT_EQ((count[{Slot::fit_parameter, static_cast<int>(k)}]), 1) << k;
       EXPECT_EQ(longest_tail, (1 + fit_parameter_pages + 3) / 4);  // 10 entries: 3, 3, 3, 1
     }
   }
@@ -973,7 +989,8 @@ TEST(ProtocolSchedule, VersionFiveAppendsTheUnconstrainedListToEveryReport) {
     for (std::size_t window_taus : {std::size_t{0}, std::size_t{1}, taus / 2, taus}) {
       std::map<int, int> count;
       for (std::uint8_t seq = 0; seq < slow_cycle_reports; ++seq) {
-        const std::size_t v4 = report_frame_count(seq, taus, 4, window_taus), v5 = report_frame_count(seq, taus, 5, window_taus);
+        const std::size_t v4 = report_frame_count(seq, taus, 4, window_taus),
+                          v5 = report_frame_count(seq, taus, 5, window_taus);
         ASSERT_EQ(v5 - v4, std::size_t{seq < 2 ? 2u : seq == 2 ? 1u : 0u});
         for (std::size_t p = 0; p < v5; ++p) {
           const ReportSlot a = report_slot(seq, taus, p, 5, window_taus);

@@ -53,8 +53,8 @@ TEST(Readoff, EachTermAloneIsReadExactly) {
   ASSERT_TRUE(n.n.valid);
   EXPECT_NEAR(n.n.value, arw.n, 1e-12 * arw.n);
   expect_interval_scaled(n.n);
-  EXPECT_FALSE(n.k.valid);                       // never rises
-  EXPECT_TRUE(n.floor_at_end);                   // still falling at the last point
+  EXPECT_FALSE(n.k.valid);      // never rises
+  EXPECT_TRUE(n.floor_at_end);  // still falling at the last point
   EXPECT_DOUBLE_EQ(n.floor.tau_s, 0.01 * std::exp2(19.0));
 
   const Readoff b = read_off(curve([&](double t) { return bias.avar(t); }, 0.01, 20));

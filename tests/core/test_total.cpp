@@ -234,15 +234,16 @@ TEST(Total, TheoBiasRatioIsTheMeanOfAvarOverTheo1) {
   const TheoBiasRatio some = theo_bias_ratio(x, 1.0, 0, 2);
   EXPECT_FALSE(some.exact);
   const LD two = (oavar_oracle(x, 9, 1.0) / theo1_oracle(x, 12, 1.0) +
-                  oavar_oracle(x, 9 + 3 * last, 1.0) / theo1_oracle(x, 12 + 4 * last, 1.0)) / 2;
+                  oavar_oracle(x, 9 + 3 * last, 1.0) / theo1_oracle(x, 12 + 4 * last, 1.0)) /
+                 2;
   EXPECT_NEAR(some.ratio / static_cast<double>(two), 1.0, 1e-11);
   EXPECT_EQ(theo_bias_ratio(record(23, 1), 1.0, 0, 10).taus, 0u);  // n < 1
   EXPECT_EQ(theo_bias_ratio(record(24, 1), 1.0, 0, 10).taus, 1u);  // n = 1, whose AVAR (m = 12) needs 25 points
 }
 
 TEST(Total, TheoHSwitchIsTheLargestOctaveWithinTenPercent) {
-  EXPECT_EQ(theoh_switch(1001), 64u);      // 100 samples: 64
-  EXPECT_EQ(theoh_switch(1281), 128u);     // 128 exactly
+  EXPECT_EQ(theoh_switch(1001), 64u);   // 100 samples: 64
+  EXPECT_EQ(theoh_switch(1281), 128u);  // 128 exactly
   EXPECT_EQ(theoh_switch(5), 1u);
   EXPECT_EQ(theoh_switch(10000001), 524288u);
 }
@@ -256,18 +257,18 @@ TEST(Total, BlockSumsAndTheDecimationPlan) {
   EXPECT_EQ(sums[2], 11.0);
   EXPECT_TRUE(block_sums(x, 2, std::span<double>(out).first(2)).empty());
   // Exact below the budget (2^26 operations), m <= S or S = 0; the cost is 15 m (N - 3m + 1).
-  EXPECT_EQ(total_block(1024, 1001, 16), 1u);          // cannot be formed, exact (cost 0)
+  EXPECT_EQ(total_block(1024, 1001, 16), 1u);  // cannot be formed, exact (cost 0)
   EXPECT_EQ(total_block(128, 100000, 0), 1u);
-  EXPECT_EQ(total_block(16, 10000000, 16), 1u);        // m <= S
-  EXPECT_EQ(total_block(256, 100000, 16), 16u);        // 15 * 256 * 99233 = 3.8e8 > 2^26
+  EXPECT_EQ(total_block(16, 10000000, 16), 1u);  // m <= S
+  EXPECT_EQ(total_block(256, 100000, 16), 16u);  // 15 * 256 * 99233 = 3.8e8 > 2^26
   EXPECT_EQ(total_block(4096, 1000000, 0), 1u);
-  EXPECT_EQ(total_block(4096, 1000000, 16), 256u);     // 2^26 < 15 * 4096 * 987713
-  EXPECT_EQ(total_block(96, 10000000, 16), 4u);        // b <= 96 / 16 = 6, a power of two, 96 / b even
-  EXPECT_EQ(total_block(99, 10000000, 16), 1u);        // odd m: only the exact estimator
+  EXPECT_EQ(total_block(4096, 1000000, 16), 256u);  // 2^26 < 15 * 4096 * 987713
+  EXPECT_EQ(total_block(96, 10000000, 16), 4u);     // b <= 96 / 16 = 6, a power of two, 96 / b even
+  EXPECT_EQ(total_block(99, 10000000, 16), 1u);     // odd m: only the exact estimator
   EXPECT_EQ(theo1_stride(16, 10000000, 16), 1u);
   EXPECT_EQ(theo1_stride(1000, 10000000, 16), 62u);
-  EXPECT_EQ(theo1_stride(1000, 1001, 16), 1u);         // (1001 - 1000) * 500: exact
-  EXPECT_EQ(theo_bias_taus(1001, 16), 164u);           // all n + 1 = floor(1001/6 - 3) + 1, exact cost 1.5e7
+  EXPECT_EQ(theo1_stride(1000, 1001, 16), 1u);  // (1001 - 1000) * 500: exact
+  EXPECT_EQ(theo_bias_taus(1001, 16), 164u);    // all n + 1 = floor(1001/6 - 3) + 1, exact cost 1.5e7
   EXPECT_EQ(theo_bias_taus(100000, 16), 64u);
   EXPECT_EQ(theo_bias_taus(100000, 0), 16664u);
   EXPECT_EQ(theo_bias_taus(23, 0), 0u);

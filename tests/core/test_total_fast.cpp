@@ -152,7 +152,7 @@ TEST(TotalFast, UndefinedInputGivesNoTerms) {
   const std::vector<double> x = record(40, 1, 0.3, 1.0, 2.5, 0.0);
   std::vector<double> work(theo1_workspace_size(x.size()));
   Theo1Workspace w = theo1_prepare(x, work);
-  EXPECT_EQ(theo1_fast(w, 3, 1.0).n, 0u);   // odd m
+  EXPECT_EQ(theo1_fast(w, 3, 1.0).n, 0u);  // odd m
   EXPECT_EQ(theo1_fast(w, 0, 1.0).n, 0u);
   EXPECT_EQ(theo1_fast(w, 40, 1.0).n, 0u);  // m > N - 1
   EXPECT_EQ(theo1_fast(w, 10, 0.0).n, 0u);  // tau0 <= 0
@@ -349,7 +349,8 @@ void htot_every_m(const std::vector<double>& x, const char* what) {
     EXPECT_GT(direct.n, 0u);
     EXPECT_EQ(fast.n, direct.n) << what << " m=" << m;
     EXPECT_EQ(fast.stride, 1u);
-    EXPECT_NEAR(fast.var, oracle, scale * mtot_tolerance(y, w, m, oracle / scale)) << what << " N=" << x.size() << " m=" << m;
+    EXPECT_NEAR(fast.var, oracle, scale * mtot_tolerance(y, w, m, oracle / scale))
+        << what << " N=" << x.size() << " m=" << m;
     worst = std::max(worst, std::abs(fast.var / oracle - 1));
   }
   EXPECT_EQ(htotvar_fast(w, scratch, 1, 1.0).n, 0u);  // m = 1: the overlapping Hadamard variance, not this kernel
@@ -370,7 +371,7 @@ TEST(MtotFast, UndefinedInputGivesNoTerms) {
   EXPECT_GT(mtotvar_fast(w, scratch, 13, 1.0).n, 0u);  // 3m = 39 <= N
   EXPECT_EQ(mtotvar_fast(w, scratch, 14, 1.0).n, 0u);  // 3m > N
   EXPECT_EQ(mtotvar_fast(w, scratch, 0, 1.0).n, 0u);
-  EXPECT_EQ(mtotvar_fast(w, scratch, 4, 0.0).n, 0u);   // tau0 <= 0
+  EXPECT_EQ(mtotvar_fast(w, scratch, 4, 0.0).n, 0u);  // tau0 <= 0
   EXPECT_EQ(mtotvar_fast(w, std::span<double>(scratch).first(scratch.size() - 1), 4, 1.0).n, 0u);
   std::vector<double> small(theo1_workspace_size(x.size()) - 1);
   Theo1Workspace none = theo1_prepare(x, small);

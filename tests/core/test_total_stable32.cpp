@@ -78,7 +78,19 @@ double printed(std::uint64_t n) {
   return static_cast<double>((n + unit / 2) / unit * unit);
 }
 
-enum class Kind { totdev, mtotdev, ttotdev, htotdev, theo1, theobr, theo1_fast, theobr_fast, mtotdev_fast, ttotdev_fast, htotdev_fast };
+enum class Kind {
+  totdev,
+  mtotdev,
+  ttotdev,
+  htotdev,
+  theo1,
+  theobr,
+  theo1_fast,
+  theobr_fast,
+  mtotdev_fast,
+  ttotdev_fast,
+  htotdev_fast
+};
 
 // PHASE.DAT prepared for the lag-sum Theo1 and MTOTVAR (total_fast.hpp).
 Theo1Workspace& phase_dat_prepared() {
@@ -196,7 +208,8 @@ TEST(Stable32Total, Stable32Version153ScaledMtotdevByOneOfTwoConstants) {
       double dev = 0;
       EXPECT_EQ(static_cast<double>(compute(kind, phase_dat(), r, dev).n), r.n) << file << " m=" << r.m;
       const double k = r.sigma / dev;
-      EXPECT_TRUE(std::abs(k / 1.1704 - 1) < 1.5e-4 || std::abs(k / 1.0976 - 1) < 1.5e-4) << file << " m=" << r.m << ": " << k;
+      EXPECT_TRUE(std::abs(k / 1.1704 - 1) < 1.5e-4 || std::abs(k / 1.0976 - 1) < 1.5e-4)
+          << file << " m=" << r.m << ": " << k;
     }
   }
 }

@@ -55,7 +55,7 @@ TEST(Wide, AdditionReportsWrapPast2To128) {
   UInt128 acc{~std::uint64_t{0}, ~std::uint64_t{0} - 1};
   EXPECT_FALSE(add_overflows(acc, UInt128{0, 1}));  // reaches exactly 2^128 - 1
   EXPECT_TRUE(acc == (UInt128{~std::uint64_t{0}, ~std::uint64_t{0}}));
-  EXPECT_TRUE(add_overflows(acc, UInt128{1, 0}));   // 2^128 wraps to 0
+  EXPECT_TRUE(add_overflows(acc, UInt128{1, 0}));  // 2^128 wraps to 0
   EXPECT_TRUE(acc == (UInt128{0, 0}));
   std::mt19937_64 rng(3);
   for (int i = 0; i < 100000; ++i) {

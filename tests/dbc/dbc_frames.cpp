@@ -235,7 +235,7 @@ std::vector<Entry> frames() {
       Ieee952ModelMsg{0, 0, 0, false, 0, false, 0, 0, false, 0.0f},
       Ieee952UnconstrainedMsg{255, Ieee952Term::rate_ramp, -FLT_MAX, 1e300},   // uncertainty code 65535 (saturated)
       Ieee952UnconstrainedMsg{0, Ieee952Term::quantization, FLT_MAX, 1e-300},  // code 1 (clamped)
-      Ieee952UnconstrainedMsg{1, Ieee952Term::bias_instability, 0.0f, 0.0},      // no estimate
+      Ieee952UnconstrainedMsg{1, Ieee952Term::bias_instability, 0.0f, 0.0},    // no estimate
       CounterInputMsg{0xFFFFFFFFu, 255, true, true},
       CounterInputMsg{0, 0, false, false},
       CounterInputMsg{123456789, 17, false, true},
@@ -268,9 +268,10 @@ int main(int argc, char** argv) {
     else usage = true;
   }
   if (usage) {
-    std::fprintf(stderr, "usage: gyrochar_dbc_frames [--log FILE] [--expected]\n"
-                         "  prints codec frames (or those of a candump log) as a candump log, or with\n"
-                         "  --expected as JSON with the value of every DBC signal\n");
+    std::fprintf(stderr,
+                 "usage: gyrochar_dbc_frames [--log FILE] [--expected]\n"
+                 "  prints codec frames (or those of a candump log) as a candump log, or with\n"
+                 "  --expected as JSON with the value of every DBC signal\n");
     return 2;
   }
   std::vector<std::tuple<double, std::string, CanFrame>> frames_out;  // time, interface, frame

@@ -507,7 +507,7 @@ TEST(Board, TheWindowFramesCarryTheCurveOfTheWindowCompletedLastWhenTheCycleBega
   auto listener = rig.bus.attach(1 << 16);
   const auto counts = test_counts(2000);
   rig.source.script_counts(rig.clock.now_ns(), ms, counts.data(), counts.size());
-  rig.run_for(2500 * ms);  // the last window completes at 2.0 s, the cycle at 2.4 s sends it
+  rig.run_for(2500 * ms);                    // the last window completes at 2.0 s, the cycle at 2.4 s sends it
   std::optional<protocol::WindowMsg> named;  // the window page of the current slow cycle
   std::map<std::uint32_t, std::unique_ptr<WindowPyramid>> oracles;
   std::size_t compared = 0, before_first = 0;
@@ -610,8 +610,8 @@ TEST(Board, AWindowSurvivesACheckpointAndAWindowlessCheckpointIsAnotherConfigura
         // Beyond the window's taus a curve stays zero (fuzz_checkpoint found a NaN there carried on).
         {curve + at(w0.mvar[29]), std::string(reinterpret_cast<const char*>(&nan), 8), "window: latest.avar/mvar"},
         // One window fewer and its curve renumbered: consistent in itself, 500 samples short.
-        {windows, std::string("\x01\0\0\0\0\0\0\0", 8) + std::string(1, '\x01') + std::string(3, '\0') +
-                      std::string(4, '\0'),
+        {windows,
+         std::string("\x01\0\0\0\0\0\0\0", 8) + std::string(1, '\x01') + std::string(3, '\0') + std::string(4, '\0'),
          "window: samples"},
     };
     for (const Case& k : cases) {

@@ -68,8 +68,8 @@ TEST(BoardMarkov, TheDecodedFitHoldsTheSimulatedMarkovTerm) {
   const auto& tc = *m.parameters[protocol::fit_parameter_position(protocol::FitParameter::markov_tc, 0)];
   const double sigma_deg_h = static_cast<double>(sigma.value);  // arcsec/s is deg/h
   const double tc_s = static_cast<double>(tc.value);
-  std::printf("  Markov: sigma %.4g deg/h +- %.1f %% (%s), Tc %.4g s +- %.1f %%\n", sigma_deg_h,
-              100 * sigma.rel_uncertainty, sigma.resolved ? "resolved" : "not resolved", tc_s, 100 * tc.rel_uncertainty);
+  std::printf("  Markov: sigma %.4g deg/h +- %.1f %% (%s), Tc %.4g s +- %.1f %%\n", sigma_deg_h, 100 * sigma.rel_uncertainty,
+              sigma.resolved ? "resolved" : "not resolved", tc_s, 100 * tc.rel_uncertainty);
   EXPECT_TRUE(sigma.resolved);
   EXPECT_NEAR(sigma_deg_h, 0.5, 0.3 * 0.5);
   EXPECT_NEAR(sigma_deg_h, 0.5, 3 * sigma.rel_uncertainty * sigma_deg_h);

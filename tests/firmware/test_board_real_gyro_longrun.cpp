@@ -102,8 +102,8 @@ TEST(BoardRealGyro, AHumpedCurveIsAcceptedNotRejectedForTheWholeRun) {
   decoder.flush();
   const NodeView& v = decoder.nodes().at(c.node);
   EXPECT_LE(v.health.reports_incomplete, 1u) << "only the report the end of the run cut off";
-  std::printf("real gyro on the board: %zu reports with a fit summary, %zu accepted, %zu rejected; last %s\n",
-              reports, accepted, rejected, last_status.c_str());
+  std::printf("real gyro on the board: %zu reports with a fit summary, %zu accepted, %zu rejected; last %s\n", reports,
+              accepted, rejected, last_status.c_str());
   ASSERT_TRUE(v.ieee952_summary.has_value());
   EXPECT_EQ(v.ieee952_summary->status, protocol::Ieee952Status::ok) << "chi2/dof " << v.ieee952_summary->chi2_per_dof;
   EXPECT_GT(accepted, rejected) << "the node showed 'rejected' most of the run";
@@ -120,8 +120,8 @@ TEST(BoardRealGyro, AHumpedCurveIsAcceptedNotRejectedForTheWholeRun) {
     const auto& tc = *m.parameters[protocol::fit_parameter_position(protocol::FitParameter::markov_tc, j)];
     std::printf("  Markov %u: sigma %.4g deg/h (+-%.1f %%, %s), Tc %.4g s (+-%.1f %%)\n", j + 1,
                 static_cast<double>(sigma.value) * 1.0,  // arcsec/s = deg/h
-                100 * sigma.rel_uncertainty, sigma.resolved ? "resolved" : "not resolved",
-                static_cast<double>(tc.value), 100 * tc.rel_uncertainty);
+                100 * sigma.rel_uncertainty, sigma.resolved ? "resolved" : "not resolved", static_cast<double>(tc.value),
+                100 * tc.rel_uncertainty);
     EXPECT_GT(sigma.value, 0.0f);
     EXPECT_GT(tc.value, 0.02f);
     EXPECT_LT(tc.value, 5243.0f);

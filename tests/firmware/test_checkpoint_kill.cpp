@@ -186,7 +186,7 @@ enum Start { resumed = 1, fresh = 0, refused = 2 };
 // `last` waits for its kill once its data are done: on a fast machine a run could otherwise finish
 // the record before its kill and end the test with fewer kills than it asks for.
 [[noreturn]] void run_child(const std::string& dir, int ready, bool last, bool power_loss = false,
-                           bool drop_file_fsync = false) {
+                            bool drop_file_fsync = false) {
   if (power_loss) powerloss::arm(dir, drop_file_fsync);
   const Config c = kill_config(dir);
   hal::FakeCanBus bus;
@@ -196,8 +196,9 @@ enum Start { resumed = 1, fresh = 0, refused = 2 };
   hal::FakeCountSource source;
   Board board(c, BoardIo{*node, &source, clock, timer});
   const std::string said = board.resume();
-  const Start start = said.find("resumed") != std::string::npos ? resumed
-                      : said.find("no checkpoint") != std::string::npos ? fresh : refused;
+  const Start start = said.find("resumed") != std::string::npos         ? resumed
+                      : said.find("no checkpoint") != std::string::npos ? fresh
+                                                                        : refused;
   std::uint64_t restarts = 0;
   {
     std::ifstream log(dir + "/segments");
@@ -229,9 +230,9 @@ enum Start { resumed = 1, fresh = 0, refused = 2 };
 struct Tally {
   int runs = 0, kills = 0;
   int resumed = 0, fresh = 0, refused = 0;  // how the runs that got to log their start started
-  int fresh_after_resume = 0;  // fresh starts after a resume: a durable checkpoint was lost
-  int during_write = 0;        // kills that left the temporary file: inside CheckpointFile::write()
-  int dropped = 0;             // power cuts that dropped something not yet durable
+  int fresh_after_resume = 0;               // fresh starts after a resume: a durable checkpoint was lost
+  int during_write = 0;                     // kills that left the temporary file: inside CheckpointFile::write()
+  int dropped = 0;                          // power cuts that dropped something not yet durable
 };
 
 // Runs until one completes, killing the first `kills` runs at random instants (and, with power
@@ -325,10 +326,11 @@ Tally kill_and_check(const std::string& name, int kills_wanted, bool power_loss,
       EXPECT_TRUE(((oracle::u128{got.sum[s].hi} << 64) | got.sum[s].lo) == want.sum[s]) << "m=" << got.m << " stat=" << s;
     }
   }
-  std::printf("%s: %d runs, %d killed (%d inside a checkpoint write, %d power cuts dropped unsynced data); of the %zu "
-              "that logged their start %d resumed, %d fresh (%d after a resume), %d refused; %zu segments kept\n",
-              name.c_str(), t.runs, t.kills, t.during_write, t.dropped, log.size(), t.resumed, t.fresh,
-              t.fresh_after_resume, t.refused, segments.size());
+  std::printf(
+      "%s: %d runs, %d killed (%d inside a checkpoint write, %d power cuts dropped unsynced data); of the %zu "
+      "that logged their start %d resumed, %d fresh (%d after a resume), %d refused; %zu segments kept\n",
+      name.c_str(), t.runs, t.kills, t.during_write, t.dropped, log.size(), t.resumed, t.fresh, t.fresh_after_resume,
+      t.refused, segments.size());
   if (!getenv("KEEP")) std::system(("rm -rf " + dir).c_str());
   return t;
 }

@@ -87,8 +87,8 @@ TEST(GyrochardStart, TheConfigurationFileIsCheckedLineByLine) {
 TEST(GyrochardStart, ConfigurationIsCheckedBeforeAnyHardware) {
   // Both wrong: the configuration is reported (2), not the missing interface (3).
   expect("--source can-counter --can-interface nosuchcan9 --octaves 0", exit_code::bad_input, "octaves: ");
-  expect("--source can-counter --can-interface nosuchcan9 --checkpoint /nonexistent-dir/run.ckpt",
-         exit_code::bad_input, "checkpoint: /nonexistent-dir: No such file or directory");
+  expect("--source can-counter --can-interface nosuchcan9 --checkpoint /nonexistent-dir/run.ckpt", exit_code::bad_input,
+         "checkpoint: /nonexistent-dir: No such file or directory");
   const std::string file = conf_file("plain_file", "");
   expect("--source can-counter --can-interface nosuchcan9 --checkpoint " + file + "/run.ckpt", exit_code::bad_input,
          "checkpoint: " + file + ": not a directory");

@@ -55,7 +55,8 @@ void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, 
   // 0.136 %; none where the term was not free. A verdict judges it as gyrochar-analyze does
   // (acceptance.cpp: normal_estimate(unconstrained, unconstrained_uncertainty)), in SI: the wire's
   // angle unit here is the arcsec.
-  const std::vector<Limit> limits = parse_limits("Q <= 1 arcsec\nN <= 1 rad/s^0.5\nB <= 1 rad/s\nK <= 1 rad/s^1.5\nR <= 1 rad/s^2\n");
+  const std::vector<Limit> limits = parse_limits(
+      "Q <= 1 arcsec\nN <= 1 rad/s^0.5\nB <= 1 rad/s\nK <= 1 rad/s^1.5\nR <= 1 rad/s^2\n");
   const std::vector<Decision> decisions = decoding::node_decisions(v, limits);
   std::size_t unconstrained = 0;
   for (std::size_t k = 0; k < 5; ++k) {
@@ -77,7 +78,8 @@ void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, 
     const double value = static_cast<double>(static_cast<float>(p.unconstrained)) * units::arcsec;
     EXPECT_DOUBLE_EQ(e.value, value) << k;
     EXPECT_NEAR(e.high - e.value, decision_z * p.unconstrained_uncertainty * units::arcsec,
-                0.00136 * decision_z * p.unconstrained_uncertainty * units::arcsec) << k;
+                0.00136 * decision_z * p.unconstrained_uncertainty * units::arcsec)
+        << k;
   }
   EXPECT_GE(unconstrained, fit.ok() ? 1u : 0u) << "an accepted fit has free terms";
   if (fit.ok() && fit.p[1].resolved && fit.p[1].unconstrained_uncertainty > 0) {
@@ -92,12 +94,15 @@ void expect_decoded_fit_is_the_boards(const NodeView& v, const Ieee952Fit& fit, 
   EXPECT_EQ(m.model->bandwidth, fit.bandwidth_tc_s > 0);
   EXPECT_EQ(m.model->runner_up, fit.chosen.valid && fit.runner_up.valid);
   for (std::size_t j = 0; j < fit.n_markov; ++j) {
-    const auto& sigma = *m.parameters[protocol::fit_parameter_position(protocol::FitParameter::markov_sigma, static_cast<std::uint8_t>(j))];
-    const auto& tc = *m.parameters[protocol::fit_parameter_position(protocol::FitParameter::markov_tc, static_cast<std::uint8_t>(j))];
+    const auto& sigma =
+        *m.parameters[protocol::fit_parameter_position(protocol::FitParameter::markov_sigma, static_cast<std::uint8_t>(j))];
+    const auto& tc =
+        *m.parameters[protocol::fit_parameter_position(protocol::FitParameter::markov_tc, static_cast<std::uint8_t>(j))];
     EXPECT_EQ(sigma.value, static_cast<float>(fit.markov[j].sigma.value)) << j;
     EXPECT_EQ(sigma.resolved, fit.ok() && fit.markov[j].sigma.resolved) << j;
     EXPECT_NEAR(sigma.rel_uncertainty, std::min(fit.markov[j].sigma.uncertainty / fit.markov[j].sigma.value, 6.5535),
-                0.5e-4 + 1e-12) << j;
+                0.5e-4 + 1e-12)
+        << j;
     EXPECT_EQ(tc.value, static_cast<float>(fit.markov[j].tc_s)) << j;
   }
   if (fit.bandwidth_tc_s > 0) {
@@ -225,12 +230,12 @@ TEST(ReportEndToEnd, PeriodicQuantizationReachesTheDecoderAsTheBoardsFitSaysIt) 
 
 TEST(ReportSchedule, RefitWhenTheRunHasGrownByAQuarterOrByFifteenMinutes) {
   // Oracle: the rule as report.hpp states it, worked by hand.
-  EXPECT_TRUE(firmware::refit_due(1000, 0, 0.01));      // no fit yet
-  EXPECT_FALSE(firmware::refit_due(1249, 1000, 0.01));  // grown 24.9 %
-  EXPECT_TRUE(firmware::refit_due(1250, 1000, 0.01));   // grown 25 %
+  EXPECT_TRUE(firmware::refit_due(1000, 0, 0.01));                // no fit yet
+  EXPECT_FALSE(firmware::refit_due(1249, 1000, 0.01));            // grown 24.9 %
+  EXPECT_TRUE(firmware::refit_due(1250, 1000, 0.01));             // grown 25 %
   EXPECT_FALSE(firmware::refit_due(1'089'999, 1'000'000, 0.01));  // 899.99 s more, 9 %
   EXPECT_TRUE(firmware::refit_due(1'090'000, 1'000'000, 0.01));   // 900 s more
-  EXPECT_TRUE(firmware::refit_due(10, 1000, 0.01));     // fewer samples than the fit: a new run
+  EXPECT_TRUE(firmware::refit_due(10, 1000, 0.01));               // fewer samples than the fit: a new run
 }
 
 TEST(ReportSchedule, EveryReportOfACycleCarriesTheFitTakenAtItsStartWithItsOwnSeq) {

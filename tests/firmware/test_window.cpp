@@ -24,8 +24,8 @@ std::vector<std::int32_t> counts(std::size_t n, std::uint64_t seed = 11) {
 
 /// The oracle: octave taus 1 .. 2^(taus-1), fed [begin, end) of `c`, with a gap before the
 /// samples listed in `gaps_before`.
-std::unique_ptr<WindowPyramid> direct(const std::vector<std::int32_t>& c, std::size_t begin, std::size_t end,
-                                      unsigned taus, const std::vector<std::size_t>& gaps_before = {}) {
+std::unique_ptr<WindowPyramid> direct(const std::vector<std::int32_t>& c, std::size_t begin, std::size_t end, unsigned taus,
+                                      const std::vector<std::size_t>& gaps_before = {}) {
   auto p = std::make_unique<WindowPyramid>();
   std::vector<std::uint64_t> m;
   for (unsigned k = 0; k < taus; ++k) m.push_back(std::uint64_t{1} << k);
@@ -60,10 +60,10 @@ void expect_curve(const WindowCurve& w, const WindowPyramid& oracle) {
 
 TEST(Window, TausReachAQuarterOfTheWindow) {
   EXPECT_EQ(window_taus(32, 3), 0u);
-  EXPECT_EQ(window_taus(32, 4), 1u);                     // m = 1: 4 m <= 4
-  EXPECT_EQ(window_taus(32, 1000), 8u);                  // m = 128: 512 <= 1000 < 1024
+  EXPECT_EQ(window_taus(32, 4), 1u);     // m = 1: 4 m <= 4
+  EXPECT_EQ(window_taus(32, 1000), 8u);  // m = 128: 512 <= 1000 < 1024
   EXPECT_EQ(window_taus(32, 1024), 9u);
-  EXPECT_EQ(window_taus(5, 1000000), 5u);                // no more than the node's taus
+  EXPECT_EQ(window_taus(5, 1000000), 5u);                               // no more than the node's taus
   EXPECT_EQ(window_taus(40, std::uint64_t{1} << 39), max_window_taus);  // nor than the capacity
 }
 

@@ -93,8 +93,8 @@ void write_seeds(const char* dir) {
     const std::string path = std::string(dir) + "/real_" + std::to_string(samples);
     std::FILE* f = std::fopen(path.c_str(), "wb");
     const std::uint8_t recompute = 0;
-    if (f == nullptr || std::fwrite(&recompute, 1, 1, f) != 1 || std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size() ||
-        std::fclose(f) != 0)
+    if (f == nullptr || std::fwrite(&recompute, 1, 1, f) != 1 ||
+        std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size() || std::fclose(f) != 0)
       std::abort();
   }
 }

@@ -128,9 +128,9 @@ TEST(Quadrature, ShortSilenceIsZerosALongOneIsOneGap) {
 TEST(Strobe, CountsAreCounterDifferencesModuloItsWidth) {
   StrobeDecoder d({10 * ms, 16});
   Recorder r;
-  d.on_strobe(0, 65530, r);  // reference
-  d.on_strobe(10 * ms, 4, r);        // wrapped: +10
-  d.on_strobe(20 * ms, 65534, r);    // backwards: -6
+  d.on_strobe(0, 65530, r);        // reference
+  d.on_strobe(10 * ms, 4, r);      // wrapped: +10
+  d.on_strobe(20 * ms, 65534, r);  // backwards: -6
   ASSERT_EQ(r.samples.size(), 2u);
   EXPECT_EQ(r.samples[0].count, 10);
   EXPECT_EQ(r.samples[1].count, -6);
@@ -140,7 +140,7 @@ TEST(Strobe, MissedStrobesAreAGapAndGlitchesAreIgnored) {
   StrobeDecoder d({10 * ms, 32});
   Recorder r;
   d.on_strobe(0, 100, r);
-  d.on_strobe(2 * ms, 101, r);   // glitch: ignored
+  d.on_strobe(2 * ms, 101, r);  // glitch: ignored
   d.on_strobe(10 * ms, 110, r);
   d.on_strobe(40 * ms, 140, r);  // two strobes missed
   d.on_strobe(50 * ms, 150, r);
@@ -167,10 +167,10 @@ TEST(CanCounter, SequenceJumpsAndErrorFlagsAreGapsWrapIsNot) {
   Recorder r;
   EXPECT_TRUE(d.on_frame(counter_frame(0x80, 0xFFFFFFF0u, 255), 0, r));
   EXPECT_FALSE(d.on_frame(counter_frame(0x81, 5, 0), 0, r)) << "another node's frames are not ours";
-  EXPECT_TRUE(d.on_frame(counter_frame(0x80, 0x10, 0), 0, r));   // wraps: +32
-  EXPECT_TRUE(d.on_frame(counter_frame(0x80, 0x20, 3), 0, r));   // seq 1, 2 lost
+  EXPECT_TRUE(d.on_frame(counter_frame(0x80, 0x10, 0), 0, r));  // wraps: +32
+  EXPECT_TRUE(d.on_frame(counter_frame(0x80, 0x20, 3), 0, r));  // seq 1, 2 lost
   EXPECT_TRUE(d.on_frame(counter_frame(0x80, 0x30, 4, true), 0, r));
-  EXPECT_TRUE(d.on_frame(counter_frame(0x80, 0x2C, 5), 0, r));   // -4
+  EXPECT_TRUE(d.on_frame(counter_frame(0x80, 0x2C, 5), 0, r));  // -4
   ASSERT_EQ(r.samples.size(), 4u);
   EXPECT_EQ(r.samples[0].count, 32);
   EXPECT_TRUE(r.samples[1].gap);

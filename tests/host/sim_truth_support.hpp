@@ -47,10 +47,9 @@ inline Measured simulate(const SimOptions& o, std::uint64_t n, std::uint64_t m_m
 // the white FM of the angle random walk, the random-walk FM).
 inline oracle::NoiseLevels levels(const SimOptions& o) {
   const double w = o.pulse_arcsec;
-  const double arw_arcsec = 60 * o.arw_deg_per_sqrt_h;       // deg/sqrt(h) = 60 arcsec/sqrt(s)
-  const double rrw_arcsec = o.rrw_deg_per_h_sqrt_h / 60;     // deg/h/sqrt(h) = arcsec/s/(60 sqrt(s))
-  return {(o.white_angle_arcsec * o.white_angle_arcsec + w * w / 12) / (w * w),
-          arw_arcsec * arw_arcsec * o.tau0_s / (w * w),
+  const double arw_arcsec = 60 * o.arw_deg_per_sqrt_h;    // deg/sqrt(h) = 60 arcsec/sqrt(s)
+  const double rrw_arcsec = o.rrw_deg_per_h_sqrt_h / 60;  // deg/h/sqrt(h) = arcsec/s/(60 sqrt(s))
+  return {(o.white_angle_arcsec * o.white_angle_arcsec + w * w / 12) / (w * w), arw_arcsec * arw_arcsec * o.tau0_s / (w * w),
           rrw_arcsec * rrw_arcsec * o.tau0_s * o.tau0_s * o.tau0_s / (w * w)};
 }
 
@@ -78,9 +77,9 @@ inline void expect_consistent(const Measured& r, const SimOptions& o, ClosedForm
     const double tau = r.tau_s(i), truth = closed(o, tau);
     const double edf = oracle::avar_edf(levels(o), r.avar.m(i), r.avar.terms(i));
     const oracle::Range range = oracle::chi2_range(r.avar_dph2(i), edf, p_false);
-    EXPECT_TRUE(range.contains(truth)) << "m=" << r.avar.m(i) << " ADEV " << std::sqrt(r.avar_dph2(i))
-                                       << " closed form " << std::sqrt(truth) << " interval " << std::sqrt(range.low)
-                                       << " .. " << std::sqrt(range.high) << " (EDF " << edf << ")";
+    EXPECT_TRUE(range.contains(truth)) << "m=" << r.avar.m(i) << " ADEV " << std::sqrt(r.avar_dph2(i)) << " closed form "
+                                       << std::sqrt(truth) << " interval " << std::sqrt(range.low) << " .. "
+                                       << std::sqrt(range.high) << " (EDF " << edf << ")";
     if (print)
       std::printf("  m %7llu  tau %9.3f s  ADEV %.6g  closed %.6g  ratio %.5f +- %.5f\n",
                   static_cast<unsigned long long>(r.avar.m(i)), tau, std::sqrt(r.avar_dph2(i)), std::sqrt(truth),

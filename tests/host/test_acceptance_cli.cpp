@@ -189,8 +189,8 @@ TEST(AcceptanceCli, ReportIsSelfContained) {
   EXPECT_NE(html.find("@media print"), std::string::npos);
   EXPECT_EQ(std::count(html.begin(), html.end(), '<') - std::count(html.begin(), html.end(), '>'), 0)
       << "every tag closed on its line (no stray bracket)";
-  for (const char* id : {"id=\"provenance-facts\"", "id=\"verdicts\"", "id=\"fit\"", "id=\"readoff\"",
-                         "id=\"stat-oadev\"", "id=\"stat-mdev\"", "id=\"stat-tdev\"", "<svg class=\"plot\""})
+  for (const char* id : {"id=\"provenance-facts\"", "id=\"verdicts\"", "id=\"fit\"", "id=\"readoff\"", "id=\"stat-oadev\"",
+                         "id=\"stat-mdev\"", "id=\"stat-tdev\"", "<svg class=\"plot\""})
     EXPECT_NE(html.find(id), std::string::npos) << id;
   EXPECT_LT(html.size(), 2u << 20) << "under 2 MB";
   EXPECT_EQ(access((report + ".part").c_str(), F_OK), -1) << "the temporary file is renamed";
@@ -213,7 +213,8 @@ TEST(AcceptanceCli, ReportRefusesToOverwriteAnInput) {
 TEST(AcceptanceCli, DecoderGivesVerdictsAndReportPerNode) {
   // The demo's two simulated gyros for 20 minutes, decoded from its candump log.
   const std::string log = temp("demo.log");
-  Outcome r = run_shell(demo + " --hours 0.34 --window 0 --view-every 0 --csv '' --plot '' --candump " + log + " > /dev/null");
+  Outcome r = run_shell(demo + " --hours 0.34 --window 0 --view-every 0 --csv '' --plot '' --candump " + log +
+                        " > /dev/null");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string lim = file_with("decode_limits.txt", "N <= 1 deg/sqrt(h)\nadev(10.24 s) <= 1e-9 deg/h\n");
   const std::string report = temp("decode_report.html"), jsonl = temp("decode.jsonl"), summary = temp("decode_summary.csv");
@@ -246,10 +247,8 @@ TEST(AcceptanceCli, DecoderGivesVerdictsAndReportPerNode) {
 std::vector<std::string> csv_fields(const std::string& line) {
   std::vector<std::string> f(1);
   for (const char c : line) {
-    if (c == ',')
-      f.emplace_back();
-    else
-      f.back().push_back(c);
+    if (c == ',') f.emplace_back();
+    else f.back().push_back(c);
   }
   return f;
 }
@@ -265,15 +264,16 @@ std::vector<std::string> csv_fields(const std::string& line) {
 // frames) must carry the same verdict columns as the decoder's.
 TEST(AcceptanceCli, DecoderJudgesEveryReportInCsvAndJsonLines) {
   const std::string log = temp("demo_judged.log"), demo_csv = temp("demo_judged.csv");
-  const std::string lim = file_with("judged_limits.txt", "N <= 1 deg/sqrt(h)\nadev(10.24 s) <= 1e-9 deg/h\nB <= 1e3 deg/h\n");
+  const std::string lim = file_with("judged_limits.txt",
+                                    "N <= 1 deg/sqrt(h)\nadev(10.24 s) <= 1e-9 deg/h\nB <= 1e3 deg/h\n");
   Outcome r = run_shell(demo + " --hours 0.34 --window 0 --view-every 0 --csv " + demo_csv + " --limits " + lim +
                         " --plot '' --candump " + log + " > /dev/null");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string csv = temp("judged.csv"), plain = temp("plain.csv"), jsonl = temp("judged.jsonl"),
                     summary = temp("judged_summary.csv");
   std::remove(summary.c_str());
-  r = run_shell(decode + " " + log + " --view none --limits " + lim + " --csv " + csv + " --jsonl " + jsonl +
-                " --summary " + summary);
+  r = run_shell(decode + " " + log + " --view none --limits " + lim + " --csv " + csv + " --jsonl " + jsonl + " --summary " +
+                summary);
   ASSERT_EQ(r.code, 0) << r.err;
   r = run_shell(decode + " " + log + " --view none --csv " + plain);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -350,8 +350,8 @@ TEST(AcceptanceCli, DecoderJudgesEveryReportInCsvAndJsonLines) {
           ++adev_rows;
           EXPECT_NEAR(std::stod(row[column("tau_s")]), 10.24, 1e-5) << "a deviation limit on its tau's row only";
         }
-        for (const std::string& c : {std::string(" verdict"), " estimate [" + unit + "]", std::string(" lower"),
-                                     std::string(" upper")})
+        for (const std::string& c :
+             {std::string(" verdict"), " estimate [" + unit + "]", std::string(" lower"), std::string(" upper")})
           EXPECT_EQ(row[column(q + c)], want.at(q + c)) << q + c;
       }
     }
@@ -402,7 +402,8 @@ TEST(AcceptanceCli, DecoderJudgesEveryReportInCsvAndJsonLines) {
 TEST(AcceptanceCli, DecoderRefusesABadLimitsFileAndWritesNothing) {
   const std::string csv = file_with("kept.csv", "an earlier run's CSV\n");
   const std::string bad = file_with("bad_for_csv.txt", "N <= 0.003 deg/sqrt(h)\nadev(0 s) <= 1 deg/h\n");
-  const Outcome r = run_shell(decode + " " + counts() + " --limits " + bad + " --csv " + csv + " --jsonl " + temp("none.jsonl"));
+  const Outcome r = run_shell(decode + " " + counts() + " --limits " + bad + " --csv " + csv + " --jsonl " +
+                              temp("none.jsonl"));
   EXPECT_EQ(r.code, exit_code::bad_input) << r.err;
   EXPECT_TRUE(std::regex_match(r.err, std::regex("gyrochar-decode: --limits: [^\n]+: line 2: [^\n]+\n"))) << r.err;
   EXPECT_EQ(slurp(csv), "an earlier run's CSV\n");
@@ -454,7 +455,8 @@ TEST(AcceptanceCli, DecoderReportHasTheViewsModelAndWindow) {
       shown.push_back(std::stod((*it)[1]));
     const auto rows = table(id + "-window");
     ASSERT_EQ(rows.size(), shown.size()) << id << ": " << window_lines[k];
-    for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_NEAR(rows[i][1], shown[i], 5e-4 * shown[i]) << id << " window tau " << i;
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      EXPECT_NEAR(rows[i][1], shown[i], 5e-4 * shown[i]) << id << " window tau " << i;
     // Each Markov term's sigma and Tc, as the view prints them (%.4g).
     std::smatch m;
     const std::regex markov_re(R"re(Markov 1: sigma ([0-9.e+-]+) \S+ .*?Tc ([0-9.e+-]+) s)re");

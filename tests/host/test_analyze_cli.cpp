@@ -133,8 +133,9 @@ TEST(AnalyzeCli, NonFiniteResultsAreErrorsWithTheirCause) {
   for (int i = 0; i < 8; ++i) huge += i % 2 ? "-1e308\n" : "1e308\n";
   expect_bad_input("--type phase --tau0 1 " + file_with("huge.txt", huge),
                    "oadev at tau = 1 s (m = 1): the squared differences of the values overflow a double");
-  expect_bad_input("--type phase --tau0 1e-200 --format json " + good_phase(),
-                   "oadev at tau = 1e-200 s (m = 1): tau0^2 = (1e-200 s)^2 is outside the range of a double: tau0 is too small");
+  expect_bad_input(
+      "--type phase --tau0 1e-200 --format json " + good_phase(),
+      "oadev at tau = 1e-200 s (m = 1): tau0^2 = (1e-200 s)^2 is outside the range of a double: tau0 is too small");
   // Finite deviations, but the output unit takes them out of range (1e308 arcsec pulses in deg/h).
   expect_bad_input("--type counts --pulse-weight 1e308arcsec --tau0 1 " + file_with("c.txt", "100\n-100\n100\n-100\n100\n"),
                    "oadev at tau = 1 s (m = 1): ");
@@ -185,8 +186,8 @@ TEST(AnalyzeCli, CollapsedResultsAreErrorsWithTheirCause) {
                    "underflows a double");
   // Constant inputs: zeros by right, and a note.
   const char* line = "a straight line (a constant frequency)";
-  for (const auto& [type, values, shape] : {std::tuple{"freq", constant, "constant"}, std::tuple{"phase", constant, line},
-                                            std::tuple{"phase", ramp, line}}) {
+  for (const auto& [type, values, shape] :
+       {std::tuple{"freq", constant, "constant"}, std::tuple{"phase", constant, line}, std::tuple{"phase", ramp, line}}) {
     const Outcome r = run(std::string("--type ") + type + " --tau0 1 --format csv " + file_with("flat.txt", values));
     EXPECT_EQ(r.code, exit_code::ok) << r.err;
     EXPECT_EQ(r.err, std::string("gyrochar-analyze: note: every deviation is 0: the values are ") + shape + "\n");
@@ -215,7 +216,10 @@ TEST(AnalyzeCli, EachStatisticOnceAndListedTausTooLongForTheDataGetANote) {
 TEST(AnalyzeCli, KalibrYamlHoldsTheFitsNAndKInSI) {
   const std::string counts = temp("sim_counts.txt"), yaml = temp("imu.yaml");
   ASSERT_EQ(std::system((GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim --duration 2000 --tau0 0.01 --arw 0.003 "
-                         "--rrw 0.5 --white-angle 2 --seed 3 --out " + counts).c_str()), 0);
+                                             "--rrw 0.5 --white-angle 2 --seed 3 --out " +
+                         counts)
+                            .c_str()),
+            0);
   const Outcome r = run("--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --format json --kalibr " + yaml +
                         " " + counts);
   ASSERT_EQ(r.code, exit_code::ok) << r.err;
@@ -233,8 +237,7 @@ TEST(AnalyzeCli, KalibrYamlHoldsTheFitsNAndKInSI) {
 
   expect_bad_input("--type counts --tau0 0.01 --pulse-weight 1arcsec --kalibr " + yaml + " " + counts,
                    "--kalibr: needs --fit ieee952");
-  expect_bad_input("--type phase --tau0 1 --fit ieee952 --kalibr " + yaml + " " + good_phase(),
-                   "--kalibr: needs gyro data");
+  expect_bad_input("--type phase --tau0 1 --fit ieee952 --kalibr " + yaml + " " + good_phase(), "--kalibr: needs gyro data");
 }
 
 // A gyro with white rate noise alone (the simulator's ARW and white angle noise: no rate random
@@ -244,7 +247,10 @@ TEST(AnalyzeCli, KalibrYamlHoldsTheFitsNAndKInSI) {
 TEST(AnalyzeCli, KalibrWithoutKWritesWhatTheFitHasAndPrintsTheAnalysis) {
   const std::string counts = temp("sim_arw.txt"), yaml = temp("imu_arw.yaml");
   ASSERT_EQ(std::system((GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim --duration 2000 --tau0 0.01 --arw 0.003 "
-                         "--white-angle 2 --seed 3 --out " + counts).c_str()), 0);
+                                             "--white-angle 2 --seed 3 --out " +
+                         counts)
+                            .c_str()),
+            0);
   const Outcome r = run("--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --format json --kalibr " + yaml +
                         " " + counts);
   ASSERT_EQ(r.code, exit_code::ok) << r.err;
@@ -253,8 +259,9 @@ TEST(AnalyzeCli, KalibrWithoutKWritesWhatTheFitHasAndPrintsTheAnalysis) {
   ASSERT_FALSE(fit["K"]["fitted"].get<bool>()) << fit.dump();
   // The first note is this test's; a second one may name what else of the model Kalibr cannot hold.
   EXPECT_EQ(r.err.substr(0, r.err.find('\n') + 1),
-            "gyrochar-analyze: note: " + yaml + ": K (rate random walk) is not in the fitted model: its key is "
-            "written commented out with '?' for you to fill in (Kalibr needs it > 0)\n");
+            "gyrochar-analyze: note: " + yaml +
+                ": K (rate random walk) is not in the fitted model: its key is "
+                "written commented out with '?' for you to fill in (Kalibr needs it > 0)\n");
   std::ifstream in(yaml);
   const std::string text((std::istreambuf_iterator<char>(in)), {});
   const auto at = text.find("\ngyroscope_noise_density: ");
@@ -327,7 +334,10 @@ TEST(AnalyzeCli, ReadoffOfARealGyroIsWhatADataSheetPrints) {
 TEST(AnalyzeCli, ReadoffSaysWhereItDisagreesWithTheFit) {
   const std::string counts = temp("sim_readoff.txt");
   ASSERT_EQ(std::system((GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim --duration 2000 --tau0 0.01 --arw 0.003 "
-                         "--rrw 0.5 --white-angle 2 --seed 3 --out " + counts).c_str()), 0);
+                                             "--rrw 0.5 --white-angle 2 --seed 3 --out " +
+                         counts)
+                            .c_str()),
+            0);
   const std::string args = "--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 ";
   const Outcome r = run(args + "--format json " + counts);
   ASSERT_EQ(r.code, exit_code::ok) << r.err;
@@ -365,8 +375,8 @@ TEST(AnalyzeCli, ReadoffSaysWhereItDisagreesWithTheFit) {
 // intervals use the exact EDF, Stable32's Greenhall's approximation: within 5 % here.)
 TEST(AnalyzeCli, Stable32TablesHaveStable32sLayout) {
   for (const std::string stat : {"oadev", "mdev"}) {
-    const Outcome r = run("--type phase --tau0 1 --alpha 0 --format stable32 --stats " + stat + " " GYROCHAR_TEST_DATA
-                          "/phasedat/PHASE.DAT");
+    const Outcome r = run("--type phase --tau0 1 --alpha 0 --format stable32 --stats " + stat +
+                          " " GYROCHAR_TEST_DATA "/phasedat/PHASE.DAT");
     ASSERT_EQ(r.code, exit_code::ok) << r.err;
     std::ifstream ref(GYROCHAR_TEST_DATA "/phasedat/phase_dat_" + stat + "_octave.txt");
     std::vector<std::string> want, got;
@@ -381,7 +391,8 @@ TEST(AnalyzeCli, Stable32TablesHaveStable32sLayout) {
     for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(got[i], want[i]) << stat << " header line " << i;
     std::size_t compared = 0;
     for (std::size_t i = 10; i < want.size(); ++i) {
-      const auto row = std::find_if(got.begin() + 10, got.end(), [&](const std::string& g) { return g.substr(0, 5) == want[i].substr(0, 5); });
+      const auto row = std::find_if(got.begin() + 10, got.end(),
+                                    [&](const std::string& g) { return g.substr(0, 5) == want[i].substr(0, 5); });
       if (row == got.end()) continue;
       ++compared;
       ASSERT_EQ(row->size(), want[i].size()) << *row << "\n" << want[i];
@@ -414,8 +425,9 @@ TEST(AnalyzeCli, TotalFamilyInEveryFormat) {
   std::string s;
   for (const int c : white_rate_counts()) s += std::to_string(c) + "\n";
   const std::string path = file_with("white_total.txt", s);
-  const std::string args = "--type counts --tau0 0.001 --pulse-weight 1arcsec --rate-unit deg/h "
-                           "--stats oadev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh ";
+  const std::string args =
+      "--type counts --tau0 0.001 --pulse-weight 1arcsec --rate-unit deg/h "
+      "--stats oadev,totdev,mtotdev,ttotdev,htotdev,theo1,theoh ";
   const Outcome table = run(args + path);
   ASSERT_EQ(table.code, 0) << table.err;
   for (const char* stat : {"\ntotdev ", "\nmtotdev ", "\nttotdev ", "\nhtotdev ", "\ntheo1 ", "\ntheoh "})
@@ -429,7 +441,8 @@ TEST(AnalyzeCli, TotalFamilyInEveryFormat) {
   const auto j = nlohmann::json::parse(js.out);
   std::map<std::string, std::vector<nlohmann::json>> by_stat;
   for (const auto& row : j["results"]) by_stat[row["stat"]].push_back(row);
-  for (const char* stat : {"totdev", "mtotdev", "ttotdev", "htotdev", "theo1", "theoh"}) EXPECT_GT(by_stat[stat].size(), 5u) << stat;
+  for (const char* stat : {"totdev", "mtotdev", "ttotdev", "htotdev", "theo1", "theoh"})
+    EXPECT_GT(by_stat[stat].size(), 5u) << stat;
   const double adev1 = by_stat["oadev"][0]["dev"];  // deg/h at m = 1
   EXPECT_NEAR(by_stat["totdev"][0]["dev"].get<double>() / adev1, 1.0, 0.02);
   for (const auto& row : by_stat["theo1"]) {  // 1/sqrt(tau) from ADEV at m = 1, within 25 % (EDF >= 30 here)
@@ -515,12 +528,13 @@ TEST(AnalyzeCli, MtotRowsAreExactUnlessTheDecimatedEstimatorIsAsked) {
         scratch.resize(gyrochar::total_scratch_size(m, 1));
         const double md = static_cast<double>(m);
         // HTOTDEV carries Stable32's white-FM bias correction (alpha 0) from m = 2 on.
-        const double exact = stat == "htotdev" ? gyrochar::htotvar(x, 1, m, 1.0, scratch).var / gyrochar::htotvar_bias(0, m)
-                                               : gyrochar::mtotvar(x, 1, m, 1.0, scratch).var * (stat == "ttotdev" ? md * md / 3 : 1.0);
+        const double exact = stat == "htotdev"
+                                 ? gyrochar::htotvar(x, 1, m, 1.0, scratch).var / gyrochar::htotvar_bias(0, m)
+                                 : gyrochar::mtotvar(x, 1, m, 1.0, scratch).var * (stat == "ttotdev" ? md * md / 3 : 1.0);
         EXPECT_NEAR(row["dev"].get<double>() / std::sqrt(exact), 1.0, 1e-9) << stat << " m=" << m;  // two summation orders
       }
     }
-    EXPECT_EQ(rows, 3 * 12);                     // m = 1 .. 2048 for each
+    EXPECT_EQ(rows, 3 * 12);                    // m = 1 .. 2048 for each
     EXPECT_EQ(strided, decimated ? 3 * 3 : 0);  // m = 512, 1024 and 2048
   }
 }
@@ -538,7 +552,7 @@ TEST(AnalyzeCli, JsonHasTheDocumentedShape) {
   EXPECT_EQ(j["tau0"], 1.0);
   EXPECT_EQ(j["n_samples"], 200);
   EXPECT_EQ(j["type"], "phase");
-  EXPECT_FALSE(j.contains("fit"));  // only when asked
+  EXPECT_FALSE(j.contains("fit"));      // only when asked
   EXPECT_FALSE(j.contains("readoff"));  // gyro data only
   ASSERT_FALSE(j["results"].empty());
   for (const auto& row : j["results"]) {
@@ -618,15 +632,18 @@ TEST(AnalyzeCli, FitRecoversTheAngleRandomWalkOfWhiteRateNoise) {
     ASSERT_TRUE(fit["N"]["resolved"].get<bool>()) << fit["curve"];
     EXPECT_NEAR(fit["N"]["value"].get<double>(), n_true, 3 * fit["N"]["uncertainty"].get<double>()) << fit["curve"];
   }
-  const Outcome table = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 " + temp("white.txt"));
+  const Outcome table = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 " +
+                            temp("white.txt"));
   EXPECT_NE(table.out.find("IEEE-952 fit of both curves (recommended)"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("IEEE-952 fit of the Allan curve alone"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("deg/sqrt(h)"), std::string::npos) << table.out;
   // With TOTDEV or TheoH at long tau (docs/metrology.md): the same closed form, and the fit says
   // what its Allan curve was made of.
   for (const char* input : {"totdev", "theoh"}) {
-    const Outcome t = run("--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 --format json "
-                          "--fit-long-tau " + std::string(input) + " " + temp("white.txt"));
+    const Outcome t = run(
+        "--type counts --tau0 0.001 --pulse-weight 1arcsec --alpha 0 --fit ieee952 --format json "
+        "--fit-long-tau " +
+        std::string(input) + " " + temp("white.txt"));
     ASSERT_EQ(t.code, 0) << t.err;
     const auto k = nlohmann::json::parse(t.out);
     EXPECT_EQ(k["fit"][0]["long_tau"], input);
@@ -757,7 +774,8 @@ TEST(AnalyzeCli, AFileBeyondTheMemoryLimitNamesTheLimit) {
   for (const std::string type : {"counts --pulse-weight 1arcsec", "phase", "freq"}) {
     const Outcome r = run_shell("ulimit -v 524288; " + tool + " --type " + type + " --tau0 1 " + big);
     EXPECT_EQ(r.code, exit_code::internal) << r.err;
-    EXPECT_NE(r.err.find("gyrochar-analyze: " + big + ": 536870913 values (at most, from the file's size) need 1152 MiB "
+    EXPECT_NE(r.err.find("gyrochar-analyze: " + big +
+                         ": 536870913 values (at most, from the file's size) need 1152 MiB "
                          "of memory with every tau up to N/4 fully overlapped (--stride-factor full, the default), more "
                          "than the 256 MiB this process may use (half of its address-space limit, ulimit -v 524288 "
                          "KiB)"),
@@ -859,8 +877,9 @@ TEST(AnalyzeCli, DynamicRefusesWhatItCannotDo) {
   expect_bad_input("--type phase --tau0 1 --dynamic 100,-1 " + good, "--dynamic");
   expect_bad_input("--type phase --tau0 1 --dynamic 100,50,25 " + good, "--dynamic");
   expect_bad_input("--type phase --tau0 1 --dynamic 3 " + good, "at least 4");
-  expect_bad_input("--type phase --tau0 1 --dynamic 1e308 " + good,
-                   "--dynamic: a window of 1e+308 s is 1e+308 values of tau0 = 1 s, more than the 1e+15 a window or step may span");
+  expect_bad_input(
+      "--type phase --tau0 1 --dynamic 1e308 " + good,
+      "--dynamic: a window of 1e+308 s is 1e+308 values of tau0 = 1 s, more than the 1e+15 a window or step may span");
   expect_bad_input("--type phase --tau0 1e-9 --dynamic 100,1e7 " + good, "a step of 1e+07 s is 1e+16 values");
   expect_bad_input("--type phase --tau0 1 --dynamic 100,0.4 " + good, "shorter than tau0");
   expect_bad_input("--type phase --tau0 1 --dynamic 500 " + good, "fewer than one window");

@@ -55,7 +55,7 @@ TEST(AnalyzeEngine, FullIsResolvedInThePlanningStep) {
   o.type = DataType::phase;
   plan_taus(o, TauRule::octave, StrideFactor::full(), {}, 4000, std::uint64_t{1} << 40);
   EXPECT_EQ(o.stride_factor, full_stride_factor(4000));  // 1024: every tau up to N/4 fully overlapped
-  EXPECT_EQ(o.m_list.back(), 1024u);  // octaves up to N/2 = 2000
+  EXPECT_EQ(o.m_list.back(), 1024u);                     // octaves up to N/2 = 2000
   plan_taus(o, TauRule::list, *StrideFactor::parse("8"), {1, 16}, 4000, std::uint64_t{1} << 40);
   EXPECT_EQ(o.stride_factor, 8u);
   EXPECT_EQ(o.m_list, (std::vector<std::uint64_t>{1, 16}));
@@ -103,7 +103,7 @@ TEST(AnalyzeEngine, AllTausAreEveryRepresentableFactor) {
     }
   }
   EXPECT_EQ(octave_taus(1001), (std::vector<std::uint64_t>{1, 2, 4, 8, 16, 32, 64, 128, 256}));
-  EXPECT_EQ(octave_taus(0).back(), std::uint64_t{1} << 39);  // unknown length
+  EXPECT_EQ(octave_taus(0).back(), std::uint64_t{1} << 39);                                        // unknown length
   EXPECT_EQ(decade_taus(1001), (std::vector<std::uint64_t>{1, 2, 4, 10, 20, 40, 100, 200, 400}));  // Stable32's decade
 }
 
@@ -290,8 +290,8 @@ TEST(AnalyzeEngine, HeldCountsGiveTheCharacterizersRowsBitForBit) {
     ASSERT_GT(a.rows.size(), 40u);
     for (std::size_t i = 0; i < a.rows.size(); ++i) {
       const AnalysisRow &x = a.rows[i], &y = b.rows[i];
-      EXPECT_TRUE(x.stat == y.stat && x.m == y.m && x.n == y.n && x.dev == y.dev && x.alpha == y.alpha &&
-                  x.edf == y.edf && x.skew_dof == y.skew_dof && x.ci.low == y.ci.low && x.ci.high == y.ci.high)
+      EXPECT_TRUE(x.stat == y.stat && x.m == y.m && x.n == y.n && x.dev == y.dev && x.alpha == y.alpha && x.edf == y.edf &&
+                  x.skew_dof == y.skew_dof && x.ci.low == y.ci.low && x.ci.high == y.ci.high)
           << name(x.stat) << " m=" << x.m << (step ? " after the step" : "");
     }
   }
@@ -317,46 +317,46 @@ TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
     clock.push_back(x + 3e-10 * g(rng));
   }
   for (const bool prefix_sums : {true, false})  // float_batch_taus() (--taus all), phase_batch_taus()
-  for (const DataType type : {DataType::phase, DataType::freq}) {
-    const std::size_t n_phase = type == DataType::phase ? clock.size() : clock.size() + 1;
-    AnalysisOptions o;
-    o.type = type;
-    o.tau0_s = 0.5;
-    o.stats = {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::tdev, DevStat::hdev, DevStat::ohdev};
-    o.stride_factor = full_stride_factor(2 * n_phase);  // as gyrochar-analyze takes it for --taus all
-    o.m_list = all_taus(n_phase, o.stride_factor);
-    ASSERT_EQ(o.m_list.size(), n_phase / 2);
-    Analyzer pyramid(o);
-    o.hold_phase = true;
-    o.hold_prefix_sums = prefix_sums;
-    o.values_hint = clock.size();
-    o.threads = 3;
-    std::size_t told = 0, total = 0;
-    o.on_summed = [&](std::size_t done, std::size_t of) {
-      EXPECT_GT(done, told);
-      told = done;
-      total = of;
-    };
-    Analyzer batch(o);
-    pyramid.add(clock);
-    batch.add(std::span<const double>(clock.data(), 1));
-    batch.add(std::span<const double>(clock.data() + 1, clock.size() - 1));
-    const Analysis a = pyramid.result(), b = batch.result();
-    EXPECT_EQ(told, o.m_list.size());
-    EXPECT_EQ(total, o.m_list.size());
-    EXPECT_EQ(b.n_phase, a.n_phase);
-    EXPECT_EQ(b.n_values, a.n_values);
-    ASSERT_EQ(a.rows.size(), b.rows.size());
-    ASSERT_GT(a.rows.size(), 4000u);
-    for (std::size_t i = 0; i < a.rows.size(); ++i) {
-      const AnalysisRow &p = a.rows[i], &q = b.rows[i];
-      const double tolerance = static_cast<double>(p.n) * DBL_EPSILON * p.dev;
-      EXPECT_TRUE(p.stat == q.stat && p.m == q.m && p.n == q.n && p.alpha == q.alpha && p.edf == q.edf &&
-                  std::fabs(p.dev - q.dev) <= tolerance)
-          << name(type) << (prefix_sums ? " prefix sums " : " ") << name(p.stat) << " m=" << p.m << ": " << p.dev
-          << " vs " << q.dev;
+    for (const DataType type : {DataType::phase, DataType::freq}) {
+      const std::size_t n_phase = type == DataType::phase ? clock.size() : clock.size() + 1;
+      AnalysisOptions o;
+      o.type = type;
+      o.tau0_s = 0.5;
+      o.stats = {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::tdev, DevStat::hdev, DevStat::ohdev};
+      o.stride_factor = full_stride_factor(2 * n_phase);  // as gyrochar-analyze takes it for --taus all
+      o.m_list = all_taus(n_phase, o.stride_factor);
+      ASSERT_EQ(o.m_list.size(), n_phase / 2);
+      Analyzer pyramid(o);
+      o.hold_phase = true;
+      o.hold_prefix_sums = prefix_sums;
+      o.values_hint = clock.size();
+      o.threads = 3;
+      std::size_t told = 0, total = 0;
+      o.on_summed = [&](std::size_t done, std::size_t of) {
+        EXPECT_GT(done, told);
+        told = done;
+        total = of;
+      };
+      Analyzer batch(o);
+      pyramid.add(clock);
+      batch.add(std::span<const double>(clock.data(), 1));
+      batch.add(std::span<const double>(clock.data() + 1, clock.size() - 1));
+      const Analysis a = pyramid.result(), b = batch.result();
+      EXPECT_EQ(told, o.m_list.size());
+      EXPECT_EQ(total, o.m_list.size());
+      EXPECT_EQ(b.n_phase, a.n_phase);
+      EXPECT_EQ(b.n_values, a.n_values);
+      ASSERT_EQ(a.rows.size(), b.rows.size());
+      ASSERT_GT(a.rows.size(), 4000u);
+      for (std::size_t i = 0; i < a.rows.size(); ++i) {
+        const AnalysisRow &p = a.rows[i], &q = b.rows[i];
+        const double tolerance = static_cast<double>(p.n) * DBL_EPSILON * p.dev;
+        EXPECT_TRUE(p.stat == q.stat && p.m == q.m && p.n == q.n && p.alpha == q.alpha && p.edf == q.edf &&
+                    std::fabs(p.dev - q.dev) <= tolerance)
+            << name(type) << (prefix_sums ? " prefix sums " : " ") << name(p.stat) << " m=" << p.m << ": " << p.dev << " vs "
+            << q.dev;
+      }
     }
-  }
 }
 
 }  // namespace

@@ -42,7 +42,8 @@ std::vector<Stable32Row> read_stable32(const std::string& path, bool commented =
   EXPECT_TRUE(in) << path;
   std::vector<Stable32Row> rows;
   for (std::string line; std::getline(in, line);) {
-    if (commented && line.size() > 1 && line[0] == '#' && std::isdigit(static_cast<unsigned char>(line[line.find_first_not_of("# ")])))
+    if (commented && line.size() > 1 && line[0] == '#' &&
+        std::isdigit(static_cast<unsigned char>(line[line.find_first_not_of("# ")])))
       line = line.substr(1);
     if (line.empty() || line[0] == '#') continue;
     std::istringstream ss(line);
@@ -131,7 +132,8 @@ Analysis compare(const std::vector<double>& values, DataType type, DevStat stat,
 }
 
 // The automatic alpha equals Stable32's on the rows `where` selects; returns the rows compared.
-int expect_same_alpha(const Analysis& automatic, const std::string& file, const std::function<bool(const Stable32Row&)>& where) {
+int expect_same_alpha(const Analysis& automatic, const std::string& file,
+                      const std::function<bool(const Stable32Row&)>& where) {
   int compared = 0;
   for (const auto& r : read_stable32(file)) {
     if (!where(r)) continue;
@@ -186,9 +188,10 @@ TEST(Stable32, OcxoFrequencyOctavesWithConfidenceIntervalsAndNoiseIdentification
     // The lag-1 autocorrelation rule (>= 30 averages) reproduces Stable32 on every such row but the
     // departures. With fewer (m >= 1024 here) Stable32 falls back to the B1 ratio alone and picks
     // white FM at m = 2048 and 4096 where the ADEV rises: not required, not checked.
-    EXPECT_GE(expect_same_alpha(automatic, file, [&](const Stable32Row& r) {
-      return (y.size() + 1) / r.m >= 30 && !departures.count(r.m);
-    }), 8) << file;
+    EXPECT_GE(expect_same_alpha(automatic, file,
+                                [&](const Stable32Row& r) { return (y.size() + 1) / r.m >= 30 && !departures.count(r.m); }),
+              8)
+        << file;
     if (s != "oadev") continue;
     for (const std::uint64_t m : departures) {
       const AnalysisRow* here = find(automatic, m);
@@ -209,8 +212,7 @@ TEST(Stable32, KeysightTimeIntervalNoiseFloorWithNoiseIdentification) {
     const Analysis automatic = compare(x, DataType::phase, *parse_dev_stat(s), file, {});
     // Octave rows (1..8192; 1..64 in the log-spaced adev file), alpha 2 then 1: the case only
     // R(n) = MVAR/AVAR separates.
-    EXPECT_GE(expect_same_alpha(automatic, file, [](const Stable32Row& r) { return (r.m & (r.m - 1)) == 0; }), 7)
-        << file;
+    EXPECT_GE(expect_same_alpha(automatic, file, [](const Stable32Row& r) { return (r.m & (r.m - 1)) == 0; }), 7) << file;
   }
 }
 
@@ -250,13 +252,16 @@ TEST(Stable32, TotalFamilyOnPhaseDat) {
   for (const char* f : {"totdev", "totdev_octave"}) compare(x, DataType::phase, DevStat::totdev, dir + f + ".txt", tol);
   tol.ci_where = [](const Stable32Row& r) { return r.alpha <= 0; };
   tol.departure = 0.035;  // measured 3.1 % (alpha 1, m = 256)
-  for (const char* f : {"htotdev_octave", "htotdev_octave_nobias"}) compare(x, DataType::phase, DevStat::htotdev, dir + f + ".txt", tol);
+  for (const char* f : {"htotdev_octave", "htotdev_octave_nobias"})
+    compare(x, DataType::phase, DevStat::htotdev, dir + f + ".txt", tol);
   tol.ci_where = [](const Stable32Row& r) { return r.m <= 16; };
   tol.departure = 0.07;  // measured 6.4 % (m = 200, alpha 1)
   for (const char* f : {"mtotdev_octave", "mtotdev_octave_alpha0", "mtotdev_decade"})
     compare(x, DataType::phase, DevStat::mtotdev, dir + f + ".txt", tol);
-  for (const char* f : {"ttotdev_octave", "ttotdev_decade"}) compare(x, DataType::phase, DevStat::ttotdev, dir + f + ".txt", tol);
-  for (const char* f : {"theo1_alpha0", "theo1_alpha0_decade"}) compare(x, DataType::phase, DevStat::theo1, dir + f + ".txt", tol);
+  for (const char* f : {"ttotdev_octave", "ttotdev_decade"})
+    compare(x, DataType::phase, DevStat::ttotdev, dir + f + ".txt", tol);
+  for (const char* f : {"theo1_alpha0", "theo1_alpha0_decade"})
+    compare(x, DataType::phase, DevStat::theo1, dir + f + ".txt", tol);
 }
 
 TEST(Stable32, TotdevOnTheOcxoAndKeysightSets) {

@@ -68,21 +68,21 @@ TEST(Candump, RoundTripThroughFormatter) {
 
 TEST(Candump, MalformedLinesAreRejectedWithAReason) {
   EXPECT_FALSE(parse_error("").empty());
-  EXPECT_FALSE(parse_error("18FF4101#00").empty());                          // no timestamp
-  EXPECT_FALSE(parse_error("(1.0 can0 18FF4101#00").empty());                // unterminated
-  EXPECT_FALSE(parse_error("(abc) can0 18FF4101#00").empty());               // bad timestamp
-  EXPECT_FALSE(parse_error("(1.0) can0").empty());                           // no frame
-  EXPECT_FALSE(parse_error("(1.0) can0 18FF4101").empty());                  // no '#'
-  EXPECT_FALSE(parse_error("(1.0) can0 18FF41#00").empty());                 // 6-digit id
-  EXPECT_FALSE(parse_error("(1.0) can0 18FG4101#00").empty());               // not hex
-  EXPECT_FALSE(parse_error("(1.0) can0 18FF4101#0").empty());                // odd digits
-  EXPECT_FALSE(parse_error("(1.0) can0 18FF4101#001122334455667788").empty());  // 9 bytes classic
-  EXPECT_FALSE(parse_error("(1.0) can0 800#00").empty());                    // 11-bit id > 0x7FF
-  EXPECT_FALSE(parse_error("(1.0) can0 18FF4101##").empty());                // FD without flags
+  EXPECT_FALSE(parse_error("18FF4101#00").empty());                                    // no timestamp
+  EXPECT_FALSE(parse_error("(1.0 can0 18FF4101#00").empty());                          // unterminated
+  EXPECT_FALSE(parse_error("(abc) can0 18FF4101#00").empty());                         // bad timestamp
+  EXPECT_FALSE(parse_error("(1.0) can0").empty());                                     // no frame
+  EXPECT_FALSE(parse_error("(1.0) can0 18FF4101").empty());                            // no '#'
+  EXPECT_FALSE(parse_error("(1.0) can0 18FF41#00").empty());                           // 6-digit id
+  EXPECT_FALSE(parse_error("(1.0) can0 18FG4101#00").empty());                         // not hex
+  EXPECT_FALSE(parse_error("(1.0) can0 18FF4101#0").empty());                          // odd digits
+  EXPECT_FALSE(parse_error("(1.0) can0 18FF4101#001122334455667788").empty());         // 9 bytes classic
+  EXPECT_FALSE(parse_error("(1.0) can0 800#00").empty());                              // 11-bit id > 0x7FF
+  EXPECT_FALSE(parse_error("(1.0) can0 18FF4101##").empty());                          // FD without flags
   EXPECT_FALSE(parse_error("(1.0) can0 18FF4101##1" + std::string(26, '0')).empty());  // 13 bytes FD
-  EXPECT_FALSE(parse_error(std::string("(1.0) ca\0n0 18FF4101#00", 23)).empty());   // NUL in the name
-  EXPECT_FALSE(parse_error("(1.0) averyveryverylongname 18FF4101#00").empty());     // > 15 characters
-  EXPECT_FALSE(parse_error("(1e300) can0 18FF4101#00").empty());                     // absurd time
+  EXPECT_FALSE(parse_error(std::string("(1.0) ca\0n0 18FF4101#00", 23)).empty());      // NUL in the name
+  EXPECT_FALSE(parse_error("(1.0) averyveryverylongname 18FF4101#00").empty());        // > 15 characters
+  EXPECT_FALSE(parse_error("(1e300) can0 18FF4101#00").empty());                       // absurd time
 }
 
 TEST(Candump, RemoteRequestsCarryALengthAndNoData) {
@@ -97,8 +97,7 @@ TEST(Candump, RemoteRequestsCarryALengthAndNoData) {
 // and trailing spaces); one of exactly the limit is parsed.
 TEST(Candump, LinesLongerThanTheLimitAreRejected) {
   const std::string frame = "(1.0) can0 18FF4101#00";
-  EXPECT_EQ(parse_error(frame + std::string(max_candump_line_bytes + 1 - frame.size(), ' ')),
-            "longer than 1024 bytes");
+  EXPECT_EQ(parse_error(frame + std::string(max_candump_line_bytes + 1 - frame.size(), ' ')), "longer than 1024 bytes");
   parse_ok(frame + std::string(max_candump_line_bytes - frame.size(), ' '));
 }
 

@@ -47,12 +47,11 @@ TEST(Coverage, WhiteNoiseIntervalsHoldTheTruthAboutTwoThirdsOfTheTime) {
   double pooled_auto = 0, pooled_true = 0;
   std::printf("stride stat  alpha    m  terms  auto   true   id    edf(true)  MC edf  mean dev^2/truth\n");
   for (const CoverageCell& c : cells) {
-    std::printf("%-6s %-5s %+d %6llu %6llu  %.3f  %.3f  %.2f  %8.0f  %7.0f  %.4f\n",
-                c.stride_factor == 0 ? "full" : "8", name(c.stat), c.alpha, static_cast<unsigned long long>(c.m),
-                static_cast<unsigned long long>(c.terms), c.coverage_auto(), c.coverage_true(), c.identified_fraction(),
-                c.edf_true, c.mc_edf, c.mean_ratio);
-    const std::string where = std::string(name(c.stat)) + " alpha " + std::to_string(c.alpha) + " m " +
-                              std::to_string(c.m) + " stride factor " + std::to_string(c.stride_factor);
+    std::printf("%-6s %-5s %+d %6llu %6llu  %.3f  %.3f  %.2f  %8.0f  %7.0f  %.4f\n", c.stride_factor == 0 ? "full" : "8",
+                name(c.stat), c.alpha, static_cast<unsigned long long>(c.m), static_cast<unsigned long long>(c.terms),
+                c.coverage_auto(), c.coverage_true(), c.identified_fraction(), c.edf_true, c.mc_edf, c.mean_ratio);
+    const std::string where = std::string(name(c.stat)) + " alpha " + std::to_string(c.alpha) + " m " + std::to_string(c.m) +
+                              " stride factor " + std::to_string(c.stride_factor);
     EXPECT_EQ(c.runs, s.runs) << where;
     EXPECT_EQ(c.no_interval_true, 0u) << where;
     EXPECT_NEAR(c.coverage_true(), nominal, 0.10) << where;

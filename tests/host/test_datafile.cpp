@@ -47,7 +47,8 @@ TEST(DataFile, OneNumberPerLineInEveryNotation) {
 
 TEST(DataFile, PercentStartsACommentAsHashDoes) {
   // SigmaTheta's .ykt files begin with '%' lines; MATLAB writes them too.
-  const auto v = read_all(file_with("ykt.txt", "% SigmaTheta\n%  tau0 = 1 s\n1.5e-12\n  % indented\n-2e-12 % after\n3e-12\n"));
+  const auto v = read_all(
+      file_with("ykt.txt", "% SigmaTheta\n%  tau0 = 1 s\n1.5e-12\n  % indented\n-2e-12 % after\n3e-12\n"));
   EXPECT_EQ(v, (std::vector<double>{1.5e-12, -2e-12, 3e-12}));
   EXPECT_EQ(read_all(file_with("ykt2.txt", "% t y\n0 1.5\n1 2.5 % late\n2 3.5\n")), (std::vector<double>{1.5, 2.5, 3.5}));
 }
@@ -72,7 +73,8 @@ TEST(DataFile, BlocksAcrossTheBufferGiveTheSameValues) {
     want.push_back(v);
   }
   const std::string path = file_with("long.txt", s);
-  for (const std::size_t block : {std::size_t{1}, std::size_t{7}, std::size_t{4096}}) EXPECT_EQ(read_all(path, 0, block), want);
+  for (const std::size_t block : {std::size_t{1}, std::size_t{7}, std::size_t{4096}})
+    EXPECT_EQ(read_all(path, 0, block), want);
   ASSERT_EQ(std::system(("gzip -kf " + path).c_str()), 0);
   EXPECT_EQ(read_all(path + ".gz", 0, 4096), want);
   // Two gzip members, as `cat a.gz b.gz` makes: both are read.
@@ -131,7 +133,8 @@ TEST(DataFile, BinaryBytesAreNeverEchoed) {
   for (const std::string& content : {bytes, "\x89PNG\r\n\x1a\n" + bytes, "1\n2\n\xff\xfe" + bytes}) {
     const std::string e = error_of(content);
     ASSERT_NE(e, "");
-    for (const char c : e) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "raw byte " << int(static_cast<unsigned char>(c)) << " in: " << e;
+    for (const char c : e)
+      EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "raw byte " << int(static_cast<unsigned char>(c)) << " in: " << e;
     EXPECT_LT(e.size(), 200u) << e;
   }
 }
@@ -143,7 +146,7 @@ TEST(DataFile, RaggedTablesAndBadNumbersAreRefused) {
   EXPECT_NE(error_of("1\n0x10\n").find("not a finite number"), std::string::npos);
   EXPECT_NE(error_of("1\ninf\n").find("not a finite number"), std::string::npos);
   EXPECT_NE(error_of("1\n2.5.1\n").find("line 2"), std::string::npos);
-  EXPECT_NE(error_of("1,,2\n", 2).find("column 2"), std::string::npos);  // an empty field is no number
+  EXPECT_NE(error_of("1,,2\n", 2).find("column 2"), std::string::npos);           // an empty field is no number
   EXPECT_NE(error_of(std::string(2 << 20, '7')).find("MiB"), std::string::npos);  // no line end at all
 }
 
@@ -159,7 +162,9 @@ TEST(DataFile, GzipCutShortOrCorruptIsAnError) {
     EXPECT_NE(std::string(e.what()).find("unexpected end of file"), std::string::npos) << e.what();
   }
   ASSERT_EQ(std::system(("cp " + path + ".gz " + path + ".bad.gz && printf 'XXXXXXXX' | dd of=" + path +
-                         ".bad.gz bs=1 seek=5000 conv=notrunc 2>/dev/null").c_str()), 0);
+                         ".bad.gz bs=1 seek=5000 conv=notrunc 2>/dev/null")
+                            .c_str()),
+            0);
   EXPECT_THROW(read_all(path + ".bad.gz"), DataFileError);
   ASSERT_EQ(std::system(("cp " + path + ".gz " + path + ".tail.gz && printf 'junk' >> " + path + ".tail.gz").c_str()), 0);
   EXPECT_THROW(read_all(path + ".tail.gz"), DataFileError);

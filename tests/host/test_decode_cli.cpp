@@ -43,9 +43,7 @@ struct Outcome {
 };
 
 // Per-process names: CTest runs the tests of this file in parallel processes.
-std::string temp(const std::string& name) {
-  return ::testing::TempDir() + std::to_string(getpid()) + "_decode_" + name;
-}
+std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_decode_" + name; }
 
 Outcome run(const std::string& args) {
   const std::string err_file = temp("stderr.txt");
@@ -77,8 +75,8 @@ struct NodeSpec {
   float tau0_s = 0.01f;
   std::uint8_t protocol_version = version;  // 1: no fit summary, no Fitted flag
   Ieee952Status fit = Ieee952Status::ok;
-  bool quantization_white = true;           // false: AVAR below 8 tau0, MVAR below 4 tau0 left out
-  float unconstrained_n = 0;                // > 0: N's unconstrained estimate (version 5), uncertainty 12.5 %
+  bool quantization_white = true;  // false: AVAR below 8 tau0, MVAR below 4 tau0 left out
+  float unconstrained_n = 0;       // > 0: N's unconstrained estimate (version 5), uncertainty 12.5 %
 };
 
 float adev_of(const NodeSpec& n, std::uint8_t seq, std::size_t i) {
@@ -90,32 +88,24 @@ NoiseType noise_of(std::size_t i) { return static_cast<NoiseType>(1 + i % 7); }
 std::uint64_t n_of(std::uint8_t seq, std::size_t i) { return 1000u * (seq + 1u) + i; }
 std::uint64_t m_of(std::size_t i) { return std::uint64_t{1} << i; }
 float ieee_of(std::size_t k) { return 0.001f * static_cast<float>(k + 1); }
-bool ieee_resolved(std::size_t k) { return k != 4; }  // R not resolved
+bool ieee_resolved(std::size_t k) { return k != 4; }             // R not resolved
 constexpr float markov_sigma_of = 0.004f, markov_tc_of = 20.0f;  // angle unit/s, s
 float chi2_per_dof_of(const NodeSpec& n) { return n.fit == Ieee952Status::rejected ? 7.5f : 0.75f; }
 
 Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t samples) {
   switch (s.slot) {
-    case Slot::status:
-      return StatusMsg{seq, NodeState::running, n.taus, samples};
-    case Slot::faults:
-      return StatusFaultsMsg{seq, 1, 2, 3, 0};
+    case Slot::status: return StatusMsg{seq, NodeState::running, n.taus, samples};
+    case Slot::faults: return StatusFaultsMsg{seq, 1, 2, 3, 0};
     case Slot::adev:
       return TauDevMsg{seq, s.index, DevKind::adev, adev_of(n, seq, s.index), edf_of(s.index), noise_of(s.index), true};
     case Slot::mdev:
       return TauDevMsg{seq, s.index, DevKind::mdev, mdev_of(n, seq, s.index), edf_of(s.index), noise_of(s.index), true};
-    case Slot::terms:
-      return TauTermsMsg{seq, s.index, n_of(seq, s.index)};
-    case Slot::tau_info:
-      return TauInfoMsg{seq, s.index, m_of(s.index), 0};
-    case Slot::sampling:
-      return MetaSamplingMsg{seq, n.tau0_s, 8};
-    case Slot::clock:
-      return MetaClockMsg{seq, samples * 10, n.protocol_version};
-    case Slot::scale:
-      return MetaScaleMsg{seq, 1.0f, n.unit, InputSource::simulated};
-    case Slot::config:
-      return MetaConfigMsg{seq, 0xC0FFEEu, 1000};
+    case Slot::terms: return TauTermsMsg{seq, s.index, n_of(seq, s.index)};
+    case Slot::tau_info: return TauInfoMsg{seq, s.index, m_of(s.index), 0};
+    case Slot::sampling: return MetaSamplingMsg{seq, n.tau0_s, 8};
+    case Slot::clock: return MetaClockMsg{seq, samples * 10, n.protocol_version};
+    case Slot::scale: return MetaScaleMsg{seq, 1.0f, n.unit, InputSource::simulated};
+    case Slot::config: return MetaConfigMsg{seq, 0xC0FFEEu, 1000};
     case Slot::ieee952: {
       if (s.index == ieee952_summary_page) {
         const std::array<std::uint8_t, 2> left_out = n.quantization_white ? std::array<std::uint8_t, 2>{0, 0}
@@ -135,8 +125,7 @@ Message message(const NodeSpec& n, std::uint8_t seq, ReportSlot s, std::uint64_t
     }
     case Slot::window:  // these nodes have no window taus
     case Slot::window_length:
-    case Slot::window_dev:
-      break;
+    case Slot::window_dev: break;
     case Slot::fit_model:  // version 4: the model holds one Markov term
       return Ieee952ModelMsg{seq, 1, 0, false, 0, true, 0, 0, false, 4.5f};
     case Slot::fit_parameter: {
@@ -181,8 +170,7 @@ class LogWriter {
       if (drop && drop(s)) continue;
       CanFrame f;
       EXPECT_EQ(encode(message(n, seq, s, samples), n.address, f), ProtocolError::none);
-      lines_.emplace_back(t_s + static_cast<double>(k) / static_cast<double>(frames),
-                          format_candump_line(0, "can0", f));
+      lines_.emplace_back(t_s + static_cast<double>(k) / static_cast<double>(frames), format_candump_line(0, "can0", f));
       if (s.slot == Slot::adev) e.adev[s.index] = true;
       if (s.slot == Slot::mdev) e.mdev[s.index] = true;
       if (s.slot == Slot::terms) st.n[s.index] = n_of(seq, s.index);
@@ -246,9 +234,7 @@ struct Csv {
     EXPECT_NE(it, header.end()) << name;
     return static_cast<std::size_t>(it - header.begin());
   }
-  const std::string& get(const std::vector<std::string>& row, const std::string& name) const {
-    return row.at(col(name));
-  }
+  const std::string& get(const std::vector<std::string>& row, const std::string& name) const { return row.at(col(name)); }
 };
 
 std::vector<std::string> split(const std::string& line) {
@@ -300,10 +286,8 @@ void expect_row(const Csv& csv, const std::vector<std::string>& row, const LogWr
   SCOPED_TRACE(testing::Message() << "node " << int(node) << " seq " << int(seq) << " tau " << i);
   EXPECT_EQ(csv.get(row, "m"), e->m[i] ? std::to_string(e->m[i]) : "");
   EXPECT_EQ(csv.get(row, "n"), e->n[i] ? std::to_string(e->n[i]) : "");
-  if (e->m[i])
-    EXPECT_FLOAT_EQ(std::stof(csv.get(row, "tau_s")), n.tau0_s * static_cast<float>(e->m[i]));
-  else
-    EXPECT_EQ(csv.get(row, "tau_s"), "");
+  if (e->m[i]) EXPECT_FLOAT_EQ(std::stof(csv.get(row, "tau_s")), n.tau0_s * static_cast<float>(e->m[i]));
+  else EXPECT_EQ(csv.get(row, "tau_s"), "");
   for (const auto& [kind, received, value] : {std::tuple{std::string("adev"), bool(e->adev[i]), adev_of(n, seq, i)},
                                               std::tuple{std::string("mdev"), bool(e->mdev[i]), mdev_of(n, seq, i)}}) {
     if (!received) {
@@ -333,8 +317,7 @@ const std::map<std::uint8_t, NodeSpec> two_nodes{{0x10, {0x10, 6, AngleUnit::arc
 LogWriter nine_reports() {
   LogWriter log;
   for (std::uint8_t seq = 0; seq < 9; ++seq)
-    for (const auto& [address, n] : two_nodes)
-      log.report(n, seq, 1000.0 + seq + 0.3 * (address == 0x2A), 100u * (seq + 1));
+    for (const auto& [address, n] : two_nodes) log.report(n, seq, 1000.0 + seq + 0.3 * (address == 0x2A), 100u * (seq + 1));
   return log;
 }
 
@@ -342,8 +325,8 @@ TEST(DecodeCli, CsvAndJsonLinesCarryTheEncodedValuesOfEveryNode) {
   const std::map<std::uint8_t, NodeSpec>& nodes = two_nodes;
   const LogWriter log = nine_reports();
   const std::string csv_path = temp("values.csv"), jsonl_path = temp("values.jsonl");
-  const Outcome r =
-      run(log.write("values.log") + " --view none --rate-unit native --csv " + csv_path + " --jsonl " + jsonl_path);
+  const Outcome r = run(log.write("values.log") + " --view none --rate-unit native --csv " + csv_path + " --jsonl " +
+                        jsonl_path);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << "--view none writes nothing on stdout";
 
@@ -426,9 +409,17 @@ TEST(DecodeCli, LimitsAddVerdictColumnsAndRecordsWhenAVerdictChanges) {
   ASSERT_EQ(run(log_path + " --view none --csv " + plain_path).code, 0);
 
   const Csv csv = read_csv(csv_path);
-  const std::vector<std::string> added{"verdict",     "N limit [deg/sqrt(h)]",        "N verdict",          "N estimate [deg/sqrt(h)]",
-                                       "N lower",     "N upper",                      "N estimate kind",   "adev(0.04 s) limit [deg/h]",
-                                       "adev(0.04 s) verdict", "adev(0.04 s) estimate [deg/h]", "adev(0.04 s) lower",
+  const std::vector<std::string> added{"verdict",
+                                       "N limit [deg/sqrt(h)]",
+                                       "N verdict",
+                                       "N estimate [deg/sqrt(h)]",
+                                       "N lower",
+                                       "N upper",
+                                       "N estimate kind",
+                                       "adev(0.04 s) limit [deg/h]",
+                                       "adev(0.04 s) verdict",
+                                       "adev(0.04 s) estimate [deg/h]",
+                                       "adev(0.04 s) lower",
                                        "adev(0.04 s) upper"};
   const Csv plain = read_csv(plain_path);
   ASSERT_EQ(csv.header.size(), plain.header.size() + added.size());
@@ -520,7 +511,8 @@ TEST(DecodeCli, LimitsJudgeTheUnconstrainedEstimateWhereTheNodeSendsIt) {
   const Outcome r = run(log_path + " --view none --limits " + limits + " --csv " + csv_path + " --jsonl " + jsonl_path);
   ASSERT_EQ(r.code, 0) << r.err;
   const double to_deg_sqrt_h = 1.0 / 60.0;
-  const double unconstrained = static_cast<double>(0.0015f) * to_deg_sqrt_h, shown = static_cast<double>(ieee_of(1)) * to_deg_sqrt_h;
+  const double unconstrained = static_cast<double>(0.0015f) * to_deg_sqrt_h,
+               shown = static_cast<double>(ieee_of(1)) * to_deg_sqrt_h;
   const Csv csv = read_csv(csv_path);
   std::size_t judged = 0;
   for (const auto& row : csv.rows) {
@@ -530,7 +522,8 @@ TEST(DecodeCli, LimitsJudgeTheUnconstrainedEstimateWhereTheNodeSendsIt) {
     const double n = v5 ? unconstrained : shown, u = 0.125 * n;
     EXPECT_EQ(csv.get(row, "N estimate kind"), v5 ? "unconstrained" : "shown");
     EXPECT_NEAR(std::stod(csv.get(row, "N estimate [deg/sqrt(h)]")), n, 1e-12 * n);
-    EXPECT_NEAR(std::stod(csv.get(row, "N upper")), n + 1.959963984540054 * u, 1.959963984540054 * u * (v5 ? 0.00136 : 1e-12));
+    EXPECT_NEAR(std::stod(csv.get(row, "N upper")), n + 1.959963984540054 * u,
+                1.959963984540054 * u * (v5 ? 0.00136 : 1e-12));
     ++judged;
   }
   EXPECT_EQ(judged, 2u * 2 * 6) << "reports 3 and 4 of both nodes, 6 taus each";
@@ -549,7 +542,8 @@ TEST(DecodeCli, LimitsJudgeTheUnconstrainedEstimateWhereTheNodeSendsIt) {
   ASSERT_TRUE(n5.contains("unconstrained")) << n5.dump();
   EXPECT_NEAR(n5.at("unconstrained").at("value").get<double>(), unconstrained, 1e-12 * unconstrained);
   EXPECT_NEAR(n5.at("unconstrained").at("signed").get<double>(), unconstrained, 1e-12 * unconstrained);
-  EXPECT_NEAR(n5.at("unconstrained").at("uncertainty").get<double>(), 0.125 * unconstrained, 0.00136 * 0.125 * unconstrained);
+  EXPECT_NEAR(n5.at("unconstrained").at("uncertainty").get<double>(), 0.125 * unconstrained,
+              0.00136 * 0.125 * unconstrained);
   EXPECT_FALSE(last_report[0x2A].at("ieee952").at("N").contains("unconstrained"));
 }
 
@@ -624,8 +618,7 @@ TEST(DecodeCli, ALostModelPageShowsMissingNeverAnotherFitsValue) {
   LogWriter log;
   for (std::uint8_t seq = 0; seq < 9; ++seq) {
     const LogWriter::Drop drop = [&](const ReportSlot& s) {
-      return seq == 4 && s.slot == Slot::fit_parameter &&
-             s.index == fit_parameter_position(FitParameter::markov_tc, 0);
+      return seq == 4 && s.slot == Slot::fit_parameter && s.index == fit_parameter_position(FitParameter::markov_tc, 0);
     };
     log.report(n, seq, 10.0 + seq, 100u * (seq + 1), drop);
   }
@@ -661,11 +654,12 @@ std::string node_section(const std::string& view, std::uint8_t address) {
 TEST(DecodeCli, TheFitSummaryIsShownAndRecordedAndAVersionOneNodeHasNone) {
   // Four nodes: an accepted fit with white quantization, a rejected one with short taus left out,
   // a fit that could not be made, and a version-1 node (no summary at all).
-  const std::map<std::uint8_t, NodeSpec> nodes{
-      {0x40, {0x40, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::ok, true}},
-      {0x41, {0x41, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::rejected, false}},
-      {0x42, {0x42, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::too_few_points, true}},
-      {0x43, {0x43, 5, AngleUnit::arcsec, 0.01f, 1, Ieee952Status::ok, true}}};
+  const std::map<std::uint8_t, NodeSpec> nodes{{0x40, {0x40, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::ok, true}},
+                                               {0x41,
+                                                {0x41, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::rejected, false}},
+                                               {0x42,
+                                                {0x42, 5, AngleUnit::arcsec, 0.01f, 2, Ieee952Status::too_few_points, true}},
+                                               {0x43, {0x43, 5, AngleUnit::arcsec, 0.01f, 1, Ieee952Status::ok, true}}};
   LogWriter log;
   for (std::uint8_t seq = 0; seq < 6; ++seq)
     for (const auto& [address, n] : nodes) log.report(n, seq, 300.0 + seq + 0.1 * (address - 0x40), 100u * (seq + 1));
@@ -675,8 +669,8 @@ TEST(DecodeCli, TheFitSummaryIsShownAndRecordedAndAVersionOneNodeHasNone) {
   ASSERT_EQ(r.code, 0) << r.err;
 
   // The view.
-  const std::string ok = node_section(r.out, 0x40), rejected = node_section(r.out, 0x41),
-                    none = node_section(r.out, 0x42), v1 = node_section(r.out, 0x43);
+  const std::string ok = node_section(r.out, 0x40), rejected = node_section(r.out, 0x41), none = node_section(r.out, 0x42),
+                    v1 = node_section(r.out, 0x43);
   EXPECT_TRUE(contains(ok, "IEEE-952 (node's fit of both curves, chi2/dof 0.75 on 10 points):  Q 0.001 arcsec (+-12.5%)"))
       << ok;
   EXPECT_TRUE(contains(ok, "  R not fitted")) << ok;
@@ -700,7 +694,8 @@ TEST(DecodeCli, TheFitSummaryIsShownAndRecordedAndAVersionOneNodeHasNone) {
   EXPECT_TRUE(contains(r.err, "node 0x43: frames 101; reports 6 complete, 0 incomplete, 0 lost; frames missing 0;"))
       << r.err;
   for (const char* node : {"node 0x40", "node 0x41", "node 0x42"})
-    EXPECT_TRUE(contains(r.err, std::string(node) + ": frames 102; reports 6 complete, 0 incomplete, 0 lost; frames missing 0;"))
+    EXPECT_TRUE(
+        contains(r.err, std::string(node) + ": frames 102; reports 6 complete, 0 incomplete, 0 lost; frames missing 0;"))
         << r.err;
 
   // The CSV: the summary of the node's latest fit on every row, empty for version 1. The first
@@ -768,8 +763,8 @@ TEST(DecodeCli, LostFramesAndReportsAreShownNeverPaperedOver) {
     });
   }
   const std::string csv_path = temp("loss.csv"), jsonl_path = temp("loss.jsonl");
-  const Outcome r =
-      run(log.write("loss.log") + " --view final --rate-unit deg/s --csv " + csv_path + " --jsonl " + jsonl_path);
+  const Outcome r = run(log.write("loss.log") + " --view final --rate-unit deg/s --csv " + csv_path + " --jsonl " +
+                        jsonl_path);
   ASSERT_EQ(r.code, 0) << r.err;
   const Csv csv = read_csv(csv_path);
   ASSERT_EQ(csv.rows.size(), 7u * 5);
@@ -867,11 +862,11 @@ TEST(DecodeCli, MalformedLinesAndRejectedFramesAreCountedAndReportedWithExitZero
       << r.err;
   EXPECT_TRUE(contains(r.err, path + ":" + std::to_string(first_report_lines + 2) + ": malformed line: bad timestamp"))
       << r.err;
-  EXPECT_TRUE(contains(
-      r.err, path + ":" + std::to_string(first_report_lines + 3) + ": malformed line: identifier is not hexadecimal"))
+  EXPECT_TRUE(contains(r.err, path + ":" + std::to_string(first_report_lines + 3) +
+                                  ": malformed line: identifier is not hexadecimal"))
       << r.err;
-  EXPECT_TRUE(contains(
-      r.err, path + ":" + std::to_string(lines.size() + 1) + ": malformed line: odd number of data hex digits"))
+  EXPECT_TRUE(
+      contains(r.err, path + ":" + std::to_string(lines.size() + 1) + ": malformed line: odd number of data hex digits"))
       << r.err;
   EXPECT_TRUE(contains(r.err, "4 malformed line(s)")) << r.err;
   EXPECT_TRUE(contains(r.err, "1 rejected frames")) << r.err;
@@ -949,8 +944,8 @@ TEST(DecodeCli, BadInvocationsAreBadInputWithWhatAndWhy) {
   expect_bad("x.log --confidence 1.5", "gyrochar-decode: --confidence: must be in (0, 1)");
   expect_bad("x.log --view sometimes", "gyrochar-decode: --view: 'sometimes' is not live, final or none");
   expect_bad("x.log --plot-every 10", "gyrochar-decode: --plot-every: needs --plot PREFIX");
-  expect_bad("x.log --csv /nonexistent/dir/out.csv",
-             "gyrochar-decode: /nonexistent/dir/out.csv: No such file or directory", exit_code::output_failed);
+  expect_bad("x.log --csv /nonexistent/dir/out.csv", "gyrochar-decode: /nonexistent/dir/out.csv: No such file or directory",
+             exit_code::output_failed);
   expect_bad("x.log --plot /nonexistent/dir/plot",
              "gyrochar-decode: /nonexistent/dir/plot.svg.part: No such file or directory", exit_code::output_failed);
   const std::string empty = temp("empty.log");
@@ -1003,8 +998,8 @@ TEST(DecodeCli, RestartsAndSilentNodesAreDetected) {
   log.restart(a.address);  // silent for 6 s, then starts again from report 0
   for (std::uint8_t seq = 0; seq < 3; ++seq) log.report(a, seq, 209.5 + seq, 100u * (seq + 1));
   const std::string csv_path = temp("restart.csv"), jsonl_path = temp("restart.jsonl");
-  const Outcome r =
-      run(log.write("restart.log") + " --view none --rate-unit native --csv " + csv_path + " --jsonl " + jsonl_path);
+  const Outcome r = run(log.write("restart.log") + " --view none --rate-unit native --csv " + csv_path + " --jsonl " +
+                        jsonl_path);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(contains(r.err, "node 0x60: frames")) << r.err;
   EXPECT_TRUE(contains(r.err, "restarts 1; offline 1;")) << r.err;
@@ -1028,8 +1023,7 @@ TEST(DecodeCli, StdinNodeFilterDurationAndTimeGoingBackwards) {
   const std::string path = log.write("stdin.log"), csv_path = temp("stdin.csv");
   // --duration 3.45: decoding stops at the first frame at 303.45 s or later, 303.5 s (frame 6 of
   // report 3 of node 0x70, written before the first frame of report 3 of node 0x71 at the same time).
-  const Outcome r =
-      run("--view none --node 0x71 --duration 3.45 --rate-unit native --csv " + csv_path + " - < " + path);
+  const Outcome r = run("--view none --node 0x71 --duration 3.45 --rate-unit native --csv " + csv_path + " - < " + path);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(contains(r.err, "gyrochar-decode: stdin: ")) << r.err;
   EXPECT_TRUE(contains(r.err, "1 timestamps backwards")) << r.err;

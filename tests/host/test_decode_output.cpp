@@ -350,7 +350,7 @@ TEST(DecodeOutput, PlotOfAVersionFourModelDrawsItsMarkovTermAndNeverAnotherCycle
   v.fit_model.parameters[1] = Ieee952ParameterMsg{0, FitParameter::markov_tc, 0, false, 5.0f, 0.2};
   ConfidenceIntervals intervals(0.683);
   const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals);  // deg/h: numerically arcsec/s
-  ASSERT_EQ(p.terms.size(), 3u);  // N, the Markov term, the sum
+  ASSERT_EQ(p.terms.size(), 3u);                                   // N, the Markov term, the sum
   EXPECT_TRUE(p.terms[1].markov);
   EXPECT_EQ(p.terms[1].label, "Markov 0.05 deg/h (±10%), Tc 5 s");  // sigma, its uncertainty, Tc
   const double n = 0.1f, sigma = 0.05f, tc = 5.0;
@@ -383,7 +383,9 @@ TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
   NodeView v = node_with_curve({0.0f, 0.1f, 0.01f, 0.0f, 0.0f});
   v.ieee952[2].resolved = false;
   v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::ok, 0.875f, 18, false, {3, 2}};
-  const TrueTerms truth{{2.5 * std::numbers::pi / 648000, 0.12 * std::numbers::pi / 648000, 0.0, 0.0, 0.0}, {}, {}};  // arcsec -> rad
+  const TrueTerms truth{{2.5 * std::numbers::pi / 648000, 0.12 * std::numbers::pi / 648000, 0.0, 0.0, 0.0},
+                        {},
+                        {}};  // arcsec -> rad
   ConfidenceIntervals intervals(0.683);
   const NodePlot p = plot_data(v, rate_unit("deg/h"), intervals, &truth);
   ASSERT_EQ(p.terms.size(), 2u);  // N's own line and the model
@@ -394,8 +396,9 @@ TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
   const double q2 = 1.0 / 12, floor = 2 * std::log(2.0) / std::numbers::pi;
   for (std::size_t j = 0; j < p.terms[1].tau_s.size(); ++j) {
     const double t = p.terms[1].tau_s[j];
-    expect_rel(p.terms[1].dev[j], std::sqrt(3 * q2 / (t * t) + static_cast<double>(0.1f) * 0.1f / t +
-                                            floor * static_cast<double>(0.01f) * 0.01f),
+    expect_rel(p.terms[1].dev[j],
+               std::sqrt(3 * q2 / (t * t) + static_cast<double>(0.1f) * 0.1f / t +
+                         floor * static_cast<double>(0.01f) * 0.01f),
                1e-12);
   }
   ASSERT_TRUE(p.truth.has_value());
@@ -406,7 +409,7 @@ TEST(DecodeOutput, PlotSumIsTheFittedModelWithHeldQAndTheTruthBeside) {
   ASSERT_EQ(p.notes.size(), 2u);
   EXPECT_EQ(p.notes[0], "quantization not white, fit");
   EXPECT_EQ(p.notes[1], "left out: ADEV < 1 s, MDEV < 0.5 s");  // 0.125 s x 2^3, 2^2
-  EXPECT_EQ(p.read_offs.size(), 1u);  // N at 1 s only: B is not resolved
+  EXPECT_EQ(p.read_offs.size(), 1u);                            // N at 1 s only: B is not resolved
 
   // A node reporting pulses: no angle to put the truth in.
   NodeView pulses = v;
@@ -418,11 +421,12 @@ TEST(DecodeOutput, ViewShowsTheSimulatedValueBesideEachTerm) {
   // Through the decoder, from frames: a node in arcsec with N = 0.18 arcsec/sqrt(s) = 0.003 deg/sqrt(h).
   Decoder decoder;
   double t = 1.0;
-  for (const Message& m : std::vector<Message>{
-           StatusMsg{3, NodeState::running, 1, 100}, MetaScaleMsg{3, 1.0f, AngleUnit::arcsec, InputSource::simulated},
-           Ieee952Msg{3, Ieee952Term::angle_random_walk, true, 0.18f, 0.018, true},
-           Ieee952Msg{3, Ieee952Term::bias_instability, false, 0.01f, 1.5, true},  // 0.01 arcsec/s = 0.01 deg/h
-           Ieee952SummaryMsg{3, Ieee952Status::ok, 0.93f, 24, true, {0, 0}}})
+  for (const Message& m : std::vector<Message>{StatusMsg{3, NodeState::running, 1, 100},
+                                               MetaScaleMsg{3, 1.0f, AngleUnit::arcsec, InputSource::simulated},
+                                               Ieee952Msg{3, Ieee952Term::angle_random_walk, true, 0.18f, 0.018, true},
+                                               Ieee952Msg{3, Ieee952Term::bias_instability, false, 0.01f, 1.5,
+                                                          true},  // 0.01 arcsec/s = 0.01 deg/h
+                                               Ieee952SummaryMsg{3, Ieee952Status::ok, 0.93f, 24, true, {0, 0}}})
     decoder.feed(frame_of(m, 0x12), t += 0.01);
   TrueTermsByNode truth;
   truth[0x12] = {{0.0, 0.003 * std::numbers::pi / 180 / 60, 0.01 * std::numbers::pi / 180 / 3600, 0.0, 0.0}, {}, {}};

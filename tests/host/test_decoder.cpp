@@ -47,9 +47,8 @@ Ieee952UnconstrainedMsg unconstrained_page(std::uint8_t seq, std::size_t k) {
 // resolved in version 2, and goes out as zeros in version 1). With `window_taus` (version 3) the
 // window frames describe window `window`, its ADEV at window tau i 1 + i + window, MDEV half that.
 std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t taus, std::uint64_t samples,
-                             std::uint64_t uptime_ms = 0, std::uint32_t hash = 7,
-                             std::uint8_t protocol_version = version, std::uint8_t window_taus = 0,
-                             std::uint32_t window = 0) {
+                             std::uint64_t uptime_ms = 0, std::uint32_t hash = 7, std::uint8_t protocol_version = version,
+                             std::uint8_t window_taus = 0, std::uint32_t window = 0) {
   std::vector<CanFrame> frames;
   const bool v2 = protocol_version >= 2;
   const auto window_dev = [&](std::size_t i) { return 1.0 + static_cast<double>(i + window); };
@@ -59,8 +58,12 @@ std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t t
     switch (s.slot) {
       case Slot::status: m = StatusMsg{seq, NodeState::running, taus, samples}; break;
       case Slot::faults: m = StatusFaultsMsg{seq, 1, 2, 3, 0}; break;
-      case Slot::adev: m = TauDevMsg{seq, s.index, DevKind::adev, 1.0f / (1 + s.index), 100.0, NoiseType::white_fm, true}; break;
-      case Slot::mdev: m = TauDevMsg{seq, s.index, DevKind::mdev, 0.5f / (1 + s.index), 90.0, NoiseType::white_fm, true}; break;
+      case Slot::adev:
+        m = TauDevMsg{seq, s.index, DevKind::adev, 1.0f / (1 + s.index), 100.0, NoiseType::white_fm, true};
+        break;
+      case Slot::mdev:
+        m = TauDevMsg{seq, s.index, DevKind::mdev, 0.5f / (1 + s.index), 90.0, NoiseType::white_fm, true};
+        break;
       case Slot::terms: m = TauTermsMsg{seq, s.index, samples - 2}; break;
       case Slot::tau_info: m = TauInfoMsg{seq, s.index, std::uint64_t{1} << s.index, 0}; break;
       case Slot::sampling: m = MetaSamplingMsg{seq, 0.01f, 8}; break;
@@ -82,9 +85,9 @@ std::vector<CanFrame> report(std::uint8_t node, std::uint8_t seq, std::uint8_t t
       case Slot::window: m = WindowMsg{seq, window_taus, true, window, 0}; break;
       case Slot::window_length: m = WindowLengthMsg{seq, 1000}; break;
       case Slot::window_dev:
-        m = WindowDevMsg{seq, s.index, static_cast<std::uint8_t>(window % 16), window_dev(s.index),
-                         window_dev(s.index) / 2};
-        break;      case Slot::fit_model: m = model_page(seq); break;
+        m = WindowDevMsg{seq, s.index, static_cast<std::uint8_t>(window % 16), window_dev(s.index), window_dev(s.index) / 2};
+        break;
+      case Slot::fit_model: m = model_page(seq); break;
       case Slot::fit_parameter: m = parameter_page(seq, s.index); break;
       case Slot::unconstrained: m = unconstrained_page(seq, s.index); break;
     }
@@ -176,7 +179,7 @@ TEST(Decoder, ModelPagesAreKeptPerSlowCycleAcrossLostReports) {
   EXPECT_FALSE(v.fit_model.model.has_value());  // the model page came in report 4
   EXPECT_FALSE(v.fit_model.complete());
   EXPECT_TRUE(v.previous_fit_model.complete());
-  EXPECT_EQ(v.ieee952_summary_cycle, 2u);       // report 7 carried the second cycle's summary
+  EXPECT_EQ(v.ieee952_summary_cycle, 2u);  // report 7 carried the second cycle's summary
   Feed late;
   for (unsigned s = 250; s < 258; ++s) late.frames(report(9, static_cast<std::uint8_t>(s), 8, 1000 + s * 100));
   late.decoder.flush();
@@ -407,7 +410,7 @@ TEST(Decoder, ReportsMadeWhileOfflineAreLost) {
   Decoder decoder;
   for (const auto& f : report(3, 10, 2, 1000)) decoder.feed(f, 1.0);
   for (const auto& f : report(3, 11, 2, 1100)) decoder.feed(f, 2.0);
-  decoder.tick(6.0);  // offline
+  decoder.tick(6.0);                                                  // offline
   for (const auto& f : report(3, 17, 2, 1700)) decoder.feed(f, 8.0);  // 12..16 never arrived
   decoder.flush();
   const NodeView& v = decoder.nodes().at(3);
@@ -423,7 +426,7 @@ TEST(Decoder, ReportsMadeWhileOfflineAreLost) {
 TEST(Decoder, RestartAfterASeqJumpIsNotALoss) {
   Decoder decoder;
   for (const auto& f : report(4, 250, 2, 5000)) decoder.feed(f, 1.0);
-  decoder.tick(5.0);  // offline
+  decoder.tick(5.0);                                               // offline
   for (const auto& f : report(4, 3, 2, 20)) decoder.feed(f, 9.0);  // d = 9, but SampleCount went back
   decoder.flush();
   const NodeView& v = decoder.nodes().at(4);

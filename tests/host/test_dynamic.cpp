@@ -54,8 +54,8 @@ TEST(Dynamic, EveryWindowIsItsValuesAnalysedAlone) {
     counts[k] = std::round(100 + 4 * noise(rng));
   }
   const std::vector<std::uint64_t> taus = window_taus(octave_taus(1001), 1000);
-  for (const auto& [type, values] : {std::pair{DataType::freq, &freq}, std::pair{DataType::counts, &counts},
-                                     std::pair{DataType::phase, &freq}}) {
+  for (const auto& [type, values] :
+       {std::pair{DataType::freq, &freq}, std::pair{DataType::counts, &counts}, std::pair{DataType::phase, &freq}}) {
     for (const std::uint64_t step : {std::uint64_t{1000}, std::uint64_t{300}}) {
       DynamicAnalyzer dynamic(options(type, taus), 1000, step);
       std::vector<WindowAnalysis> windows;

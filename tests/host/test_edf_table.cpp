@@ -58,13 +58,13 @@ TEST_P(EdfTableError, EveryMWithinTheStatedErrorOfTheExactEdf) {
     }
   }
   std::printf("%s N=%llu: %zu anchors for %llu taus, worst EDF error %.2e, interval bound %.2e\n", name(stat),
-              static_cast<unsigned long long>(n_phase), table.anchors(), static_cast<unsigned long long>(m_max - 63),
-              worst, worst_skew);
+              static_cast<unsigned long long>(n_phase), table.anchors(), static_cast<unsigned long long>(m_max - 63), worst,
+              worst_skew);
 }
 
 INSTANTIATE_TEST_SUITE_P(Stats, EdfTableError,
-                         ::testing::Values(Case{DevStat::oadev, 4001}, Case{DevStat::mdev, 4001},
-                                           Case{DevStat::ohdev, 4001}, Case{DevStat::oadev, 30001}));
+                         ::testing::Values(Case{DevStat::oadev, 4001}, Case{DevStat::mdev, 4001}, Case{DevStat::ohdev, 4001},
+                                           Case{DevStat::oadev, 30001}));
 
 TEST(EdfTable, EstimateWithGapsAndPlausibleRangesAsEstimate) {
   // A tau with a tenth of its terms lost to gaps and three plausible noises: the smallest EDF of
@@ -114,8 +114,8 @@ TEST(EdfTable, DenseNoiseSumsWithinTheStatedErrorOfTheExactOnes) {
       }
     }
   }
-  std::printf("noise sums N=%llu: %zu anchors for %zu taus, worst error %.2e\n",
-              static_cast<unsigned long long>(n_phase), anchors, m_list.size() - 63, worst);
+  std::printf("noise sums N=%llu: %zu anchors for %zu taus, worst error %.2e\n", static_cast<unsigned long long>(n_phase),
+              anchors, m_list.size() - 63, worst);
 }
 
 }  // namespace

@@ -32,9 +32,7 @@ ServerLimits quick_limits() {
 
 class Server : public ::testing::Test {
  protected:
-  Server() : server(ListenAddress{"127.0.0.1", 0}, page_assets(), quick_limits()) {
-    server.publish(R"({"snapshot":1})");
-  }
+  Server() : server(ListenAddress{"127.0.0.1", 0}, page_assets(), quick_limits()) { server.publish(R"({"snapshot":1})"); }
   // The server still answers a normal request with the latest snapshot.
   void expect_responsive(const std::string& snapshot = R"({"snapshot":1})") {
     const std::string answer = get(server.port(), "/data.json");
@@ -50,7 +48,8 @@ TEST_F(Server, ServesItsPageItsDataAndNothingElse) {
   EXPECT_NE(page.find("Content-Type: text/html; charset=utf-8\r\n"), std::string::npos);
   EXPECT_NE(page.find("<script src=\"app.js\""), std::string::npos);
   EXPECT_NE(page.find("Content-Security-Policy: default-src 'none'"), std::string::npos);
-  for (const char* path : {"/app.js", "/style.css", "/chart.js"}) EXPECT_EQ(status_of(get(server.port(), path)), 200) << path;
+  for (const char* path : {"/app.js", "/style.css", "/chart.js"})
+    EXPECT_EQ(status_of(get(server.port(), path)), 200) << path;
   // The plotting library is served from the page's own origin, before the page's script: Chart.js
   // as Debian's libjs-chart.js installs it (oracle: the banner that file begins with).
   EXPECT_LT(page.find("<script src=\"chart.js\""), page.find("<script src=\"app.js\""));
@@ -79,8 +78,8 @@ TEST_F(Server, PathTraversalFindsNothing) {
 
 TEST_F(Server, OtherMethodsAre405WithAllow) {
   for (const char* method : {"POST", "PUT", "DELETE", "PATCH", "OPTIONS", "TRACE", "CONNECT", "PROPFIND"}) {
-    const std::string answer =
-        ask(server.port(), std::string(method) + " / HTTP/1.1\r\nHost: localhost\r\nContent-Length: 3\r\n\r\nabc");
+    const std::string answer = ask(server.port(),
+                                   std::string(method) + " / HTTP/1.1\r\nHost: localhost\r\nContent-Length: 3\r\n\r\nabc");
     EXPECT_EQ(status_of(answer), 405) << method;
     EXPECT_NE(answer.find("Allow: GET, HEAD\r\n"), std::string::npos) << method;
   }
@@ -116,8 +115,7 @@ TEST_F(Server, HugeRequestsAreCutAtTheLimit) {
 TEST_F(Server, ForeignHostNamesAreRefusedOnLoopback) {
   EXPECT_EQ(status_of(ask(server.port(), "GET /data.json HTTP/1.1\r\nHost: evil.example:8080\r\n\r\n")), 403);
   for (const char* host : {"localhost", "LOCALHOST:1", "127.0.0.1", "127.1.2.3:80", "[::1]:8080"})
-    EXPECT_EQ(status_of(ask(server.port(), std::string("GET / HTTP/1.1\r\nHost: ") + host + "\r\n\r\n")), 200)
-        << host;
+    EXPECT_EQ(status_of(ask(server.port(), std::string("GET / HTTP/1.1\r\nHost: ") + host + "\r\n\r\n")), 200) << host;
 }
 
 TEST_F(Server, SlowlorisGets408AndOthersAreServedMeanwhile) {

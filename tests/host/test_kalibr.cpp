@@ -67,8 +67,9 @@ TEST(Kalibr, PartialLeavesATermTheFitLeftOutToFillIn) {
   const double n = 8.726646259971648e-07;  // the header's hand-computed value
   const auto yaml = kalibr_imu_yaml({n, 0.02, true, true}, {0, 0, false, false}, 100.0, "t", why, true);
   ASSERT_TRUE(yaml) << why;
-  EXPECT_EQ(why, "K (rate random walk) is not in the fitted model: its key is written commented out with '?' for you to "
-                 "fill in (Kalibr needs it > 0)");
+  EXPECT_EQ(why,
+            "K (rate random walk) is not in the fitted model: its key is written commented out with '?' for you to "
+            "fill in (Kalibr needs it > 0)");
   const auto keys = yaml_keys(*yaml);
   EXPECT_EQ(std::stod(keys.at("gyroscope_noise_density")), n);
   EXPECT_EQ(keys.count("gyroscope_random_walk"), 0u);
@@ -87,8 +88,8 @@ NodeView node_in(protocol::AngleUnit unit) {
   v.address = 0x10;
   v.scale = MetaScaleMsg{0, 1.0f, unit, InputSource::simulated};
   v.sampling = MetaSamplingMsg{0, 0.01f, 8};
-  v.ieee952[1] = {true, true, 10.8f, 0.05f, true};   // N, arcsec/sqrt(s)
-  v.ieee952[3] = {true, false, 0.36f, 0.4f, true};   // K, arcsec/s^1.5
+  v.ieee952[1] = {true, true, 10.8f, 0.05f, true};  // N, arcsec/sqrt(s)
+  v.ieee952[3] = {true, false, 0.36f, 0.4f, true};  // K, arcsec/s^1.5
   v.ieee952_summary = Ieee952SummaryMsg{0, Ieee952Status::ok, 1.0f, 20, true, {0, 0}};
   return v;
 }

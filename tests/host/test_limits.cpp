@@ -49,17 +49,17 @@ TEST(Limits, ParsesTermsAndDeviationsInTheirUnits) {
   EXPECT_EQ(limits[0].text, "N <= 0.003 deg/sqrt(h)");
   EXPECT_NEAR(limits[0].value_si, 8.726646259971648e-07, 1e-21);  // header: by hand
   EXPECT_EQ(limits[1].term, 2u);
-  EXPECT_NEAR(limits[1].value_si, 4.84813681109536e-08, 1e-22);     // header: by hand
-  EXPECT_NEAR(limits[2].value_si, 8.080228018492267e-11, 1e-25);    // header: by hand
+  EXPECT_NEAR(limits[1].value_si, 4.84813681109536e-08, 1e-22);   // header: by hand
+  EXPECT_NEAR(limits[2].value_si, 8.080228018492267e-11, 1e-25);  // header: by hand
   EXPECT_EQ(limits[3].kind, Limit::Kind::adev);
   EXPECT_EQ(limits[3].tau_s, 100.0);
   EXPECT_EQ(limits[3].quantity(), "adev(100 s)");
-  EXPECT_NEAR(limits[3].value_si, 2.42406840554768e-08, 1e-22);     // header: by hand
+  EXPECT_NEAR(limits[3].value_si, 2.42406840554768e-08, 1e-22);  // header: by hand
   EXPECT_EQ(limits[4].kind, Limit::Kind::mdev);
-  EXPECT_EQ(limits[4].tau_s, 120.0);  // 2 min
-  EXPECT_EQ(limits[4].value_si, 2.42406840554768e-08);              // given in SI: as written
+  EXPECT_EQ(limits[4].tau_s, 120.0);                    // 2 min
+  EXPECT_EQ(limits[4].value_si, 2.42406840554768e-08);  // given in SI: as written
   EXPECT_EQ(limits[5].term, 0u);
-  EXPECT_NEAR(limits[5].value_si, 4.84813681109536e-06, 1e-20);     // 1 arcsec = pi / 648000 rad
+  EXPECT_NEAR(limits[5].value_si, 4.84813681109536e-06, 1e-20);  // 1 arcsec = pi / 648000 rad
   EXPECT_EQ(limits[5].line, 8u);
 }
 
@@ -108,8 +108,8 @@ TEST(Limits, DecisionRuleIsGuardBanded) {
   ASSERT_TRUE(e.usable);
   EXPECT_NEAR(e.low, 0.8040036015459946, 1e-15);
   EXPECT_NEAR(e.high, 1.1959963984540054, 1e-15);
-  EXPECT_EQ(decide(upper(1.3), e).verdict, Verdict::pass);   // upper bound 1.196 within 1.3
-  EXPECT_EQ(decide(upper(0.7), e).verdict, Verdict::fail);   // lower bound 0.804 beyond 0.7
+  EXPECT_EQ(decide(upper(1.3), e).verdict, Verdict::pass);  // upper bound 1.196 within 1.3
+  EXPECT_EQ(decide(upper(0.7), e).verdict, Verdict::fail);  // lower bound 0.804 beyond 0.7
   const Decision d = decide(upper(1.1), e);
   EXPECT_EQ(d.verdict, Verdict::undecided);
   // T (d / gap)^2 = 3600 (0.1959963984540054 / 0.1)^2 = 3600 x 3.841458820694124 (by hand).
@@ -127,7 +127,7 @@ TEST(Limits, DecisionRuleIsGuardBanded) {
 TEST(Limits, DeviationBoundsAreTheChiSquaredInterval) {
   const LimitEstimate e = deviation_estimate(1.0, 100, 0, 7200);
   ASSERT_TRUE(e.usable);
-  EXPECT_NEAR(e.low, std::sqrt(100 / 129.5612), 2e-6);   // header: chi2 table
+  EXPECT_NEAR(e.low, std::sqrt(100 / 129.5612), 2e-6);  // header: chi2 table
   EXPECT_NEAR(e.high, std::sqrt(100 / 74.22193), 2e-6);
   EXPECT_FALSE(deviation_estimate(1.0, 0, 0, 7200).usable) << "no EDF: no verdict";
   EXPECT_EQ(decide(upper(2), deviation_estimate(1.0, 0, 0, 7200)).verdict, Verdict::undecided);

@@ -49,7 +49,8 @@ std::string output_of(const std::string& command) {
 
 TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
   const std::string browser = chromium();
-  if (browser.empty()) GTEST_SKIP() << "chromium is not installed (Debian package chromium; toolchain/build.sh test installs it)";
+  if (browser.empty())
+    GTEST_SKIP() << "chromium is not installed (Debian package chromium; toolchain/build.sh test installs it)";
   const std::string csv = temp("demo.csv"), limits = temp("limits.txt");
   // A limit no gyro meets (oracle: no gyro's ADEV is below 1e-9 deg/h): each card's verdict fails.
   std::ofstream(limits) << "adev(10.24 s) <= 1e-9 deg/h\n";
@@ -72,8 +73,9 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
                                     " 2>" + log);
   const std::string shot = GYROCHAR_BINARY_DIR "/tests/live_page.png";
   std::remove(shot.c_str());
-  std::system(("timeout 120 " + browser + flags + "--window-size=1400,1700 --screenshot=" + shot + " " + url +
-               " >/dev/null 2>&1").c_str());
+  std::system(
+      ("timeout 120 " + browser + flags + "--window-size=1400,1700 --screenshot=" + shot + " " + url + " >/dev/null 2>&1")
+          .c_str());
   // The demo goes on to its end (its CSV complete), then is stopped.
   ASSERT_TRUE(demo.wait_for("serves the finished run", 300)) << demo.err();
   EXPECT_EQ(demo.stop(), 0) << demo.err();
@@ -89,7 +91,8 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
   // Each card's ADEV/MDEV plot is a canvas that Chart.js (served by the demo as /chart.js) took
   // over: it gives the canvas its display style. No script error and no request refused by the
   // Content-Security-Policy (the library needs no inline style and no eval).
-  const std::regex chart_re(R"re(<canvas (?=[^>]*style="display: block;)(?=[^>]*aria-label="[^"]*: ADEV and MDEV")[^>]*>)re");
+  const std::regex chart_re(
+      R"re(<canvas (?=[^>]*style="display: block;)(?=[^>]*aria-label="[^"]*: ADEV and MDEV")[^>]*>)re");
   EXPECT_EQ(std::distance(std::sregex_iterator(dom.begin(), dom.end(), chart_re), std::sregex_iterator()), 2)
       << "a plot drawn by Chart.js on each card";
   std::stringstream console;

@@ -97,7 +97,9 @@ void expect_rows_in_csv(const Json& snapshot, const std::map<Key, std::pair<std:
 
 TEST(LivePage, DecoderServesTheRowsOfItsCsv) {
   const std::string log = temp("two.log"), csv = temp("decoded.csv"), fifo = temp("bus.fifo");
-  ASSERT_EQ(std::system((bin + "gyrochar-demo --hours 0.05 --plot '' --csv '' --candump " + log + " >/dev/null 2>&1").c_str()), 0);
+  ASSERT_EQ(std::system(
+                (bin + "gyrochar-demo --hours 0.05 --plot '' --csv '' --candump " + log + " >/dev/null 2>&1").c_str()),
+            0);
   // The log comes through a FIFO held open, so that the decoder keeps serving after its last line.
   std::remove(fifo.c_str());
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
@@ -160,8 +162,8 @@ TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
   const char* speed_env = std::getenv("GYROCHAR_LIVE_SPEED");
   const char* hours_env = std::getenv("GYROCHAR_LIVE_HOURS");
   const std::string speed = speed_env != nullptr ? speed_env : "40", hours = hours_env != nullptr ? hours_env : "0.1";
-  Background demo(bin + "gyrochar-demo --nodes 8 --hours " + hours + " --speed " + speed + " --view-every 0 --plot '' --csv " + csv +
-                      " --http 127.0.0.1:0",
+  Background demo(bin + "gyrochar-demo --nodes 8 --hours " + hours + " --speed " + speed +
+                      " --view-every 0 --plot '' --csv " + csv + " --http 127.0.0.1:0",
                   temp("eight.err"));
   const std::uint16_t port = demo.port();
   ASSERT_NE(port, 0) << demo.err();
@@ -208,13 +210,13 @@ TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
   std::uint64_t attacks = 0;
   std::thread attackers([&] {
     std::vector<int> slow;
-    const std::vector<std::string> hostile = {
-        "GET /../../../../etc/passwd HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
-        "POST /events HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 4\r\n\r\nkill",
-        "GET /\r\n",
-        std::string("\x16\x03\x01\x00\xa5\x01\x00\x00\xa1\x03\x03garbage\r\n\r\n", 22),
-        "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX: " + std::string(20000, 'x') + "\r\n\r\n",
-        "GET /data.json HTTP/1.1\r\nHost: attacker.example\r\n\r\n"};
+    const std::vector<std::string> hostile = {"GET /../../../../etc/passwd HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
+                                              "POST /events HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 4\r\n\r\nkill",
+                                              "GET /\r\n",
+                                              std::string("\x16\x03\x01\x00\xa5\x01\x00\x00\xa1\x03\x03garbage\r\n\r\n", 22),
+                                              "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX: " + std::string(20000, 'x') +
+                                                  "\r\n\r\n",
+                                              "GET /data.json HTTP/1.1\r\nHost: attacker.example\r\n\r\n"};
     std::vector<int> deaf;  // event streams that are never read, on small receive buffers
     for (int i = 0; i < 10; ++i) {
       deaf.push_back(connect_local(port));
@@ -258,8 +260,10 @@ TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
   // The same run without the page (the demo is deterministic: seeded gyros, virtual clock) gives
   // the same link health per node, line for line (the last report of each is cut by the run's end).
   const std::string plain = temp("plain.err");
-  ASSERT_EQ(std::system((bin + "gyrochar-demo --nodes 8 --hours " + hours + " --view-every 0 --plot '' --csv '' >/dev/null 2>" +
-                         plain).c_str()), 0);
+  ASSERT_EQ(std::system((bin + "gyrochar-demo --nodes 8 --hours " + hours +
+                         " --view-every 0 --plot '' --csv '' >/dev/null 2>" + plain)
+                            .c_str()),
+            0);
   std::ifstream plain_in(plain);
   const std::string reference{std::istreambuf_iterator<char>(plain_in), {}};
   std::size_t node_lines = 0;
@@ -278,12 +282,15 @@ TEST(LivePage, DemoKeepsEveryFrameUnderLoadAndAttack) {
   EXPECT_EQ(demo.stop(), 0) << demo.err();
   ASSERT_FALSE(latency_ms.empty());
   std::sort(latency_ms.begin(), latency_ms.end());
-  const auto at = [&](double q) { return latency_ms[static_cast<std::size_t>(q * static_cast<double>(latency_ms.size() - 1))]; };
-  std::printf("live page latency (report closed -> event received), %zu reports of 8 nodes, speed %s, refresh 1 s, "
-              "100 followers, %llu hostile requests: median %.0f ms, 95%% %.0f ms, max %.0f ms; frames %llu on the bus, "
-              "%llu received; snapshot of 8 nodes %zu bytes\n",
-              latency_ms.size(), speed.c_str(), static_cast<unsigned long long>(attacks), at(0.5), at(0.95), latency_ms.back(),
-              static_cast<unsigned long long>(on_bus), static_cast<unsigned long long>(received), last_text.size());
+  const auto at = [&](double q) {
+    return latency_ms[static_cast<std::size_t>(q * static_cast<double>(latency_ms.size() - 1))];
+  };
+  std::printf(
+      "live page latency (report closed -> event received), %zu reports of 8 nodes, speed %s, refresh 1 s, "
+      "100 followers, %llu hostile requests: median %.0f ms, 95%% %.0f ms, max %.0f ms; frames %llu on the bus, "
+      "%llu received; snapshot of 8 nodes %zu bytes\n",
+      latency_ms.size(), speed.c_str(), static_cast<unsigned long long>(attacks), at(0.5), at(0.95), latency_ms.back(),
+      static_cast<unsigned long long>(on_bus), static_cast<unsigned long long>(received), last_text.size());
 }
 
 }  // namespace

@@ -199,10 +199,10 @@ TEST(PowerLawNoise, MeanEstimatesMatchTheExactExpectation) {
         const double want = expected_variance(alpha, v == 0 ? Variance::avar : Variance::mvar, m);
         const double z = (mean - want) / se;
         worst_z = std::max(worst_z, std::fabs(z));
-        std::printf("alpha %+d %s m %4zu: mean/exact %.4f, standard error %.4f, z %+.2f\n", alpha, v == 0 ? "AVAR" : "MVAR", m,
-                    mean / want, se / want, z);
-        EXPECT_LT(std::fabs(z), 4.0) << "alpha " << alpha << (v == 0 ? " AVAR" : " MVAR") << " m " << m << ": mean "
-                                     << mean << ", exact " << want;
+        std::printf("alpha %+d %s m %4zu: mean/exact %.4f, standard error %.4f, z %+.2f\n", alpha, v == 0 ? "AVAR" : "MVAR",
+                    m, mean / want, se / want, z);
+        EXPECT_LT(std::fabs(z), 4.0) << "alpha " << alpha << (v == 0 ? " AVAR" : " MVAR") << " m " << m << ": mean " << mean
+                                     << ", exact " << want;
       }
     }
   }

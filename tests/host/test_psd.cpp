@@ -85,7 +85,8 @@ TEST(WelchPsd, ASinusoidsPowerIsHalfItsAmplitudeSquaredAndIsFound) {
   // Oracle: a sinusoid of amplitude A has mean power A^2 / 2; its frequency is the one generated.
   const double A = 3.0, f = 1.2345, tau0 = 0.01, sigma = 0.5;
   std::vector<double> x = white(1 << 18, sigma, 5);
-  for (std::size_t n = 0; n < x.size(); ++n) x[n] += A * std::sin(2 * std::numbers::pi * f * static_cast<double>(n) * tau0 + 0.4);
+  for (std::size_t n = 0; n < x.size(); ++n)
+    x[n] += A * std::sin(2 * std::numbers::pi * f * static_cast<double>(n) * tau0 + 0.4);
   const Psd p = welch_psd(x, tau0, default_psd_segment(x.size()), 0.683);
   const PeakSearch s = find_sinusoids(p);
   ASSERT_EQ(s.peaks.size(), 1u);

@@ -86,8 +86,10 @@ TEST(AnalyzePsd, TheSimulatedSinusoidIsFoundWithinItsUncertaintyAndFitted) {
 
 TEST(AnalyzePsd, WritesEveryBinToTheCsvAndTurnsTheSearchOff) {
   const std::string csv = temp("psd.csv");
-  const Outcome r = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --format json "
-                                     "--no-sinusoid-search --psd-segment 4096 --psd " + csv + " " + sinusoid_counts());
+  const Outcome r = run_shell(tool +
+                              " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --format json "
+                              "--no-sinusoid-search --psd-segment 4096 --psd " +
+                              csv + " " + sinusoid_counts());
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j.at("psd").at("search").is_null());
@@ -104,13 +106,15 @@ TEST(AnalyzePsd, WritesEveryBinToTheCsvAndTurnsTheSearchOff) {
     EXPECT_LT(low, psd);
     EXPECT_GT(high, psd);
   }
-  EXPECT_EQ(rows, 4096u / 2 - 1);               // bins 1 .. L/2 - 1
+  EXPECT_EQ(rows, 4096u / 2 - 1);                    // bins 1 .. L/2 - 1
   EXPECT_DOUBLE_EQ(freq, (4096.0 / 2 - 1) / 40.96);  // the last: k / (L tau0)
 }
 
 TEST(AnalyzePsd, GivenFrequenciesAreOfferedToTheFitAndCheckedFirst) {
-  const Outcome r = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --format json "
-                                     "--no-sinusoid-search --sinusoid-hz 0.05 " + sinusoid_counts());
+  const Outcome r = run_shell(tool +
+                              " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --format json "
+                              "--no-sinusoid-search --sinusoid-hz 0.05 " +
+                              sinusoid_counts());
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("fit").at(0).at("sinusoids").size(), 1u);
@@ -123,7 +127,8 @@ TEST(AnalyzePsd, GivenFrequenciesAreOfferedToTheFitAndCheckedFirst) {
     EXPECT_NE(bad.err.find("gyrochar-analyze: --sinusoid-hz: "), std::string::npos) << bad.err;
     EXPECT_TRUE(bad.out.empty());
   }
-  const Outcome odd = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --psd-segment 1001 " + sinusoid_counts());
+  const Outcome odd = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --psd-segment 1001 " +
+                                sinusoid_counts());
   EXPECT_EQ(odd.code, exit_code::bad_input);
   EXPECT_NE(odd.err.find("--psd-segment: must be even"), std::string::npos) << odd.err;
 }
@@ -133,11 +138,14 @@ TEST(AnalyzePsd, KalibrGetsNAndKAloneAndSaysWhatItLeavesOut) {
   // has the sinusoid, which Kalibr's model has no place for; the file's first comment line and
   // stderr name it.
   const std::string counts = temp("sinusoid_rrw.txt"), yaml = temp("imu.yaml");
-  ASSERT_EQ(run_shell(sim + " --duration 7200 --tau0 0.01 --arw 0.02 --rrw 2 --sinusoid 2,0.05 --seed 3 > " + counts).code, 0);
-  const Outcome r = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --kalibr " + yaml + " " + counts);
+  ASSERT_EQ(run_shell(sim + " --duration 7200 --tau0 0.01 --arw 0.02 --rrw 2 --sinusoid 2,0.05 --seed 3 > " + counts).code,
+            0);
+  const Outcome r = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --kalibr " + yaml + " " +
+                              counts);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("gyrochar-analyze: note: --kalibr: gyroscope_noise_density is the fitted white-rate N"),
-            std::string::npos) << r.err;
+            std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("1 sinusoid"), std::string::npos) << r.err;
   const std::string text = slurp(yaml);
   const std::string first = text.substr(0, text.find('\n'));
@@ -165,7 +173,8 @@ TEST(AnalyzePlot, AnUnwritablePrefixIsAnOutputError) {
   const Outcome r = run_shell(tool + " --type counts --tau0 0.01 --pulse-weight 1 --plot /nonexistent/dir/x " +
                               sinusoid_counts());
   EXPECT_EQ(r.code, exit_code::output_failed) << r.err;
-  EXPECT_NE(r.err.find("gyrochar-analyze: --plot: /nonexistent/dir/x.svg.part: No such file or directory"), std::string::npos)
+  EXPECT_NE(r.err.find("gyrochar-analyze: --plot: /nonexistent/dir/x.svg.part: No such file or directory"),
+            std::string::npos)
       << r.err;
 }
 

@@ -19,7 +19,8 @@ namespace {
 const std::string tool = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-analyze";
 
 nlohmann::json analyze(const std::string& path) {
-  const std::string command = tool + " --type freq --unit deg/s --tau0 0.01 --fit ieee952 --format json " + path + " 2>/dev/null";
+  const std::string command = tool + " --type freq --unit deg/s --tau0 0.01 --fit ieee952 --format json " + path +
+                              " 2>/dev/null";
   FILE* p = popen(command.c_str(), "r");
   std::string out;
   char buf[4096];

@@ -76,33 +76,39 @@ void expect_same(const std::string& cell, const nlohmann::json& j, const std::st
 
 TEST(ReportBrowser, RenderedValuesEqualTheAnalyzersJson) {
   const std::string browser = chromium();
-  if (browser.empty()) GTEST_SKIP() << "chromium is not installed (Debian package chromium; toolchain/build.sh test installs it)";
+  if (browser.empty())
+    GTEST_SKIP() << "chromium is not installed (Debian package chromium; toolchain/build.sh test installs it)";
   int code = 0;
   const std::string counts = temp("browser_gyro.txt"), report = temp("browser_report.html");
   const std::string limits = temp("browser_limits.txt");
   std::ofstream(limits) << "N <= 0.006 deg/sqrt(h)\nadev(100 s) <= 0.5 deg/h\nK <= 1 deg/h/sqrt(h)\n";
   run(sim + " --duration 3600 --tau0 0.1 --arw 0.003 --white-angle 1 --seed 11 > " + counts, code);
   ASSERT_EQ(code, 0);
-  const std::string args = " --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 --stats oadev,mdev,tdev --limits " +
-                           limits + " " + counts;
+  const std::string args =
+      " --type counts --tau0 0.1 --pulse-weight 1arcsec --fit ieee952 --stats oadev,mdev,tdev --limits " + limits + " " +
+      counts;
   const auto json = nlohmann::json::parse(run(analyze + args + " --format json --report " + report, code));
   ASSERT_EQ(code, 5) << "K is not resolved: undecided";
 
   mkdir(artifacts.c_str(), 0755);
-  const std::string flags = " --headless --no-sandbox --disable-gpu --no-first-run --disable-extensions"
-                            " --user-data-dir=" + temp("chromium_profile") + " --proxy-server=127.0.0.1:9 ";
+  const std::string flags =
+      " --headless --no-sandbox --disable-gpu --no-first-run --disable-extensions"
+      " --user-data-dir=" +
+      temp("chromium_profile") + " --proxy-server=127.0.0.1:9 ";
   const std::string dom = run(browser + flags + "--dump-dom file://" + report + " 2>/dev/null", code);
   ASSERT_EQ(code, 0) << "chromium --dump-dom";
   ASSERT_NE(dom.find("</html>"), std::string::npos) << dom.substr(0, 500);
   run(browser + flags + "--window-size=1200,2400 --screenshot=" + artifacts + "/report.png file://" + report +
-          " >/dev/null 2>&1", code);
+          " >/dev/null 2>&1",
+      code);
   EXPECT_EQ(code, 0) << "chromium --screenshot";
   struct stat st {};
   EXPECT_EQ(stat((artifacts + "/report.png").c_str(), &st), 0);
   EXPECT_GT(st.st_size, 10000) << "a screenshot with something in it";
   // Printed to PDF as a browser's print dialog would (the @media print style).
   run(browser + flags + "--no-pdf-header-footer --print-to-pdf=" + artifacts + "/report.pdf file://" + report +
-          " >/dev/null 2>&1", code);
+          " >/dev/null 2>&1",
+      code);
   EXPECT_EQ(code, 0) << "chromium --print-to-pdf";
   const std::string pdf = gyrochar::test_support::slurp(artifacts + "/report.pdf");
   EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u) << "a PDF";
@@ -154,7 +160,8 @@ TEST(ReportBrowser, RenderedValuesEqualTheAnalyzersJson) {
   }
   // The plots rendered as inline SVG.
   std::size_t plots = 0;
-  for (auto at = dom.find("<svg class=\"plot\""); at != std::string::npos; at = dom.find("<svg class=\"plot\"", at + 1)) ++plots;
+  for (auto at = dom.find("<svg class=\"plot\""); at != std::string::npos; at = dom.find("<svg class=\"plot\"", at + 1))
+    ++plots;
   EXPECT_EQ(plots, 2u) << "ADEV and MDEV";
 }
 
@@ -178,21 +185,29 @@ std::vector<std::string> fields(const std::string& line) {
 // rendered DOM equal the decoder's CSV row of the last report (oracle: the CSV of the same run).
 TEST(ReportBrowser, DecoderReportEqualsItsCsv) {
   const std::string browser = chromium();
-  if (browser.empty()) GTEST_SKIP() << "chromium is not installed (Debian package chromium; toolchain/build.sh test installs it)";
+  if (browser.empty())
+    GTEST_SKIP() << "chromium is not installed (Debian package chromium; toolchain/build.sh test installs it)";
   int code = 0;
   const std::string log = temp("browser_demo.log"), csv = temp("browser_decode.csv"), report = temp("browser_decode.html");
-  run(std::string(GYROCHAR_BINARY_DIR) + "/host_tools/gyrochar-demo --hours 0.3 --window 0 --view-every 0 --csv '' --plot '' "
-      "--candump " + log + " > /dev/null", code);
+  run(std::string(GYROCHAR_BINARY_DIR) +
+          "/host_tools/gyrochar-demo --hours 0.3 --window 0 --view-every 0 --csv '' --plot '' "
+          "--candump " +
+          log + " > /dev/null",
+      code);
   ASSERT_EQ(code, 0);
-  run(std::string(GYROCHAR_BINARY_DIR) + "/host_tools/gyrochar-decode " + log + " --csv " + csv + " --report " + report, code);
+  run(std::string(GYROCHAR_BINARY_DIR) + "/host_tools/gyrochar-decode " + log + " --csv " + csv + " --report " + report,
+      code);
   ASSERT_EQ(code, 0);
-  const std::string flags = " --headless --no-sandbox --disable-gpu --no-first-run --disable-extensions"
-                            " --user-data-dir=" + temp("chromium_profile_decode") + " --proxy-server=127.0.0.1:9 ";
+  const std::string flags =
+      " --headless --no-sandbox --disable-gpu --no-first-run --disable-extensions"
+      " --user-data-dir=" +
+      temp("chromium_profile_decode") + " --proxy-server=127.0.0.1:9 ";
   const std::string dom = run(browser + flags + "--dump-dom file://" + report + " 2>/dev/null", code);
   ASSERT_EQ(code, 0);
   mkdir(artifacts.c_str(), 0755);
   run(browser + flags + "--window-size=1200,2400 --screenshot=" + artifacts + "/decode_report.png file://" + report +
-          " >/dev/null 2>&1", code);
+          " >/dev/null 2>&1",
+      code);
   // The last row of each node and tau.
   std::ifstream in(csv);
   std::string line;
@@ -204,7 +219,8 @@ TEST(ReportBrowser, DecoderReportEqualsItsCsv) {
   std::map<std::pair<int, int>, std::vector<std::string>> last;
   while (std::getline(in, line)) {
     const auto f = fields(line);
-    if (f.size() == header.size() && f[col("type")] == "tau") last[{std::stoi(f[col("node")]), std::stoi(f[col("tau_index")])}] = f;
+    if (f.size() == header.size() && f[col("type")] == "tau")
+      last[{std::stoi(f[col("node")]), std::stoi(f[col("tau_index")])}] = f;
   }
   ASSERT_FALSE(last.empty());
   std::size_t compared = 0;

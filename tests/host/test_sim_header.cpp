@@ -166,14 +166,19 @@ TEST(SimHeader, RateTermOptionsAndTheirLimits) {
   EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{1, 10}, {1, 10}, {1, 10}, {1, 10}}; }), "");
   EXPECT_EQ(problem([](SimOptions& o) { o.markov.assign(5, {1, 10}); }), "--markov: at most 4 Gauss-Markov terms");
   EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{0, 10}}; }), "--markov: SIGMA must be positive and at most 10^9 deg/h");
-  EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{2e9, 10}}; }), "--markov: SIGMA must be positive and at most 10^9 deg/h");
+  EXPECT_EQ(problem([](SimOptions& o) {
+              o.markov = {{2e9, 10}};
+            }),
+            "--markov: SIGMA must be positive and at most 10^9 deg/h");
   EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{1, 0}}; }), "--markov: TC must be positive and finite (s)");
   EXPECT_EQ(problem([](SimOptions& o) { o.markov = {{1, -1}}; }), "--markov: TC must be positive and finite (s)");
   EXPECT_EQ(problem([](SimOptions& o) { o.sinusoids = {{0, 49.99}}; }), "");
   EXPECT_EQ(problem([](SimOptions& o) { o.sinusoids.assign(5, {1, 1}); }), "--sinusoid: at most 4 sinusoids");
   EXPECT_EQ(problem([](SimOptions& o) { o.sinusoids = {{-1, 1}}; }), "--sinusoid: AMP must be between 0 and 10^9 deg/h");
   for (double f : {0.0, -1.0, 50.0, 1e300})
-    EXPECT_EQ(problem([f](SimOptions& o) { o.sinusoids = {{1, f}}; }),
+    EXPECT_EQ(problem([f](SimOptions& o) {
+                o.sinusoids = {{1, f}};
+              }),
               "--sinusoid: FREQ must be above 0 and below the Nyquist frequency 1/(2 tau0) = 50 Hz")
         << f;
 }
@@ -229,10 +234,10 @@ TEST(SimHeader, RefusesWhatIsNotATruthLine) {
   auto replaced = [&good](const std::string& from, const std::string& to) { return replaced_in(good, from, to); };
   EXPECT_FALSE(parse_sim_truth_line(""));
   EXPECT_FALSE(parse_sim_truth_line("# gyrochar-sim counts: tau0 0.01 s"));
-  EXPECT_FALSE(parse_sim_truth_line(good.substr(1)));                          // no '#'
-  EXPECT_FALSE(parse_sim_truth_line(replaced(" seed=1", "")));                 // missing key
-  EXPECT_FALSE(parse_sim_truth_line(good + " seed=2"));                        // repeated key
-  EXPECT_FALSE(parse_sim_truth_line(replaced("format=1", "format=2")));        // unknown format
+  EXPECT_FALSE(parse_sim_truth_line(good.substr(1)));                           // no '#'
+  EXPECT_FALSE(parse_sim_truth_line(replaced(" seed=1", "")));                  // missing key
+  EXPECT_FALSE(parse_sim_truth_line(good + " seed=2"));                         // repeated key
+  EXPECT_FALSE(parse_sim_truth_line(replaced("format=1", "format=2")));         // unknown format
   EXPECT_FALSE(parse_sim_truth_line(replaced("tau0_s=0.01", "tau0_s=0.01x")));  // trailing garbage
   EXPECT_FALSE(parse_sim_truth_line(replaced("tau0_s=0.01", "tau0_s=")));
   EXPECT_FALSE(parse_sim_truth_line(replaced("tau0_s=0.01", "tau0_s=nan")));
@@ -241,7 +246,7 @@ TEST(SimHeader, RefusesWhatIsNotATruthLine) {
   EXPECT_FALSE(parse_sim_truth_line(replaced("seed=1", "seed=-1")));
   EXPECT_FALSE(parse_sim_truth_line(replaced("Q_white=no", "Q_white=maybe")));
   EXPECT_FALSE(parse_sim_truth_line(replaced("B_deg_per_h=0", "B_deg_per_h=-1")));
-  EXPECT_FALSE(parse_sim_truth_line(good + " orphan"));                        // a token without '='
+  EXPECT_FALSE(parse_sim_truth_line(good + " orphan"));  // a token without '='
   EXPECT_FALSE(parse_sim_truth_line(good + " =3"));
   // Later formats may add keys; blanks may be tabs; order does not matter.
   EXPECT_TRUE(parse_sim_truth_line(good + " temperature_C=25"));
@@ -253,7 +258,8 @@ TEST(SimHeader, RefusesWhatIsNotATruthLine) {
 
 TEST(SimHeader, TheProgramWritesTheTruthLine) {
   const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_sim_header.txt";
-  const std::string command = GYROCHAR_BINARY_DIR
+  const std::string command =
+      GYROCHAR_BINARY_DIR
       "/host_tools/gyrochar-sim --duration 2 --tau0 0.1 --pulse-weight 0.5 --rate -3 --white-angle 0.25 --arw 0.005 "
       "--rrw 0.15 --bias-instability 0.05 --bias-time 2000 --ramp 0.01 --dither 7 --dither-hz 437.3 --seed 99 "
       "--markov 0.05,300 --sinusoid 0.02,0.01 --markov 1,0.3 --out " +
@@ -325,9 +331,9 @@ TEST(SimSegments, TheTruthLineSaysFormatTwoAndCarriesEverySegmentExactly) {
   EXPECT_FALSE(parse_sim_truth_line(replaced("format=2", "format=1")));
   EXPECT_FALSE(parse_sim_truth_line(replaced(" segments=2", " segments=3")));
   EXPECT_FALSE(parse_sim_truth_line(replaced(" segment1_start_s=10", "")));
-  EXPECT_FALSE(parse_sim_truth_line(line + " segment1_start_s=10"));               // repeated
-  EXPECT_FALSE(parse_sim_truth_line(line + " segment2_rrw_deg_per_h_sqrt_h=1"));   // a key twice in a segment
-  EXPECT_FALSE(parse_sim_truth_line(line + " segment2_bias_deg_per_h=1"));         // not a level that may change
+  EXPECT_FALSE(parse_sim_truth_line(line + " segment1_start_s=10"));                          // repeated
+  EXPECT_FALSE(parse_sim_truth_line(line + " segment2_rrw_deg_per_h_sqrt_h=1"));              // a key twice in a segment
+  EXPECT_FALSE(parse_sim_truth_line(line + " segment2_bias_deg_per_h=1"));                    // not a level that may change
   EXPECT_FALSE(parse_sim_truth_line(replaced("segment2_start_s=15", "segment2_start_s=5")));  // out of order
 }
 
@@ -339,8 +345,8 @@ TEST(SimSegments, TheOptionReadsTimeAndChanges) {
   EXPECT_EQ(g->arw_deg_per_sqrt_h, 0.004);
   EXPECT_EQ(g->rate_deg_per_h, -15);
   EXPECT_FALSE(g->rrw_deg_per_h_sqrt_h);
-  for (const char* bad : {"3600", "x:arw=1", "3600:", "3600:arw", "3600:arw=", "3600:bias=1", "3600:arw=1,arw=2",
-                          "3600:arw=nan"}) {
+  for (const char* bad :
+       {"3600", "x:arw=1", "3600:", "3600:arw", "3600:arw=", "3600:bias=1", "3600:arw=1,arw=2", "3600:arw=nan"}) {
     EXPECT_FALSE(parse_segment_option(bad, why)) << bad;
     EXPECT_FALSE(why.empty());
   }
@@ -363,15 +369,17 @@ TEST(SimSegments, TheProgramWritesItsSegmentsAndTheirCounts) {
   // Oracle: SimRun of the same options (the program's own loop) gives the counts it writes.
   const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_sim_segments.txt";
   const std::string sim = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim";
-  ASSERT_EQ(std::system((sim + " --duration 20 --arw 0.002 --segment 10:arw=0.004 --segment 15:rate=-20,white-angle=0.5"
-                              ",rrw=0.1 --out " + out).c_str()),
+  ASSERT_EQ(std::system((sim +
+                         " --duration 20 --arw 0.002 --segment 10:arw=0.004 --segment 15:rate=-20,white-angle=0.5"
+                         ",rrw=0.1 --out " +
+                         out)
+                            .c_str()),
             0);
   std::ifstream in(out);
   std::string first, second;
   std::getline(in, first);
   std::getline(in, second);
-  EXPECT_NE(first.find("; from 10 s: arw 0.004; from 15 s: rate -20 white-angle 0.5 rrw 0.1"), std::string::npos)
-      << first;
+  EXPECT_NE(first.find("; from 10 s: arw 0.004; from 15 s: rate -20 white-angle 0.5 rrw 0.1"), std::string::npos) << first;
   const auto t = parse_sim_truth_line(second);
   ASSERT_TRUE(t) << second;
   expect_same_options(t->options, doubling());

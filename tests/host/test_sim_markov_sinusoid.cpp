@@ -47,9 +47,7 @@ std::vector<real> phase_weights_on_rates(const std::vector<std::pair<std::uint64
     for (std::uint64_t k = 1; k <= i; ++k) w[k - 1] += c;  // x[i] holds y_1 .. y_i
   return w;
 }
-std::vector<real> avar_weights(std::uint64_t n) {
-  return phase_weights_on_rates({{2 * n, 1}, {n, -2}, {0, 1}}, 2 * n);
-}
+std::vector<real> avar_weights(std::uint64_t n) { return phase_weights_on_rates({{2 * n, 1}, {n, -2}, {0, 1}}, 2 * n); }
 std::vector<real> mvar_weights(std::uint64_t n) {
   std::vector<std::pair<std::uint64_t, int>> terms;
   for (std::uint64_t i = 0; i < n; ++i) terms.insert(terms.end(), {{i + 2 * n, 1}, {i + n, -2}, {i, 1}});
@@ -60,8 +58,7 @@ std::vector<real> mvar_weights(std::uint64_t n) {
 real double_sum(const std::vector<real>& w, real a) {
   real s = 0;
   for (std::size_t t = 0; t < w.size(); ++t)
-    for (std::size_t u = 0; u < w.size(); ++u)
-      s += w[t] * w[u] * std::expm1(-a * static_cast<real>(t > u ? t - u : u - t));
+    for (std::size_t u = 0; u < w.size(); ++u) s += w[t] * w[u] * std::expm1(-a * static_cast<real>(t > u ? t - u : u - t));
   return s;
 }
 
@@ -252,7 +249,8 @@ TEST(SimMarkov, EachTermAloneFollowsItsExactAvarAndMvar) {
       EXPECT_TRUE(within(want_m, sm.mean - hm, sm.mean + hm, bound))
           << "Tc " << tc << " m=" << m << " MVAR " << sm.mean << " +- " << hm << " exact " << want_m;
       std::printf("  %5llu  %.5f(%.5f)  %.5f(%.5f)\n", static_cast<unsigned long long>(m), std::sqrt(sa.mean / want_a),
-                  sa.sd / std::sqrt(16.0) / (2 * want_a), std::sqrt(sm.mean / want_m), sm.sd / std::sqrt(16.0) / (2 * want_m));
+                  sa.sd / std::sqrt(16.0) / (2 * want_a), std::sqrt(sm.mean / want_m),
+                  sm.sd / std::sqrt(16.0) / (2 * want_m));
       if (tc == 1.0 && m <= 2) {
         const double x = tau / tc, continuous = (2 * x - 3 + 4 * std::exp(-x) - std::exp(-2 * x)) / (x * x);
         EXPECT_FALSE(within(continuous, sa.mean - ha, sa.mean + ha, bound)) << "m=" << m;
@@ -285,7 +283,8 @@ TEST(SimSinusoid, EachTermAloneFollowsItsClosedForm) {
       const double tau = static_cast<double>(c.m[i]) * o.tau0_s;
       const double bound = std::sqrt(2.0) * (o.pulse_arcsec + rounding) / tau;
       const double want_a = sinusoid_avar(a, f, tau), want_m = sinusoid_mvar(a, f, o.tau0_s, c.m[i]);
-      const double ra = 1 / (static_cast<double>(c.avar_terms[i]) * sin_b), rm = 1 / (static_cast<double>(c.mvar_terms[i]) * sin_b);
+      const double ra = 1 / (static_cast<double>(c.avar_terms[i]) * sin_b),
+                   rm = 1 / (static_cast<double>(c.mvar_terms[i]) * sin_b);
       EXPECT_TRUE(within(c.avar[i], want_a * (1 - ra), want_a * (1 + ra), bound))
           << "f tau0 " << f_tau0 << " m=" << c.m[i] << " ADEV " << std::sqrt(c.avar[i]) << " closed " << std::sqrt(want_a);
       EXPECT_TRUE(within(c.mvar[i], want_m * (1 - rm), want_m * (1 + rm), bound))

@@ -61,7 +61,8 @@ TEST(SimRange, EveryTermCountsAndSegmentsTakeTheirLargestLevel) {
     return worst_case_pulses(o);
   };
   const double t = 100;
-  EXPECT_NEAR(alone([](SimOptions& o) { o.ramp_deg_per_h2 = 3600; }).total, 1 * t * t / 2, 1e-9);  // 3600 deg/h/h = 1 arcsec/s^2
+  EXPECT_NEAR(alone([](SimOptions& o) { o.ramp_deg_per_h2 = 3600; }).total, 1 * t * t / 2,
+              1e-9);  // 3600 deg/h/h = 1 arcsec/s^2
   EXPECT_NEAR(alone([](SimOptions& o) { o.white_angle_arcsec = 2; }).total, 10 * 2, 1e-12);
   EXPECT_NEAR(alone([](SimOptions& o) { o.rrw_deg_per_h_sqrt_h = 60; }).total,  // 60 deg/h/sqrt(h) = 1 arcsec/s^1.5
               10 * std::pow(t, 1.5) / std::sqrt(3.0), 1e-9);

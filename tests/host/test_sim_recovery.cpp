@@ -41,7 +41,7 @@ TEST(SimulatedGyro, FitRecoversTheKnownParameters) {
   s.pulse_arcsec = 2;
   s.white_angle_arcsec = 3;  // randomizes the quantization residual, as dither does in a real RLG
   s.arw_deg_per_sqrt_h = 0.003;
-  s.bias_deg_per_h = 0.05;       // dominates from about 30 s to 10 min
+  s.bias_deg_per_h = 0.05;        // dominates from about 30 s to 10 min
   s.rrw_deg_per_h_sqrt_h = 0.15;  // beyond about 10 min
   s.seed = 7;
   const Ieee952Truth t = ieee952_truth(s);

@@ -81,7 +81,8 @@ TEST(SimTruth, RateRandomWalkAtEveryTau) {
     // The deviation without quantization is within dev +- bound; its interval spans both ends.
     const double low = oracle::chi2_range((dev - bound) * (dev - bound), edf, p_false).low;
     const double high = oracle::chi2_range((dev + bound) * (dev + bound), edf, p_false).high;
-    EXPECT_TRUE(truth >= low && truth <= high) << "m=" << r.avar.m(i) << " ADEV " << dev << " closed form " << std::sqrt(truth);
+    EXPECT_TRUE(truth >= low && truth <= high)
+        << "m=" << r.avar.m(i) << " ADEV " << dev << " closed form " << std::sqrt(truth);
     const double held = truth * (1 + 0.5 / static_cast<double>(r.avar.m(i) * r.avar.m(i)));
     if (r.avar.m(i) <= 4) {  // the held-rate law is excluded where it differs by more than the interval
       EXPECT_FALSE(held >= low && held <= high) << "m=" << r.avar.m(i);
@@ -121,7 +122,8 @@ TEST(SimTruth, DitherFollowsTheSampledClosedForm) {
     const double phase_error_rad = 2 * pi * o.dither_hz * static_cast<double>(n) * o.tau0_s * 1e-15;
     for (std::size_t i = 0; i < r.avar.size(); ++i) {
       const double tau = r.tau_s(i);
-      const double tolerance = std::sqrt(2.0) * o.pulse_arcsec / tau + 4 * o.dither_arcsec * phase_error_rad / (std::sqrt(2.0) * tau);
+      const double tolerance = std::sqrt(2.0) * o.pulse_arcsec / tau +
+                               4 * o.dither_arcsec * phase_error_rad / (std::sqrt(2.0) * tau);
       const double sampled = dither_avar_sampled(o.dither_arcsec, o.dither_hz, o.tau0_s, r.avar.m(i), n);
       EXPECT_NEAR(std::sqrt(r.avar_dph2(i)), std::sqrt(sampled), tolerance) << "f tau0 " << f_tau0 << " m=" << r.avar.m(i);
       const double s = std::sin(pi * o.dither_hz * tau);
@@ -186,7 +188,8 @@ TEST(SimTruth, BiasInstabilityReachesItsFloor) {
     const double tau = static_cast<double>(m) * o.tau0_s;
     const oracle::Spread s = oracle::spread(per_tau[i]);
     const double model = oracle::flicker_model_avar(o.bias_deg_per_h, o.tau0_s, o.bias_time_s, m);
-    EXPECT_NEAR(s.mean, model, s.half_width(p_false)) << "m=" << m << " ADEV " << std::sqrt(s.mean) << " model " << std::sqrt(model);
+    EXPECT_NEAR(s.mean, model, s.half_width(p_false))
+        << "m=" << m << " ADEV " << std::sqrt(s.mean) << " model " << std::sqrt(model);
     if (m >= 4 && tau <= 0.059 * o.bias_time_s) {
       const double band = tau <= 0.017 * o.bias_time_s ? 0.003 : 0.01;  // on the deviation: 2x on AVAR
       EXPECT_NEAR(s.mean, floor_avar, s.half_width(p_false) + 2 * band * floor_avar)

@@ -120,9 +120,8 @@ std::vector<oracle::Spread> over_seeds(SimOptions o, std::uint64_t seeds, std::u
 void check_flicker(const SimOptions& o, std::uint64_t seeds, std::uint64_t n) {
   const std::vector<oracle::Spread> s = over_seeds(o, seeds, n, n / 4);
   const double floor_avar = std::pow(flicker_floor * o.bias_deg_per_h, 2);
-  std::printf("B %g deg/h, bias time %g s, tau0 %g s: %llu seeds of %llu samples; ADEV / (0.664 B)\n",
-              o.bias_deg_per_h, o.bias_time_s, o.tau0_s, static_cast<unsigned long long>(seeds),
-              static_cast<unsigned long long>(n));
+  std::printf("B %g deg/h, bias time %g s, tau0 %g s: %llu seeds of %llu samples; ADEV / (0.664 B)\n", o.bias_deg_per_h,
+              o.bias_time_s, o.tau0_s, static_cast<unsigned long long>(seeds), static_cast<unsigned long long>(n));
   for (std::size_t i = 0; i < s.size(); ++i) {
     const std::uint64_t m = std::uint64_t{1} << i;
     const double tau = static_cast<double>(m) * o.tau0_s;
@@ -182,8 +181,8 @@ TEST(SimTruthLong, ArwPlusBiasInstabilityFourHoursAtTenthSecond) {
     const double closed = white + std::pow(flicker_floor * o.bias_deg_per_h, 2);
     const double u = s[i].sd / std::sqrt(static_cast<double>(seeds)) / (2 * s[i].mean);
     std::printf("  m %6llu  tau %7.1f s  measured %.5f +- %.5f  closed form %.5f  ratio %.4f\n",
-                static_cast<unsigned long long>(m), tau, std::sqrt(s[i].mean), u * std::sqrt(s[i].mean),
-                std::sqrt(closed), std::sqrt(s[i].mean / closed));
+                static_cast<unsigned long long>(m), tau, std::sqrt(s[i].mean), u * std::sqrt(s[i].mean), std::sqrt(closed),
+                std::sqrt(s[i].mean / closed));
     if (m >= 128) {
       const double band = tau <= 0.017 * o.bias_time_s ? 0.003 : 0.01;
       const double flicker = std::pow(flicker_floor * o.bias_deg_per_h, 2);
@@ -195,13 +194,14 @@ TEST(SimTruthLong, ArwPlusBiasInstabilityFourHoursAtTenthSecond) {
       std::printf("    B from the curve: %.4f +- %.4f deg/h\n", b, u_b);
       b_sum += b / (u_b * u_b);
       b_var += 1 / (u_b * u_b);
-      const double half = s[i].half_width(p_false) / (2 * (s[i].mean - white)) * b;  // Student t, 15 dof
+      const double half = s[i].half_width(p_false) / (2 * (s[i].mean - white)) * b;    // Student t, 15 dof
       EXPECT_NEAR(b, o.bias_deg_per_h, half + 0.003 * o.bias_deg_per_h) << "m=" << m;  // + the band's 0.3 %
     }
   }
-  std::printf("  B read off the simulator's curve (weighted over the three taus, correlated): %.4f +- %.4f deg/h "
-              "(truth 0.05)\n",
-              b_sum / b_var, 1 / std::sqrt(b_var));
+  std::printf(
+      "  B read off the simulator's curve (weighted over the three taus, correlated): %.4f +- %.4f deg/h "
+      "(truth 0.05)\n",
+      b_sum / b_var, 1 / std::sqrt(b_var));
 }
 
 TEST(SimTruthLong, SteadyRateBelowAPulsePerSampleQuantizesPeriodically) {
@@ -222,8 +222,8 @@ TEST(SimTruthLong, SteadyRateBelowAPulsePerSampleQuantizesPeriodically) {
     const double closed = avar_white_angle(o, tau) + avar_arw(o, tau);
     const double ratio = std::sqrt(s[i].mean / closed);
     const double u = s[i].sd / std::sqrt(static_cast<double>(seeds)) / (2 * s[i].mean) * ratio;
-    std::printf("  m %6llu  tau %7.2f s  ADEV / closed form %.4f +- %.1e\n", static_cast<unsigned long long>(m), tau,
-                ratio, u);
+    std::printf("  m %6llu  tau %7.2f s  ADEV / closed form %.4f +- %.1e\n", static_cast<unsigned long long>(m), tau, ratio,
+                u);
     if (m >= 4096) {
       EXPECT_NEAR(s[i].mean, closed, s[i].half_width(p_false)) << "m=" << m;
     }

@@ -73,7 +73,8 @@ TEST(ToolErrors, SimulatorNamesWhatIsWrong) {
          "--markov: at most 4");
   expect("gyrochar-sim", "--duration 1 --sinusoid 1,50", bad,
          "--sinusoid: FREQ must be above 0 and below the Nyquist frequency 1/(2 tau0) = 50 Hz");
-  expect("gyrochar-sim", "--duration 1 --tau0 0.1 --sinusoid 1,5", bad, "--sinusoid: FREQ must be above 0 and below "
+  expect("gyrochar-sim", "--duration 1 --tau0 0.1 --sinusoid 1,5", bad,
+         "--sinusoid: FREQ must be above 0 and below "
          "the Nyquist frequency 1/(2 tau0) = 5 Hz");
   expect("gyrochar-sim", "--duration 1 --seed -1", bad, "options: --seed: must be an integer 0..2^64-1");
   expect("gyrochar-sim", "--duration 1 --seed 18446744073709551616", bad, "options: --seed: must be an integer 0..2^64-1");
@@ -104,8 +105,8 @@ TEST(ToolErrors, AnImpossibleInterfaceNameIsBadInputAMissingOneIsHardware) {
 // Oracle: the angle each term adds (sim_truth.hpp, worst_case_pulses) against 2^53 pulses.
 TEST(ToolErrors, SimulatorRefusesParametersBeyondItsCountRange) {
   const int bad = exit_code::bad_input;
-  for (const std::string& args : {std::string("--duration 5 --tau0 1 --arw 1e20"),
-                                  std::string("--rate 1e9 --pulse-weight 1e-9")}) {
+  for (const std::string& args :
+       {std::string("--duration 5 --tau0 1 --arw 1e20"), std::string("--rate 1e9 --pulse-weight 1e-9")}) {
     const Outcome r = run(bin + "gyrochar-sim " + args);
     EXPECT_EQ(r.code, bad) << args << ": " << r.err;
     const std::string option = args.find("--arw") != std::string::npos ? "--arw" : "--rate";
@@ -145,7 +146,8 @@ TEST(ToolErrors, EveryToolChecksItsStandardOutput) {
   for (const char* program : {"gyrochar-analyze", "gyrochar-decode", "gyrochar-sim", "gyrochar-demo"})
     expect(program, "--help > /dev/full", exit_code::output_failed, lost);
   // The decoder's and the demo's summaries come first on stderr; the last line says what was lost.
-  for (const std::string& command : {"gyrochar-decode " + log + " --view final", std::string("gyrochar-demo --hours 0.01 --plot '' --csv ''")}) {
+  for (const std::string& command :
+       {"gyrochar-decode " + log + " --view final", std::string("gyrochar-demo --hours 0.01 --plot '' --csv ''")}) {
     const Outcome r = run(bin + command + " > /dev/full");
     EXPECT_EQ(r.code, exit_code::output_failed) << command << ": " << r.err;
     const std::string program = command.substr(0, command.find(' '));
@@ -192,19 +194,23 @@ TEST(ToolErrors, NoOutputOverwritesAnInputOrAnotherOutput) {
     std::string program, args, what;
   } cases[] = {
       {"gyrochar-decode", log + " --view none --csv " + log, "--csv: '" + log + "' is the same file as the input LOG"},
-      {"gyrochar-decode", log + " --view none --jsonl " + symbolic, "--jsonl: '" + symbolic + "' is the same file as the input LOG"},
+      {"gyrochar-decode", log + " --view none --jsonl " + symbolic,
+       "--jsonl: '" + symbolic + "' is the same file as the input LOG"},
       {"gyrochar-decode", log + " --view none --node 0x10 --kalibr " + respelled, "--kalibr: "},
       {"gyrochar-decode", log + " --view none --plot " + prefix, "--plot: '" + hard + "' is the same file as the input LOG"},
-      {"gyrochar-decode", "- --view none --csv " + hard + " < " + log, "--csv: '" + hard +
-                                                                        "' is the same file as the input LOG (standard input)"},
-      {"gyrochar-decode", log + " --view none --csv " + fresh + " --jsonl " + fresh, "--jsonl: '" + fresh +
-                                                                                        "' is the same file as the output --csv"},
-      {"gyrochar-analyze", "--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --kalibr " + counts + " " + counts,
+      {"gyrochar-decode", "- --view none --csv " + hard + " < " + log,
+       "--csv: '" + hard + "' is the same file as the input LOG (standard input)"},
+      {"gyrochar-decode", log + " --view none --csv " + fresh + " --jsonl " + fresh,
+       "--jsonl: '" + fresh + "' is the same file as the output --csv"},
+      {"gyrochar-analyze",
+       "--type counts --tau0 0.01 --pulse-weight 1arcsec --fit ieee952 --kalibr " + counts + " " + counts,
        "--kalibr: '" + counts + "' is the same file as the input file"},
-      {"gyrochar-demo", "--hours 0.001 --plot '' --csv " + fresh + " --candump " + fresh, "--candump: '" + fresh +
-                                                                                              "' is the same file as the output --csv"},
-      {"gyrochar-demo", "--hours 0.001 --csv " + prefix + ".png --plot " + prefix, "--plot: '" + prefix + ".png' is the same "
-                                                                                    "file as the output --csv"},
+      {"gyrochar-demo", "--hours 0.001 --plot '' --csv " + fresh + " --candump " + fresh,
+       "--candump: '" + fresh + "' is the same file as the output --csv"},
+      {"gyrochar-demo", "--hours 0.001 --csv " + prefix + ".png --plot " + prefix,
+       "--plot: '" + prefix +
+           ".png' is the same "
+           "file as the output --csv"},
   };
   for (const auto& c : cases) {
     const Outcome r = run(bin + c.program + " " + c.args);
@@ -270,7 +276,8 @@ TEST(ToolErrors, LivePageAddressIsCheckedFirst) {
   const int bad = exit_code::bad_input;
   expect("gyrochar-decode", "--interface vcan0 --http http", bad, "--http: port 'http' is not a number 0..65535");
   expect("gyrochar-decode", "x.log --http 70000", bad, "--http: port '70000' is not a number 0..65535");
-  expect("gyrochar-decode", "x.log --http ::1:80", bad, "--http: '::1:80': an IPv6 address goes in brackets, e.g. [::1]:8080");
+  expect("gyrochar-decode", "x.log --http ::1:80", bad,
+         "--http: '::1:80': an IPv6 address goes in brackets, e.g. [::1]:8080");
   expect("gyrochar-decode", "x.log --http gyro.example:80", bad,
          "--http: 'gyro.example' is not a numeric IPv4 or IPv6 address or localhost");
   expect("gyrochar-demo", "--http :80", bad, "--http: ':80': no address before ':'");

@@ -82,7 +82,9 @@ TEST(VerdictMonteCarlo, WrongVerdictsStayWithinTheStatedRiskAndUndecidedShrinks)
                   t.fail, t.undecided, t.decided_by_prediction);
     }
   // Binomial bound of the header: fewer than 5 wrong verdicts in 40 runs (scaled for other counts).
-  const double bound = runs == 40 ? 4.0 : 0.025 * static_cast<double>(runs) + 3 * std::sqrt(0.025 * 0.975 * static_cast<double>(runs));
+  const double bound = runs == 40
+                           ? 4.0
+                           : 0.025 * static_cast<double>(runs) + 3 * std::sqrt(0.025 * 0.975 * static_cast<double>(runs));
   for (std::size_t d = 0; d < durations.size(); ++d) {
     EXPECT_LE(static_cast<double>(tally[d][0].fail), bound) << "fail for a gyro inside, run " << durations[d] << " s";
     EXPECT_LE(static_cast<double>(tally[d][2].pass), bound) << "pass for a gyro beyond, run " << durations[d] << " s";

@@ -147,7 +147,8 @@ std::vector<CoverageCell> run_coverage_study(const StudySettings& s) {
       for (const int alpha : s.alphas) tasks.push_back({length, alpha, run});
 
   // Cells keyed by list positions, so they come out in the order the settings list them.
-  using Key = std::tuple<std::size_t, std::size_t, std::size_t, std::size_t, std::uint64_t>;  // length, stride, stat, alpha, m
+  using Key =
+      std::tuple<std::size_t, std::size_t, std::size_t, std::size_t, std::uint64_t>;  // length, stride, stat, alpha, m
   std::map<Key, Accumulator> cells;
   auto index_of = [](const auto& list, const auto& value) {
     return static_cast<std::size_t>(std::find(list.begin(), list.end(), value) - list.begin());

@@ -23,21 +23,21 @@ const char* name(Statistic s);
 struct EngineRequest {
   std::vector<std::uint64_t> m_list;  // averaging factors, strictly increasing
   std::vector<Statistic> stats;
-  std::uint32_t stride_factor = 0;    // 0: full (every tau fully overlapped); else S, a power of two
-  std::optional<int> alpha;           // noise exponent given for the EDF; empty: the engine identifies it
+  std::uint32_t stride_factor = 0;  // 0: full (every tau fully overlapped); else S, a power of two
+  std::optional<int> alpha;         // noise exponent given for the EDF; empty: the engine identifies it
 };
 
 /// One estimate as the engine states it (tau0 = 1, so deviations are in phase units per sample).
 struct EngineEstimate {
   Statistic stat = Statistic::oadev;
   std::uint64_t m = 0;
-  std::uint64_t terms = 0;        // number of terms in the estimate
-  std::uint64_t stride = 1;       // terms every `stride` phase points
+  std::uint64_t terms = 0;   // number of terms in the estimate
+  std::uint64_t stride = 1;  // terms every `stride` phase points
   double dev = 0.0;
   double ci_low = 0.0, ci_high = 0.0;
-  bool ci_valid = false;          // false: the engine gave no interval
-  std::optional<int> alpha;       // exponent the engine used (given or identified)
-  double edf = 0.0;               // EDF the engine stated (0: none)
+  bool ci_valid = false;     // false: the engine gave no interval
+  std::optional<int> alpha;  // exponent the engine used (given or identified)
+  double edf = 0.0;          // EDF the engine stated (0: none)
 };
 
 /// The adapter: runs the offline engine over `phase` (phase points, tau0 = 1) and returns its
@@ -53,13 +53,13 @@ double true_variance(int alpha, Statistic stat, std::uint64_t m);
 
 struct StudySettings {
   std::vector<int> alphas{2, 1, 0, -1, -2};
-  std::vector<std::size_t> lengths{4096};           // phase points per run
-  std::vector<std::uint32_t> stride_factors{0};     // 0: full, else S
+  std::vector<std::size_t> lengths{4096};        // phase points per run
+  std::vector<std::uint32_t> stride_factors{0};  // 0: full, else S
   std::vector<Statistic> stats{Statistic::oadev, Statistic::mdev};
-  std::uint64_t max_m = 0;        // largest averaging factor; 0: every octave with a term
-  std::size_t runs = 1000;        // independent realizations per (length, alpha)
-  unsigned workers = 2;           // threads; results do not depend on it
-  std::uint64_t seed = 1;         // run r of (length, alpha) is seeded by a hash of all four
+  std::uint64_t max_m = 0;  // largest averaging factor; 0: every octave with a term
+  std::size_t runs = 1000;  // independent realizations per (length, alpha)
+  unsigned workers = 2;     // threads; results do not depend on it
+  std::uint64_t seed = 1;   // run r of (length, alpha) is seeded by a hash of all four
   /// Called on the calling thread about once a second and at the end: realizations done, total.
   std::function<void(std::size_t done, std::size_t total)> progress;
 };
@@ -73,18 +73,18 @@ struct CoverageCell {
   Statistic stat = Statistic::oadev;
   int alpha = 0;
   std::uint64_t m = 0;
-  std::uint64_t terms = 0;        // terms per estimate
-  std::uint64_t stride = 1;       // terms every `stride` points
+  std::uint64_t terms = 0;   // terms per estimate
+  std::uint64_t stride = 1;  // terms every `stride` points
   double true_dev = 0.0;
   std::size_t runs = 0;
-  std::size_t covered_auto = 0, covered_true = 0;   // intervals holding true_dev
+  std::size_t covered_auto = 0, covered_true = 0;  // intervals holding true_dev
   std::size_t no_interval_auto = 0, no_interval_true = 0;
   std::size_t identified_right = 0;
   std::array<std::size_t, 6> identified{};  // runs identified as +2, +1, 0, -1, -2, anything else or none
-  double mean_edf_auto = 0.0;     // mean EDF stated with the identified alpha (runs with one)
-  double edf_true = 0.0;          // EDF stated with the true alpha (mean; the same every run)
-  double mean_ratio = 0.0;        // mean of dev^2 / true variance (1: unbiased)
-  double mc_edf = 0.0;            // 2 mean^2 / variance of dev^2 / true variance over the runs
+  double mean_edf_auto = 0.0;               // mean EDF stated with the identified alpha (runs with one)
+  double edf_true = 0.0;                    // EDF stated with the true alpha (mean; the same every run)
+  double mean_ratio = 0.0;                  // mean of dev^2 / true variance (1: unbiased)
+  double mc_edf = 0.0;                      // 2 mean^2 / variance of dev^2 / true variance over the runs
   double coverage_auto() const { return runs ? double(covered_auto) / double(runs) : 0.0; }
   double coverage_true() const { return runs ? double(covered_true) / double(runs) : 0.0; }
   double identified_fraction() const { return runs ? double(identified_right) / double(runs) : 0.0; }

@@ -129,8 +129,8 @@ double filter_square_sum(double e, int D, std::uint64_t m, std::uint64_t terms) 
 }
 
 struct FilterSpec {
-  double e;  // order of the Kasdin response: d (AVAR) or d + 1 (MVAR, phase sums)
-  int D;     // difference order: 2 (AVAR) or 3 (MVAR)
+  double e;     // order of the Kasdin response: d (AVAR) or d + 1 (MVAR, phase sums)
+  int D;        // difference order: 2 (AVAR) or 3 (MVAR)
   double norm;  // 2 m^2 (AVAR) or 2 m^4 (MVAR)
 };
 
@@ -148,8 +148,7 @@ std::vector<double> kasdin_response(double d, std::size_t n) {
   std::vector<double> h(n);
   if (n == 0) return h;
   h[0] = 1.0;
-  for (std::size_t k = 1; k < n; ++k)
-    h[k] = h[k - 1] * ((static_cast<double>(k) - 1.0 + d) / static_cast<double>(k));
+  for (std::size_t k = 1; k < n; ++k) h[k] = h[k - 1] * ((static_cast<double>(k) - 1.0 + d) / static_cast<double>(k));
   return h;
 }
 

@@ -14,8 +14,9 @@ inline std::string real_imu_record(const std::string& name) { return std::string
 // Empty when the record can be read, else the reason its test skips.
 inline std::string real_imu_absent(const std::string& path) {
   if (std::ifstream(path)) return {};
-  return path + " cannot be read: the ADIS16405 records (CC BY-NC-SA 4.0) are not part of the project; "
-                "configure with -DGYROCHAR_REAL_IMU=<their folder> to run this test";
+  return path +
+         " cannot be read: the ADIS16405 records (CC BY-NC-SA 4.0) are not part of the project; "
+         "configure with -DGYROCHAR_REAL_IMU=<their folder> to run this test";
 }
 
 }  // namespace gyrochar::test

@@ -119,7 +119,8 @@ std::vector<Scenario> standard_scenarios() {
              o.markov = {{0.5, 300}};
            }),
       // Long runs, the seed paper's length and a day: N/B cross at 80 s, B/K at 760 s, K/R at 17 h.
-      long_run("long-run RLG, 24 h", 24, 0.01), long_run("long-run RLG, 120 h", 120, 0.01),
+      long_run("long-run RLG, 24 h", 24, 0.01),
+      long_run("long-run RLG, 120 h", 120, 0.01),
       long_run("long-run RLG without ramp, 24 h", 24, 0),
   };
 }
@@ -230,8 +231,8 @@ void tally_markov(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit&
   for (const MarkovRate& m : truth_si.markov) {
     std::size_t nearest = f.n_markov;
     for (std::size_t j = 0; j < f.n_markov; ++j)
-      if (nearest == f.n_markov || std::fabs(std::log(f.markov[j].tc_s / m.tc_s)) <
-                                       std::fabs(std::log(f.markov[nearest].tc_s / m.tc_s)))
+      if (nearest == f.n_markov ||
+          std::fabs(std::log(f.markov[j].tc_s / m.tc_s)) < std::fabs(std::log(f.markov[nearest].tc_s / m.tc_s)))
         nearest = j;
     const bool found = nearest < f.n_markov;
     const MarkovTerm fitted = found ? f.markov[nearest] : MarkovTerm{};

@@ -61,20 +61,20 @@ Recovery recover(const SimOptions& sim, bool long_tau = false);
 /// against the fitted one nearest in ln Tc; with none simulated, a resolved one is "false"), then a
 /// sinusoid's amplitude (each simulated one against the fitted one nearest in frequency; likewise).
 inline constexpr std::size_t tallied_terms = 8;
-inline constexpr std::array<const char*, tallied_terms> tallied_names{"Q",        "N",           "B",
-                                                                      "K",        "R",           "Markov sigma",
+inline constexpr std::array<const char*, tallied_terms> tallied_names{"Q",         "N",         "B",
+                                                                      "K",         "R",         "Markov sigma",
                                                                       "Markov Tc", "Sinusoid A"};
 
 /// The tally of one term over the runs of a scenario.
 struct TermTally {
   std::size_t runs = 0;
-  std::size_t present = 0;         // runs whose truth is not zero
-  std::size_t fitted = 0;          // the fit kept the term in its model
-  std::size_t resolved = 0;        // ... and called it resolved
-  std::size_t within1 = 0, within2 = 0;  // resolved and within 1 (2) stated sigma of a non-zero truth
-  std::size_t false_resolved = 0;  // resolved although the truth is zero
-  std::size_t held = 0;            // not fitted but held at a known value (Q of periodic quantization)
-  double sum_relative_uncertainty = 0;  // over resolved runs of a non-zero truth: stated sigma / truth
+  std::size_t present = 0;                // runs whose truth is not zero
+  std::size_t fitted = 0;                 // the fit kept the term in its model
+  std::size_t resolved = 0;               // ... and called it resolved
+  std::size_t within1 = 0, within2 = 0;   // resolved and within 1 (2) stated sigma of a non-zero truth
+  std::size_t false_resolved = 0;         // resolved although the truth is zero
+  std::size_t held = 0;                   // not fitted but held at a known value (Q of periodic quantization)
+  double sum_relative_uncertainty = 0;    // over resolved runs of a non-zero truth: stated sigma / truth
   double sum_squared_relative_error = 0;  // ... and ((value - truth) / truth)^2
 };
 
@@ -82,20 +82,20 @@ struct RecoveryCell {
   std::string scenario;
   std::size_t runs = 0;
   std::size_t ok = 0, rejected = 0, too_few = 0, singular = 0;  // fit status counts
-  std::size_t quantization_white = 0;                            // runs that found it white
+  std::size_t quantization_white = 0;                           // runs that found it white
   double mean_chi2_per_dof = 0;
-  std::array<TermTally, tallied_terms> terms{};                  // the OADEV fit
+  std::array<TermTally, tallied_terms> terms{};  // the OADEV fit
   bool long_tau = false;
   std::array<std::array<TermTally, tallied_terms>, 3> by_long_tau{};  // long_tau: every fit by LongTau
-  std::array<std::size_t, 3> long_tau_ok{};                      // ... its fits with status ok
-  std::array<double, 3> long_tau_chi2{};                         // ... their mean chi2/dof
+  std::array<std::size_t, 3> long_tau_ok{};                           // ... its fits with status ok
+  std::array<double, 3> long_tau_chi2{};                              // ... their mean chi2/dof
 };
 
 struct RecoverySettings {
   std::vector<Scenario> scenarios = standard_scenarios();
-  std::size_t runs = 100;   // per scenario
-  unsigned workers = 2;     // results do not depend on it
-  std::uint64_t seed = 1;   // run r of scenario s is seeded by a hash of both and this
+  std::size_t runs = 100;  // per scenario
+  unsigned workers = 2;    // results do not depend on it
+  std::uint64_t seed = 1;  // run r of scenario s is seeded by a hash of both and this
   std::function<void(std::size_t done, std::size_t total)> progress;
 };
 

@@ -27,15 +27,15 @@ struct CountArith {
   };
   using X = std::int64_t;
   using Sum = UInt128;
-  using Increment = std::int32_t;  // pulses per tau0: the exactness bounds rely on |c| < 2^31
+  using Increment = std::int32_t;               // pulses per tau0: the exactness bounds rely on |c| < 2^31
   using NoiseSums = IntegerNoiseIdAccumulator;  // the decimated phase is integer: exact sums
   static constexpr bool exact = true;
 
   static constexpr Int128 add_prefix(Int128 p, std::int64_t x) { return p + widen(x); }
 
   /// Second and third differences of x; false when a value does not fit in int64.
-  static constexpr bool x_terms(std::int64_t x0, std::int64_t x1, std::int64_t x2, std::int64_t x3,
-                                std::int64_t& a, std::int64_t& h) {
+  static constexpr bool x_terms(std::int64_t x0, std::int64_t x1, std::int64_t x2, std::int64_t x3, std::int64_t& a,
+                                std::int64_t& h) {
     std::int64_t d1 = 0, d2 = 0, d3 = 0, e2 = 0;
     unsigned bad = __builtin_sub_overflow(x0, x1, &d1);
     bad |= __builtin_sub_overflow(x1, x2, &d2);

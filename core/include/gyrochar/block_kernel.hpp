@@ -37,9 +37,8 @@ struct BlockTerms {
 /// decimated series reuses them; a partial sum that is not exact is summed again from them).
 /// O(n), no allocation, cannot fail.
 BlockTerms block_terms(std::size_t n, const std::int64_t* x0, const std::int64_t* x1, const std::int64_t* x2,
-                       const std::int64_t* x3, const std::uint64_t* p0, const std::uint64_t* p1,
-                       const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
-                       std::int64_t* hvar_out, std::int64_t* mvar_out);
+                       const std::int64_t* x3, const std::uint64_t* p0, const std::uint64_t* p1, const std::uint64_t* p2,
+                       const std::uint64_t* p3, std::int64_t* avar_out, std::int64_t* hvar_out, std::int64_t* mvar_out);
 
 /// The sums of the squares of a block's terms when the caller has proved beforehand that every
 /// |term| <= bound with squares_exact({bound}, n) (characterizer.hpp's proved_small(): |a| <= m D,
@@ -52,9 +51,8 @@ struct ProvedSums {
 /// and hvar_out[j] (the decimated series reads them). AVX2 on the x86-64 host (chosen at run
 /// time), NEON on aarch64, scalar elsewhere; the same bits on every path. O(n), cannot fail.
 ProvedSums proved_terms(std::size_t n, const std::int64_t* x0, const std::int64_t* x1, const std::int64_t* x2,
-                        const std::int64_t* x3, const std::uint64_t* p0, const std::uint64_t* p1,
-                        const std::uint64_t* p2, const std::uint64_t* p3, std::int64_t* avar_out,
-                        std::int64_t* hvar_out);
+                        const std::int64_t* x3, const std::uint64_t* p0, const std::uint64_t* p1, const std::uint64_t* p2,
+                        const std::uint64_t* p3, std::int64_t* avar_out, std::int64_t* hvar_out);
 /// The same for consecutive phase points (a level-0 tau) without their P: the MVAR term as the
 /// running sum t_j = t_{j-1} + h_j (t sums m consecutive AVAR terms) from t_first, the term of
 /// point 0, which the caller forms from P.

@@ -49,10 +49,10 @@ namespace gyrochar {
 
 enum class ConfigureStatus : std::uint8_t {
   ok,
-  bad_stride_factor,     // S must be a power of two, 2 <= S <= 2^24
-  too_many_taus,         // more taus than the tau storage holds
-  tau_not_representable, // m must be r * 2^L with r <= S; taus strictly increasing, m >= 1
-  history_too_small,     // storage cannot hold the history for the largest tau at this S
+  bad_stride_factor,      // S must be a power of two, 2 <= S <= 2^24
+  too_many_taus,          // more taus than the tau storage holds
+  tau_not_representable,  // m must be r * 2^L with r <= S; taus strictly increasing, m >= 1
+  history_too_small,      // storage cannot hold the history for the largest tau at this S
 };
 
 struct CharacterizerConfig {
@@ -81,10 +81,10 @@ class Characterizer {
     std::array<std::uint32_t, 3> back{};    // its slot is head(ring) - back, modulo the ring size
     std::uint64_t sticky = 0;               // OR of the sums' high words: bit 63 = overflow
     // The decimated series x[k m]:
-    std::uint64_t countdown = 0;            // runs of this level until the next multiple of m
-    std::array<X, 3> decimated{};           // the last three decimated points of this segment
-    std::uint8_t decimated_count = 0;       // how many of them are valid (0..3)
-    typename Arith::NoiseSums noise;        // lag-1 autocorrelation sums
+    std::uint64_t countdown = 0;       // runs of this level until the next multiple of m
+    std::array<X, 3> decimated{};      // the last three decimated points of this segment
+    std::uint8_t decimated_count = 0;  // how many of them are valid (0..3)
+    typename Arith::NoiseSums noise;   // lag-1 autocorrelation sums
   };
 
   /// Binds the characterizer to storage owned by the caller, which must outlive it. No allocation.
@@ -125,8 +125,7 @@ class Characterizer {
     history_.configure(s, max_level + 1);
     fast_count_ = 0;
     while (fast_count_ < ntaus_ && taus_[fast_count_].level == 0) ++fast_count_;
-    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.capacity())
-      return ConfigureStatus::history_too_small;
+    if (history_entries(s, ntaus_ ? m_list[ntaus_ - 1] : 1) > history_.capacity()) return ConfigureStatus::history_too_small;
     GYROCHAR_ASSERT(history_.used() <= history_.capacity());
     restart();
     return ConfigureStatus::ok;
@@ -536,7 +535,7 @@ class Characterizer {
   std::uint32_t identity_ = 0;
   std::uint32_t restored_identity_ = 0;
   const char* restore_field_ = nullptr;
-  std::size_t fast_count_ = 0;  // the level-0 taus (m <= S), first in the list
+  std::size_t fast_count_ = 0;                      // the level-0 taus (m <= S), first in the list
   static constexpr std::size_t block_points = 256;  // staged points per block (a power of two)
   std::array<X, block_points> staged_{};
   std::size_t staged_count_ = 0;
@@ -548,11 +547,11 @@ class Characterizer {
     std::uint64_t steady_from = 0;    // from here on level 0 has its whole history in the segment
     std::uint64_t increments = 0;     // add_increment() calls
     std::uint64_t gaps = 0;
-    decltype(Entry{}.p) p{};          // P of the next point
+    decltype(Entry{}.p) p{};  // P of the next point
     decltype(Entry{}.p) p_segment_start{};
-    X x{};                            // running phase for add_increment()
+    X x{};                                        // running phase for add_increment()
     typename Arith::Increment first_increment{};  // FloatArith: increments are taken relative to it
-    std::uint64_t line_points = 0;    // FloatArith phase input: the reference line
+    std::uint64_t line_points = 0;                // FloatArith phase input: the reference line
     double line_x0 = 0, line_slope = 0;
     bool phase_overflow = false;
     // CountArith: the smallest and largest increment of this segment (they bound the terms).
@@ -583,8 +582,7 @@ struct CharacterizerStorage {
 /// 2^(Octaves-1) with any stride factor 2 <= S <= MaxStride. Not copyable (the base refers to the
 /// members).
 template <class Arith, unsigned Octaves, std::uint32_t MaxStride, std::size_t MaxTaus = Octaves>
-class StaticCharacterizer : private CharacterizerStorage<Arith, Octaves, MaxStride, MaxTaus>,
-                            public Characterizer<Arith> {
+class StaticCharacterizer : private CharacterizerStorage<Arith, Octaves, MaxStride, MaxTaus>, public Characterizer<Arith> {
   using Storage = CharacterizerStorage<Arith, Octaves, MaxStride, MaxTaus>;
 
  public:

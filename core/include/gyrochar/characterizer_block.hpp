@@ -180,8 +180,8 @@ inline void Characterizer<Arith>::level0_block(TauState& t, const Block& b)
 {
   // clang-format on
   const auto m = static_cast<std::size_t>(t.result.m >> b.level);  // the lag in the block's series (<= S)
-  if (!terms_fit(t.result.m)) {  // level 0 only (higher_levels() checks first)
-    for (std::size_t j = 0; j < b.n; ++j) {  // the checked path, point by point
+  if (!terms_fit(t.result.m)) {                                    // level 0 only (higher_levels() checks first)
+    for (std::size_t j = 0; j < b.n; ++j) {                        // the checked path, point by point
       const Entry now = b.at(*this, j, 0);
       checked_terms(t, now, b.at(*this, j, m), b.at(*this, j, 2 * m), b.at(*this, j, 3 * m));
       if (--t.countdown == 0) decimate(t, now.x);

@@ -19,13 +19,13 @@ namespace gyrochar {
 
 enum class RestoreStatus : std::uint8_t {
   ok,
-  truncated,        // fewer bytes than the checkpoint needs
-  not_a_checkpoint, // wrong magic number
-  wrong_version,    // written by another checkpoint format version
-  corrupted,        // CRC mismatch
-  config_mismatch,  // another arithmetic, stride factor, tau list or caller tag than now
-  other_identity,   // written for another identity (another instrument): checkpoint_identity() has it
-  invalid_state,    // the CRC holds but a field breaks the state's invariants: restore_field() names it
+  truncated,         // fewer bytes than the checkpoint needs
+  not_a_checkpoint,  // wrong magic number
+  wrong_version,     // written by another checkpoint format version
+  corrupted,         // CRC mismatch
+  config_mismatch,   // another arithmetic, stride factor, tau list or caller tag than now
+  other_identity,    // written for another identity (another instrument): checkpoint_identity() has it
+  invalid_state,     // the CRC holds but a field breaks the state's invariants: restore_field() names it
 };
 
 template <class Arith>
@@ -43,7 +43,7 @@ class CheckpointCodec {
 
  public:
   static constexpr std::uint32_t magic = 0x43525947;  // "GYRC"
-  static constexpr std::uint16_t version = 5;          // 5: the identity in the header
+  static constexpr std::uint16_t version = 5;         // 5: the identity in the header
   /// Phase points (and gaps) a checkpoint may count: 2^62 (146 000 years at 1 MHz); indices and
   /// counts stay far from wrapping around.
   static constexpr std::uint64_t max_phase_points = std::uint64_t{1} << 62;
@@ -51,8 +51,7 @@ class CheckpointCodec {
   /// Bytes save() writes for c's configuration. O(1).
   static std::size_t size(const C& c) {
     return sizeof(Header) + c.ntaus_ * sizeof(std::uint64_t) + sizeof(typename C::RunState) +
-           c.history_.used() * sizeof(typename C::Entry) + c.ntaus_ * sizeof(typename C::TauState) +
-           sizeof(std::uint32_t);
+           c.history_.used() * sizeof(typename C::Entry) + c.ntaus_ * sizeof(typename C::TauState) + sizeof(std::uint32_t);
   }
 
   /// Characterizer::save().
@@ -181,8 +180,9 @@ class CheckpointCodec {
         return "line (reference line or first increment)";
     }
     for (std::size_t l = 0; l < r.head.size(); ++l) {
-      const std::uint64_t want =
-          l < c.history_.levels() && e > 0 ? ((e - 1) >> l) % c.history_.ring_size(static_cast<unsigned>(l)) : 0;
+      const std::uint64_t want = l < c.history_.levels() && e > 0
+                                     ? ((e - 1) >> l) % c.history_.ring_size(static_cast<unsigned>(l))
+                                     : 0;
       if (r.head[l] != want) return "head (history position)";
     }
     for (std::size_t i = 0; i < c.ntaus_; ++i) {
@@ -194,8 +194,7 @@ class CheckpointCodec {
   }
 
   // A tau state against the configured one, after e phase points.
-  static const char* invalid_tau(const typename C::TauState& t, const typename C::TauState& configured,
-                                 std::uint64_t e) {
+  static const char* invalid_tau(const typename C::TauState& t, const typename C::TauState& configured, std::uint64_t e) {
     const auto& r = t.result;
     if (r.m != configured.result.m || r.stride != configured.result.stride || t.level != configured.level ||
         t.ring_of != configured.ring_of || t.back != configured.back)

@@ -87,8 +87,8 @@ enum class NoiseIdMethod : std::uint8_t {
 const char* name(NoiseIdMethod m);
 
 struct NoiseId {
-  int alpha = 0;                               // the most likely exponent
-  int low = 0, high = 0;                       // plausible exponents: low <= alpha <= high
+  int alpha = 0;          // the most likely exponent
+  int low = 0, high = 0;  // plausible exponents: low <= alpha <= high
   NoiseIdMethod method = NoiseIdMethod::none;
   bool identified() const { return method != NoiseIdMethod::none; }
 };
@@ -126,9 +126,9 @@ struct Estimate {
   double variance = 0;       // AVAR, MVAR, TVAR or HVAR in (phase unit / s)^2 (TVAR: phase unit^2)
   double deviation = 0;
   NoiseId noise;
-  int edf_alpha = 0;         // the alpha whose EDF was used (the smallest of the plausible ones)
-  double edf = 0;            // 0: not available (no identification, or alpha outside the statistic's range)
-  double skew_dof = 0;       // nu3 of noise_model.hpp (the distribution's skewness); 0: plain chi-squared
+  int edf_alpha = 0;    // the alpha whose EDF was used (the smallest of the plausible ones)
+  double edf = 0;       // 0: not available (no identification, or alpha outside the statistic's range)
+  double skew_dof = 0;  // nu3 of noise_model.hpp (the distribution's skewness); 0: plain chi-squared
   bool clean = true;
 };
 

@@ -93,26 +93,26 @@ namespace gyrochar {
 /// estimate's scaled by sqrt(variance_scale): the correlations of the Allan estimates it replaces,
 /// its own smaller variance (docs/metrology.md says why that is the honest choice we can make).
 struct FitPoint {
-  Stat stat = Stat::avar;    // avar or mvar
-  std::uint64_t m = 1;       // averaging factor
-  std::uint64_t stride = 1;  // terms every `stride` phase points (a power of two)
-  std::uint64_t n = 0;       // terms formed (gaps remove some)
-  double variance = 0;       // the estimate, (r/s)^2
-  double edf = 0;            // the per-tau EDF (first weights only); <= 0: n
-  double variance_scale = 1; // 1: the Allan-family estimate itself; < 1: a total-family one for it
+  Stat stat = Stat::avar;     // avar or mvar
+  std::uint64_t m = 1;        // averaging factor
+  std::uint64_t stride = 1;   // terms every `stride` phase points (a power of two)
+  std::uint64_t n = 0;        // terms formed (gaps remove some)
+  double variance = 0;        // the estimate, (r/s)^2
+  double edf = 0;             // the per-tau EDF (first weights only); <= 0: n
+  double variance_scale = 1;  // 1: the Allan-family estimate itself; < 1: a total-family one for it
 };
 
-inline constexpr std::size_t max_markov = 2;      // Markov terms a model may have
-inline constexpr std::size_t max_sinusoids = 2;   // sinusoids a model may have
+inline constexpr std::size_t max_markov = 2;     // Markov terms a model may have
+inline constexpr std::size_t max_sinusoids = 2;  // sinusoids a model may have
 inline constexpr std::size_t max_fit_points = 128;
 
 struct FitSetup {
   double tau0_s = 1.0;
-  std::uint64_t n_phase = 0;        // phase points of the run (the unbroken grids)
-  double white_quantization = 0.0;  // Q_w in r when the data are counts (pulse weight / sqrt 12); 0: unknown
-  double model_spread = 0.001;      // how closely the model is taken to describe each point (relative)
-  bool select_model = true;         // false: the five terms only, as IEEE 952's basic model
-  std::size_t markov_terms = max_markov;           // at most this many Markov terms (<= max_markov)
+  std::uint64_t n_phase = 0;                        // phase points of the run (the unbroken grids)
+  double white_quantization = 0.0;                  // Q_w in r when the data are counts (pulse weight / sqrt 12); 0: unknown
+  double model_spread = 0.001;                      // how closely the model is taken to describe each point (relative)
+  bool select_model = true;                         // false: the five terms only, as IEEE 952's basic model
+  std::size_t markov_terms = max_markov;            // at most this many Markov terms (<= max_markov)
   std::array<double, max_sinusoids> sinusoid_hz{};  // candidate sinusoid frequencies (0: none)
 };
 
@@ -175,21 +175,21 @@ struct FitResidual {
 struct Ieee952Fit {
   FitCurve curve = FitCurve::both;
   FitStatus status = FitStatus::too_few_points;
-  std::array<Ieee952Parameter, 5> p{};  // Q, N, B, K, R
-  double chi2 = 0;                      // generalized chi-squared of the final fit
-  std::size_t dof = 0;                  // points used minus terms fitted
-  double birge = 1;                     // factor applied to the uncertainties (>= 1)
-  std::size_t points = 0;               // points used
-  bool quantization_white = true;       // false: periodic quantization detected (counts only)
+  std::array<Ieee952Parameter, 5> p{};           // Q, N, B, K, R
+  double chi2 = 0;                               // generalized chi-squared of the final fit
+  std::size_t dof = 0;                           // points used minus terms fitted
+  double birge = 1;                              // factor applied to the uncertainties (>= 1)
+  std::size_t points = 0;                        // points used
+  bool quantization_white = true;                // false: periodic quantization detected (counts only)
   std::array<double, 2> excluded_below_tau_s{};  // AVAR, MVAR points below these taus left out (non-white)
   std::array<MarkovTerm, max_markov> markov{};   // the first n_markov are in the model
   std::size_t n_markov = 0;
   std::array<SinusoidTerm, max_sinusoids> sinusoids{};
   std::size_t n_sinusoids = 0;
   double bandwidth_excluded_below_tau_s = 0;  // points below this tau left out: the sensor's own filter (0: none)
-  double bandwidth_tc_s = 0;               // Tf of the filter on N's white noise (0: none in the model)
+  double bandwidth_tc_s = 0;                  // Tf of the filter on N's white noise (0: none in the model)
   double bandwidth_tc_uncertainty_s = 0;
-  ModelSummary chosen, runner_up;          // the selected model and the next best candidate
+  ModelSummary chosen, runner_up;                       // the selected model and the next best candidate
   std::array<FitResidual, max_fit_points> residuals{};  // every point used, in the fit's order
   std::size_t n_residuals = 0;
   bool ok() const { return status == FitStatus::ok; }
@@ -208,8 +208,8 @@ constexpr std::size_t ieee952_workspace_doubles(std::size_t points) {
 /// order). `workspace` holds at least ieee952_workspace_doubles(points.size()) doubles. O(P^2 x
 /// pair_sums()) for the covariances (O(P^2) from `cache`, optional), then O(P^3) per iteration;
 /// no allocation; never fails hard.
-Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve,
-                       std::span<double> workspace, PairSumCache* cache = nullptr);
+Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve, std::span<double> workspace,
+                       PairSumCache* cache = nullptr);
 
 /// The model's exact expected AVAR or MVAR at averaging factor m for parameters {Q, N, B, K, R}.
 /// O(1).

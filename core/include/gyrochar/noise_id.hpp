@@ -77,7 +77,7 @@ class NoiseIdAccumulator {
   // Generic vectors (GCC and Clang): SIMD where the target has it, scalar code elsewhere. The
   // alignment is explicit: the AVX2 clone of add_run() must agree with the baseline on it.
   using Lanes = double __attribute__((vector_size(4 * sizeof(double)), aligned(4 * sizeof(double))));
-  void add_ramp(double z);  // the first values of a segment, order by order
+  void add_ramp(double z);                                                   // the first values of a segment, order by order
   void add_run(const std::int64_t* z, std::size_t count, std::size_t step);  // add_steady(), SIMD-compiled
   void add_run(const double* z, std::size_t count, std::size_t step);
   // Every order has a previous value in this segment: the four advance together.
@@ -106,12 +106,12 @@ class NoiseIdAccumulator {
   using Counts = std::uint64_t __attribute__((vector_size(4 * sizeof(std::uint64_t)), aligned(4 * sizeof(std::uint64_t))));
   Lanes shift_{}, sum_{}, sum_sq_{}, sum_lag_{};
   Lanes firsts_{}, lasts_{};  // sums of the first and of the last value of each (closed) segment
-  Lanes last_{};  // last shifted value of each order in this segment
-  Lanes raw_{};   // last unshifted value of orders 0..2 in this segment (the differences' base)
+  Lanes last_{};              // last shifted value of each order in this segment
+  Lanes raw_{};               // last unshifted value of orders 0..2 in this segment (the differences' base)
   Counts n_{};
   Counts pairs_{};
   bool linked_[4] = {false, false, false, false};  // order d's next value pairs with last_[d]
-  int have_ = 0;  // values of this segment seen so far (capped at 3)
+  int have_ = 0;                                   // values of this segment seen so far (capped at 3)
 };
 
 /// The same sums for an integer series (the decimated phase of counts), exact: every sum is an

@@ -102,8 +102,8 @@ PairSums pair_sums(const NoiseSet& set, const TermGrid& a, const TermGrid& b);
 /// pair_sums(set, a1, b1) and pair_sums(set, a2, b2), the same to the last bit, in one pass where
 /// the two pairs have the same kernel (the same statistics, m and strides; say the same grids at
 /// two lengths of the run): the covariances at the lags both sums visit are evaluated once.
-void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b1, const TermGrid& a2,
-                      const TermGrid& b2, PairSums& out1, PairSums& out2);
+void pair_sums_of_two(const NoiseSet& set, const TermGrid& a1, const TermGrid& b1, const TermGrid& a2, const TermGrid& b2,
+                      PairSums& out1, PairSums& out2);
 
 /// The same sums with first-order Gauss-Markov rates beside the noises of `set` (the IEEE-952
 /// fit's exact covariance of a model with Markov terms): c_j the term covariance of Markov rate j
@@ -203,9 +203,9 @@ class PairSumCache {
     bool linear = false;
     Stat stat_a = Stat::avar, stat_b = Stat::avar;
     std::uint64_t m_a = 0, m_b = 0, stride_a = 0, stride_b = 0;
-    std::uint64_t from = 0;         // linear: valid from this many coarse terms
-    std::uint64_t n_a = 0, n_b = 0; // not linear: the term counts of `sums`
-    PairSums slope, sums;           // linear: sums = slope * n + sums (the intercept)
+    std::uint64_t from = 0;          // linear: valid from this many coarse terms
+    std::uint64_t n_a = 0, n_b = 0;  // not linear: the term counts of `sums`
+    PairSums slope, sums;            // linear: sums = slope * n + sums (the intercept)
   };
   /// sinusoid_pair_sums() of one pair of grids at given frequencies, kept exactly as computed.
   struct SinusoidEntry {
@@ -223,8 +223,7 @@ class PairSumCache {
   /// sinusoid_pair_sums(set, thetas, a, b), the same to the last bit: kept in the sinusoid storage
   /// (when there is one) for the next fit of the same grids and frequencies (the analyzer fits
   /// both curves and each alone). O(1) once kept; a full storage computes afresh.
-  SinusoidPairSums sinusoid_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a,
-                                 const TermGrid& b);
+  SinusoidPairSums sinusoid_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a, const TermGrid& b);
   /// Asks `source` first from now on (null: none); it must outlive its use here.
   void attach(const PairSumSource* source) { source_ = source; }
   /// Forgets everything (a new configuration). O(capacity).

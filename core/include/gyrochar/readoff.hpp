@@ -58,17 +58,17 @@ struct AdevPoint {
 /// One read-off value: valid false when it could not be read (the other fields are then 0).
 struct ReadoffValue {
   bool valid = false;
-  double value = 0;    // unit: see the header
-  double ci_low = 0;   // the chosen point's interval, scaled like the value
+  double value = 0;   // unit: see the header
+  double ci_low = 0;  // the chosen point's interval, scaled like the value
   double ci_high = 0;
-  double tau_s = 0;    // tau of the point it was read at
+  double tau_s = 0;  // tau of the point it was read at
 };
 
 struct Readoff {
-  ReadoffValue n;      // angle random walk N, r/s^0.5
-  ReadoffValue floor;  // the smallest adev, r/s
-  ReadoffValue b;      // bias instability B = floor / 0.664, r/s
-  ReadoffValue k;      // rate random walk K, r/s^1.5
+  ReadoffValue n;             // angle random walk N, r/s^0.5
+  ReadoffValue floor;         // the smallest adev, r/s
+  ReadoffValue b;             // bias instability B = floor / 0.664, r/s
+  ReadoffValue k;             // rate random walk K, r/s^1.5
   bool floor_at_end = false;  // the floor is the first or the last point: the curve has not turned there
 };
 

@@ -43,7 +43,9 @@ inline constexpr std::size_t sum_kinds = 5;
 
 /// The family a sum belongs to.
 constexpr Stat stat_of(SumKind k) {
-  return k == SumKind::mvar ? Stat::mvar : (k == SumKind::hvar || k == SumKind::hvar_nonoverlapped) ? Stat::hvar : Stat::avar;
+  return k == SumKind::mvar                                         ? Stat::mvar
+         : (k == SumKind::hvar || k == SumKind::hvar_nonoverlapped) ? Stat::hvar
+                                                                    : Stat::avar;
 }
 
 /// The statistics: the six deviations the characterizer's sums give, Allan (non-overlapped),
@@ -83,9 +85,9 @@ constexpr bool dev_stats_in_order() {
 static_assert(dev_stats_in_order(), "dev_stats lists every DevStat once, in its order");
 
 inline constexpr std::array<DevStat, 6> all_dev_stats{DevStat::adev, DevStat::oadev, DevStat::mdev,
-                                                       DevStat::tdev, DevStat::hdev, DevStat::ohdev};
+                                                      DevStat::tdev, DevStat::hdev,  DevStat::ohdev};
 inline constexpr std::array<DevStat, 6> total_dev_stats{DevStat::totdev,  DevStat::mtotdev, DevStat::ttotdev,
-                                                         DevStat::htotdev, DevStat::theo1,   DevStat::theoh};
+                                                        DevStat::htotdev, DevStat::theo1,   DevStat::theoh};
 constexpr bool is_total(DevStat s) { return s >= DevStat::totdev; }
 
 /// The table's row of s (the first row for a value outside the enumeration).

@@ -91,10 +91,10 @@ TotalVariance theo1(std::span<const double> x, std::uint64_t m, double tau0_s, s
 TotalVariance oavar(std::span<const double> x, std::uint64_t m, double tau0_s, std::uint64_t stride = 1);
 
 struct TheoBiasRatio {
-  double ratio = 0.0;          // (1 / taus) sum AVAR(9 + 3i) / Theo1(12 + 4i); 0: undefined
-  std::uint64_t taus = 0;      // taus averaged
-  std::uint64_t defined = 0;   // taus of the definition (n + 1, less the one N may leave out)
-  bool exact = true;           // every tau of the definition, each estimate exact
+  double ratio = 0.0;         // (1 / taus) sum AVAR(9 + 3i) / Theo1(12 + 4i); 0: undefined
+  std::uint64_t taus = 0;     // taus averaged
+  std::uint64_t defined = 0;  // taus of the definition (n + 1, less the one N may leave out)
+  bool exact = true;          // every tau of the definition, each estimate exact
 };
 
 /// TheoBR's bias ratio of phase x (N >= 24, so that n >= 1). With stride_factor S = 0 every

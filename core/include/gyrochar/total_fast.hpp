@@ -39,13 +39,13 @@ void fft_twiddles(std::span<double> twiddle, std::size_t P);
 std::size_t theo1_workspace_size(std::size_t n_phase);
 
 struct Theo1Workspace {
-  std::span<double> r;          // x less its least-squares quadratic
-  std::span<double> s1, s2;     // prefix sums of r and r^2 (N + 1 each)
-  std::span<double> ac;         // sum_i r[i] r[i+d], d < N
+  std::span<double> r;       // x less its least-squares quadratic
+  std::span<double> s1, s2;  // prefix sums of r and r^2 (N + 1 each)
+  std::span<double> ac;      // sum_i r[i] r[i+d], d < N
   std::span<double> twiddle, buffer;
-  std::size_t P = 0;            // the twiddle table's FFT length
-  double curvature = 0.0;       // the removed quadratic's coefficient of i^2
-  bool ready = false;           // false: N < 3 or the workspace too small
+  std::size_t P = 0;       // the twiddle table's FFT length
+  double curvature = 0.0;  // the removed quadratic's coefficient of i^2
+  bool ready = false;      // false: N < 3 or the workspace too small
 };
 
 /// Prepares x (N >= 3) in `work` (theo1_workspace_size(N) doubles). O(N log N).
@@ -93,7 +93,6 @@ TotalVariance htotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::ui
 
 /// theo_bias_ratio with every Theo1 and AVAR exact, Theo1 by theo1_fast: at most `ratio_taus` of the
 /// definition's taus, evenly spread (all when ratio_taus >= n + 1). O(taus (N + m log^2 m)).
-TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s,
-                                   std::uint64_t ratio_taus);
+TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s, std::uint64_t ratio_taus);
 
 }  // namespace gyrochar

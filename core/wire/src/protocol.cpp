@@ -21,7 +21,7 @@ constexpr std::uint16_t min_report_period_ms = 100;
 constexpr std::uint16_t max_report_period_ms = 2000;
 constexpr unsigned excluded_code_bits = 5;  // Ieee952 summary: log2 m below which points were left out
 constexpr unsigned ieee952_resolved_bit = 8u, ieee952_fitted_bit = 16u;  // Ieee952 term pages, byte 0
-constexpr std::uint64_t min_window_length = 4;  // the shortest window holds an MDEV term at m = 1
+constexpr std::uint64_t min_window_length = 4;                           // the shortest window holds an MDEV term at m = 1
 constexpr unsigned window_dev_code_bits = 22;
 constexpr double window_dev_codes_per_octave = 16384.0;  // log2(dev) = code / 2^14 - 128; code 0: none
 constexpr double window_dev_log2_offset = -128.0;
@@ -48,7 +48,9 @@ std::uint64_t saturate(std::uint64_t value, unsigned bits) {
 }
 std::uint8_t u8(unsigned value) { return static_cast<std::uint8_t>(value); }
 template <class E>
-unsigned code(E e) { return static_cast<unsigned>(e); }
+unsigned code(E e) {
+  return static_cast<unsigned>(e);
+}
 
 CanFrame blank(std::uint32_t base, std::uint8_t node, std::uint8_t len) {
   CanFrame f;
@@ -66,9 +68,7 @@ std::uint16_t edf_code(double edf) {
   const double max = double((1u << edf_code_bits) - 1);
   return static_cast<std::uint16_t>(c < 1.0 ? 1.0 : c > max ? max : c);
 }
-double edf_from_code(unsigned c) {
-  return c == 0 ? 0.0 : std::exp2(c / edf_codes_per_octave + edf_log2_offset);
-}
+double edf_from_code(unsigned c) { return c == 0 ? 0.0 : std::exp2(c / edf_codes_per_octave + edf_log2_offset); }
 std::uint32_t window_dev_code(double dev) {
   if (dev == 0.0) return 0;
   const double c = std::round(window_dev_codes_per_octave * (std::log2(dev) - window_dev_log2_offset));
@@ -95,30 +95,23 @@ std::uint16_t rel_uncertainty_code(double rel) {
 
 bool nonnegative(double v) { return std::isfinite(v) && v >= 0.0; }
 bool positive(double v) { return std::isfinite(v) && v > 0.0; }
-constexpr ProtocolError ok_if(bool in_range) {
-  return in_range ? ProtocolError::none : ProtocolError::out_of_range;
-}
+constexpr ProtocolError ok_if(bool in_range) { return in_range ? ProtocolError::none : ProtocolError::out_of_range; }
 
-ProtocolError check(const StatusMsg& m) {
-  return ok_if(m.state <= NodeState::input_lost && m.tau_count <= max_taus);
-}
+ProtocolError check(const StatusMsg& m) { return ok_if(m.state <= NodeState::input_lost && m.tau_count <= max_taus); }
 ProtocolError check(const StatusFaultsMsg&) { return ProtocolError::none; }
 ProtocolError check(const TauDevMsg& m) {
-  return ok_if(m.tau_index < max_taus && m.kind <= DevKind::mdev && nonnegative(m.dev_angle_per_s) &&
-               nonnegative(m.edf) && m.noise <= NoiseType::random_run_fm);
+  return ok_if(m.tau_index < max_taus && m.kind <= DevKind::mdev && nonnegative(m.dev_angle_per_s) && nonnegative(m.edf) &&
+               m.noise <= NoiseType::random_run_fm);
 }
 ProtocolError check(const TauTermsMsg& m) { return ok_if(m.tau_index < max_taus); }
 ProtocolError check(const TauInfoMsg& m) {
   return ok_if(m.tau_index < max_taus && m.m >= 1 && m.m < max_m && m.stride_log2 < 40 &&
                (m.m & ((std::uint64_t{1} << m.stride_log2) - 1)) == 0);
 }
-ProtocolError check(const MetaSamplingMsg& m) {
-  return ok_if(positive(m.tau0_s) && std::has_single_bit(m.stride_factor));
-}
+ProtocolError check(const MetaSamplingMsg& m) { return ok_if(positive(m.tau0_s) && std::has_single_bit(m.stride_factor)); }
 ProtocolError check(const MetaClockMsg& m) { return ok_if(m.protocol_version >= 1); }
 ProtocolError check(const MetaScaleMsg& m) {
-  return ok_if(positive(m.angle_per_pulse) && m.angle_unit <= AngleUnit::arcsec &&
-               m.input_source <= InputSource::simulated);
+  return ok_if(positive(m.angle_per_pulse) && m.angle_unit <= AngleUnit::arcsec && m.input_source <= InputSource::simulated);
 }
 ProtocolError check(const MetaConfigMsg& m) {
   return ok_if(m.report_period_ms >= min_report_period_ms && m.report_period_ms <= max_report_period_ms);
@@ -130,8 +123,8 @@ ProtocolError check(const Ieee952Msg& m) {
 ProtocolError check(const Ieee952SummaryMsg& m) {
   const auto [avar, mvar] = m.excluded_below_log2_m;
   constexpr unsigned max_code = (1u << excluded_code_bits) - 1;
-  return ok_if(m.status <= Ieee952Status::singular && nonnegative(m.chi2_per_dof) && avar <= max_code &&
-               mvar <= max_code && (!m.quantization_white || (avar == 0 && mvar == 0)));
+  return ok_if(m.status <= Ieee952Status::singular && nonnegative(m.chi2_per_dof) && avar <= max_code && mvar <= max_code &&
+               (!m.quantization_white || (avar == 0 && mvar == 0)));
 }
 ProtocolError check(const WindowMsg& m) {
   return ok_if(m.tau_count >= 1 && m.tau_count < max_taus && (m.complete || (m.window == 0 && m.gaps == 0)));
@@ -142,20 +135,20 @@ ProtocolError check(const WindowDevMsg& m) {
                nonnegative(m.mdev_angle_per_s));
 }
 ProtocolError check(const Ieee952ParameterMsg& m) {
-  const std::size_t terms = m.parameter == FitParameter::filter_tf ? 1
+  const std::size_t terms = m.parameter == FitParameter::filter_tf   ? 1
                             : m.parameter <= FitParameter::markov_tc ? wire_markov_terms
                                                                      : wire_sinusoids;
   return ok_if(m.parameter <= FitParameter::sinusoid_frequency && m.index < terms &&
-               (!m.resolved || has_resolved(m.parameter)) && nonnegative(m.value) &&
-               !std::isnan(m.rel_uncertainty) && m.rel_uncertainty >= 0.0);
+               (!m.resolved || has_resolved(m.parameter)) && nonnegative(m.value) && !std::isnan(m.rel_uncertainty) &&
+               m.rel_uncertainty >= 0.0);
 }
 ProtocolError check(const Ieee952ModelMsg& m) {
   const bool runner_up_blank = m.runner_up_markov == 0 && m.runner_up_sinusoids == 0 && !m.runner_up_bandwidth &&
                                m.criterion_margin == 0.0f;
   return ok_if(m.markov <= wire_markov_terms && m.sinusoids <= wire_sinusoids &&
-               m.bandwidth_excluded_below_log2_m < (1u << excluded_code_bits) &&
-               m.runner_up_markov <= wire_markov_terms && m.runner_up_sinusoids <= wire_sinusoids &&
-               std::isfinite(m.criterion_margin) && (m.runner_up || runner_up_blank));
+               m.bandwidth_excluded_below_log2_m < (1u << excluded_code_bits) && m.runner_up_markov <= wire_markov_terms &&
+               m.runner_up_sinusoids <= wire_sinusoids && std::isfinite(m.criterion_margin) &&
+               (m.runner_up || runner_up_blank));
 }
 ProtocolError check(const Ieee952UnconstrainedMsg& m) {
   return ok_if(m.term <= Ieee952Term::rate_ramp && std::isfinite(m.value) && nonnegative(m.uncertainty) &&
@@ -167,8 +160,8 @@ ProtocolError check(const CounterInputMsg&) { return ProtocolError::none; }
 
 /// Checks node and ranges, then packs with `pack` into a fresh frame that replaces `frame`.
 template <class Msg, class Pack>
-ProtocolError encode_with(const Msg& msg, std::uint8_t node, std::uint32_t base, std::uint8_t len,
-                          CanFrame& frame, Pack pack) {
+ProtocolError encode_with(const Msg& msg, std::uint8_t node, std::uint32_t base, std::uint8_t len, CanFrame& frame,
+                          Pack pack) {
   if (node > max_node_address) return ProtocolError::bad_address;
   if (const ProtocolError e = check(msg); e != ProtocolError::none) return e;
   CanFrame f = blank(base, node, len);
@@ -503,8 +496,9 @@ ProtocolError encode(const WindowLengthMsg& msg, std::uint8_t node, CanFrame& fr
 ProtocolError encode(const WindowDevMsg& msg, std::uint8_t node, CanFrame& frame) {
   return encode_with(msg, node, window_id, report_len, frame, [&](CanFrame& f) {
     header(f, 2, msg.tau_index, msg.seq);
-    put(f, 2, 6, std::uint64_t{msg.window} | std::uint64_t{window_dev_code(msg.adev_angle_per_s)} << 4 |
-                     std::uint64_t{window_dev_code(msg.mdev_angle_per_s)} << 26);
+    put(f, 2, 6,
+        std::uint64_t{msg.window} | std::uint64_t{window_dev_code(msg.adev_angle_per_s)} << 4 |
+            std::uint64_t{window_dev_code(msg.mdev_angle_per_s)} << 26);
   });
 }
 
@@ -562,10 +556,9 @@ Decoded decode(const CanFrame& frame) {
   if (frame.error) return fail(ProtocolError::error_frame);
   if (!frame.extended) return fail(ProtocolError::not_extended);
   const std::uint32_t base = frame.id & ~std::uint32_t{0xFF};
-  const bool known = frame.id <= id_mask && (base == status_id || base == tau_stats_id ||
-                                             base == metadata_id || base == ieee952_id ||
-                                             base == window_id || base == unconstrained_id ||
-                                             base == counter_input_id);
+  const bool known = frame.id <= id_mask &&
+                     (base == status_id || base == tau_stats_id || base == metadata_id || base == ieee952_id ||
+                      base == window_id || base == unconstrained_id || base == counter_input_id);
   if (!known) return fail(ProtocolError::unknown_id);
   out.node = u8(frame.id & 0xFFu);  // set before any later refusal: the frame is counted against its node
   if (out.node > max_node_address) return fail(ProtocolError::bad_address);

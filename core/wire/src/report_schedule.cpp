@@ -128,9 +128,9 @@ ReportSlot report_slot(std::uint8_t seq, std::size_t tau_count, std::size_t posi
   const std::size_t before_unconstrained = frames_before_unconstrained(seq, tau_count, protocol_version, window_taus);
   if (position < before_unconstrained)
     return model_slot(seq % slow_cycle_reports * model_part_length(protocol_version) + position - before_model);
-  return {Slot::unconstrained, std::uint8_t(static_cast<unsigned>(seq % slow_cycle_reports *
-                                                                   unconstrained_part_length(protocol_version) +
-                                                                   position - before_unconstrained))};
+  return {Slot::unconstrained,
+          std::uint8_t(static_cast<unsigned>(seq % slow_cycle_reports * unconstrained_part_length(protocol_version) +
+                                             position - before_unconstrained))};
 }
 
 double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps, std::size_t window_taus) {

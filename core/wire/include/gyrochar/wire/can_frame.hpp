@@ -10,11 +10,11 @@ struct CanFrame {
   static constexpr std::uint8_t max_classic_len = 8;
   static constexpr std::uint8_t max_fd_len = 64;
 
-  std::uint32_t id = 0;        // 11-bit or 29-bit identifier, without flag bits
-  bool extended = false;       // 29-bit identifier
-  bool fd = false;             // CAN FD frame (len may exceed 8)
-  bool error = false;          // error frame reported by the controller (id holds error class bits)
-  std::uint8_t len = 0;        // data length in bytes
+  std::uint32_t id = 0;   // 11-bit or 29-bit identifier, without flag bits
+  bool extended = false;  // 29-bit identifier
+  bool fd = false;        // CAN FD frame (len may exceed 8)
+  bool error = false;     // error frame reported by the controller (id holds error class bits)
+  std::uint8_t len = 0;   // data length in bytes
   std::array<std::uint8_t, max_fd_len> data{};
 };
 

@@ -23,9 +23,9 @@
 
 namespace gyrochar::protocol {
 
-inline constexpr std::uint8_t version = 5;             // what this codec's nodes send
-inline constexpr std::uint8_t oldest_version = 1;      // the oldest version decoders accept
-inline constexpr std::size_t max_taus = 64;          // tau index is 6 bits
+inline constexpr std::uint8_t version = 5;              // what this codec's nodes send
+inline constexpr std::uint8_t oldest_version = 1;       // the oldest version decoders accept
+inline constexpr std::size_t max_taus = 64;             // tau index is 6 bits
 inline constexpr std::uint8_t max_node_address = 0xFD;  // J1939: 0xFE null, 0xFF global
 
 // Identifier bases; the node address goes in the low byte (frame_id()).
@@ -160,13 +160,13 @@ struct StatusFaultsMsg {
 /// Tau statistics pages 0 (ADEV) and 1 (MDEV), every report, for every tau.
 struct TauDevMsg {
   std::uint8_t seq = 0;
-  std::uint8_t tau_index = 0;    // 0..max_taus-1
+  std::uint8_t tau_index = 0;  // 0..max_taus-1
   DevKind kind = DevKind::adev;
   float dev_angle_per_s = 0.0f;  // the deviation, >= 0, finite
   double edf = 0.0;              // equivalent degrees of freedom; 0 = not available. On the wire as
                                  // log2(edf) in 1/64 steps, clamped to [2^-3.98, 2^59.98]
   NoiseType noise = NoiseType::not_identified;
-  bool valid = false;            // false: no estimate yet, or terms were lost (do not plot)
+  bool valid = false;  // false: no estimate yet, or terms were lost (do not plot)
   bool operator==(const TauDevMsg&) const = default;
 };
 
@@ -182,8 +182,8 @@ struct TauTermsMsg {
 struct TauInfoMsg {
   std::uint8_t seq = 0;
   std::uint8_t tau_index = 0;
-  std::uint64_t m = 1;            // tau = m * tau0; 1 <= m < 2^40
-  std::uint8_t stride_log2 = 0;   // terms are formed every 2^stride_log2 samples; 2^stride_log2 divides m
+  std::uint64_t m = 1;           // tau = m * tau0; 1 <= m < 2^40
+  std::uint8_t stride_log2 = 0;  // terms are formed every 2^stride_log2 samples; 2^stride_log2 divides m
   bool operator==(const TauInfoMsg&) const = default;
 };
 
@@ -198,7 +198,7 @@ struct MetaSamplingMsg {
 /// Metadata page 1.
 struct MetaClockMsg {
   std::uint8_t seq = 0;
-  std::uint64_t uptime_ms = 0;  // 40 bits, saturates
+  std::uint64_t uptime_ms = 0;              // 40 bits, saturates
   std::uint8_t protocol_version = version;  // >= 1
   bool operator==(const MetaClockMsg&) const = default;
 };
@@ -215,7 +215,7 @@ struct MetaScaleMsg {
 /// Metadata page 3.
 struct MetaConfigMsg {
   std::uint8_t seq = 0;
-  std::uint32_t config_hash = 0;        // changes whenever the configuration does
+  std::uint32_t config_hash = 0;          // changes whenever the configuration does
   std::uint16_t report_period_ms = 1000;  // 100..2000
   bool operator==(const MetaConfigMsg&) const = default;
 };
@@ -224,15 +224,15 @@ struct MetaConfigMsg {
 struct Ieee952Msg {
   std::uint8_t seq = 0;
   Ieee952Term term = Ieee952Term::quantization;
-  bool resolved = false;        // the fit resolved this term: significant, and the largest term at
-                                // one of the taus fitted at least
-  float value = 0.0f;           // >= 0, finite, in the term's unit (see Ieee952Term)
-  double rel_uncertainty = 0.0; // standard uncertainty / value, >= 0; on the wire in 0.01 % steps,
-                                // saturating at 655.35 %
-  bool fitted = false;          // version 2: the term is in the fitted model, so value and
-                                // uncertainty are the fit's even when not resolved (an upper-bound
-                                // reading). Version-1 nodes send 0 (their Resolved implies fitted);
-                                // a version-2 node sets it whenever it sets resolved.
+  bool resolved = false;         // the fit resolved this term: significant, and the largest term at
+                                 // one of the taus fitted at least
+  float value = 0.0f;            // >= 0, finite, in the term's unit (see Ieee952Term)
+  double rel_uncertainty = 0.0;  // standard uncertainty / value, >= 0; on the wire in 0.01 % steps,
+                                 // saturating at 655.35 %
+  bool fitted = false;           // version 2: the term is in the fitted model, so value and
+                                 // uncertainty are the fit's even when not resolved (an upper-bound
+                                 // reading). Version-1 nodes send 0 (their Resolved implies fitted);
+                                 // a version-2 node sets it whenever it sets resolved.
   bool operator==(const Ieee952Msg&) const = default;
 };
 
@@ -240,12 +240,12 @@ struct Ieee952Msg {
 struct Ieee952SummaryMsg {
   std::uint8_t seq = 0;
   Ieee952Status status = Ieee952Status::too_few_points;
-  float chi2_per_dof = 0.0f;      // generalized chi-squared per degree of freedom; finite, >= 0
-                                  // (0 when no fit was made or no degree of freedom was left)
-  std::uint32_t points = 0;       // points (AVAR and MVAR estimates) the fit used; 8 bits, saturates
-  bool quantization_white = true; // false: periodic quantization of the counts was detected, the
-                                  // short taus it reaches were left out and Q was held at
-                                  // pulse weight / sqrt(12) rather than fitted
+  float chi2_per_dof = 0.0f;       // generalized chi-squared per degree of freedom; finite, >= 0
+                                   // (0 when no fit was made or no degree of freedom was left)
+  std::uint32_t points = 0;        // points (AVAR and MVAR estimates) the fit used; 8 bits, saturates
+  bool quantization_white = true;  // false: periodic quantization of the counts was detected, the
+                                   // short taus it reaches were left out and Q was held at
+                                   // pulse weight / sqrt(12) rather than fitted
   /// AVAR [0] and MVAR [1] points with averaging factor m < 2^c were left out of the fit because of
   /// that quantization; 0: none. 0..31 (5 bits); both 0 when quantization_white.
   std::array<std::uint8_t, 2> excluded_below_log2_m{};
@@ -258,12 +258,12 @@ struct Ieee952SummaryMsg {
 struct Ieee952ParameterMsg {
   std::uint8_t seq = 0;
   FitParameter parameter = FitParameter::markov_sigma;
-  std::uint8_t index = 0;       // the Markov term or sinusoid, 0..1; 0 for filter_tf
-  bool resolved = false;        // markov_sigma, sinusoid_amplitude only: the term is resolved in an
-                                // accepted fit (as Ieee952Msg::resolved); false for the others
-  float value = 0.0f;           // >= 0, finite, in the parameter's unit (see FitParameter)
-  double rel_uncertainty = 0.0; // standard uncertainty / value, >= 0; as Ieee952Msg's on the wire
-                                // (a sinusoid's frequency is given to the fit, not fitted: 0)
+  std::uint8_t index = 0;        // the Markov term or sinusoid, 0..1; 0 for filter_tf
+  bool resolved = false;         // markov_sigma, sinusoid_amplitude only: the term is resolved in an
+                                 // accepted fit (as Ieee952Msg::resolved); false for the others
+  float value = 0.0f;            // >= 0, finite, in the parameter's unit (see FitParameter)
+  double rel_uncertainty = 0.0;  // standard uncertainty / value, >= 0; as Ieee952Msg's on the wire
+                                 // (a sinusoid's frequency is given to the fit, not fitted: 0)
   bool operator==(const Ieee952ParameterMsg&) const = default;
 };
 
@@ -271,13 +271,13 @@ struct Ieee952ParameterMsg {
 /// of the cycle's model list. Every Ieee952 frame of one slow cycle describes the same fit.
 struct Ieee952ModelMsg {
   std::uint8_t seq = 0;
-  std::uint8_t markov = 0;      // Markov terms in the model, 0..wire_markov_terms
-  std::uint8_t sinusoids = 0;   // sinusoids in the model, 0..wire_sinusoids
-  bool bandwidth = false;       // the sensor's own filter is in the model (its Tf on a parameter page)
+  std::uint8_t markov = 0;     // Markov terms in the model, 0..wire_markov_terms
+  std::uint8_t sinusoids = 0;  // sinusoids in the model, 0..wire_sinusoids
+  bool bandwidth = false;      // the sensor's own filter is in the model (its Tf on a parameter page)
   /// Points with averaging factor m < 2^c were left out because the sensor's filter shapes them in
   /// a way the model does not describe; 0: none. 0..31 (5 bits).
   std::uint8_t bandwidth_excluded_below_log2_m = 0;
-  bool runner_up = false;       // a runner-up candidate was fitted; false: its fields are all 0
+  bool runner_up = false;  // a runner-up candidate was fitted; false: its fields are all 0
   std::uint8_t runner_up_markov = 0, runner_up_sinusoids = 0;  // 0..2 each
   bool runner_up_bandwidth = false;
   float criterion_margin = 0.0f;  // the runner-up's information criterion minus the chosen
@@ -310,11 +310,11 @@ struct Ieee952UnconstrainedMsg {
 /// (WindowLengthMsg); window k covers the samples k length .. (k+1) length - 1 of the SampleCount.
 struct WindowMsg {
   std::uint8_t seq = 0;
-  std::uint8_t tau_count = 1;    // window taus: window tau i has the node's tau i's m; 1..63
-  bool complete = false;         // false: no window completed yet (then window = 0, gaps = 0, and
-                                 // every WindowDevMsg says "no estimate")
-  std::uint32_t window = 0;      // k, the number of the window described
-  std::uint32_t gaps = 0;        // sample gaps inside that window; 8 bits, saturates
+  std::uint8_t tau_count = 1;  // window taus: window tau i has the node's tau i's m; 1..63
+  bool complete = false;       // false: no window completed yet (then window = 0, gaps = 0, and
+                               // every WindowDevMsg says "no estimate")
+  std::uint32_t window = 0;    // k, the number of the window described
+  std::uint32_t gaps = 0;      // sample gaps inside that window; 8 bits, saturates
   bool operator==(const WindowMsg&) const = default;
 };
 
@@ -344,17 +344,16 @@ struct WindowDevMsg {
 
 /// Counter input: sent by the gyro's readout electronics to the board once per sample interval.
 struct CounterInputMsg {
-  std::uint32_t count = 0;  // accumulated pulses, wraps modulo 2^32 (differences are signed)
-  std::uint8_t seq = 0;     // +1 per frame, wraps
+  std::uint32_t count = 0;        // accumulated pulses, wraps modulo 2^32 (differences are signed)
+  std::uint8_t seq = 0;           // +1 per frame, wraps
   bool count_error = false;       // the electronics lost counts during this interval
   bool sensor_not_ready = false;  // e.g. dither or laser not locked
   bool operator==(const CounterInputMsg&) const = default;
 };
 
-using Message = std::variant<StatusMsg, StatusFaultsMsg, TauDevMsg, TauTermsMsg, TauInfoMsg,
-                             MetaSamplingMsg, MetaClockMsg, MetaScaleMsg, MetaConfigMsg, Ieee952Msg,
-                             CounterInputMsg, Ieee952SummaryMsg, WindowMsg, WindowLengthMsg, WindowDevMsg,
-                             Ieee952ParameterMsg, Ieee952ModelMsg, Ieee952UnconstrainedMsg>;
+using Message = std::variant<StatusMsg, StatusFaultsMsg, TauDevMsg, TauTermsMsg, TauInfoMsg, MetaSamplingMsg, MetaClockMsg,
+                             MetaScaleMsg, MetaConfigMsg, Ieee952Msg, CounterInputMsg, Ieee952SummaryMsg, WindowMsg,
+                             WindowLengthMsg, WindowDevMsg, Ieee952ParameterMsg, Ieee952ModelMsg, Ieee952UnconstrainedMsg>;
 
 // ---------------------------------------------------------------------------------------------
 // Codec
@@ -441,10 +440,23 @@ Decoded decode(const CanFrame& frame);
 inline constexpr std::size_t slow_cycle_reports = 4;
 
 enum class Slot : std::uint8_t {
-  status, faults, adev, mdev, terms, tau_info, sampling, clock, scale, config, ieee952,
-  window, window_length, window_dev,  // version 3
-  fit_model, fit_parameter,           // version 4
-  unconstrained                       // version 5
+  status,
+  faults,
+  adev,
+  mdev,
+  terms,
+  tau_info,
+  sampling,
+  clock,
+  scale,
+  config,
+  ieee952,
+  window,
+  window_length,
+  window_dev,  // version 3
+  fit_model,
+  fit_parameter,  // version 4
+  unconstrained   // version 5
 };
 inline constexpr std::size_t slot_kinds = 17;
 struct ReportSlot {
@@ -481,7 +493,6 @@ constexpr std::uint32_t worst_case_frame_bits(std::uint32_t data_bytes) {
 /// Worst-case share of a bus of `bitrate_bps` taken by one node reporting `tau_count` taus and
 /// `window_taus` window taus every `report_period_s` seconds (the longest report of the slow cycle,
 /// current version). O(slow_cycle_reports).
-double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps,
-                           std::size_t window_taus = 0);
+double worst_case_bus_load(std::size_t tau_count, double report_period_s, double bitrate_bps, std::size_t window_taus = 0);
 
 }  // namespace gyrochar::protocol
