@@ -21,6 +21,7 @@ try:
 except ImportError as e:  # allantools needs scipy (Debian python3-scipy)
     pytest.skip(f"allantools at {PEER} does not import: {e}", allow_module_level=True)
 
+import gyrochar
 import gyrochar.allantools as ours
 
 # Functions compared with allantools number for number: taus, ns, devs (1e-10 relative), errs.
@@ -113,3 +114,64 @@ def test_htotdev_carries_stable32s_bias_correction(data_dir):
     ratio = got[1][1:] / want[1][1:]
     np.testing.assert_allclose(ratio, ratio[0], rtol=1e-10)
     assert abs(ratio[0] - 1) > 1e-3
+
+
+# The two long sets (the OCXO's frequency and the time-interval counter's floor). allantools'
+# total family costs O(N m) Python steps per tau, and cuts are needed to keep the suite fast
+# (measured with allantools 2024.06 on one core: totdev 0.03 s on the whole counter set; mtotdev,
+# ttotdev and htotdev about 1.8 s each at octave taus on 1 024 values and 7 s at the three taus
+# 1, 3, 10 s on the counter's 55 688; theo1 3.5 s at octave taus on 4 096 values). So totdev is
+# compared on the whole sets, theo1 on the first 2 048 values and mtotdev, ttotdev and htotdev on
+# the first 1 024 (octave and decade taus, and a tau list up to a third of the points).
+LONG_SETS = [
+    ("ocxo/ocxo_frequency.txt", "freq", lambda f: (f - 1e7) / 1e7),
+    ("Keysight53230A_ti_noise_floor/tic_phase.txt", "phase", None),
+]
+LONG_CUTS = {"totdev": None, "theo1": 2048, "mtotdev": 1024, "ttotdev": 1024, "htotdev": 1024}
+
+
+def stable32_bias_factor(function, m, n_points, alpha):
+    """Stable32's bias correction of the deviation (docs/total.md): what gyrochar divides
+    allantools' deviation by at the noise gyrochar identifies (alpha) at m."""
+    if function == "totdev":  # TOTVAR / (1 - a tau / T), T the record's length
+        a = {-1: 1 / (3 * np.log(2)), -2: 0.75}.get(alpha, 0.0)
+        return np.sqrt(1 - a * m / (n_points - 1))
+    if function == "htotdev" and m >= 2:  # HTOTVAR / (1 + a)
+        return np.sqrt(1 + {0: -0.005, -1: -0.149, -2: -0.229, -3: -0.283, -4: -0.321}.get(alpha, 0.0))
+    return 1.0
+
+
+# A genuine disagreement, not a Stable32 convention: on the OCXO (frequency offset 1.26e-8)
+# gyrochar's TOTDEV without bias correction is 7.230073976757042e-12 at m = 4096, allantools'
+# 7.2300739775351006e-12 (-1.08e-10 relative; allantools on long doubles agrees with itself to
+# 5e-15). gyrochar's departure grows with the offset (1.5e-9 after adding 1e-6 to every value)
+# and vanishes (8e-15) when the mean frequency is removed first: a loss of precision on the phase
+# ramp. Octave and decade taus reach m = 4096 and 4000, beyond 1e-10 (the list stops at 250 and passes).
+TOTDEV_RAMP = ("ocxo", "totdev")
+
+
+@pytest.mark.parametrize("taus", ["octave", "decade", "list"])
+@pytest.mark.parametrize("function", list(LONG_CUTS))
+@pytest.mark.parametrize("case", LONG_SETS, ids=[s[0].split("/")[0] for s in LONG_SETS])
+def test_total_family_matches_allantools_on_the_long_sets(request, data_dir, case, function, taus):
+    name, data_type, convert = case
+    if (name.split("/")[0], function) == TOTDEV_RAMP and taus != "list":
+        request.applymarker(pytest.mark.xfail(strict=True, reason="gyrochar's TOTDEV loses 1e-10 relative on the "
+                                              "OCXO's phase ramp at m = 4000 and 4096 (see TOTDEV_RAMP)"))
+    values = reference(data_dir, name, convert)[:LONG_CUTS[function]]
+    if taus == "list":
+        taus = np.array([1.0, 6.0, 10.0, 12.0, 33.0, 100.0, 250.0])
+    want = getattr(peer, function)(values, rate=1.0, data_type=data_type, taus=taus)
+    got = getattr(ours, function)(values, rate=1.0, data_type=data_type, taus=taus)
+    n_points = len(values) + (data_type == "freq")
+    m = want[0]
+    kept = (m <= n_points / 2) if function == "totdev" else (m >= 10) if function == "theo1" else m > 0
+    want = tuple(w[kept] for w in want)
+    np.testing.assert_array_equal(got[0], want[0])
+    # The noise gyrochar identifies at each tau, for Stable32's bias corrections of totdev and htotdev.
+    stride = ours._overlapping_stride(int(got[0][-1]))
+    r = gyrochar.analyze(values, 1.0, type=data_type, stats=(function,), taus=got[0].astype(np.int64),
+                         stride_factor=stride, total_stride_factor="exact").stats[function]
+    alpha = r.alpha[np.isin(r.m, got[0])]
+    factor = np.array([stable32_bias_factor(function, mi, n_points, a) for mi, a in zip(got[0], alpha)])
+    assert_same(got, (want[0], want[1] / factor, want[2] / factor, want[3]))
