@@ -60,6 +60,9 @@ class Board final : public hal::CountSink {
   /// The dynamic Allan deviation's window (window.hpp); taus() == 0 when the configuration has none.
   const DynamicWindow& window() const { return window_; }
   const FaultCounters& faults() const { return faults_; }
+  /// True between two reports: every frame of the last report sent, the next not yet built (a run
+  /// that ends here leaves no report cut off at its end).
+  bool between_reports() const { return frame_ == 0; }
 
  private:
   void on_tick();

@@ -7,6 +7,7 @@
 // (sim_truth.hpp, the simulator's own options): the view shows them beside every node's fitted
 // terms, and the plot draws the true model beside the fitted one. Each board also keeps the
 // dynamic Allan deviation over --window minutes, which the plot draws as a heat map per node.
+#include <algorithm>
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <unistd.h>
@@ -215,12 +216,10 @@ void run_clock(const DemoOptions& d, Rig& rig) {
   std::uint64_t scripted_ns = start_ns, next_view_ns = start_ns + view_every_ns;
   std::vector<std::int64_t> counts;
   const auto wall_start = std::chrono::steady_clock::now();
-  while (clock.now_ns() < end_ns && !stop_requested) {
-    if (d.speed > 0)  // hold the virtual clock to `speed` gyro seconds per wall-clock second
-      std::this_thread::sleep_until(
-          wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                           std::chrono::duration<double>(static_cast<double>(clock.now_ns() - start_ns) * 1e-9 / d.speed)));
-    clock.advance(step_ns);
+  // One step of the virtual clock: the counts of its samples into every node's source, each
+  // board's loop once, and what crossed the bus to the decoder.
+  const auto advance = [&](std::uint64_t ns) {
+    clock.advance(ns);
     const std::uint64_t n = (clock.now_ns() - scripted_ns) / tau0_ns;
     for (auto& node : rig.gyros) {
       counts.resize(n);
@@ -235,12 +234,27 @@ void run_clock(const DemoOptions& d, Rig& rig) {
       rig.session.feed(*frame, t_s);
       if (rig.candump != nullptr) std::fprintf(rig.candump, "%s\n", format_candump_line(t_s, "vcan0", *frame).c_str());
     }
+  };
+  while (clock.now_ns() < end_ns && !stop_requested) {
+    if (d.speed > 0)  // hold the virtual clock to `speed` gyro seconds per wall-clock second
+      std::this_thread::sleep_until(
+          wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                           std::chrono::duration<double>(static_cast<double>(clock.now_ns() - start_ns) * 1e-9 / d.speed)));
+    advance(step_ns);
     if (rig.web) rig.web->update(rig.session);
     if (view_every_ns != 0 && clock.now_ns() >= next_view_ns) {
       show(rig, tty);
       next_view_ns += view_every_ns;
     }
   }
+  // The report each board is sending at the end goes out whole (at most two report periods more of
+  // the gyros, in steps of a millisecond): the last view, plot and CSV rows show a whole report,
+  // not one the end of the run cut off.
+  const std::uint64_t finish_by_ns = clock.now_ns() + 2000000000;
+  const auto between_reports = [&] {
+    return std::all_of(rig.gyros.begin(), rig.gyros.end(), [](const auto& node) { return node->board.between_reports(); });
+  };
+  while (!stop_requested && !between_reports() && clock.now_ns() < finish_by_ns) advance(1000000);
   rig.session.finish();
   if (rig.web) rig.web->update(rig.session, true);
   show(rig, tty);

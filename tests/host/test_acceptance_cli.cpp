@@ -243,6 +243,23 @@ TEST(AcceptanceCli, DecoderGivesVerdictsAndReportPerNode) {
   EXPECT_EQ(static_cast<std::size_t>(std::count(rows.begin(), rows.end(), '\n')), records + 1) << rows;
 }
 
+TEST(AcceptanceCli, DemoEndsWithNoReportCutOff) {
+  // The demo lets each board finish the report it is sending when the run ends. Oracle: on a bus
+  // that loses nothing (no --loss) every report the decoder closed arrived whole, the last one too
+  // (its link health on stderr: "0 incomplete" and "frames missing 0" for both nodes), so the last
+  // view shows no "missing" value.
+  const Outcome r = run_shell(demo + " --hours 0.1 --window 0 --view-every 0 --csv '' --plot ''");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* node : {"node 0x10: ", "node 0x11: "}) {
+    const std::size_t at = r.err.find(std::string("gyrochar-demo: ") + node);
+    ASSERT_NE(at, std::string::npos) << r.err;
+    const std::string line = r.err.substr(at, r.err.find('\n', at) - at);
+    EXPECT_NE(line.find(" 0 incomplete,"), std::string::npos) << line;
+    EXPECT_NE(line.find("frames missing 0;"), std::string::npos) << line;
+  }
+  EXPECT_EQ(r.out.find("missing  "), std::string::npos) << "a value of the last report shown as missing";
+}
+
 // Fields of a CSV line (the decoder's names and values hold no comma or quote).
 std::vector<std::string> csv_fields(const std::string& line) {
   std::vector<std::string> f(1);
