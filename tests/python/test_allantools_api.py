@@ -83,6 +83,21 @@ def test_bad_arguments_raise():
 # no bias correction applies); where allantools departs from Stable32 (docs/python.md) the rows
 # it computes beyond Stable32's limits are left out and the bias corrections differ.
 TOTAL_SETS = [("phasedat/PHASE.DAT", "phase"), ("nbs14/nbs14_1000point_freq.txt", "freq")]
+TOTAL_TAU_LIST = np.array([1.0, 6.0, 10.0, 12.0, 33.0, 100.0, 250.0])
+
+
+def total_family_pair(function, values, data_type, taus):
+    """allantools' and gyrochar.allantools' (taus, devs, errs, ns) of one total-family function,
+    allantools' rows kept within Stable32's limits (docs/python.md): TOTDEV up to m = N/2, Theo1
+    from m = 10 (allantools: to N - 1, from 2)."""
+    if taus == "list":
+        taus = TOTAL_TAU_LIST
+    want = getattr(peer, function)(values, rate=1.0, data_type=data_type, taus=taus)
+    got = getattr(ours, function)(values, rate=1.0, data_type=data_type, taus=taus)
+    n_points = len(values) + (data_type == "freq")
+    m = want[0]
+    kept = (m <= n_points / 2) if function == "totdev" else (m >= 10) if function == "theo1" else m > 0
+    return tuple(w[kept] for w in want), got
 
 
 @pytest.mark.parametrize("taus", ["octave", "decade", "list"])
@@ -91,15 +106,8 @@ TOTAL_SETS = [("phasedat/PHASE.DAT", "phase"), ("nbs14/nbs14_1000point_freq.txt"
 def test_total_family_matches_allantools_within_stable32s_limits(data_dir, case, function, taus):
     name, data_type = case
     values = load(data_dir / name)
-    if taus == "list":
-        taus = np.array([1.0, 6.0, 10.0, 12.0, 33.0, 100.0, 250.0])
-    want = getattr(peer, function)(values, rate=1.0, data_type=data_type, taus=taus)
-    got = getattr(ours, function)(values, rate=1.0, data_type=data_type, taus=taus)
-    n_points = len(values) + (data_type == "freq")
-    m = want[0]
-    # Stable32's limits (docs/python.md): TOTDEV up to m = N/2, Theo1 from m = 10 (allantools: to N - 1, from 2).
-    kept = (m <= n_points / 2) if function == "totdev" else (m >= 10) if function == "theo1" else m > 0
-    assert_same(got, tuple(w[kept] for w in want))
+    want, got = total_family_pair(function, values, data_type, taus)
+    assert_same(got, want)
 
 
 def test_htotdev_carries_stable32s_bias_correction(data_dir):
@@ -159,19 +167,13 @@ def test_total_family_matches_allantools_on_the_long_sets(request, data_dir, cas
         request.applymarker(pytest.mark.xfail(strict=True, reason="gyrochar's TOTDEV loses 1e-10 relative on the "
                                               "OCXO's phase ramp at m = 4000 and 4096 (see TOTDEV_RAMP)"))
     values = reference(data_dir, name, convert)[:LONG_CUTS[function]]
-    if taus == "list":
-        taus = np.array([1.0, 6.0, 10.0, 12.0, 33.0, 100.0, 250.0])
-    want = getattr(peer, function)(values, rate=1.0, data_type=data_type, taus=taus)
-    got = getattr(ours, function)(values, rate=1.0, data_type=data_type, taus=taus)
-    n_points = len(values) + (data_type == "freq")
-    m = want[0]
-    kept = (m <= n_points / 2) if function == "totdev" else (m >= 10) if function == "theo1" else m > 0
-    want = tuple(w[kept] for w in want)
+    want, got = total_family_pair(function, values, data_type, taus)
     np.testing.assert_array_equal(got[0], want[0])
     # The noise gyrochar identifies at each tau, for Stable32's bias corrections of totdev and htotdev.
     stride = ours._overlapping_stride(int(got[0][-1]))
     r = gyrochar.analyze(values, 1.0, type=data_type, stats=(function,), taus=got[0].astype(np.int64),
                          stride_factor=stride, total_stride_factor="exact").stats[function]
     alpha = r.alpha[np.isin(r.m, got[0])]
+    n_points = len(values) + (data_type == "freq")
     factor = np.array([stable32_bias_factor(function, mi, n_points, a) for mi, a in zip(got[0], alpha)])
     assert_same(got, (want[0], want[1] / factor, want[2] / factor, want[3]))
