@@ -47,7 +47,7 @@ unsigned sums_needed(const AnalysisOptions& o);
 // reflections at the ends continue a line); for counts the running sum of the counts (exact in
 // integers). A frequency offset would make the running sum a ramp that loses, at every step, the
 // rounding of the ramp's size (on a 1.3e-8 offset, 1e-10 of TOTDEV at long tau); less it, and
-// summed with its compensation (Neumaier), each point is the exact sum rounded once.
+// summed with its compensation (Neumaier), each point is the exact sum to about one rounding.
 struct KeptRecord {
   KeptRecord(DataType data_type, bool keep_it) : type(data_type), on(keep_it) {}
   void keep(double value) {
