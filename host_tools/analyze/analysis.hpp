@@ -149,8 +149,9 @@ struct AnalysisRow {
 };
 
 /// The phase record the analyzer holds for the total family: points in the engine's representation
-/// (phase relative to the first point; for freq and counts the running sum of the values) and the
-/// factor that makes them phase units (tau0 for frequency data, else 1). Empty when not held.
+/// (phase relative to the first point; for freq the running sum of the values less the first value,
+/// a line less, which the total family does not see; for counts the running sum of the counts) and
+/// the factor that makes them phase units (tau0 for frequency data, else 1). Empty when not held.
 struct PhaseRecord {
   std::span<const double> phase;
   double phase_scale = 1.0;

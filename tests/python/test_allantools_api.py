@@ -149,23 +149,11 @@ def stable32_bias_factor(function, m, n_points, alpha):
     return 1.0
 
 
-# A genuine disagreement, not a Stable32 convention: on the OCXO (frequency offset 1.26e-8)
-# gyrochar's TOTDEV without bias correction is 7.230073976757042e-12 at m = 4096, allantools'
-# 7.2300739775351006e-12 (-1.08e-10 relative; allantools on long doubles agrees with itself to
-# 5e-15). gyrochar's departure grows with the offset (1.5e-9 after adding 1e-6 to every value)
-# and vanishes (8e-15) when the mean frequency is removed first: a loss of precision on the phase
-# ramp. Octave and decade taus reach m = 4096 and 4000, beyond 1e-10 (the list stops at 250 and passes).
-TOTDEV_RAMP = ("ocxo", "totdev")
-
-
 @pytest.mark.parametrize("taus", ["octave", "decade", "list"])
 @pytest.mark.parametrize("function", list(LONG_CUTS))
 @pytest.mark.parametrize("case", LONG_SETS, ids=[s[0].split("/")[0] for s in LONG_SETS])
-def test_total_family_matches_allantools_on_the_long_sets(request, data_dir, case, function, taus):
+def test_total_family_matches_allantools_on_the_long_sets(data_dir, case, function, taus):
     name, data_type, convert = case
-    if (name.split("/")[0], function) == TOTDEV_RAMP and taus != "list":
-        request.applymarker(pytest.mark.xfail(strict=True, reason="gyrochar's TOTDEV loses 1e-10 relative on the "
-                                              "OCXO's phase ramp at m = 4000 and 4096 (see TOTDEV_RAMP)"))
     values = reference(data_dir, name, convert)[:LONG_CUTS[function]]
     want, got = total_family_pair(function, values, data_type, taus)
     np.testing.assert_array_equal(got[0], want[0])
