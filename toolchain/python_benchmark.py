@@ -6,8 +6,12 @@ by gyrochar.allantools (three calls, allantools' API) and by allantools; then 10
 pulse counts by gyrochar.analyze (type="counts") and allantools on their phase. Prints the CPU time of
 each (time.process_time: every thread of the process) and the ratio, and the peak RSS after each
 step (ru_maxrss: the largest so far, so a step's own peak shows only when it is the largest).
+With `mtotdev` instead of N: MTOTDEV of 10^5 phase points (random walk plus white, seeded) at
+every octave tau by gyrochar.allantools, against allantools at the octave taus up to 32 only (its
+whole octave list would take hours: its cost per tau grows with m); the ratio printed is allantools'
+CPU on those six taus over gyrochar's on all of them, a lower bound of the whole job's.
 
-    PYTHONPATH=build/host/python python3 toolchain/python_benchmark.py ../shared/peers/allantools [N]
+    PYTHONPATH=build/host/python python3 toolchain/python_benchmark.py ../shared/peers/allantools [N|mtotdev]
 """
 import resource
 import sys
@@ -28,12 +32,28 @@ def timed(what, call):
     return cpu
 
 
+def mtotdev_job(allantools, gat):
+    rng = np.random.default_rng(22)
+    x = np.cumsum(rng.normal(0, 1, 10**5)) + rng.normal(0, 1, 10**5)
+    ours = timed("gyrochar.allantools.mtotdev, octave", lambda: gat.mtotdev(x, rate=1.0, taus="octave"))
+    taus = gat.mtotdev(x, rate=1.0, taus="octave")[0]
+    short = taus[taus <= 32]
+    theirs = timed(f"allantools.mtotdev, taus {short.min():.0f}..{short.max():.0f}",
+                   lambda: allantools.mtotdev(x, rate=1.0, taus=short))
+    print(f"{len(taus)} taus by gyrochar, {len(short)} by allantools; CPU-time ratio allantools (its "
+          f"{len(short)} taus) / gyrochar (all {len(taus)}): {theirs / ours:.0f}", flush=True)
+
+
 def main():
     sys.path.insert(0, sys.argv[1])
-    n = int(float(sys.argv[2])) if len(sys.argv) > 2 else 10**7
     import allantools
     import gyrochar
     import gyrochar.allantools as gat
+
+    if len(sys.argv) > 2 and sys.argv[2] == "mtotdev":
+        mtotdev_job(allantools, gat)
+        return
+    n = int(float(sys.argv[2])) if len(sys.argv) > 2 else 10**7
 
     rng = np.random.default_rng(21)
     y = rng.normal(0, 1e-11, n) + np.cumsum(rng.normal(0, 1e-14, n))
