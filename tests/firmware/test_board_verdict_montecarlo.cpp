@@ -16,8 +16,9 @@
 // link's own accounting: every report of every run arrives whole (a lossless bus), and the node's N
 // is judged by its unconstrained estimate.
 // GYROCHAR_DECODER_VERDICT_RUNS=N runs N a cell and GYROCHAR_DECODER_VERDICT_DURATIONS=900,3600
-// other run lengths (s); the table is printed (docs/metrology.md, "Acceptance limits and verdicts",
-// has the larger study's figures).
+// other run lengths (s); GYROCHAR_DECODER_VERDICT_FIRST_RUN=F makes them runs F to F + N - 1 of each
+// cell (their seeds), to share a study between processes. The table is printed (docs/metrology.md,
+// "Acceptance limits and verdicts", has the larger study's figures).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -100,6 +101,7 @@ RunRecord board_run(const SimOptions& o, const Limit& limit) {
 
 TEST(BoardVerdictMonteCarlo, DecodedWrongVerdictsStayWithinTheStatedRisk) {
   const std::size_t runs = env_count("GYROCHAR_DECODER_VERDICT_RUNS", 3);
+  const std::size_t first_run = env_count("GYROCHAR_DECODER_VERDICT_FIRST_RUN", 0);
   const Limit limit = parse_limits(verdict_limit_text).front();
   const std::vector<double> durations = env_durations("GYROCHAR_DECODER_VERDICT_DURATIONS", {900, 3600});
   ASSERT_GE(durations.size(), 1u);
@@ -116,7 +118,7 @@ TEST(BoardVerdictMonteCarlo, DecodedWrongVerdictsStayWithinTheStatedRisk) {
         o.tau0_s = 0.1;
         o.white_angle_arcsec = 1;  // a random dither residue: white quantization
         o.arw_deg_per_sqrt_h = verdict_limit_n * verdict_truth_ratio[c];
-        o.seed = verdict_seed(d, c, r);
+        o.seed = verdict_seed(d, c, first_run + r);
         const RunRecord run = board_run(o, limit);
         tally[d][c].add(run.decision, o.duration_s);
         missing += run.frames_missing;
