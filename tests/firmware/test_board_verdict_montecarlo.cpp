@@ -124,7 +124,11 @@ TEST(BoardVerdictMonteCarlo, DecodedWrongVerdictsStayWithinTheStatedRisk) {
         missing += run.frames_missing;
         incomplete += run.reports_incomplete;
         const LimitEstimate& e = run.decision.estimate;
-        if (!e.usable) continue;
+        if (!e.usable) {  // said, so that a larger study names the run (its seed) and the cause
+          std::printf("%s, %.0f s, run %zu (seed %llu): no verdict on N: %s\n", verdict_where[c], durations[d],
+                      first_run + r, static_cast<unsigned long long>(o.seed), e.why.c_str());
+          continue;
+        }
         ++judged;
         unconstrained += run.unconstrained;
         const double u = (e.high - e.value) / decision_z;
