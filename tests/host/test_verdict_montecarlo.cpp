@@ -15,72 +15,39 @@
 
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <string>
 #include <vector>
 
 #include "acceptance.hpp"
 #include "limits.hpp"
 #include "support/recovery.hpp"
+#include "support/verdict_study.hpp"
 
 namespace gyrochar::test_support {
 namespace {
 
-struct Tally {
-  std::size_t runs = 0, pass = 0, fail = 0, undecided = 0, resolved = 0;
-  std::size_t decided_by_prediction = 0;  // undecided with a predicted decision time <= 4 T
-};
-
 TEST(VerdictMonteCarlo, WrongVerdictsStayWithinTheStatedRiskAndUndecidedShrinks) {
-  std::size_t runs = 40;
-  if (const char* env = std::getenv("GYROCHAR_VERDICT_RUNS")) runs = std::strtoul(env, nullptr, 10);
-  const double limit_n = 0.003;  // deg/sqrt(h)
-  Limit limit = parse_limits("N <= 0.003 deg/sqrt(h)\n").front();
-  constexpr std::array<double, 3> truth_ratio{0.9, 1.0, 1.1};  // inside, at, beyond
-  constexpr std::array<const char*, 3> where{"10 % inside", "at the limit", "10 % beyond"};
-  std::vector<double> durations{900, 3600};
-  if (const char* env = std::getenv("GYROCHAR_VERDICT_DURATIONS")) {  // "900,3600,14400"
-    durations.clear();
-    for (const char* p = env; *p;) {
-      char* end = nullptr;
-      durations.push_back(std::strtod(p, &end));
-      p = *end == ',' ? end + 1 : end;
-      if (end == p && *p) break;
-    }
-  }
+  const std::size_t runs = env_count("GYROCHAR_VERDICT_RUNS", 40);
+  const Limit limit = parse_limits(verdict_limit_text).front();
+  const std::vector<double> durations = env_durations("GYROCHAR_VERDICT_DURATIONS", {900, 3600});
   ASSERT_GE(durations.size(), 2u);
-  std::vector<std::array<Tally, 3>> tally(durations.size());
+  std::vector<std::array<VerdictTally, 3>> tally(durations.size());
   for (std::size_t d = 0; d < durations.size(); ++d)
-    for (std::size_t c = 0; c < truth_ratio.size(); ++c)
+    for (std::size_t c = 0; c < verdict_truth_ratio.size(); ++c)
       for (std::size_t r = 0; r < runs; ++r) {
         SimOptions o;
         o.duration_s = durations[d];
         o.tau0_s = 0.1;
         o.white_angle_arcsec = 1;  // a random dither residue: white quantization
-        o.arw_deg_per_sqrt_h = limit_n * truth_ratio[c];
-        o.seed = 1000003 * (d + 1) + 7919 * c + r;
+        o.arw_deg_per_sqrt_h = verdict_limit_n * verdict_truth_ratio[c];
+        o.seed = verdict_seed(d, c, r);
         const Recovery rec = recover(o);
         const Ieee952Fit& fit = rec.fit();
         const Ieee952Parameter& n = fit.p[1];
         const LimitEstimate e = fit.ok() && n.fitted && n.resolved ? fitted_term_estimate(n, o.duration_s)
                                                                    : no_estimate("not resolved");
-        const Decision v = decide(limit, e);
-        Tally& t = tally[d][c];
-        ++t.runs;
-        t.resolved += e.usable;
-        t.pass += v.verdict == Verdict::pass;
-        t.fail += v.verdict == Verdict::fail;
-        t.undecided += v.verdict == Verdict::undecided;
-        t.decided_by_prediction += v.verdict == Verdict::undecided && v.decide_at_s <= 4 * o.duration_s;
+        tally[d][c].add(decide(limit, e), o.duration_s);
       }
-  std::printf("true N         run    runs  resolved  pass  fail  undecided  (undecided expected to decide by 4 T)\n");
-  for (std::size_t d = 0; d < durations.size(); ++d)
-    for (std::size_t c = 0; c < truth_ratio.size(); ++c) {
-      const Tally& t = tally[d][c];
-      std::printf("%-13s %5.0f s %5zu %9zu %5zu %5zu %10zu  %zu\n", where[c], durations[d], t.runs, t.resolved, t.pass,
-                  t.fail, t.undecided, t.decided_by_prediction);
-    }
+  print_verdict_table(durations, tally);
   // Binomial bound of the header: fewer than 5 wrong verdicts in 40 runs (scaled for other counts).
   const double bound = runs == 40
                            ? 4.0
@@ -90,7 +57,7 @@ TEST(VerdictMonteCarlo, WrongVerdictsStayWithinTheStatedRiskAndUndecidedShrinks)
     EXPECT_LE(static_cast<double>(tally[d][2].pass), bound) << "pass for a gyro beyond, run " << durations[d] << " s";
     EXPECT_LE(static_cast<double>(tally[d][1].pass), bound) << "pass at the limit (the boundary: at most the risk)";
     EXPECT_LE(static_cast<double>(tally[d][1].fail), bound) << "fail at the limit";
-    for (const Tally& t : tally[d]) EXPECT_EQ(t.resolved, t.runs) << "N is resolved in every run of this gyro";
+    for (const VerdictTally& t : tally[d]) EXPECT_EQ(t.resolved, t.runs) << "N is resolved in every run of this gyro";
   }
   // Undecided shrinks with the run: pooled over the gyros off the limit, first and last run length.
   const auto& first = tally.front();
