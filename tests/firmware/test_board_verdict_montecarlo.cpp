@@ -113,12 +113,7 @@ TEST(BoardVerdictMonteCarlo, DecodedWrongVerdictsStayWithinTheStatedRisk) {
   for (std::size_t d = 0; d < durations.size(); ++d)
     for (std::size_t c = 0; c < verdict_truth_ratio.size(); ++c)
       for (std::size_t r = 0; r < runs; ++r) {
-        SimOptions o;
-        o.duration_s = durations[d];
-        o.tau0_s = 0.1;
-        o.white_angle_arcsec = 1;  // a random dither residue: white quantization
-        o.arw_deg_per_sqrt_h = verdict_limit_n * verdict_truth_ratio[c];
-        o.seed = verdict_seed(d, c, first_run + r);
+        const SimOptions o = verdict_gyro(durations[d], d, c, first_run + r);
         const RunRecord run = board_run(o, limit);
         tally[d][c].add(run.decision, o.duration_s);
         missing += run.frames_missing;

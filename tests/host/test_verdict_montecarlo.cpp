@@ -34,12 +34,7 @@ TEST(VerdictMonteCarlo, WrongVerdictsStayWithinTheStatedRiskAndUndecidedShrinks)
   for (std::size_t d = 0; d < durations.size(); ++d)
     for (std::size_t c = 0; c < verdict_truth_ratio.size(); ++c)
       for (std::size_t r = 0; r < runs; ++r) {
-        SimOptions o;
-        o.duration_s = durations[d];
-        o.tau0_s = 0.1;
-        o.white_angle_arcsec = 1;  // a random dither residue: white quantization
-        o.arw_deg_per_sqrt_h = verdict_limit_n * verdict_truth_ratio[c];
-        o.seed = verdict_seed(d, c, r);
+        const SimOptions o = verdict_gyro(durations[d], d, c, r);
         const Recovery rec = recover(o);
         const Ieee952Fit& fit = rec.fit();
         const Ieee952Parameter& n = fit.p[1];

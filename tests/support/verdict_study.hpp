@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "limits.hpp"
+#include "sim_truth.hpp"
 
 namespace gyrochar::test_support {
 
@@ -24,6 +25,19 @@ inline constexpr std::array<const char*, 3> verdict_where{"10 % inside", "at the
 /// The seed of run r of cell (run length d, gyro c): the same in both studies, so that a cell's
 /// run r is the same simulated record on either path.
 inline std::uint64_t verdict_seed(std::size_t d, std::size_t c, std::size_t r) { return 1000003 * (d + 1) + 7919 * c + r; }
+
+/// The simulated gyro of run r of cell (run length d lasting `duration_s`, gyro c): white quantization
+/// (1 arcsec pulses and a random 1 arcsec dither residue, tau0 0.1 s), its true N at the cell's
+/// ratio to the limit.
+inline SimOptions verdict_gyro(double duration_s, std::size_t d, std::size_t c, std::size_t r) {
+  SimOptions o;
+  o.duration_s = duration_s;
+  o.tau0_s = 0.1;
+  o.white_angle_arcsec = 1;
+  o.arw_deg_per_sqrt_h = verdict_limit_n * verdict_truth_ratio[c];
+  o.seed = verdict_seed(d, c, r);
+  return o;
+}
 
 struct VerdictTally {
   std::size_t runs = 0, pass = 0, fail = 0, undecided = 0, resolved = 0;
