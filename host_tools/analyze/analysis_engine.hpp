@@ -3,7 +3,6 @@
 // interface, the read-out of the sums into rows, the record kept for the total family) and the
 // engines over a held record (held_engines.cpp): the batch kernels of counts and of phase or
 // frequency. The characterizer's engine is analysis.cpp's own.
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -13,6 +12,7 @@
 #include <vector>
 
 #include "analysis.hpp"
+#include "gyrochar/arith.hpp"
 #include "gyrochar/estimates.hpp"
 
 namespace gyrochar {
@@ -47,7 +47,8 @@ unsigned sums_needed(const AnalysisOptions& o);
 // reflections at the ends continue a line); for counts the running sum of the counts (exact in
 // integers). A frequency offset would make the running sum a ramp that loses, at every step, the
 // rounding of the ramp's size (on a 1.3e-8 offset, 1e-10 of TOTDEV at long tau); less it, and
-// summed with its compensation (Neumaier), each point is the exact sum to about one rounding.
+// summed in double-double (the characterizer's FloatArith::add_prefix), each point is the exact sum
+// to about one rounding.
 struct KeptRecord {
   KeptRecord(DataType data_type, bool keep_it) : type(data_type), on(keep_it) {}
   void keep(double value) {
@@ -60,10 +61,8 @@ struct KeptRecord {
         first = value;
         points.push_back(0.0);
       }
-      const double step = value - first, next = sum + step;
-      compensation += std::abs(sum) >= std::abs(step) ? (sum - next) + step : (step - next) + sum;
-      sum = next;
-      points.push_back(sum + compensation);
+      sum = FloatArith::add_prefix(sum, value - first);
+      points.push_back(sum.hi);
     } else {
       if (points.empty()) points.push_back(0.0);
       points.push_back(points.back() + value);
@@ -71,8 +70,8 @@ struct KeptRecord {
   }
   DataType type;
   bool on;
-  double first = 0.0;                    // the first phase value, or the first frequency
-  double sum = 0.0, compensation = 0.0;  // frequency data: the running sum and its lost low part
+  double first = 0.0;      // the first phase value, or the first frequency
+  FloatArith::Prefix sum;  // frequency data: the running sum in double-double
   std::vector<double> points;
 };
 
