@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -49,6 +50,8 @@ namespace powerloss {
 struct Disk {
   bool armed = false;
   bool drop_file_fsync = false;  // the negative control: a writer that never fsyncs its data
+  int cut_before = 0;            // > 0: the power fails just before the checkpoint fsync of this number
+  int fsyncs = 0;                // checkpoint fsyncs (of a run.ckpt* file or of the directory) so far
   std::string dir;
   std::map<ino_t, std::string> durable_content;  // per inode, as of its last fsync
   std::map<std::string, ino_t> durable_names;    // run.ckpt* names, as of the last directory fsync
@@ -96,21 +99,33 @@ void write_image() {
 }
 
 // In a child: the directory as it is now is durable (it is what the previous power cut left).
-void arm(const std::string& dir, bool drop_file_fsync) {
+void arm(const std::string& dir, bool drop_file_fsync, int cut_before) {
   disk.armed = true;
   disk.drop_file_fsync = drop_file_fsync;
+  disk.cut_before = cut_before;
   disk.dir = dir;
   disk.durable_names = current_names(dir);
   for (const auto& [name, ino] : disk.durable_names) disk.durable_content[ino] = read_whole(dir + "/" + name);
   write_image();
 }
 
+bool is_checkpoint_path(const std::string& path) {
+  const auto slash = path.rfind('/');
+  return path == disk.dir ||
+         (slash != std::string::npos && path.substr(0, slash) == disk.dir && is_checkpoint_name(path.substr(slash + 1)));
+}
+
+// Before an fsync: a run told to cut at this one dies here, the data it would make durable not yet
+// durable (a random SIGKILL lands in that window rarely: the cuts need not find it by chance).
+void before_fsync(int fd) {
+  if (disk.cut_before > 0 && is_checkpoint_path(fd_path(fd)) && ++disk.fsyncs == disk.cut_before) raise(SIGKILL);
+}
+
 void on_fsync(int fd) {
   const std::string path = fd_path(fd);
   if (path == disk.dir) {
     disk.durable_names = current_names(disk.dir);
-  } else if (const auto slash = path.rfind('/'); slash != std::string::npos && path.substr(0, slash) == disk.dir &&
-                                                 is_checkpoint_name(path.substr(slash + 1)) && !disk.drop_file_fsync) {
+  } else if (is_checkpoint_path(path) && !disk.drop_file_fsync) {
     struct stat st {};
     if (fstat(fd, &st) != 0) return;
     disk.durable_content[st.st_ino] = read_whole(path);
@@ -145,6 +160,7 @@ bool cut_power(const std::string& dir) {
 }  // namespace powerloss
 
 extern "C" int fsync(int fd) {
+  if (powerloss::disk.armed) powerloss::before_fsync(fd);
   const long r = ::syscall(SYS_fsync, fd);
   if (r == 0 && powerloss::disk.armed) powerloss::on_fsync(fd);
   return static_cast<int>(r);
@@ -184,10 +200,11 @@ enum Start { resumed = 1, fresh = 0, refused = 2 };
 // `ready` (a pipe) gets a byte once the start is logged: the kill's random instant counts from there,
 // so that a loaded machine does not shift the kills before the runs' loops. A run that is not the
 // `last` waits for its kill once its data are done: on a fast machine a run could otherwise finish
-// the record before its kill and end the test with fewer kills than it asks for.
+// the record before its kill and end the test with fewer kills than it asks for. With `cut_before`
+// set, the run cuts its own power just before that checkpoint fsync instead.
 [[noreturn]] void run_child(const std::string& dir, int ready, bool last, bool power_loss = false,
-                            bool drop_file_fsync = false) {
-  if (power_loss) powerloss::arm(dir, drop_file_fsync);
+                            bool drop_file_fsync = false, int cut_before = 0) {
+  if (power_loss) powerloss::arm(dir, drop_file_fsync, cut_before);
   const Config c = kill_config(dir);
   hal::FakeCanBus bus;
   auto node = bus.attach();
@@ -229,14 +246,17 @@ enum Start { resumed = 1, fresh = 0, refused = 2 };
 
 struct Tally {
   int runs = 0, kills = 0;
-  int resumed = 0, fresh = 0, refused = 0;  // how the runs that got to log their start started
-  int fresh_after_resume = 0;               // fresh starts after a resume: a durable checkpoint was lost
-  int during_write = 0;                     // kills that left the temporary file: inside CheckpointFile::write()
-  int dropped = 0;                          // power cuts that dropped something not yet durable
+  int resumed = 0, fresh = 0, refused = 0;     // how the runs that got to log their start started
+  int fresh_after_resume = 0;                  // fresh starts after a resume: a durable checkpoint was lost
+  int during_write = 0;                        // kills that left the temporary file: inside CheckpointFile::write()
+  int dropped = 0;                             // power cuts that dropped something not yet durable
+  int cuts_in_write = 0, dropped_by_them = 0;  // runs cut inside a checkpoint write on purpose
 };
 
 // Runs until one completes, killing the first `kills` runs at random instants (and, with power
-// loss, dropping what was not durable after each kill). Then checks the final state, as a new run
+// loss, dropping what was not durable after each kill). With power loss, every tenth run instead
+// cuts its power inside its third checkpoint write: before the file's fsync, or (the next time)
+// after the rename and before the directory's fsync, the two windows where a write is not durable. Then checks the final state, as a new run
 // resumes it, against brute force over the segments kept since the last fresh start.
 Tally kill_and_check(const std::string& name, int kills_wanted, bool power_loss, bool drop_file_fsync = false) {
   Tally t;
@@ -244,31 +264,41 @@ Tally kill_and_check(const std::string& name, int kills_wanted, bool power_loss,
   std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
   std::mt19937_64 rng(2026);
   for (bool done = false; !done && t.runs < 2 * kills_wanted + 100; ++t.runs) {
+    const bool cut = power_loss && !drop_file_fsync && t.kills < kills_wanted && t.runs % 10 == 9;
+    const int cut_before = cut ? 5 + (t.runs / 10) % 2 : 0;  // checkpoint fsyncs go file, directory, file, ...
     int ready[2];
     EXPECT_EQ(pipe(ready), 0);
     const pid_t child = fork();
     EXPECT_GE(child, 0);
     if (child == 0) {
       close(ready[0]);
-      run_child(dir, ready[1], t.kills >= kills_wanted, power_loss, drop_file_fsync);
+      run_child(dir, ready[1], t.kills >= kills_wanted, power_loss, drop_file_fsync, cut_before);
     }
     close(ready[1]);
     char byte = 0;
     EXPECT_EQ(read(ready[0], &byte, 1), 1);
-    if (t.kills < kills_wanted) {
+    if (cut) {
+      ++t.kills;  // it kills itself
+      ++t.cuts_in_write;
+    } else if (t.kills < kills_wanted) {
       std::this_thread::sleep_for(std::chrono::microseconds(rng() % 40000));
       if (kill(child, SIGKILL) == 0) ++t.kills;
     }
     close(ready[0]);
     int status = 0;
     waitpid(child, &status, 0);
+    EXPECT_TRUE(!cut || (WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL)) << "run " << t.runs << " did not cut";
     done = WIFEXITED(status) && WEXITSTATUS(status) == 0;
     if (WIFEXITED(status)) {
       EXPECT_EQ(WEXITSTATUS(status), 0) << "run " << t.runs;
       continue;
     }
     t.during_write += access((dir + "/run.ckpt.tmp").c_str(), F_OK) == 0;
-    if (power_loss) t.dropped += powerloss::cut_power(dir);
+    if (power_loss) {
+      const bool dropped = powerloss::cut_power(dir);
+      t.dropped += dropped;
+      t.dropped_by_them += cut && dropped;
+    }
   }
 
   // The segments the runs kept since the last fresh start: each starts at its logged index; its
@@ -327,10 +357,11 @@ Tally kill_and_check(const std::string& name, int kills_wanted, bool power_loss,
     }
   }
   std::printf(
-      "%s: %d runs, %d killed (%d inside a checkpoint write, %d power cuts dropped unsynced data); of the %zu "
-      "that logged their start %d resumed, %d fresh (%d after a resume), %d refused; %zu segments kept\n",
-      name.c_str(), t.runs, t.kills, t.during_write, t.dropped, log.size(), t.resumed, t.fresh, t.fresh_after_resume,
-      t.refused, segments.size());
+      "%s: %d runs, %d killed (%d inside a checkpoint write, %d power cuts dropped unsynced data, %d of the %d "
+      "cut inside a write on purpose); of the %zu that logged their start %d resumed, %d fresh (%d after a resume), %d "
+      "refused; %zu segments kept\n",
+      name.c_str(), t.runs, t.kills, t.during_write, t.dropped, t.dropped_by_them, t.cuts_in_write, log.size(), t.resumed,
+      t.fresh, t.fresh_after_resume, t.refused, segments.size());
   if (!getenv("KEEP")) std::system(("rm -rf " + dir).c_str());
   return t;
 }
@@ -348,7 +379,8 @@ TEST(CheckpointKill, RandomSigkillsLoseOnlyTheUncheckpointedData) {
 TEST(CheckpointKill, PowerCutsDropOnlyWhatWasNotDurable) {
   const Tally t = kill_and_check("power", 100, true);
   EXPECT_EQ(t.kills, 100);
-  EXPECT_GT(t.dropped, 2) << "the cuts must land where unsynced data is lost";
+  EXPECT_EQ(t.cuts_in_write, 10);
+  EXPECT_EQ(t.dropped_by_them, t.cuts_in_write) << "a cut inside a checkpoint write loses what was not yet durable";
   EXPECT_GT(t.resumed, 75);
   EXPECT_EQ(t.fresh_after_resume, 0) << "a durable checkpoint is never lost";
   EXPECT_EQ(t.refused, 0) << "a power cut never leaves a torn checkpoint";
