@@ -23,6 +23,7 @@
 #include "hal/fake/fake_can_bus.hpp"
 #include "hal/fake/fake_clock.hpp"
 #include "hal/fake/fake_count_source.hpp"
+#include "support/shell.hpp"
 
 // Counts every heap allocation of this test program while armed. The replacement pairs malloc
 // with free on purpose; GCC cannot see that both are replaced.
@@ -118,7 +119,7 @@ std::unique_ptr<BoardCharacterizer> direct(const Config& c, const std::vector<st
 
 TEST(Board, NoHeapAllocationAfterStartUp) {
   Config c = test_config();
-  c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_alloc.ckpt";
+  c.checkpoint_path = test_support::temp_path("alloc.ckpt");
   c.checkpoint_period_s = 0.5;
   c.window_s = 0.5;  // ten windows of the dynamic Allan deviation complete too
   Rig rig(c);
@@ -312,7 +313,7 @@ class BoardCheckpoint : public ::testing::Test {
   Config c = test_config();
   std::vector<std::int64_t> counts = test_counts(2000);
   void SetUp() override {
-    c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_board.ckpt";
+    c.checkpoint_path = test_support::temp_path("board.ckpt");
     std::remove(c.checkpoint_path.c_str());
     std::remove((c.checkpoint_path + ".bad").c_str());
     Rig rig(c);
@@ -450,7 +451,7 @@ TEST(Board, CheckpointsThatCannotBeWrittenAreCounted) {
   EXPECT_NE(rig.board->checkpoint(), 0);
   EXPECT_EQ(rig.board->characterizer().increments(), counts.size());
   Config fine = c;
-  fine.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_fine.ckpt";
+  fine.checkpoint_path = test_support::temp_path("fine.ckpt");
   Rig ok(fine);
   ok.run_for(300 * ms);
   EXPECT_EQ(ok.board->checkpoint(), 0);
@@ -463,7 +464,7 @@ TEST(Board, AnotherCounterNodesCheckpointIsRefused) {
   Config c = test_config();
   c.source = SourceKind::can_counter;  // the rig's scripted source still feeds the board
   c.counter_node = 0x80;
-  c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_counter_node.ckpt";
+  c.checkpoint_path = test_support::temp_path("counter_node.ckpt");
   std::remove(c.checkpoint_path.c_str());
   const auto counts = test_counts(500);
   {
@@ -549,7 +550,7 @@ TEST(Board, TheWindowFramesCarryTheCurveOfTheWindowCompletedLastWhenTheCycleBega
 TEST(Board, AWindowSurvivesACheckpointAndAWindowlessCheckpointIsAnotherConfiguration) {
   Config c = test_config();
   c.window_s = 0.5;
-  c.checkpoint_path = ::testing::TempDir() + std::to_string(getpid()) + "_window.ckpt";
+  c.checkpoint_path = test_support::temp_path("window.ckpt");
   std::remove(c.checkpoint_path.c_str());
   const auto counts = test_counts(1300);
   {

@@ -30,6 +30,7 @@
 #include "hal/fake/fake_clock.hpp"
 #include "hal/fake/fake_count_source.hpp"
 #include "oracle/brute_force.hpp"
+#include "support/shell.hpp"
 
 // --- the simulated disk: power loss drops what was not made durable ---------------------------
 //
@@ -260,7 +261,7 @@ struct Tally {
 // resumes it, against brute force over the segments kept since the last fresh start.
 Tally kill_and_check(const std::string& name, int kills_wanted, bool power_loss, bool drop_file_fsync = false) {
   Tally t;
-  const std::string dir = ::testing::TempDir() + "gyrochar_" + name + "_" + std::to_string(getpid());
+  const std::string dir = test_support::temp_path(name);
   std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
   std::mt19937_64 rng(2026);
   for (bool done = false; !done && t.runs < 2 * kills_wanted + 100; ++t.runs) {

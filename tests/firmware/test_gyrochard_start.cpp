@@ -12,6 +12,7 @@
 #include <string>
 
 #include "hal/program/exit_codes.hpp"
+#include "support/shell.hpp"
 
 namespace {
 
@@ -25,7 +26,7 @@ struct Outcome {
 };
 
 Outcome run(const std::string& args) {
-  const std::string err_file = ::testing::TempDir() + std::to_string(getpid()) + "_gyrochard_err.txt";
+  const std::string err_file = gyrochar::test_support::temp_path("gyrochard_err.txt");
   const int status = std::system((tool + " " + args + " >/dev/null 2>" + err_file).c_str());
   std::ifstream e(err_file);
   Outcome r;
@@ -41,7 +42,7 @@ void expect(const std::string& args, int code, const std::string& what) {
 }
 
 std::string conf_file(const std::string& name, const std::string& content) {
-  const std::string path = ::testing::TempDir() + std::to_string(getpid()) + "_" + name + ".conf";
+  const std::string path = gyrochar::test_support::temp_path(name + ".conf");
   std::ofstream(path) << content;
   return path;
 }
@@ -125,7 +126,7 @@ TEST(GyrochardStart, ConfigurationReadsAreBounded) {
 }
 
 TEST(GyrochardStart, TheHelpStatesTheLimitsAndExitFour) {
-  const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_help.txt";
+  const std::string out = gyrochar::test_support::temp_path("help.txt");
   ASSERT_EQ(std::system((tool + " --help >" + out).c_str()), 0);
   std::ifstream in(out);
   const std::string help{std::istreambuf_iterator<char>(in), {}};

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "datafile.hpp"
+#include "support/shell.hpp"
 
 namespace {
 
@@ -18,7 +19,7 @@ using gyrochar::DataFile;
 using gyrochar::DataFileError;
 
 std::string file_with(const std::string& name, const std::string& content) {
-  const std::string path = ::testing::TempDir() + std::to_string(getpid()) + "_" + name;
+  const std::string path = gyrochar::test_support::temp_path(name);
   std::ofstream(path, std::ios::binary) << content;
   return path;
 }

@@ -24,6 +24,7 @@
 #include "confidence.hpp"
 #include "gyrochar/wire/protocol.hpp"
 #include "hal/program/exit_codes.hpp"
+#include "support/shell.hpp"
 
 namespace gyrochar {
 namespace {
@@ -43,7 +44,7 @@ struct Outcome {
 };
 
 // Per-process names: CTest runs the tests of this file in parallel processes.
-std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_decode_" + name; }
+std::string temp(const std::string& name) { return gyrochar::test_support::temp_path("decode_" + name); }
 
 Outcome run(const std::string& args) {
   const std::string err_file = temp("stderr.txt");

@@ -17,6 +17,7 @@
 #include "plot_data.hpp"
 #include "session.hpp"
 #include "view.hpp"
+#include "support/shell.hpp"
 
 namespace gyrochar::decoding {
 namespace {
@@ -462,7 +463,7 @@ TEST(DecodeOutput, LineReaderGivesWholeLinesWhateverTheReads) {
 // A line of 5 MB, far longer than the reader's buffer, is skipped across many reads: the reader
 // returns its first max_candump_line_bytes + 1 bytes once, then the next line whole.
 TEST(DecodeOutput, LineReaderSkipsAnOverlongLineAcrossReads) {
-  const std::string path = ::testing::TempDir() + std::to_string(getpid()) + "_long_line.txt";
+  const std::string path = gyrochar::test_support::temp_path("long_line.txt");
   {
     std::FILE* f = std::fopen(path.c_str(), "w");
     ASSERT_NE(f, nullptr);

@@ -22,6 +22,7 @@
 
 #include "support/http_client.hpp"
 #include "support/live_process.hpp"
+#include "support/shell.hpp"
 
 namespace gyrochar {
 namespace {
@@ -30,7 +31,7 @@ using namespace gyrochar::test;
 
 const std::string bin = GYROCHAR_BINARY_DIR "/host_tools/";
 
-std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_browser_" + name; }
+std::string temp(const std::string& name) { return gyrochar::test_support::temp_path("browser_" + name); }
 
 std::string chromium() {
   for (const char* path : {"/usr/bin/chromium", "/usr/bin/chromium-browser"})

@@ -25,6 +25,7 @@
 #include "live_feed.hpp"
 #include "support/http_client.hpp"
 #include "support/live_process.hpp"
+#include "support/shell.hpp"
 
 namespace gyrochar {
 namespace {
@@ -34,7 +35,7 @@ using Json = nlohmann::json;
 
 const std::string bin = GYROCHAR_BINARY_DIR "/host_tools/";
 
-std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_live_" + name; }
+std::string temp(const std::string& name) { return gyrochar::test_support::temp_path("live_" + name); }
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> fields;

@@ -16,6 +16,7 @@
 
 #include "gyro_sim.hpp"
 #include "sim_truth.hpp"
+#include "support/shell.hpp"
 
 namespace gyrochar {
 namespace {
@@ -257,7 +258,7 @@ TEST(SimHeader, RefusesWhatIsNotATruthLine) {
 }
 
 TEST(SimHeader, TheProgramWritesTheTruthLine) {
-  const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_sim_header.txt";
+  const std::string out = gyrochar::test_support::temp_path("sim_header.txt");
   const std::string command =
       GYROCHAR_BINARY_DIR
       "/host_tools/gyrochar-sim --duration 2 --tau0 0.1 --pulse-weight 0.5 --rate -3 --white-angle 0.25 --arw 0.005 "
@@ -367,7 +368,7 @@ TEST(SimSegments, TheOptionReadsTimeAndChanges) {
 
 TEST(SimSegments, TheProgramWritesItsSegmentsAndTheirCounts) {
   // Oracle: SimRun of the same options (the program's own loop) gives the counts it writes.
-  const std::string out = ::testing::TempDir() + std::to_string(getpid()) + "_sim_segments.txt";
+  const std::string out = gyrochar::test_support::temp_path("sim_segments.txt");
   const std::string sim = GYROCHAR_BINARY_DIR "/host_tools/gyrochar-sim";
   ASSERT_EQ(std::system((sim +
                          " --duration 20 --arw 0.002 --segment 10:arw=0.004 --segment 15:rate=-20,white-angle=0.5"
@@ -389,7 +390,7 @@ TEST(SimSegments, TheProgramWritesItsSegmentsAndTheirCounts) {
   for (; in >> count; ++k) ASSERT_EQ(count, run.next_count()) << k;
   EXPECT_EQ(k, run.samples());
   std::remove(out.c_str());
-  const std::string err = ::testing::TempDir() + std::to_string(getpid()) + "_sim_segments.err";
+  const std::string err = gyrochar::test_support::temp_path("sim_segments.err");
   EXPECT_EQ(WEXITSTATUS(std::system((sim + " --duration 20 --segment 25:arw=1 > /dev/null 2> " + err).c_str())), 2);
   std::ifstream e(err);
   const std::string why{std::istreambuf_iterator<char>(e), {}};

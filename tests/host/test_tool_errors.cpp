@@ -16,6 +16,7 @@
 #include <string>
 
 #include "hal/program/exit_codes.hpp"
+#include "support/shell.hpp"
 
 namespace {
 
@@ -28,7 +29,7 @@ struct Outcome {
   std::string out, err;
 };
 
-std::string temp(const std::string& name) { return ::testing::TempDir() + std::to_string(getpid()) + "_" + name; }
+std::string temp(const std::string& name) { return gyrochar::test_support::temp_path(name); }
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
@@ -248,7 +249,7 @@ std::string unprivileged(const std::string& command) {
 }
 
 TEST(ToolErrors, PermissionDeniedIsNamedWithItsReason) {
-  const std::string dir = ::testing::TempDir() + "gyrochar_perm_" + std::to_string(getpid());
+  const std::string dir = temp("perm");
   std::system(("rm -rf " + dir + " && mkdir -p " + dir + "/locked && chmod 755 " + dir).c_str());
   std::ofstream(dir + "/secret.txt") << "5\n6\n7\n";
   std::system(("chmod 000 " + dir + "/secret.txt && chmod 555 " + dir + "/locked").c_str());
