@@ -21,6 +21,7 @@ using Wide = long double;
 struct Terms {
   int a[4] = {}, s[4] = {};
   Pos o[4] = {};
+  int at_len = 0;      // the coefficient of U[len] from the reflections
   double phi[4] = {};  // at the fixed positions 0, h, len - h, len
   Pos pos(int i, Pos k) const { return s[i] * k + o[i]; }
 };
@@ -51,15 +52,21 @@ struct Geometry {
       else t.a[i] = -w[i], t.s[i] = -1, t.o[i] = 3 * len - i * m, at_len += 3 * w[i];
       moving += t.a[i];
     }
-    // z_k of the ramp t (a constant changes no z), in integers: exact (below 2^53 for len < 2^25).
-    auto sum_t_int = [](Pos tau) { return tau * (tau - 1) / 2; };
-    Pos ramp = at_len * sum_t_int(len);
-    for (int i = 0; i < 4; ++i) ramp += t.a[i] * sum_t_int(t.pos(i, k));
-    const double beta = -static_cast<double>(ramp) / (static_cast<double>(h) * static_cast<double>(run));
-    t.phi[0] = -(moving + at_len) + beta;  // U[t] = Sp[n + t] - Sp[n]: the coefficients sum to 0
-    t.phi[1] = -beta, t.phi[2] = -beta, t.phi[3] = at_len + beta;
+    t.at_len = at_len;
+    const double b = beta(t, k);
+    t.phi[0] = -(moving + at_len) + b;  // U[t] = Sp[n + t] - Sp[n]: the coefficients sum to 0
+    t.phi[1] = -b, t.phi[2] = -b, t.phi[3] = at_len + b;
     return t;
   }
+  // The slope's coefficient beta of term k, whose m-run has the coefficients and offsets of t:
+  // minus z_k of the ramp t (a constant changes no z), computed in integers, exact (below 2^53 for
+  // len < 2^25), over h run.
+  double beta(const Terms& t, Pos k) const {
+    Pos ramp = t.at_len * sum_t_int(len);
+    for (int i = 0; i < 4; ++i) ramp += t.a[i] * sum_t_int(t.pos(i, k));
+    return -static_cast<double>(ramp) / (static_cast<double>(h) * static_cast<double>(run));
+  }
+  static Pos sum_t_int(Pos tau) { return tau * (tau - 1) / 2; }  // sum_{t<tau} t
   // The same term's value on a window whose U is the function u.
   template <class F>
   Wide apply(const Terms& t, Pos k, F u) const {
@@ -181,45 +188,67 @@ struct EndWindows {
 // ends and their windows of Sp[n + fixed_f] Sp[n + p] = sum_{i=1}^{fixed_f - 1} Sp[i] Sp[i + p -
 // fixed_f] (f = 0 gives nothing: Sp[n] = 0 for n < 0). X[3] is the ends' autocorrelation read
 // backwards; X[1] a correlation of each end's first h values with the end; X[2] the same as X[1]
-// when len is even (len - h = h), one point longer and one lag further when it is odd. X[1] and X[3]
-// in the caller's scratch, X[2] in the FFT buffer once its results are read out.
-Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail, std::span<double> (&X)[4],
+// when len is even (len - h = h), one point longer and one lag further when it is odd. X[1] and X[2]
+// share their coefficient (phi_1 = phi_2 = -beta), so only their sum Y = X[1] + X[2] is kept.
+// With three FFTs X[1] and X[3] go in the FFT buffer past the transform (memory the transform has
+// touched), Y at its start once they are read out; otherwise in `spare` (2 len + 2 doubles).
+bool fixed_terms_in_buffer(Pos len, const Theo1Workspace& w) {
+  return 4 * fft_length(2 * static_cast<Index>(len)) <= w.buffer.size();
+}
+
+Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail, std::span<double> spare,
                  Theo1Workspace& w) {
   const Pos len = g.len, h = g.h;
   const Index L = static_cast<Index>(len), H = static_cast<Index>(h);
-  for (Index p = 0; p <= L; ++p) X[1][p] = 0.0;
-  X[3][0] = 0.0;
   const Index n = fft_length(2 * L);  // at least h + len: no wrap-around for X[1] either
-  if (4 * n <= w.buffer.size()) {
+  std::span<double> X1, X3;
+  if (fixed_terms_in_buffer(len, w)) {
     // X[3] and X[1] from three FFTs: the ends' autocorrelations and their correlations with their
     // first h values, both real, come back together from one inverse (docs/total.md).
     ends_correlations(head, tail, H, n, w);
     const double* d = w.buffer.data();
+    X3 = w.buffer.subspan(2 * n, L + 1), X1 = w.buffer.subspan(2 * n + L + 1, L + 1);
     const double scale = 1.0 / static_cast<double>(n);
-    for (Index p = 1; p <= L; ++p) X[3][p] = d[2 * (L - p)] * scale;
-    for (Index p = 0; p <= L; ++p) X[1][p] = d[2 * ((p + n - H) % n) + 1] * scale;
+    X3[0] = 0.0;
+    for (Index p = 1; p <= L; ++p) X3[p] = d[2 * (L - p)] * scale;
+    for (Index p = 0; p <= L; ++p) X1[p] = d[2 * ((p + n - H) % n) + 1] * scale;
   } else {  // the buffer holds one spectrum of length n, not two: six FFTs
+    X3 = spare.first(L + 1), X1 = spare.subspan(L + 1, L + 1);
+    for (Index p = 0; p <= L; ++p) X1[p] = 0.0;
     autocorrelation_sum(head, tail, n, w);
-    for (Index p = 1; p <= L; ++p) X[3][p] = w.buffer[L - p];
+    X3[0] = 0.0;
+    for (Index p = 1; p <= L; ++p) X3[p] = w.buffer[L - p];
     const Index c = fft_length(H + L);
     for (const std::span<const double> Sp : {head, tail}) {
       cross_correlation(Sp.first(H), Sp, c, w);
-      for (Index p = 0; p <= L; ++p) X[1][p] += w.buffer[(p + c - H) % c];
+      for (Index p = 0; p <= L; ++p) X1[p] += w.buffer[(p + c - H) % c];
     }
   }
-  X[2] = w.buffer.first(L + 1);
-  X[2][0] = 0.0;
+  const std::span<double> Y = w.buffer.first(L + 1);  // X[1] + X[2]
+  Y[0] = X1[0];
   for (Index p = 1; p <= L; ++p)
-    X[2][p] = len % 2 == 0 ? X[1][p] : X[1][p - 1] + (p >= 2 ? head[H] * head[p - 1] + tail[H] * tail[p - 1] : 0.0);
-  Wide sum = 0;  // every k: the split into moving and fixed positions is not mirror-symmetric
-  for (Pos k = 0; k < 2 * len; ++k) {
-    const Terms t = g.terms(k);
-    for (int f = 1; f < 4; ++f) {
-      double moving = 0;
-      for (int i = 0; i < 4; ++i) moving += t.a[i] * X[f][static_cast<Index>(t.pos(i, k))];
-      double fixed = 0;
-      for (int e = 1; e < 4; ++e) fixed += t.phi[e] * X[f][static_cast<Index>(g.fixed[e])];
-      sum += t.phi[f] * (2 * moving + fixed);
+    Y[p] = X1[p] + (len % 2 == 0 ? X1[p] : X1[p - 1] + (p >= 2 ? head[H] * head[p - 1] + tail[H] * tail[p - 1] : 0.0));
+  // The fixed positions' values, read once.
+  double y_at[4], x3_at[4];
+  for (int e = 1; e < 4; ++e) {
+    const Index at = static_cast<Index>(g.fixed[e]);
+    y_at[e] = Y[at], x3_at[e] = X3[at];
+  }
+  Wide sum = 0;                  // every k: the split into moving and fixed positions is not mirror-symmetric
+  for (Pos j = 0; j < 6; ++j) {  // per m-run of k the moving positions' coefficients are constant
+    const Pos k0 = j * g.m;
+    const Terms t0 = g.terms(k0);
+    for (Pos k = k0; k < k0 + g.m; ++k) {
+      const double beta = g.beta(t0, k);
+      double moving_y = 0, moving_3 = 0;
+      for (int i = 0; i < 4; ++i) {
+        const Index at = static_cast<Index>(t0.pos(i, k));
+        moving_y += t0.a[i] * Y[at], moving_3 += t0.a[i] * X3[at];
+      }
+      const double phi3 = t0.at_len + beta;  // phi_1 = phi_2 = -beta
+      const double fixed_y = -beta * (y_at[1] + y_at[2]) + phi3 * y_at[3];
+      const double fixed_3 = -beta * (x3_at[1] + x3_at[2]) + phi3 * x3_at[3];
+      sum += -beta * (2 * moving_y + fixed_y) + phi3 * (2 * moving_3 + fixed_3);
     }
   }
   return sum;
@@ -239,21 +268,23 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
   };
   // The arrays needed while the FFT buffer is free live in it (its first P doubles are already
   // touched by the preparation): on this scale first touching fresh memory costs as much as the
-  // arithmetic (docs/total.md). The caller's scratch holds the ends and two of the correlations.
+  // arithmetic (docs/total.md). The caller's scratch holds the end's prefix sums (the start's are the
+  // record's, w.s1) and, where the buffer is too short for them, two of the correlations.
   const std::span<double> A = w.buffer.first(len + 1), B = w.buffer.subspan(len + 1, len + 1);
-  const std::span<double> head = take(len), tail = take(len);
-  std::span<double> X[4] = {{}, take(len + 1), {}, take(len + 1)};
+  const std::span<const double> head = w.s1.first(len);
+  const std::span<double> tail = take(len),
+                          spare = fixed_terms_in_buffer(g.len, w) ? std::span<double>{} : take(2 * len + 2);
   // Every window that meets the record, the residual zero outside: the autocorrelation weighted.
   kernel_autocorrelation(g, A, B);
   Wide sum = static_cast<Wide>(A[0]) * w.ac[0];
   for (Index d = 1; d < len; ++d) sum += 2 * static_cast<Wide>(A[d]) * w.ac[d];
   // Less the windows that stick out at the start, and at the end (the sum of a window's squares does
   // not change when the window is reversed: the end's residuals are read backwards).
-  head[0] = tail[0] = 0.0;
-  for (Index i = 1; i < len; ++i) head[i] = head[i - 1] + w.r[i - 1], tail[i] = tail[i - 1] + w.r[N - i];
+  tail[0] = 0.0;
+  for (Index i = 1; i < len; ++i) tail[i] = tail[i - 1] + w.r[N - i];
   const std::span<double> T2 = w.buffer.first(len + 2);  // A and B no longer needed
   sum -= EndWindows{g, head, T2}.moving_terms() + EndWindows{g, tail, T2}.moving_terms();
-  sum -= fixed_terms(g, head, tail, X, w);
+  sum -= fixed_terms(g, head, tail, spare, w);
   // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
   const Wide c = w.curvature;
   if (c != 0) {
@@ -274,7 +305,12 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
 
 }  // namespace
 
-std::size_t mtotvar_scratch_size(std::size_t n_phase) { return 4 * n_phase + 2; }
+std::size_t mtotvar_scratch_size(std::size_t n_phase) {
+  // The end's prefix sums (len <= N), and two correlations (len + 1 each) where the largest window's
+  // do not fit the FFT buffer (fixed_terms_in_buffer).
+  const std::size_t len = 3 * (n_phase / 3), buffer = 2 * fft_length(2 * n_phase);
+  return 4 * fft_length(2 * len) <= buffer ? n_phase : 3 * n_phase + 2;
+}
 
 TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
   const std::uint64_t N = w.r.size();
