@@ -7,6 +7,7 @@
 // p = s k + o (s = +-1, the reflected copies) with integer coefficients constant over each m-run of
 // k, and four fixed positions 0, h, len - h, len (the constant of the reflection and the slope's
 // half sums) whose coefficients phi depend on k.
+#include <algorithm>
 #include <cstdint>
 
 #include "gyrochar/total_fast.hpp"
@@ -133,21 +134,6 @@ struct EndWindows {
     return T2[static_cast<Index>(x)];
   }
 
-  // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + s k + ou] Sp[n + s k + ou + delta]
-  double same(Pos s, Pos ou, Pos delta, Pos k0, Pos k1, Pos n0, Pos n1) const {
-    Pos lo = s > 0 ? n0 + k0 + ou : n0 - (k1 - 1) + ou, hi = s > 0 ? n1 + k1 - 2 + ou : n1 - 1 - k0 + ou;
-    lo = lo > 1 ? lo : 1, lo = lo + delta > 1 ? lo : 1 - delta;
-    hi = hi < g.len - 1 ? hi : g.len - 1, hi = hi + delta < g.len - 1 ? hi : g.len - 1 - delta;
-    double sum = 0;  // double within a run (the FFT parts carry the same relative rounding)
-    for (Pos i = lo; i <= hi; ++i) {
-      Pos klo, khi;
-      if (s > 0) klo = i - ou - (n1 - 1), khi = i - ou - n0;
-      else klo = n0 - i + ou, khi = n1 - 1 - i + ou;
-      klo = klo > k0 ? klo : k0, khi = khi < k1 - 1 ? khi : k1 - 1;
-      if (khi >= klo) sum += static_cast<double>(khi - klo + 1) * (sp(i) * sp(i + delta));
-    }
-    return sum;
-  }
   // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + k + op] Sp[n - k + om]: for each i = n - k + om, the
   // other factor runs over every other position, a difference of T2.
   double opposite(Pos op, Pos om, Pos k0, Pos k1, Pos n0, Pos n1) const {
@@ -164,7 +150,9 @@ struct EndWindows {
     return sum;
   }
 
-  Wide moving_terms() {
+  // The products of two moving positions that move oppositely (those that move the same way:
+  // same_way_terms, for both ends at once).
+  Wide opposite_terms() {
     const Pos len = g.len, n0 = -(len - 1), n1 = 0;
     T2[0] = T2[1] = 0.0;
     for (Pos x = 2; x <= len + 1; ++x) T2[static_cast<Index>(x)] = T2[static_cast<Index>(x - 2)] + sp(x - 2);
@@ -173,16 +161,88 @@ struct EndWindows {
       const Pos k0 = j * g.m, k1 = k0 + g.m;
       const Terms t = g.terms(k0);
       for (int u = 0; u < 4; ++u)
-        for (int v = u; v < 4; ++v) {
-          const Wide c = (u == v ? 1 : 2) * t.a[u] * t.a[v];
-          if (t.s[u] == t.s[v]) sum += c * same(t.s[u], t.o[u], t.o[v] - t.o[u], k0, k1, n0, n1);
-          else if (t.s[u] > 0) sum += c * opposite(t.o[u], t.o[v], k0, k1, n0, n1);
+        for (int v = u + 1; v < 4; ++v) {
+          if (t.s[u] == t.s[v]) continue;
+          const Wide c = 2 * t.a[u] * t.a[v];
+          if (t.s[u] > 0) sum += c * opposite(t.o[u], t.o[v], k0, k1, n0, n1);
           else sum += c * opposite(t.o[v], t.o[u], k0, k1, n0, n1);
         }
     }
     return sum;
   }
 };
+
+// The products of two moving positions that move the same way, over the windows past both ends:
+// sum over (n, k) of Sp[n + s k + o] Sp[n + s k + o + delta] is sum_i W(i) Sp[i] Sp[i + delta], W(i)
+// the number of (n, k) with n + s k + o = i, a trapezoid in i (the convolution of the boxes of n and
+// of s k), whose second difference is four spikes of +-1. All the pairs and m-runs with one distance
+// delta (0, m, 2m or 3m: the offsets differ by multiples of m) share one weight, the sum of their
+// trapezoids times their coefficients: an integer, piecewise linear between the spikes, built from
+// them in one sweep. So four passes over the ends instead of one per pair and run; both ends in each
+// (the windows' geometry is the same), W exact (integers below 2^53 in doubles).
+struct Spike {
+  Pos delta, at, step;  // the weight of distance delta: its second difference at `at`
+};
+
+Wide same_way_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail) {
+  const Pos len = g.len, n0 = -(len - 1), n1 = 0;
+  Spike spikes[6 * 10 * 4];
+  int count = 0;
+  for (Pos j = 0; j < 6; ++j) {
+    const Pos k0 = j * g.m, k1 = k0 + g.m;
+    const Terms t = g.terms(k0);
+    for (int u = 0; u < 4; ++u)
+      for (int v = u; v < 4; ++v) {
+        if (t.s[u] != t.s[v]) continue;
+        const Pos c = (u == v ? 1 : 2) * t.a[u] * t.a[v];
+        // The first factor the lower position: i = n + s k + o, the other at i + delta, delta >= 0.
+        const Pos o = t.o[u] <= t.o[v] ? t.o[u] : t.o[v], delta = t.o[u] <= t.o[v] ? t.o[v] - t.o[u] : t.o[u] - t.o[v];
+        // The box of s k: [k0, k1), or [1 - k1, 1 - k0) for s = -1; that of n: [n0, n1).
+        const Pos a = t.s[u] > 0 ? k0 : 1 - k1, b = t.s[u] > 0 ? k1 : 1 - k0;
+        spikes[count++] = {delta, o + a + n0, c};
+        spikes[count++] = {delta, o + b + n0, -c};
+        spikes[count++] = {delta, o + a + n1, -c};
+        spikes[count++] = {delta, o + b + n1, c};
+      }
+  }
+  std::sort(spikes, spikes + count,
+            [](const Spike& x, const Spike& y) { return x.delta != y.delta ? x.delta < y.delta : x.at < y.at; });
+  Wide sum = 0;
+  for (int first = 0; first < count;) {
+    int last = first;  // the spikes of this distance: [first, last)
+    while (last < count && spikes[last].delta == spikes[first].delta) ++last;
+    const Pos delta = spikes[first].delta, lo = 1, hi = len - delta;  // Sp nonzero at 1 .. len - 1
+    // W(i) = slope i + offset between spikes: each spike (at, step) adds step (i - at + 1) from at on.
+    Pos slope = 0, offset = 0;
+    double part = 0;
+    for (int e = first; e < last; ++e) {
+      slope += spikes[e].step, offset += spikes[e].step * (1 - spikes[e].at);
+      const Pos from = spikes[e].at > lo ? spikes[e].at : lo;
+      const Pos next = e + 1 < last ? spikes[e + 1].at : hi;
+      const Pos to = next < hi ? next : hi;
+      if (from >= to || (slope == 0 && offset + slope * from == 0)) continue;
+      double weight = static_cast<double>(slope * from + offset), step = static_cast<double>(slope);
+      const double* x = head.data() + delta;
+      const double* y = tail.data() + delta;
+      double s0 = 0, s1 = 0;  // two chains: the additions' latency, not their count, bounds the loop
+      Pos i = from;
+      for (; i + 1 < to; i += 2) {
+        const Index at = static_cast<Index>(i);
+        s0 += weight * (head[at] * x[at] + tail[at] * y[at]);
+        s1 += (weight + step) * (head[at + 1] * x[at + 1] + tail[at + 1] * y[at + 1]);
+        weight += 2 * step;
+      }
+      if (i < to) {
+        const Index at = static_cast<Index>(i);
+        s0 += weight * (head[at] * x[at] + tail[at] * y[at]);
+      }
+      part += s0 + s1;
+    }
+    sum += part;
+    first = last;
+  }
+  return sum;
+}
 
 // The products with a fixed position in the windows past both ends, from X[f][p] = sum over both
 // ends and their windows of Sp[n + fixed_f] Sp[n + p] = sum_{i=1}^{fixed_f - 1} Sp[i] Sp[i + p -
@@ -283,7 +343,8 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
   tail[0] = 0.0;
   for (Index i = 1; i < len; ++i) tail[i] = tail[i - 1] + w.r[N - i];
   const std::span<double> T2 = w.buffer.first(len + 2);  // A and B no longer needed
-  sum -= EndWindows{g, head, T2}.moving_terms() + EndWindows{g, tail, T2}.moving_terms();
+  sum -= same_way_terms(g, head, tail);
+  sum -= EndWindows{g, head, T2}.opposite_terms() + EndWindows{g, tail, T2}.opposite_terms();
   sum -= fixed_terms(g, head, tail, spare, w);
   // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
   const Wide c = w.curvature;
