@@ -119,59 +119,6 @@ void kernel_autocorrelation(const Geometry& g, std::span<double> A, std::span<do
   A[static_cast<Index>(g.len)] = 0.0;
 }
 
-// The windows that stick out of one end: n in [-(len - 1), -1], the residual zero before the record.
-// Sp[i] for i in [0, len) the prefix sums of that end's residuals (read from the end inwards). Here
-// the products of two moving positions; those with a fixed position in fixed_terms.
-struct EndWindows {
-  const Geometry& g;
-  std::span<const double> Sp;  // len values, Sp[0] = 0
-  std::span<double> T2;        // len + 2: sums of Sp over positions below i of i's parity
-
-  double sp(Pos i) const { return i >= 1 && i < g.len ? Sp[static_cast<Index>(i)] : 0.0; }
-  double t2(Pos x) const {
-    if (x < 0) return 0.0;
-    if (x >= g.len) x = g.len + ((x - g.len) & 1);
-    return T2[static_cast<Index>(x)];
-  }
-
-  // sum_{k in [k0,k1), n in [n0,n1)} Sp[n + k + op] Sp[n - k + om]: for each i = n - k + om, the
-  // other factor runs over every other position, a difference of T2.
-  double opposite(Pos op, Pos om, Pos k0, Pos k1, Pos n0, Pos n1) const {
-    Pos lo = n0 - (k1 - 1) + om, hi = n1 - 1 - k0 + om;
-    lo = lo > 1 ? lo : 1, hi = hi < g.len - 1 ? hi : g.len - 1;
-    double sum = 0;
-    for (Pos i = lo; i <= hi; ++i) {
-      Pos ka = n0 - i + om, kb = n1 - i + om;
-      ka = ka > k0 ? ka : k0, kb = kb < k1 ? kb : k1;
-      if (kb <= ka) continue;
-      const Pos c = i + op - om;
-      sum += sp(i) * (t2(c + 2 * kb) - t2(c + 2 * ka));
-    }
-    return sum;
-  }
-
-  // The products of two moving positions that move oppositely (those that move the same way:
-  // same_way_terms, for both ends at once).
-  Wide opposite_terms() {
-    const Pos len = g.len, n0 = -(len - 1), n1 = 0;
-    T2[0] = T2[1] = 0.0;
-    for (Pos x = 2; x <= len + 1; ++x) T2[static_cast<Index>(x)] = T2[static_cast<Index>(x - 2)] + sp(x - 2);
-    Wide sum = 0;  // per m-run of k the coefficients are constant
-    for (Pos j = 0; j < 6; ++j) {
-      const Pos k0 = j * g.m, k1 = k0 + g.m;
-      const Terms t = g.terms(k0);
-      for (int u = 0; u < 4; ++u)
-        for (int v = u + 1; v < 4; ++v) {
-          if (t.s[u] == t.s[v]) continue;
-          const Wide c = 2 * t.a[u] * t.a[v];
-          if (t.s[u] > 0) sum += c * opposite(t.o[u], t.o[v], k0, k1, n0, n1);
-          else sum += c * opposite(t.o[v], t.o[u], k0, k1, n0, n1);
-        }
-    }
-    return sum;
-  }
-};
-
 // The products of two moving positions that move the same way, over the windows past both ends:
 // sum over (n, k) of Sp[n + s k + o] Sp[n + s k + o + delta] is sum_i W(i) Sp[i] Sp[i + delta], W(i)
 // the number of (n, k) with n + s k + o = i, a trapezoid in i (the convolution of the boxes of n and
@@ -237,6 +184,88 @@ Wide same_way_terms(const Geometry& g, std::span<const double> head, std::span<c
         s0 += weight * (head[at] * x[at] + tail[at] * y[at]);
       }
       part += s0 + s1;
+    }
+    sum += part;
+    first = last;
+  }
+  return sum;
+}
+
+// The products of two moving positions that move oppositely, over the windows past both ends: for
+// a pair (op moving up, om down) and an m-run [k0, k1), sum over n in [n0, n1) and k of Sp[n + k +
+// op] Sp[n - k + om]. For each y = n - k + om the other factor runs over every other position from
+// y + op - om + 2 ka to y + op - om + 2 kb (k in [ka, kb), the run clipped by n's range): a
+// difference of T2 (sums of Sp over the positions below x of x's parity). Where the run clips, the
+// T2 is read at y + D (D = op - om + 2 k0 or 2 k1: a lag); where n's range does, at E - y (E = op +
+// om + 2 n0 or 2 n1: a reflection). So every pair and run is up to four pieces sum_y c Sp[y]
+// T2[y + D] or T2[E - y] over ranges of y; the pieces of one D (or E) share a sweep, their
+// coefficients summed as steps at the ends of their ranges (11 sweeps of at most len instead of 20
+// loops a tau, both ends in each). T2 of the start in T2h, of the end in T2t (len + 2 each).
+struct Piece {
+  int reflected;  // 0: T2[y + key], 1: T2[key - y]
+  Pos key, at, step;
+};
+
+Wide opposite_way_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail, std::span<double> T2h,
+                        std::span<double> T2t) {
+  const Pos len = g.len, n0 = -(len - 1), n1 = 0;
+  T2h[0] = T2h[1] = T2t[0] = T2t[1] = 0.0;
+  for (Index x = 2; x <= static_cast<Index>(len) + 1; ++x) {
+    const bool inside = x - 2 >= 1 && x - 2 < static_cast<Index>(len);  // Sp[0] = 0, zero from len on
+    T2h[x] = T2h[x - 2] + (inside ? head[x - 2] : 0.0), T2t[x] = T2t[x - 2] + (inside ? tail[x - 2] : 0.0);
+  }
+  Piece pieces[6 * 4 * 4 * 2];
+  int count = 0;
+  auto add = [&](int reflected, Pos key, Pos lo, Pos hi, Pos c) {  // c on [lo, hi]
+    if (lo > hi) return;
+    pieces[count++] = {reflected, key, lo, c};
+    pieces[count++] = {reflected, key, hi + 1, -c};
+  };
+  for (Pos j = 0; j < 6; ++j) {
+    const Pos k0 = j * g.m, k1 = k0 + g.m;
+    const Terms t = g.terms(k0);
+    for (int u = 0; u < 4; ++u)
+      for (int v = u + 1; v < 4; ++v) {
+        if (t.s[u] == t.s[v]) continue;
+        const Pos c = 2 * t.a[u] * t.a[v];
+        const Pos op = t.s[u] > 0 ? t.o[u] : t.o[v], om = t.s[u] > 0 ? t.o[v] : t.o[u];
+        // y in [lo, hi]: every y there has ka < kb; kb = k1 up to yb, ka = k0 from ya on.
+        const Pos lo = std::max<Pos>(n0 - (k1 - 1) + om, 1), hi = std::min<Pos>(n1 - 1 - k0 + om, len - 1);
+        const Pos yb = n1 + om - k1, ya = n0 + om - k0;
+        add(0, op - om + 2 * k1, lo, std::min(hi, yb), c);
+        add(1, op + om + 2 * n1, std::max(lo, yb + 1), hi, c);
+        add(0, op - om + 2 * k0, std::max(lo, ya), hi, -c);
+        add(1, op + om + 2 * n0, lo, std::min(hi, ya - 1), -c);
+      }
+  }
+  std::sort(pieces, pieces + count, [](const Piece& x, const Piece& y) {
+    if (x.reflected != y.reflected) return x.reflected < y.reflected;
+    return x.key != y.key ? x.key < y.key : x.at < y.at;
+  });
+  auto at2 = [len](Pos x) -> Index {  // T2's index for x >= 0: constant by parity from len on
+    return static_cast<Index>(x < len ? x : len + ((x - len) & 1));
+  };
+  Wide sum = 0;
+  for (int first = 0; first < count;) {
+    int last = first;
+    while (last < count && pieces[last].reflected == pieces[first].reflected && pieces[last].key == pieces[first].key)
+      ++last;
+    const bool reflected = pieces[first].reflected == 1;
+    const Pos key = pieces[first].key;
+    Pos weight = 0;
+    double part = 0;
+    for (int e = first; e + 1 < last; ++e) {
+      weight += pieces[e].step;
+      if (weight == 0) continue;
+      const Pos from = pieces[e].at, to = pieces[e + 1].at;  // [from, to), within [1, len - 1]
+      double s0 = 0;
+      for (Pos y = from; y < to; ++y) {
+        const Pos x = reflected ? key - y : y + key;
+        if (x < 0) continue;
+        const Index i = at2(x), at = static_cast<Index>(y);
+        s0 += head[at] * T2h[i] + tail[at] * T2t[i];
+      }
+      part += static_cast<double>(weight) * s0;
     }
     sum += part;
     first = last;
@@ -342,9 +371,9 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
   // not change when the window is reversed: the end's residuals are read backwards).
   tail[0] = 0.0;
   for (Index i = 1; i < len; ++i) tail[i] = tail[i - 1] + w.r[N - i];
-  const std::span<double> T2 = w.buffer.first(len + 2);  // A and B no longer needed
   sum -= same_way_terms(g, head, tail);
-  sum -= EndWindows{g, head, T2}.opposite_terms() + EndWindows{g, tail, T2}.opposite_terms();
+  // A and B no longer needed: T2 of both ends in their place.
+  sum -= opposite_way_terms(g, head, tail, w.buffer.first(len + 2), w.buffer.subspan(len + 2, len + 2));
   sum -= fixed_terms(g, head, tail, spare, w);
   // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
   const Wide c = w.curvature;
