@@ -23,6 +23,7 @@ struct Terms {
   int a[4] = {}, s[4] = {};
   Pos o[4] = {};
   int at_len = 0;      // the coefficient of U[len] from the reflections
+  int moving = 0;      // the sum of a
   double phi[4] = {};  // at the fixed positions 0, h, len - h, len
   Pos pos(int i, Pos k) const { return s[i] * k + o[i]; }
 };
@@ -53,10 +54,14 @@ struct Geometry {
       else t.a[i] = -w[i], t.s[i] = -1, t.o[i] = 3 * len - i * m, at_len += 3 * w[i];
       moving += t.a[i];
     }
-    t.at_len = at_len;
+    t.at_len = at_len, t.moving = moving;
+    return at(t, k);
+  }
+  // Term k of the m-run whose coefficients and offsets are t's: its fixed positions' coefficients.
+  Terms at(Terms t, Pos k) const {
     const double b = beta(t, k);
-    t.phi[0] = -(moving + at_len) + b;  // U[t] = Sp[n + t] - Sp[n]: the coefficients sum to 0
-    t.phi[1] = -b, t.phi[2] = -b, t.phi[3] = at_len + b;
+    t.phi[0] = -(t.moving + t.at_len) + b;  // U[t] = Sp[n + t] - Sp[n]: the coefficients sum to 0
+    t.phi[1] = -b, t.phi[2] = -b, t.phi[3] = t.at_len + b;
     return t;
   }
   // The slope's coefficient beta of term k, whose m-run has the coefficients and offsets of t:
@@ -78,35 +83,70 @@ struct Geometry {
   }
 };
 
-// Calls f(k, weight) over the 6m terms, each pair of mirror terms once with weight 2: the extension
+// The 6m terms, each pair of mirror terms once with weight 2: the extension
 // is even about its reflection points and the modified Allan filter symmetric, so z_k = z_{len-k}
 // on [0, len] and z_k = z_{3 len - k} on (len, 2 len), for every window (the kernels are equal,
 // not their split into moving and fixed positions).
+// for_each_run_piece calls f(k0, k1, weight, t) for the k in [k0, k1), pieces that lie in one m-run
+// each, t the run's coefficients and offsets (Geometry::at gives term k's fixed coefficients from it).
 template <class F>
-void for_each_term(const Geometry& g, F f) {
+void for_each_run_piece(const Geometry& g, F f) {
+  auto split = [&](Pos lo, Pos hi, double weight) {
+    for (Pos k = lo; k < hi;) {
+      const Pos end = std::min(hi, (k / g.m + 1) * g.m);
+      f(k, end, weight, g.terms(k));
+      k = end;
+    }
+  };
   const Pos len = g.len;
-  for (Pos k = 0; 2 * k < len; ++k) f(k, 2.0);
-  if (len % 2 == 0) f(len / 2, 1.0);
-  for (Pos k = len + 1; 2 * k < 3 * len; ++k) f(k, 2.0);
-  if (len % 2 == 0) f(3 * len / 2, 1.0);
+  split(0, (len + 1) / 2, 2.0);  // 2 k < len
+  if (len % 2 == 0) split(len / 2, len / 2 + 1, 1.0);
+  split(len + 1, (3 * len + 1) / 2, 2.0);  // len < k, 2 k < 3 len
+  if (len % 2 == 0) split(3 * len / 2, 3 * len / 2 + 1, 1.0);
 }
 
 // The sum over every k of the autocorrelation of z_k's kernel on the window (as a function of the
 // residual), A(d) for d in [0, len]: from the autocorrelation B of its first difference (eight
-// spikes a k), summed twice (A vanishes from d = len on).
-void kernel_autocorrelation(const Geometry& g, std::span<double> A, std::span<double> B) {
+// spikes a k), summed twice (A vanishes from d = len on). Per m-run and pair of spikes: two that
+// move the same way, or two fixed ones, are at one distance for the whole run (their products
+// summed, one update); the others sweep B once each (one stream at a time, not 28 scattered updates
+// a term). `beta` holds the run's slope coefficients (m doubles).
+void kernel_autocorrelation(const Geometry& g, std::span<double> A, std::span<double> B, std::span<double> beta) {
   for (Pos d = 0; d <= g.len; ++d) B[static_cast<Index>(d)] = 0.0;
-  for_each_term(g, [&](Pos k, double weight) {
-    const Terms t = g.terms(k);
-    Pos p[8];
-    double v[8];
-    for (int i = 0; i < 4; ++i) p[i] = t.pos(i, k), v[i] = t.a[i], p[4 + i] = g.fixed[i], v[4 + i] = t.phi[i];
-    for (int u = 0; u < 8; ++u) {
-      B[0] += weight * v[u] * v[u];
-      for (int x = u + 1; x < 8; ++x) {
-        const Pos d = p[u] > p[x] ? p[u] - p[x] : p[x] - p[u];
-        B[static_cast<Index>(d)] += (d == 0 ? 2.0 : 1.0) * weight * v[u] * v[x];
+  auto add = [&B](Pos d, double v) { B[static_cast<Index>(d < 0 ? -d : d)] += d == 0 ? 2.0 * v : v; };
+  for_each_run_piece(g, [&](Pos k0, Pos k1, double weight, const Terms& t) {
+    const double count = static_cast<double>(k1 - k0);
+    for (Pos k = k0; k < k1; ++k) beta[static_cast<Index>(k - k0)] = g.beta(t, k);
+    // phi_e(k) as Geometry::at: base_e + beta(k) at the ends (0, len), -beta(k) at h and len - h
+    const double base[4] = {static_cast<double>(-(t.moving + t.at_len)), 0.0, 0.0, static_cast<double>(t.at_len)};
+    auto phi = [&](int e, Pos k) {
+      const double b = beta[static_cast<Index>(k - k0)];
+      return e == 0 || e == 3 ? base[e] + b : -b;
+    };
+    for (int u = 0; u < 4; ++u) {
+      const double au = t.a[u];
+      B[0] += weight * au * au * count;
+      for (int x = u + 1; x < 4; ++x) {
+        const double c = weight * au * t.a[x];
+        if (t.s[u] == t.s[x]) add(t.o[u] - t.o[x], c * count);
+        else
+          for (Pos k = k0; k < k1; ++k) add(t.pos(u, k) - t.pos(x, k), c);
       }
+      for (int e = 0; e < 4; ++e) {
+        const double c = weight * au;
+        for (Pos k = k0; k < k1; ++k) add(t.pos(u, k) - g.fixed[e], c * phi(e, k));
+      }
+    }
+    double products[4][4] = {};
+    for (Pos k = k0; k < k1; ++k) {
+      double p[4];
+      for (int e = 0; e < 4; ++e) p[e] = phi(e, k);
+      for (int e = 0; e < 4; ++e)
+        for (int f = e; f < 4; ++f) products[e][f] += p[e] * p[f];
+    }
+    for (int e = 0; e < 4; ++e) {
+      B[0] += weight * products[e][e];
+      for (int f = e + 1; f < 4; ++f) add(g.fixed[e] - g.fixed[f], weight * products[e][f]);
     }
   });
   // B(d) = 2 A(d) - A(d - 1) - A(d + 1)
@@ -364,7 +404,7 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
   const std::span<double> tail = take(len),
                           spare = fixed_terms_in_buffer(g.len, w) ? std::span<double>{} : take(2 * len + 2);
   // Every window that meets the record, the residual zero outside: the autocorrelation weighted.
-  kernel_autocorrelation(g, A, B);
+  kernel_autocorrelation(g, A, B, w.buffer.subspan(2 * len + 2, static_cast<Index>(g.m)));
   Wide sum = static_cast<Wide>(A[0]) * w.ac[0];
   for (Index d = 1; d < len; ++d) sum += 2 * static_cast<Wide>(A[d]) * w.ac[d];
   // Less the windows that stick out at the start, and at the end (the sum of a window's squares does
@@ -382,11 +422,13 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
     G[0] = 0.0;
     for (Index t = 0; t < len; ++t) G[t + 1] = G[t] + (w.s1[windows + t] - w.s1[t]);
     Wide cross = 0, square = 0;
-    for_each_term(g, [&](Pos k, double weight) {
-      const Terms t = g.terms(k);
-      const Wide q = g.apply(t, k, [](Pos tau) { return Geometry::sum_t2(tau); });
-      cross += weight * q * g.apply(t, k, [&](Pos tau) { return static_cast<Wide>(G[static_cast<Index>(tau)]); });
-      square += weight * q * q;
+    for_each_run_piece(g, [&](Pos k0, Pos k1, double weight, const Terms& run) {
+      for (Pos k = k0; k < k1; ++k) {
+        const Terms t = g.at(run, k);
+        const Wide q = g.apply(t, k, [](Pos tau) { return Geometry::sum_t2(tau); });
+        cross += weight * q * g.apply(t, k, [&](Pos tau) { return static_cast<Wide>(G[static_cast<Index>(tau)]); });
+        square += weight * q * q;
+      }
     });
     sum += 2 * c * cross + static_cast<Wide>(windows) * c * c * square;
   }
