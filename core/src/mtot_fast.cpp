@@ -162,11 +162,12 @@ void kernel_autocorrelation(const Geometry& g, std::span<double> A, std::span<do
 // The products of two moving positions that move the same way, over the windows past both ends:
 // sum over (n, k) of Sp[n + s k + o] Sp[n + s k + o + delta] is sum_i W(i) Sp[i] Sp[i + delta], W(i)
 // the number of (n, k) with n + s k + o = i, a trapezoid in i (the convolution of the boxes of n and
-// of s k), whose second difference is four spikes of +-1. All the pairs and m-runs with one distance
-// delta (0, m, 2m or 3m: the offsets differ by multiples of m) share one weight, the sum of their
-// trapezoids times their coefficients: an integer, piecewise linear between the spikes, built from
-// them in one sweep. So four passes over the ends instead of one per pair and run; both ends in each
-// (the windows' geometry is the same), W exact (integers below 2^53 in doubles).
+// of s k), whose second difference is four spikes of +-1. All the pairs and m-runs with one
+// distance delta (0, m or 2m: the offsets within one reflected copy differ by multiples of m) share
+// one weight, the sum of their trapezoids times their coefficients: an integer, piecewise linear
+// between the spikes, built from them in one sweep. So three passes over the ends instead of one
+// per pair, run and end; both ends in each (the windows' geometry is the same), W exact (integers
+// below 2^53 in doubles).
 struct Spike {
   Pos delta, at, step;  // the weight of distance delta: its second difference at `at`
 };
