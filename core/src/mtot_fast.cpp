@@ -320,19 +320,20 @@ Wide opposite_way_terms(const Geometry& g, std::span<const double> head, std::sp
 // backwards; X[1] a correlation of each end's first h values with the end; X[2] the same as X[1]
 // when len is even (len - h = h), one point longer and one lag further when it is odd. X[1] and X[2]
 // share their coefficient (phi_1 = phi_2 = -beta), so only their sum Y = X[1] + X[2] is kept.
-// With three FFTs X[1] and X[3] go in the FFT buffer past the transform (memory the transform has
-// touched), Y at its start once they are read out; otherwise in `spare` (2 len + 2 doubles).
-bool fixed_terms_in_buffer(Pos len, const Theo1Workspace& w) {
-  return 4 * fft_length(2 * static_cast<Index>(len)) <= w.buffer.size();
+// X[1] and X[3] go in the FFT buffer past the transforms' part, Y at its start once they are read
+// out. Three FFTs of length n = fft_length(2 len) where their two spectra fit the half of the buffer
+// the preparation has touched (4 n <= P); otherwise, near the largest m, X[1] from three
+// autocorrelation sums that stay within 2 n doubles (fixed_terms), not the buffer's fresh half.
+bool three_transforms(Pos len, const Theo1Workspace& w) {
+  return 4 * fft_length(2 * static_cast<Index>(len)) <= w.buffer.size() / 2;
 }
 
-Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail, std::span<double> spare,
-                 Theo1Workspace& w) {
+Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<const double> tail, Theo1Workspace& w) {
   const Pos len = g.len, h = g.h;
   const Index L = static_cast<Index>(len), H = static_cast<Index>(h);
   const Index n = fft_length(2 * L);  // at least h + len: no wrap-around for X[1] either
   std::span<double> X1, X3;
-  if (fixed_terms_in_buffer(len, w)) {
+  if (three_transforms(len, w)) {
     // X[3] and X[1] from three FFTs: the ends' autocorrelations and their correlations with their
     // first h values, both real, come back together from one inverse (docs/total.md).
     ends_correlations(head, tail, H, n, w);
@@ -342,17 +343,20 @@ Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<cons
     X3[0] = 0.0;
     for (Index p = 1; p <= L; ++p) X3[p] = d[2 * (L - p)] * scale;
     for (Index p = 0; p <= L; ++p) X1[p] = d[2 * ((p + n - H) % n) + 1] * scale;
-  } else {  // the buffer holds one spectrum of length n, not two: six FFTs
-    X3 = spare.first(L + 1), X1 = spare.subspan(L + 1, L + 1);
-    for (Index p = 0; p <= L; ++p) X1[p] = 0.0;
+  } else {
+    // X[1][p] = c(p - h), c(e) the sum over both ends of sum_{i < h} Sp[i] Sp[i + e]: for e >= 0 the
+    // ends' autocorrelation less that of their values from h on, for e < 0 the autocorrelation of
+    // their first h values at -e. Three autocorrelation sums (two FFTs each, of length n and twice
+    // of at most n / 2) in the buffer's first 2 n doubles, X[3] and X[1] past its first n.
+    X3 = w.buffer.subspan(n, L + 1), X1 = w.buffer.subspan(n + L + 1, L + 1);  // 2 L + 2 <= n
     autocorrelation_sum(head, tail, n, w);
     X3[0] = 0.0;
     for (Index p = 1; p <= L; ++p) X3[p] = w.buffer[L - p];
-    const Index c = fft_length(H + L);
-    for (const std::span<const double> Sp : {head, tail}) {
-      cross_correlation(Sp.first(H), Sp, c, w);
-      for (Index p = 0; p <= L; ++p) X1[p] += w.buffer[(p + c - H) % c];
-    }
+    for (Index p = H; p <= L; ++p) X1[p] = w.buffer[p - H];
+    autocorrelation_sum(head.subspan(H), tail.subspan(H), fft_length(2 * (L - H)), w);
+    for (Index p = H; p <= L; ++p) X1[p] -= w.buffer[p - H];
+    autocorrelation_sum(head.first(H), tail.first(H), fft_length(2 * H), w);
+    for (Index p = 0; p < H; ++p) X1[p] = w.buffer[H - p];
   }
   const std::span<double> Y = w.buffer.first(L + 1);  // X[1] + X[2]
   Y[0] = X1[0];
@@ -390,20 +394,13 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
   const Index N = w.r.size();
   const Geometry g(static_cast<Pos>(m));
   const Index len = static_cast<Index>(g.len), windows = N - len + 1;
-  std::span<double> rest = scratch;
-  auto take = [&](Index count) {
-    const std::span<double> s = rest.first(count);
-    rest = rest.subspan(count);
-    return s;
-  };
   // The arrays needed while the FFT buffer is free live in it (its first P doubles are already
   // touched by the preparation): on this scale first touching fresh memory costs as much as the
   // arithmetic (docs/total.md). The caller's scratch holds the end's prefix sums (the start's are the
-  // record's, w.s1) and, where the buffer is too short for them, two of the correlations.
+  // record's, w.s1).
   const std::span<double> A = w.buffer.first(len + 1), B = w.buffer.subspan(len + 1, len + 1);
   const std::span<const double> head = w.s1.first(len);
-  const std::span<double> tail = take(len),
-                          spare = fixed_terms_in_buffer(g.len, w) ? std::span<double>{} : take(2 * len + 2);
+  const std::span<double> tail = scratch.first(len);
   // Every window that meets the record, the residual zero outside: the autocorrelation weighted.
   kernel_autocorrelation(g, A, B, w.buffer.subspan(2 * len + 2, static_cast<Index>(g.m)));
   Wide sum = static_cast<Wide>(A[0]) * w.ac[0];
@@ -415,7 +412,7 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
   sum -= same_way_terms(g, head, tail);
   // A and B no longer needed: T2 of both ends in their place.
   sum -= opposite_way_terms(g, head, tail, w.buffer.first(len + 2), w.buffer.subspan(len + 2, len + 2));
-  sum -= fixed_terms(g, head, tail, spare, w);
+  sum -= fixed_terms(g, head, tail, w);
   // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
   const Wide c = w.curvature;
   if (c != 0) {
@@ -438,12 +435,7 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
 
 }  // namespace
 
-std::size_t mtotvar_scratch_size(std::size_t n_phase) {
-  // The end's prefix sums (len <= N), and two correlations (len + 1 each) where the largest window's
-  // do not fit the FFT buffer (fixed_terms_in_buffer).
-  const std::size_t len = 3 * (n_phase / 3), buffer = 2 * fft_length(2 * n_phase);
-  return 4 * fft_length(2 * len) <= buffer ? n_phase : 3 * n_phase + 2;
-}
+std::size_t mtotvar_scratch_size(std::size_t n_phase) { return n_phase; }  // the end's prefix sums
 
 TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
   const std::uint64_t N = w.r.size();

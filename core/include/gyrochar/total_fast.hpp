@@ -74,8 +74,7 @@ void ends_correlations(std::span<const double> a, std::span<const double> b, std
                        Theo1Workspace& w);
 
 /// Doubles of scratch mtotvar_fast needs beside a prepared Theo1Workspace of N points: N (the end's
-/// prefix sums; the workspace's FFT buffer holds the rest), or 3 N + 2 where the largest tau's
-/// correlations do not fit that buffer (fft_length(6 floor(N / 3)) = fft_length(2 N)).
+/// prefix sums; the workspace's FFT buffer holds the rest).
 std::size_t mtotvar_scratch_size(std::size_t n_phase);
 
 /// MTOTVAR at averaging factor m (1 <= m <= N / 3), exactly the estimator mtotvar(x, 1, m, tau0_s, .)
