@@ -348,7 +348,8 @@ Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<cons
     // ends' autocorrelation less that of their values from h on, for e < 0 the autocorrelation of
     // their first h values at -e. Three autocorrelation sums (two FFTs each, of length n and twice
     // of at most n / 2) in the buffer's first 2 n doubles, X[3] and X[1] past its first n.
-    X3 = w.buffer.subspan(n, L + 1), X1 = w.buffer.subspan(n + L + 1, L + 1);  // 2 L + 2 <= n
+    // 2 L + 2 <= n: n = fft_length(2 L) is above 2 L, as len = 3 m is no power of two
+    X3 = w.buffer.subspan(n, L + 1), X1 = w.buffer.subspan(n + L + 1, L + 1);
     autocorrelation_sum(head, tail, n, w);
     X3[0] = 0.0;
     for (Index p = 1; p <= L; ++p) X3[p] = w.buffer[L - p];
