@@ -52,37 +52,8 @@ void inverse_butterflies(double* u, double* t, const double* tw, Index half) {
   }
 }
 
-// The same over a stage larger than whole_up_to, its twiddles from the stage's two lists (large_stage).
-void forward_butterflies_large(double* u, double* t, const double* stage, Index half) {
-  const double* coarse = stage + 2 * fine;
-  for (Index c = 0; c * fine < half; ++c, u += 2 * fine, t += 2 * fine) {
-    const double cr = coarse[2 * c], ci = coarse[2 * c + 1];
-    for (Index k = 0; k < fine; ++k) {
-      const double fr = stage[2 * k], fi = stage[2 * k + 1];
-      const double ar = u[2 * k], ai = u[2 * k + 1], br = t[2 * k], bi = t[2 * k + 1];
-      const double wr = cr * fr - ci * fi, wi = -(cr * fi + ci * fr);
-      u[2 * k] = ar + br, u[2 * k + 1] = ai + bi;
-      const double dr = ar - br, di = ai - bi;
-      t[2 * k] = dr * wr - di * wi, t[2 * k + 1] = dr * wi + di * wr;
-    }
-  }
-}
-void inverse_butterflies_large(double* u, double* t, const double* stage, Index half) {
-  const double* coarse = stage + 2 * fine;
-  for (Index c = 0; c * fine < half; ++c, u += 2 * fine, t += 2 * fine) {
-    const double cr = coarse[2 * c], ci = coarse[2 * c + 1];
-    for (Index k = 0; k < fine; ++k) {
-      const double fr = stage[2 * k], fi = stage[2 * k + 1];
-      const double wr = cr * fr - ci * fi, wi = cr * fi + ci * fr;
-      const double br = t[2 * k] * wr - t[2 * k + 1] * wi, bi = t[2 * k] * wi + t[2 * k + 1] * wr;
-      t[2 * k] = u[2 * k] - br, t[2 * k + 1] = u[2 * k + 1] - bi;
-      u[2 * k] += br, u[2 * k + 1] += bi;
-    }
-  }
-}
-
 // The twiddles of stage len: from the whole stages (len <= whole_up_to) or as the product of the large
-// stage's two lists, the same product as the butterflies above.
+// stage's two lists.
 struct StageTwiddles {
   const double* at;
   bool large;
@@ -99,78 +70,118 @@ struct StageTwiddles {
   }
 };
 
-// Two stages in one pass over memory, where neither fits the cache: stage n, then stage n / 2 on
-// both halves, on the quarters' values k, k + q, k + 2q, k + 3q (q = n / 4) together. The same
+// Two stages in one pass over memory: stage len, then stage len / 2 on both halves, on the quarters'
+// values k, k + q, k + 2q, k + 3q (q = len / 4) together, with the twiddles w1 = w^k and w2 =
+// w^(k+q) of stage len and v = w^k of stage len / 2 (forward: already conjugated). The same
 // operations on the same values as the two passes, in the same order: the same results, half the
-// memory traffic (the large stages stream from main memory).
+// loads and stores (and, for the large stages, half the traffic to main memory).
+struct Quad {
+  double w1r, w1i, w2r, w2i, vr, vi;
+};
+inline void forward_quad(double* u0, Index q, const Quad& t) {
+  double* u1 = u0 + 2 * q;
+  double* u2 = u1 + 2 * q;
+  double* u3 = u2 + 2 * q;
+  const double a0r = u0[0] + u2[0], a0i = u0[1] + u2[1], e0r = u0[0] - u2[0], e0i = u0[1] - u2[1];
+  const double a1r = u1[0] + u3[0], a1i = u1[1] + u3[1], e1r = u1[0] - u3[0], e1i = u1[1] - u3[1];
+  const double a2r = e0r * t.w1r - e0i * t.w1i, a2i = e0r * t.w1i + e0i * t.w1r;
+  const double a3r = e1r * t.w2r - e1i * t.w2i, a3i = e1r * t.w2i + e1i * t.w2r;
+  u0[0] = a0r + a1r, u0[1] = a0i + a1i;
+  const double f0r = a0r - a1r, f0i = a0i - a1i;
+  u1[0] = f0r * t.vr - f0i * t.vi, u1[1] = f0r * t.vi + f0i * t.vr;
+  u2[0] = a2r + a3r, u2[1] = a2i + a3i;
+  const double f1r = a2r - a3r, f1i = a2i - a3i;
+  u3[0] = f1r * t.vr - f1i * t.vi, u3[1] = f1r * t.vi + f1i * t.vr;
+}
+inline void inverse_quad(double* u0, Index q, const Quad& t) {
+  double* u1 = u0 + 2 * q;
+  double* u2 = u1 + 2 * q;
+  double* u3 = u2 + 2 * q;
+  const double b0r = u1[0] * t.vr - u1[1] * t.vi, b0i = u1[0] * t.vi + u1[1] * t.vr;
+  const double b1r = u3[0] * t.vr - u3[1] * t.vi, b1i = u3[0] * t.vi + u3[1] * t.vr;
+  const double a0r = u0[0] + b0r, a0i = u0[1] + b0i, a1r = u0[0] - b0r, a1i = u0[1] - b0i;
+  const double a2r = u2[0] + b1r, a2i = u2[1] + b1i, a3r = u2[0] - b1r, a3i = u2[1] - b1i;
+  const double c0r = a2r * t.w1r - a2i * t.w1i, c0i = a2r * t.w1i + a2i * t.w1r;
+  const double c1r = a3r * t.w2r - a3i * t.w2i, c1i = a3r * t.w2i + a3i * t.w2r;
+  u0[0] = a0r + c0r, u0[1] = a0i + c0i, u2[0] = a0r - c0r, u2[1] = a0i - c0i;
+  u1[0] = a1r + c1r, u1[1] = a1i + c1i, u3[0] = a1r - c1r, u3[1] = a1i - c1i;
+}
+// The three twiddles of quarter value k.
+Quad quad_twiddles(const StageTwiddles& whole, const StageTwiddles& halves, Index k, Index q, bool forward) {
+  Quad t;
+  whole.get(k, t.w1r, t.w1i);
+  whole.get(k + q, t.w2r, t.w2i);
+  halves.get(k, t.vr, t.vi);
+  if (forward) t.w1i = -t.w1i, t.w2i = -t.w2i, t.vi = -t.vi;  // forward: exp(-2 pi i k / len)
+  return t;
+}
 void forward_two_stages(double* d, Index n, const double* table) {
   const Index q = n / 4;
   const StageTwiddles whole(table, n), halves(table, n / 2);
-  for (Index k = 0; k < q; ++k) {
-    double w1r, w1i, w2r, w2i, vr, vi;
-    whole.get(k, w1r, w1i);
-    whole.get(k + q, w2r, w2i);
-    halves.get(k, vr, vi);
-    w1i = -w1i, w2i = -w2i, vi = -vi;  // forward: exp(-2 pi i k / len)
-    double* u0 = d + 2 * k;
-    double* u1 = u0 + 2 * q;
-    double* u2 = u1 + 2 * q;
-    double* u3 = u2 + 2 * q;
-    const double a0r = u0[0] + u2[0], a0i = u0[1] + u2[1], e0r = u0[0] - u2[0], e0i = u0[1] - u2[1];
-    const double a1r = u1[0] + u3[0], a1i = u1[1] + u3[1], e1r = u1[0] - u3[0], e1i = u1[1] - u3[1];
-    const double a2r = e0r * w1r - e0i * w1i, a2i = e0r * w1i + e0i * w1r;
-    const double a3r = e1r * w2r - e1i * w2i, a3i = e1r * w2i + e1i * w2r;
-    u0[0] = a0r + a1r, u0[1] = a0i + a1i;
-    const double f0r = a0r - a1r, f0i = a0i - a1i;
-    u1[0] = f0r * vr - f0i * vi, u1[1] = f0r * vi + f0i * vr;
-    u2[0] = a2r + a3r, u2[1] = a2i + a3i;
-    const double f1r = a2r - a3r, f1i = a2i - a3i;
-    u3[0] = f1r * vr - f1i * vi, u3[1] = f1r * vi + f1i * vr;
-  }
+  for (Index k = 0; k < q; ++k) forward_quad(d + 2 * k, q, quad_twiddles(whole, halves, k, q, true));
 }
 void inverse_two_stages(double* d, Index n, const double* table) {
   const Index q = n / 4;
   const StageTwiddles whole(table, n), halves(table, n / 2);
-  for (Index k = 0; k < q; ++k) {
-    double w1r, w1i, w2r, w2i, vr, vi;
-    whole.get(k, w1r, w1i);
-    whole.get(k + q, w2r, w2i);
-    halves.get(k, vr, vi);
-    double* u0 = d + 2 * k;
-    double* u1 = u0 + 2 * q;
-    double* u2 = u1 + 2 * q;
-    double* u3 = u2 + 2 * q;
-    const double b0r = u1[0] * vr - u1[1] * vi, b0i = u1[0] * vi + u1[1] * vr;
-    const double b1r = u3[0] * vr - u3[1] * vi, b1i = u3[0] * vi + u3[1] * vr;
-    const double a0r = u0[0] + b0r, a0i = u0[1] + b0i, a1r = u0[0] - b0r, a1i = u0[1] - b0i;
-    const double a2r = u2[0] + b1r, a2i = u2[1] + b1i, a3r = u2[0] - b1r, a3i = u2[1] - b1i;
-    const double c0r = a2r * w1r - a2i * w1i, c0i = a2r * w1i + a2i * w1r;
-    const double c1r = a3r * w2r - a3i * w2i, c1i = a3r * w2i + a3i * w2r;
-    u0[0] = a0r + c0r, u0[1] = a0i + c0i, u2[0] = a0r - c0r, u2[1] = a0i - c0i;
-    u1[0] = a1r + c1r, u1[1] = a1i + c1i, u3[0] = a1r - c1r, u3[1] = a1i - c1i;
+  for (Index k = 0; k < q; ++k) inverse_quad(d + 2 * k, q, quad_twiddles(whole, halves, k, q, false));
+}
+// (forward_two_stages and inverse_two_stages: stage n and n / 2 over the whole of d, where the
+// block does not fit the cache.)
+
+// The stages of a block that fits the cache (n <= cached, whole twiddles), two at a time: stage len
+// and len / 2 on every block of len values, each pair of twiddles read once for all the blocks
+// (the small stages were loops of one, two or four butterflies a call). With an odd number of
+// stages, the largest (forward) or the last (inverse) goes alone.
+void forward_cached(double* d, Index n, const double* table) {
+  Index len = n;
+  Index stages = 0;
+  for (Index s = n; s >= 2; s /= 2) ++stages;
+  if (stages % 2 == 1) {
+    forward_butterflies(d, d + n, table + n, n / 2);
+    len = n / 2;
   }
+  for (; len >= 4; len /= 4) {
+    const Index q = len / 4;
+    const StageTwiddles whole(table, len), halves(table, len / 2);
+    for (Index k = 0; k < q; ++k) {
+      const Quad t = quad_twiddles(whole, halves, k, q, true);
+      for (Index i = 0; i < n; i += len) forward_quad(d + 2 * (i + k), q, t);
+    }
+  }
+}
+void inverse_cached(double* d, Index n, const double* table) {
+  Index stages = 0;
+  for (Index s = n; s >= 2; s /= 2) ++stages;
+  Index len = 4;
+  for (Index pairs = stages / 2; pairs > 0; --pairs, len *= 4) {
+    const Index q = len / 4;
+    const StageTwiddles whole(table, len), halves(table, len / 2);
+    for (Index k = 0; k < q; ++k) {
+      const Quad t = quad_twiddles(whole, halves, k, q, false);
+      for (Index i = 0; i < n; i += len) inverse_quad(d + 2 * (i + k), q, t);
+    }
+  }
+  if (stages % 2 == 1) inverse_butterflies(d, d + n, table + n, n / 2);
 }
 
 void forward_bitreversed(double* d, Index n, const double* table) {
-  if (n / 2 > whole_up_to) {  // two stages over the whole, then each quarter
+  if (n >= 4 * cached) {  // two stages over the whole, then each quarter
     forward_two_stages(d, n, table);
     for (Index i = 0; i < 4; ++i) forward_bitreversed(d + 2 * i * (n / 4), n / 4, table);
     return;
   }
   if (n > cached) {  // one stage over the whole, then each half while it stays in the cache
     const Index half = n / 2;
-    if (n > whole_up_to) forward_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
-    else forward_butterflies(d, d + 2 * half, table + 2 * half, half);
+    forward_butterflies(d, d + 2 * half, table + 2 * half, half);
     forward_bitreversed(d, half, table);
     forward_bitreversed(d + 2 * half, half, table);
     return;
   }
-  for (Index len = n; len >= 2; len /= 2)
-    for (Index i = 0; i < n; i += len) forward_butterflies(d + 2 * i, d + 2 * (i + len / 2), table + len, len / 2);
+  forward_cached(d, n, table);
 }
 
 void inverse_from_bitreversed(double* d, Index n, const double* table) {
-  if (n / 2 > whole_up_to) {
+  if (n >= 4 * cached) {
     for (Index i = 0; i < 4; ++i) inverse_from_bitreversed(d + 2 * i * (n / 4), n / 4, table);
     inverse_two_stages(d, n, table);
     return;
@@ -179,12 +190,10 @@ void inverse_from_bitreversed(double* d, Index n, const double* table) {
     const Index half = n / 2;
     inverse_from_bitreversed(d, half, table);
     inverse_from_bitreversed(d + 2 * half, half, table);
-    if (n > whole_up_to) inverse_butterflies_large(d, d + 2 * half, table + 2 * large_stage(n), half);
-    else inverse_butterflies(d, d + 2 * half, table + 2 * half, half);
+    inverse_butterflies(d, d + 2 * half, table + 2 * half, half);
     return;
   }
-  for (Index len = 2; len <= n; len *= 2)
-    for (Index i = 0; i < n; i += len) inverse_butterflies(d + 2 * i, d + 2 * (i + len / 2), table + len, len / 2);
+  inverse_cached(d, n, table);
 }
 
 // Calls f(p, q, k) once for every pair of frequencies k and n - k (k = 0 .. n / 2) of a

@@ -73,8 +73,8 @@ void autocorrelation_sum(std::span<const double> a, std::span<const double> b, s
 void ends_correlations(std::span<const double> a, std::span<const double> b, std::size_t first, std::size_t n,
                        Theo1Workspace& w);
 
-/// Doubles of scratch mtotvar_fast needs beside a prepared Theo1Workspace of N points: 4 N + 2 (the
-/// workspace's FFT buffer holds the rest).
+/// Doubles of scratch mtotvar_fast needs beside a prepared Theo1Workspace of N points: N (the end's
+/// prefix sums; the workspace's FFT buffer holds the rest).
 std::size_t mtotvar_scratch_size(std::size_t n_phase);
 
 /// MTOTVAR at averaging factor m (1 <= m <= N / 3), exactly the estimator mtotvar(x, 1, m, tau0_s, .)
