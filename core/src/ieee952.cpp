@@ -273,7 +273,7 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
     std::array<double, max_markov + 1> more_sd = nl_sd;
     Candidate none;
     bool taken = false;
-    if (more.valid && refit_exactly(pr, setup, free, fixed, more, none, more_sd) && markov_terms_hold(more, fewer)) {
+    if (more.valid && refit_exactly(pr, setup, free, fixed, more, none, more_sd, false) && markov_terms_hold(more, fewer)) {
       const double more_log_det = log_det(pr);
       // An accepted model is never traded for a rejected one.
       taken = fewer.criterion + fewer_log_det > more.criterion + more_log_det &&
@@ -283,6 +283,7 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
         const double fewer_chi2 = profile_chi2(pr, free, fixed);  // on the chosen model's covariance
         pr.model = more.model;
         set_rows(pr);
+        profile_markov_terms(pr, free, fixed, more_sd);  // only the chosen model's profile is needed
         chosen = more;
         nl_sd = more_sd;
         runner_up = fewer;

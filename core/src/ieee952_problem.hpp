@@ -151,7 +151,8 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
 void widen_by_nonlinear(Problem& pr, const Flags& free, const Terms& fixed, const std::array<double, max_markov + 1>& nl_sd,
                         Solution& sol);
 bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const Terms& fixed, Candidate& chosen,
-                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd);
+                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd, bool with_profile = true);
+void profile_markov_terms(Problem& pr, const Flags& free, const Terms& fixed, std::array<double, max_markov + 1>& nl_sd);
 bool markov_terms_hold(const Candidate& more, const Candidate& fewer);
 
 }  // namespace gyrochar::ieee952_fit

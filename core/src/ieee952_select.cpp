@@ -261,11 +261,17 @@ void widen_by_nonlinear(Problem& pr, const Flags& free, const Terms& fixed, cons
   widen(&pr.model.band, nl_sd[max_markov]);
 }
 
+// Each Markov term's sd(ln Tc) from its profile (profile_log_sd()) on the covariance pr holds.
+void profile_markov_terms(Problem& pr, const Flags& free, const Terms& fixed, std::array<double, max_markov + 1>& nl_sd) {
+  for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = profile_log_sd(pr, free, fixed, k);
+}
+
 // The chosen model with Markov terms fitted again on the exact covariance (the selection used the
 // approximation local_noise() makes): its terms, its correlation times' uncertainties and the
-// runner-up's figures on it. Keeps the approximate fit where the exact one fails (false).
+// runner-up's figures on it (without_profile: the terms alone). Keeps the approximate fit where the
+// exact one fails (false).
 bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const Terms& fixed, Candidate& chosen,
-                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd) {
+                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd, bool with_profile) {
   pr.model = chosen.model;
   markov_sums_of_points(pr, setup);
   Candidate exact = fit_model(pr, free, fixed, false, 12);
@@ -277,7 +283,8 @@ bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const 
     return false;
   }
   chosen = exact;
-  for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = profile_log_sd(pr, free, fixed, k);
+  if (!with_profile) return true;
+  profile_markov_terms(pr, free, fixed, nl_sd);
   if (runner_up.valid) {
     pr.model = runner_up.model;
     runner_up.sol.chi2 = profile_chi2(pr, free, fixed);
