@@ -260,9 +260,9 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
   // (the reason the search compares on the candidate's covariance); chi2 on a common covariance
   // charges a model for nothing its covariance lacks. Under the approximation a Markov term whose
   // hump lies near the record's end is charged as rate random walk: with two Markov terms (20 s
-  // and 1500 s over 8 h) the model with B and K in the second one's place won in two thirds of
-  // the recovery study's runs, and was rejected on the exact covariance in 7 of them (chi2/dof up
-  // to 23) where the two-term model was accepted (0.75).
+  // and 1500 s over 8 h) the model with B or K in the second one's place won in 74 of the
+  // recovery study's 100 runs and was rejected on the exact covariance in 7 of them (chi2/dof up
+  // to 23; on one, the two-term model: 0.75). Measured in docs/metrology.md.
   if (runner_up.valid && runner_up.placed && runner_up.model.markov > chosen.model.markov &&
       (chosen.model.markov == 0 || exact)) {
     const Candidate fewer = chosen;
