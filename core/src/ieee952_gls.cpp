@@ -426,6 +426,13 @@ void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* c
   }
 }
 
+// ln det Sigma of the covariance pr.sigma holds, factored (twice the sum of ln L_ii).
+double log_det(const Problem& pr) {
+  double sum = 0;
+  for (std::size_t i = 0; i < pr.n; ++i) sum += 2 * std::log(pr.sigma[i * pr.n + i]);
+  return sum;
+}
+
 double criterion_of(double chi2, std::size_t parameters, std::size_t points) {
   return chi2 + static_cast<double>(parameters) * std::log(static_cast<double>(points));
 }

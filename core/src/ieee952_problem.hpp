@@ -122,6 +122,9 @@ struct Candidate {
   std::size_t parameters = 0;
   double criterion = 0;
   bool valid = false;
+  // Its correlation times lie inside their search range and chi2 curves around each (the
+  // selection's test of where a Markov term was found; significance is judged on the fit).
+  bool placed = true;
 };
 
 // ieee952_gls.cpp
@@ -138,6 +141,7 @@ void pair_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache
 void markov_sums_of_points(Problem& pr, const FitSetup& setup);
 void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache);
 double criterion_of(double chi2, std::size_t parameters, std::size_t points);
+double log_det(const Problem& pr);
 Candidate fit_model(Problem& pr, const Flags& free, const Terms& fixed, bool first, int iterations);
 double profile_chi2(Problem& pr, const Flags& free, const Terms& fixed);
 
@@ -147,6 +151,8 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
 void widen_by_nonlinear(Problem& pr, const Flags& free, const Terms& fixed, const std::array<double, max_markov + 1>& nl_sd,
                         Solution& sol);
 bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const Terms& fixed, Candidate& chosen,
-                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd);
+                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd, bool with_profile = true);
+void profile_markov_terms(Problem& pr, const Flags& free, const Terms& fixed, std::array<double, max_markov + 1>& nl_sd);
+bool markov_terms_hold(const Candidate& more, const Candidate& fewer);
 
 }  // namespace gyrochar::ieee952_fit

@@ -203,16 +203,14 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
         search(pr, free, fixed, &pr.model.a[j], std::fmax(lo, at / 4), std::fmin(hi, at * 4), 8);
       }
     for (std::size_t j = 0; j <= k; ++j) inside &= inside_search_range(pr.model.a[j], lo, hi);
-    const Candidate c = fit_model(pr, free, fixed, false, 12);
+    Candidate c = fit_model(pr, free, fixed, false, 12);
     std::array<double, max_markov + 1> sds = nonlinear_sd;
     for (std::size_t j = 0; j <= k; ++j) sds[j] = log_sd(pr, free, fixed, &pr.model.a[j]);
-    const double sd = sds[k];
     // Its Tc inside the range and determined (chi2 curves around it), every Markov term significant
     // (a second one that splits the first in two is not), and none taking white rate noise's place
     // (N fitted before, not after: that is N again).
-    bool holds = inside && sd > 0 && (!best.sol.active[1] || c.sol.active[1]);
-    for (std::size_t j = 0; j <= k; ++j) holds &= column_significant(c, power_terms + j);
-    const bool better = consider(c, holds);
+    c.placed = inside && sds[k] > 0;
+    const bool better = consider(c, c.placed && markov_terms_hold(c, best));
     if (better) nonlinear_sd = sds;
     settle();
     if (!better) break;
@@ -225,6 +223,13 @@ Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Fl
     settle();
   }
   return best;
+}
+
+// Every Markov term of `more` significant, and N in it if it was in `fewer`, the model it adds to.
+bool markov_terms_hold(const Candidate& more, const Candidate& fewer) {
+  bool holds = !fewer.sol.active[1] || more.sol.active[1];
+  for (std::size_t j = 0; j < more.model.markov; ++j) holds &= column_significant(more, power_terms + j);
+  return holds;
 }
 
 // The linear terms' covariance given the nonlinear parameters, widened by what their uncertainty
@@ -256,11 +261,17 @@ void widen_by_nonlinear(Problem& pr, const Flags& free, const Terms& fixed, cons
   widen(&pr.model.band, nl_sd[max_markov]);
 }
 
+// Each Markov term's sd(ln Tc) from its profile (profile_log_sd()) on the covariance pr holds.
+void profile_markov_terms(Problem& pr, const Flags& free, const Terms& fixed, std::array<double, max_markov + 1>& nl_sd) {
+  for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = profile_log_sd(pr, free, fixed, k);
+}
+
 // The chosen model with Markov terms fitted again on the exact covariance (the selection used the
 // approximation local_noise() makes): its terms, its correlation times' uncertainties and the
-// runner-up's figures on it. Keeps the approximate fit where the exact one fails (false).
+// runner-up's figures on it (without_profile: the terms alone). Keeps the approximate fit where the
+// exact one fails (false).
 bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const Terms& fixed, Candidate& chosen,
-                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd) {
+                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd, bool with_profile) {
   pr.model = chosen.model;
   markov_sums_of_points(pr, setup);
   Candidate exact = fit_model(pr, free, fixed, false, 12);
@@ -272,7 +283,8 @@ bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const 
     return false;
   }
   chosen = exact;
-  for (std::size_t k = 0; k < pr.model.markov; ++k) nl_sd[k] = profile_log_sd(pr, free, fixed, k);
+  if (!with_profile) return true;
+  profile_markov_terms(pr, free, fixed, nl_sd);
   if (runner_up.valid) {
     pr.model = runner_up.model;
     runner_up.sol.chi2 = profile_chi2(pr, free, fixed);

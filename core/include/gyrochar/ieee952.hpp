@@ -59,8 +59,11 @@
 // white, +1: random walk), the filter as white rate noise of the filtered level. A sinusoid is
 // deterministic but for its phase: its part is its cross term with the noises, exact for a phase
 // uniform over the turn (sinusoid_pair_sums(); its cross term with a Markov term is left out). The chosen model's Markov terms are then fitted again on the exact
-// covariance (markov_pair_sums()), where the choice is checked once more; the recovery study
-// measures the result (docs/metrology.md).
+// covariance (markov_pair_sums()), where the choice is checked once more: a runner-up with fewer
+// Markov terms and the lower criterion on that covariance is the model; a runner-up with one more
+// Markov term (it lost on the approximate covariance) is fitted on its own exact covariance and is
+// the model when its Gaussian likelihood is the higher, each model on its own exact covariance
+// (criterion + ln det Sigma); the recovery study measures the result (docs/metrology.md).
 // Model selection (FitSetup::select_model): from the five terms, the filter, then the given
 // sinusoids (spectral lines found in the record), then one Markov term and a second are added while
 // each lowers the Bayesian information criterion chi2 + p ln(points) (p: the terms fitted plus
