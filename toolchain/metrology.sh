@@ -109,7 +109,9 @@ closed forms above), analyzed as `gyrochar-analyze --type counts --fit ieee952` 
 full, octave taus) and judged by the recommended fit of both curves (`tests/support/recovery.cpp`).
 A term counts as "within 1 sigma" when it is resolved and lies within its stated standard
 uncertainty of the simulator's value; "false resolved" is a term resolved although the simulator
-does not have it. The pooled figures take every resolved term of every scenario.
+does not have it. A correlation time is stated to a factor and judged in its logarithm: within k
+sigma where the truth lies in Tc exp(+-k sd(ln Tc)) (sd(ln Tc) = uncertainty / Tc). The pooled
+figures take every resolved term of every scenario.
 EOF
   write_block recovery "Recovery of simulated gyros by the IEEE-952 fit (Monte Carlo)" "$intro" "$tables"
   echo "metrology.sh: wrote the recovery block of $doc" >&2

@@ -58,8 +58,10 @@ std::string fit_summary(const CurveFit& f) {
 }
 
 // "+- 61 s", or why there is no uncertainty (a time whose chi2 has no curvature).
-std::string with_uncertainty(double sd_s) {
-  return sd_s > 0 ? fmt::format("+- {:.2g} s", sd_s) : std::string("s (uncertainty not determined)");
+// A correlation time with its 68 % interval: "s (68 %: 250 .. 1620 s)" (tc_interval(): known to a factor).
+std::string with_interval(double tc_s, double sd_s) {
+  const auto [low, high] = tc_interval(tc_s, sd_s);
+  return high > 0 ? fmt::format("s (68 %: {:.3g} .. {:.3g} s)", low, high) : std::string("s (uncertainty not determined)");
 }
 
 // "5 terms + filter + 1 Markov (criterion 41.2); runner-up 5 terms + filter (criterion 96.3, chi2/dof 2.6)"
@@ -327,12 +329,12 @@ std::string format_table(const Report& r) {
       fmt::format_to(to,
                      "#   sensor bandwidth: N's white noise through a first-order filter, Tf = {:.3g} {} "
                      "(corner {:.4g} Hz)\n",
-                     f.fit.bandwidth_tc_s, with_uncertainty(f.fit.bandwidth_tc_uncertainty_s),
+                     f.fit.bandwidth_tc_s, with_interval(f.fit.bandwidth_tc_s, f.fit.bandwidth_tc_uncertainty_s),
                      1 / (2 * std::numbers::pi * f.fit.bandwidth_tc_s));
     for (std::size_t j = 0; j < f.fit.n_markov; ++j) {
       const MarkovTerm& m = f.fit.markov[j];
       fmt::format_to(to, "#   Markov {}: sigma = {:.4g} +- {:.2g} {}, Tc = {:.4g} {}{}{}\n", j + 1, m.sigma.value / rate.si,
-                     m.sigma.uncertainty / rate.si, rate.name, m.tc_s, with_uncertainty(m.tc_uncertainty_s),
+                     m.sigma.uncertainty / rate.si, rate.name, m.tc_s, with_interval(m.tc_s, m.tc_uncertainty_s),
                      m.sigma.resolved ? "" : "  (not resolved)", simulated_markov(r.truth, m.tc_s, rate));
     }
     if (r.truth && f.fit.n_markov == 0)
@@ -408,6 +410,17 @@ nlohmann::json parameter_json(const Ieee952Parameter& p, double si, const std::s
           {"resolved", p.resolved}};
 }
 
+// A correlation time: its value, uncertainty (Tc sd(ln Tc)) and the 68 % interval that follows from
+// it (ci_low, ci_high: tc_interval()); null where not determined.
+nlohmann::json tc_json(double tc_s, double sd_s) {
+  const auto [low, high] = tc_interval(tc_s, sd_s);
+  return {{"value", tc_s},
+          {"uncertainty", positive_or_null(sd_s)},
+          {"ci_low", positive_or_null(low)},
+          {"ci_high", positive_or_null(high)},
+          {"unit", "s"}};
+}
+
 // The terms beyond the five, the model selection and the residuals of a fit.
 void add_model_json(nlohmann::json& one, const Ieee952Fit& fit, const ReportUnits& u) {
   using nlohmann::json;
@@ -415,10 +428,7 @@ void add_model_json(nlohmann::json& one, const Ieee952Fit& fit, const ReportUnit
   json markov = json::array();
   for (std::size_t j = 0; j < fit.n_markov; ++j)
     markov.push_back({{"sigma", parameter_json(fit.markov[j].sigma, rate.si, rate.name)},
-                      {"tc",
-                       {{"value", fit.markov[j].tc_s},
-                        {"uncertainty", positive_or_null(fit.markov[j].tc_uncertainty_s)},
-                        {"unit", "s"}}}});
+                      {"tc", tc_json(fit.markov[j].tc_s, fit.markov[j].tc_uncertainty_s)}});
   json sinusoids = json::array();
   for (std::size_t j = 0; j < fit.n_sinusoids; ++j)
     sinusoids.push_back(
@@ -426,10 +436,7 @@ void add_model_json(nlohmann::json& one, const Ieee952Fit& fit, const ReportUnit
          {"frequency", {{"value", fit.sinusoids[j].frequency_hz}, {"uncertainty", nullptr}, {"unit", "Hz"}}}});
   one["markov"] = std::move(markov);
   one["sinusoids"] = std::move(sinusoids);
-  one["bandwidth"] = fit.bandwidth_tc_s > 0 ? json{{"tc",
-                                                    {{"value", fit.bandwidth_tc_s},
-                                                     {"uncertainty", positive_or_null(fit.bandwidth_tc_uncertainty_s)},
-                                                     {"unit", "s"}}},
+  one["bandwidth"] = fit.bandwidth_tc_s > 0 ? json{{"tc", tc_json(fit.bandwidth_tc_s, fit.bandwidth_tc_uncertainty_s)},
                                                    {"corner_hz", 1 / (2 * std::numbers::pi * fit.bandwidth_tc_s)}}
                                             : json(nullptr);
   one["bandwidth_excluded_below_tau"] = fit.bandwidth_excluded_below_tau_s > 0 ? json(fit.bandwidth_excluded_below_tau_s)

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gyrochar/ieee952.hpp"
+
 #include <algorithm>
 
 namespace gyrochar::decoding {
@@ -175,6 +177,16 @@ Json parameter_json(const FitModelRow::Parameter& p, const std::string& unit, bo
   return j;
 }
 
+/// A correlation time as parameter_json() gives it, with its 68 % interval (ci_low, ci_high:
+/// tc_interval(), as the analyzer's; null where the uncertainty is not known).
+Json correlation_time_json(const FitModelRow::Parameter& p) {
+  Json j = parameter_json(p, "s", false);
+  const auto [low, high] = tc_interval(p.value, p.rel_uncertainty * p.value);
+  j["ci_low"] = high > 0 ? Json(low) : Json(nullptr);
+  j["ci_high"] = high > 0 ? Json(high) : Json(nullptr);
+  return j;
+}
+
 /// The model beyond the five terms (version 4) in the fit object: "model_status", and when shown
 /// "markov", "sinusoids", "bandwidth", "bandwidth_excluded_below_tau_s", "model", "runner_up" in
 /// the analyzer's shape (the uncertainty absolute); null when not shown.
@@ -190,13 +202,13 @@ void add_model_json(Json& fit, const std::optional<FitModelRow>& model, const Un
   Json markov = Json::array(), sinusoids = Json::array();
   for (std::uint8_t j = 0; j < model->markov; ++j)
     markov.push_back({{"sigma", parameter_json(page(FitParameter::markov_sigma, j), units.rate_name, true)},
-                      {"tc", parameter_json(page(FitParameter::markov_tc, j), "s", false)}});
+                      {"tc", correlation_time_json(page(FitParameter::markov_tc, j))}});
   for (std::uint8_t j = 0; j < model->sinusoids; ++j)
     sinusoids.push_back({{"amplitude", parameter_json(page(FitParameter::sinusoid_amplitude, j), units.rate_name, true)},
                          {"frequency", parameter_json(page(FitParameter::sinusoid_frequency, j), "Hz", false)}});
   fit["markov"] = std::move(markov);
   fit["sinusoids"] = std::move(sinusoids);
-  fit["bandwidth"] = model->bandwidth ? Json{{"tf", parameter_json(page(FitParameter::filter_tf, 0), "s", false)}}
+  fit["bandwidth"] = model->bandwidth ? Json{{"tf", correlation_time_json(page(FitParameter::filter_tf, 0))}}
                                       : Json(nullptr);
   fit["bandwidth_excluded_below_tau_s"] = json_or_null(model->bandwidth_excluded_below_tau_s);
   fit["model"] = candidate_json(model->markov, model->sinusoids, model->bandwidth);

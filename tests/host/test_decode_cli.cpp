@@ -604,6 +604,10 @@ TEST(DecodeCli, RatesInDegreesPerHourAndPulsesNeverConverted) {
   EXPECT_EQ(sigma.at("resolved"), true);
   EXPECT_EQ(fit.at("markov").at(0).at("tc").at("value"), 20.0);
   EXPECT_EQ(fit.at("markov").at(0).at("tc").at("unit"), "s");
+  // Its 68 % interval, 20 s exp(+-u / 20 s) (tc_interval(): stated to a factor, as the analyzer's).
+  const double tc_u = fit.at("markov").at(0).at("tc").at("uncertainty");
+  EXPECT_NEAR(fit.at("markov").at(0).at("tc").at("ci_low").get<double>(), 20.0 * std::exp(-tc_u / 20.0), 1e-12);
+  EXPECT_NEAR(fit.at("markov").at(0).at("tc").at("ci_high").get<double>(), 20.0 * std::exp(tc_u / 20.0), 1e-12);
   EXPECT_TRUE(fit.at("sinusoids").empty());
   EXPECT_TRUE(fit.at("bandwidth").is_null());
   EXPECT_EQ(fit.at("runner_up").at("criterion_margin"), 4.5);

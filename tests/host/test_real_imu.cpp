@@ -56,6 +56,16 @@ TEST_P(RealImu, TheRecommendedModelDescribesTheCurveAndNeverClaimsAFloorAboveIt)
   EXPECT_NEAR(N, white, 0.05 * white);
   // The sensor's own filter bends the shortest taus: they are left out, and the fit says where.
   EXPECT_GT(fit.at("bandwidth_excluded_below_tau").get<double>(), 0.01);
+  // A correlation time is stated to a factor: its 68 % interval is Tc exp(+-u / Tc) (u = Tc sd(ln Tc),
+  // tc_interval()), above zero however wide (Tc +- u was not: 636 +- 520 s on a simulated gyro).
+  for (const auto& m : fit.at("markov")) {
+    const nlohmann::json& tc = m.at("tc");
+    if (tc.at("uncertainty").is_null()) continue;
+    const double value = tc.at("value"), u = tc.at("uncertainty"), low = tc.at("ci_low"), high = tc.at("ci_high");
+    EXPECT_GT(low, 0);
+    EXPECT_NEAR(std::log(high / value), u / value, 1e-12);
+    EXPECT_NEAR(std::log(value / low), u / value, 1e-12);
+  }
   // Residuals for every point used, in sigma.
   EXPECT_EQ(fit.at("residuals").size(), fit.at("points").get<std::size_t>());
 }

@@ -202,7 +202,13 @@ void tally(RecoveryCell& cell, const Recovery& r, bool long_tau) {
 }
 
 // One value against its truth (zero: a resolved value is false).
-void tally_value(TermTally& t, double truth, bool usable, bool fitted, bool resolved, double value, double uncertainty) {
+// How a value's distance from the truth is judged: in its unit, or in its logarithm (a correlation
+// time is stated to a factor, tc_interval(): within k sigma where the truth lies in exp(+-k sd(ln Tc))
+// about the fit, sd(ln Tc) = uncertainty / Tc).
+enum class Scale { linear, logarithmic };
+
+void tally_value(TermTally& t, double truth, bool usable, bool fitted, bool resolved, double value, double uncertainty,
+                 Scale scale = Scale::linear) {
   ++t.runs;
   const bool present = truth > 0;
   t.present += present;
@@ -213,11 +219,14 @@ void tally_value(TermTally& t, double truth, bool usable, bool fitted, bool reso
     ++t.false_resolved;
     return;
   }
-  const double off = std::fabs(value - truth);
-  t.within1 += off <= uncertainty;
-  t.within2 += off <= 2 * uncertainty;
+  const bool log = scale == Scale::logarithmic && value > 0;
+  const double off = log ? std::fabs(std::log(value / truth)) : std::fabs(value - truth);
+  const double sd = log ? uncertainty / value : uncertainty;
+  t.within1 += off <= sd;
+  t.within2 += off <= 2 * sd;
   t.sum_relative_uncertainty += uncertainty / truth;
-  t.sum_squared_relative_error += (off / truth) * (off / truth);
+  const double error = (value - truth) / truth;
+  t.sum_squared_relative_error += error * error;
 }
 
 void tally_markov(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit& f, const Ieee952Truth& truth_si) {
@@ -238,7 +247,8 @@ void tally_markov(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit&
     const MarkovTerm fitted = found ? f.markov[nearest] : MarkovTerm{};
     tally_value(terms[5], m.sigma_rad_s, f.ok(), found, found && fitted.sigma.resolved, fitted.sigma.value,
                 fitted.sigma.uncertainty);
-    tally_value(terms[6], m.tc_s, f.ok(), found, found && fitted.sigma.resolved, fitted.tc_s, fitted.tc_uncertainty_s);
+    tally_value(terms[6], m.tc_s, f.ok(), found, found && fitted.sigma.resolved, fitted.tc_s, fitted.tc_uncertainty_s,
+                Scale::logarithmic);
   }
 }
 

@@ -78,6 +78,7 @@
 // (there either could stand in for a quantization pattern). The runner-up's figures are given on
 // the chosen model's covariance.
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -150,8 +151,18 @@ struct Ieee952Parameter {
 struct MarkovTerm {
   Ieee952Parameter sigma;
   double tc_s = 0;
-  double tc_uncertainty_s = 0;  // from the curvature of chi2 in ln Tc on the model's covariance, Birge-scaled
+  // Tc times the standard deviation of ln Tc (chi2's profile in ln Tc on the model's covariance,
+  // Birge-scaled). The 68 % interval is Tc exp(-u / Tc) .. Tc exp(u / Tc) (tc_interval()): a
+  // correlation time is known to a factor, and Tc +- u would reach zero where u approaches Tc.
+  double tc_uncertainty_s = 0;
 };
+/// The 68 % interval of a correlation time stated as Tc and u = Tc sd(ln Tc): {Tc e^(-u/Tc),
+/// Tc e^(u/Tc)}; {0, 0} where it is not determined (u = 0).
+inline std::array<double, 2> tc_interval(double tc_s, double uncertainty_s) {
+  if (!(tc_s > 0) || !(uncertainty_s > 0)) return {0.0, 0.0};
+  const double factor = std::exp(uncertainty_s / tc_s);
+  return {tc_s / factor, tc_s * factor};
+}
 /// A sinusoid of the fit: amplitude [r/s] at a given frequency.
 struct SinusoidTerm {
   Ieee952Parameter amplitude;
@@ -189,9 +200,9 @@ struct Ieee952Fit {
   std::size_t n_markov = 0;
   std::array<SinusoidTerm, max_sinusoids> sinusoids{};
   std::size_t n_sinusoids = 0;
-  double bandwidth_excluded_below_tau_s = 0;  // points below this tau left out: the sensor's own filter (0: none)
-  double bandwidth_tc_s = 0;                  // Tf of the filter on N's white noise (0: none in the model)
-  double bandwidth_tc_uncertainty_s = 0;
+  double bandwidth_excluded_below_tau_s = 0;            // points below this tau left out: the sensor's own filter (0: none)
+  double bandwidth_tc_s = 0;                            // Tf of the filter on N's white noise (0: none in the model)
+  double bandwidth_tc_uncertainty_s = 0;                // Tf sd(ln Tf), as a Markov term's (tc_interval())
   ModelSummary chosen, runner_up;                       // the selected model and the next best candidate
   std::array<FitResidual, max_fit_points> residuals{};  // every point used, in the fit's order
   std::size_t n_residuals = 0;
