@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gyrochar/ieee952.hpp"
 #include "html_report.hpp"
 #include "plot_data.hpp"
 
@@ -195,6 +196,14 @@ GyroSummary node_summary(const NodeView& node, const std::string& source, const 
 
 namespace {
 
+// A correlation time's 68 % interval, "68 %: 101 .. 286 s" (tc_interval(): known to a factor);
+// empty for the other parameters.
+std::string time_note(protocol::FitParameter kind, const FitModelRow::Parameter& q) {
+  if (kind != protocol::FitParameter::markov_tc && kind != protocol::FitParameter::filter_tf) return {};
+  const auto [low, high] = tc_interval(q.value, q.rel_uncertainty * q.value);
+  return high > 0 ? fmt::format("68 %: {:.3g} .. {:.3g} s", low, high) : std::string();
+}
+
 // The model beyond the five terms (protocol version 4: Markov terms, the sensor's filter,
 // sinusoids) with each parameter's uncertainty and the runner-up, as the terminal view gives them.
 void model_table(html::Document& doc, const NodeView& node, const Units& u, const std::string& id) {
@@ -216,7 +225,7 @@ void model_table(html::Document& doc, const NodeView& node, const Units& u, cons
                     number(q.value),
                     q.rel_uncertainty > 0 ? number(q.value * q.rel_uncertainty) : Cell{},
                     {unit, {}, "text"},
-                    {with_status ? (q.resolved ? "resolved" : "not resolved") : "", {}, "text"}});
+                    {with_status ? (q.resolved ? "resolved" : "not resolved") : time_note(kind, q), {}, "text"}});
   };
   using protocol::FitParameter;
   for (std::uint8_t j = 0; j < m->markov; ++j) {

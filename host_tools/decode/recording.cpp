@@ -4,9 +4,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "gyrochar/ieee952.hpp"
-
 #include <algorithm>
+
+#include "gyrochar/ieee952.hpp"
 
 namespace gyrochar::decoding {
 

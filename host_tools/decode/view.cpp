@@ -5,6 +5,8 @@
 #include <cmath>
 #include <iterator>
 
+#include "gyrochar/ieee952.hpp"
+
 namespace gyrochar::decoding {
 
 using namespace protocol;
@@ -111,6 +113,14 @@ std::string parameter_text(const FitModelRow::Parameter& p, const char* unit, bo
   return s;
 }
 
+/// A correlation time with its 68 % interval, "170 s (68 %: 101 .. 286 s)" (tc_interval(): known to
+/// a factor; the relative uncertainty sent is sd(ln Tc)).
+std::string time_text(const FitModelRow::Parameter& p) {
+  const auto [low, high] = tc_interval(p.value, p.rel_uncertainty * p.value);
+  return high > 0 ? fmt::format("{:.4g} s (68 %: {:.3g} .. {:.3g} s)", p.value, low, high)
+                  : fmt::format("{:.4g} s", p.value);
+}
+
 /// The model's line (protocol version 4): the Markov terms, the sensor's filter and the sinusoids
 /// of the fit the summary above describes, or why they are not shown.
 void model_view(std::string& s, const NodeView& v, const Units& u) {
@@ -131,9 +141,8 @@ void model_view(std::string& s, const NodeView& v, const Units& u) {
   for (std::uint8_t j = 0; j < m->markov; ++j)
     fmt::format_to(out, "  Markov {}: sigma {}, Tc {}", j + 1,
                    parameter_text(page(FitParameter::markov_sigma, j), rate.c_str(), true),
-                   parameter_text(page(FitParameter::markov_tc, j), "s", false));
-  if (m->bandwidth)
-    fmt::format_to(out, "  sensor filter: Tf {}", parameter_text(page(FitParameter::filter_tf, 0), "s", false));
+                   time_text(page(FitParameter::markov_tc, j)));
+  if (m->bandwidth) fmt::format_to(out, "  sensor filter: Tf {}", time_text(page(FitParameter::filter_tf, 0)));
   for (std::uint8_t j = 0; j < m->sinusoids; ++j)
     fmt::format_to(out, "  sinusoid {}: amplitude {} at {:.4g} Hz", j + 1,
                    parameter_text(page(FitParameter::sinusoid_amplitude, j), rate.c_str(), true),

@@ -612,7 +612,8 @@ TEST(DecodeCli, RatesInDegreesPerHourAndPulsesNeverConverted) {
   EXPECT_TRUE(fit.at("bandwidth").is_null());
   EXPECT_EQ(fit.at("runner_up").at("criterion_margin"), 4.5);
   EXPECT_TRUE(contains(r.out, "model:  Markov 1: sigma")) << r.out;
-  EXPECT_TRUE(contains(r.out, "Tc 20 s (+-25.0%)")) << r.out;
+  // Tc sent with 25 %: sd(ln Tc) = 0.25, its 68 % interval 20 s exp(-+0.25) = 15.58 .. 25.68 s.
+  EXPECT_TRUE(contains(r.out, "Tc 20 s (68 %: 15.6 .. 25.7 s)")) << r.out;
 }
 
 TEST(DecodeCli, ALostModelPageShowsMissingNeverAnotherFitsValue) {
