@@ -1,7 +1,12 @@
 #include "total_analysis.hpp"
 
+#include <sys/mman.h>
+
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <memory>
+#include <new>
 
 #include "confidence.hpp"
 #include "gyrochar/total.hpp"
@@ -158,6 +163,24 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
 
 }  // namespace
 
+void FreeDoubles::operator()(double* p) const noexcept { std::free(p); }
+
+HugeArray huge_array(std::size_t n) {
+  constexpr std::size_t huge_page = std::size_t{1} << 21;
+  if (n > (std::numeric_limits<std::size_t>::max() - huge_page) / sizeof(double)) throw std::bad_alloc();
+  const std::size_t bytes = n * sizeof(double);
+  void* p = nullptr;
+  if (bytes < 4 * huge_page) {
+    p = std::malloc(bytes ? bytes : 1);
+  } else {
+    const std::size_t rounded = (bytes + huge_page - 1) / huge_page * huge_page;  // aligned_alloc's rule
+    p = std::aligned_alloc(huge_page, rounded);
+    if (p != nullptr) madvise(p, rounded, MADV_HUGEPAGE);
+  }
+  if (p == nullptr) throw std::bad_alloc();
+  return HugeArray(static_cast<double*>(p));
+}
+
 Theo1Workspace& LagSumRecord::prepared(std::span<const double> x, bool frequencies) {
   const std::size_t n = frequencies ? x.size() - 1 : x.size();
   if (w_.ready && frequencies_ == frequencies && w_.r.size() == n) return w_;
@@ -168,7 +191,7 @@ Theo1Workspace& LagSumRecord::prepared(std::span<const double> x, bool frequenci
     y_.resize(n);
     for (std::size_t i = 0; i < n; ++i) y_[i] = x[i + 1] - x[i];
   }
-  work_ = std::make_unique_for_overwrite<double[]>(theo1_workspace_size(n));
+  work_ = huge_array(theo1_workspace_size(n));
   w_ = theo1_prepare(frequencies ? std::span<const double>(y_) : x, {work_.get(), theo1_workspace_size(n)});
   frequencies_ = frequencies;
   return w_;
@@ -178,7 +201,7 @@ std::span<double> LagSumRecord::scratch() {
   const std::size_t size = mtotvar_scratch_size(w_.r.size());
   if (scratch_size_ < size) {
     scratch_.reset();
-    scratch_ = std::make_unique_for_overwrite<double[]>(size);
+    scratch_ = huge_array(size);
     scratch_size_ = size;
   }
   return {scratch_.get(), size};

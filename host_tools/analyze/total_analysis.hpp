@@ -19,6 +19,16 @@
 
 namespace gyrochar {
 
+/// Memory for the lag sums' workspaces, not zero-filled: from 8 MiB up aligned to 2 MiB and offered
+/// to transparent huge pages (madvise; a hint the kernel may refuse), so that first touching the
+/// 0.9 GB of a 10^7-point record costs one fault every 2 MiB, not every 4 KiB (BENCHMARKS.md, the
+/// exact MTOTDEV at 10^7). Throws std::bad_alloc.
+struct FreeDoubles {
+  void operator()(double* p) const noexcept;
+};
+using HugeArray = std::unique_ptr<double[], FreeDoubles>;
+HugeArray huge_array(std::size_t n);
+
 /// The record prepared for the lag sums (total_fast.hpp), kept between the statistics of one run:
 /// Theo1, TheoH, MTOTDEV and TTOTDEV share the preparation of the phase points, HTOTDEV prepares
 /// their first differences. One preparation is held at a time (at 10^7 points 1.5 GB), the other
@@ -31,7 +41,7 @@ class LagSumRecord {
   std::span<double> scratch();
 
  private:
-  std::unique_ptr<double[]> work_, scratch_;  // not zero-filled: prepare writes before it reads
+  HugeArray work_, scratch_;  // not zero-filled: prepare writes before it reads
   std::vector<double> y_;
   Theo1Workspace w_;
   bool frequencies_ = false;

@@ -30,6 +30,7 @@
 
 #include "gyrochar/total.hpp"
 #include "gyrochar/total_fast.hpp"
+#include "total_analysis.hpp"
 
 namespace {
 
@@ -91,7 +92,7 @@ double lag_sum_octaves(Theo1Workspace& w) {
 // their seconds returned.
 double mtot_lag_sum_octaves(Theo1Workspace& w) {
   const std::size_t size = mtotvar_scratch_size(w.r.size());
-  const auto scratch = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  const auto scratch = huge_array(size);  // as the analyzer allocates it (not zero-filled)
   double total = 0;
   for (std::uint64_t m = 1; 3 * m <= w.r.size(); m *= 2) {
     const auto t0 = Clock::now();
@@ -132,7 +133,7 @@ int octave(const char* file, std::uint32_t S) {
   std::printf("theo1,total,%.9f\n", total);
   auto t0 = Clock::now();  // the exact lag-sum Theo1 (total_fast.hpp), its preparation included
   const std::size_t size = theo1_workspace_size(x.size());
-  const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  const auto work = huge_array(size);  // as the analyzer allocates it (not zero-filled)
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   total = seconds_since(t0);
   std::printf("theo1-lagsums,prepare,%.9f\n", total);
@@ -161,7 +162,7 @@ int lag_sums(std::uint64_t n, std::uint32_t S) {
   auto t0 = Clock::now();
   double c0 = cpu_seconds();
   const std::size_t size = theo1_workspace_size(n);
-  const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  const auto work = huge_array(size);  // as the analyzer allocates it (not zero-filled)
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   const double prepare = seconds_since(t0), prepare_cpu = cpu_seconds() - c0;
   std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace)\n", prepare, prepare_cpu,
@@ -193,7 +194,7 @@ int mtot_lag_sums(std::uint64_t n) {
   auto t0 = Clock::now();
   double c0 = cpu_seconds();
   const std::size_t size = theo1_workspace_size(n);
-  const auto work = std::make_unique_for_overwrite<double[]>(size);  // as the analyzer: not zero-filled
+  const auto work = huge_array(size);  // as the analyzer allocates it (not zero-filled)
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   const double prepare = seconds_since(t0), prepare_cpu = cpu_seconds() - c0;
   std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace, %.0f MB of scratch)\n", prepare, prepare_cpu,

@@ -1,12 +1,15 @@
 // The analysis engine's own contract, beside the reference sets: the tau lists and the stride
 // factor, what it refuses, strided taus above the "full" cap against a brute-force strided
-// estimator, and the floating phase reference (a line added to phase changes nothing).
+// estimator, the floating phase reference (a line added to phase changes nothing), and the lag
+// sums' workspace memory.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <new>
 #include <random>
 #include <span>
 #include <stdexcept>
@@ -15,6 +18,7 @@
 #include "analysis.hpp"
 #include "datafile.hpp"
 #include "plan.hpp"
+#include "total_analysis.hpp"
 
 namespace gyrochar {
 namespace {
@@ -400,6 +404,23 @@ TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
             << q.dev;
       }
     }
+}
+
+TEST(AnalyzeEngine, LagSumWorkspacesAreWholeAndLargeOnesStartOnAHugePage) {
+  // huge_array()'s contract (total_analysis.hpp): n doubles, every one writable; from 8 MiB up the
+  // start aligned to 2 MiB (what lets the kernel back it with huge pages); an impossible size is
+  // std::bad_alloc, never a short buffer.
+  for (const std::size_t n :
+       {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{1} << 20, (std::size_t{3} << 20) + 5}) {
+    const HugeArray a = huge_array(n);
+    ASSERT_NE(a.get(), nullptr) << n;
+    for (std::size_t i = 0; i < n; i += 4096) a[i] = static_cast<double>(i);
+    if (n > 0) a[n - 1] = 1.0;
+    if (n * sizeof(double) >= (std::size_t{8} << 20)) {
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(a.get()) % (std::size_t{1} << 21), 0u) << n;
+    }
+  }
+  EXPECT_THROW(huge_array(std::numeric_limits<std::size_t>::max() / 4), std::bad_alloc);
 }
 
 }  // namespace
