@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "confidence.hpp"
 #include "html_report.hpp"
 
 namespace gyrochar {
@@ -119,9 +120,8 @@ void fit_tables(html::Document& doc, const Report& r) {
       rows.push_back({text(fmt::format("Markov {} sigma", i + 1)), number(mt.sigma.value / unit),
                       number(mt.sigma.uncertainty / unit), text(r.units.unit(DevStat::oadev)),
                       text(mt.sigma.resolved ? "resolved" : "not resolved")});
-      const auto [low, high] = tc_interval(mt.tc_s, mt.tc_uncertainty_s);
       rows.push_back({text(fmt::format("Markov {} Tc", i + 1)), number(mt.tc_s), number(mt.tc_uncertainty_s), text("s"),
-                      text(high > 0 ? fmt::format("68 %: {:.3g} .. {:.3g} s", low, high) : std::string())});
+                      text(correlation_time_interval(mt.tc_s, mt.tc_uncertainty_s))});
     }
     for (std::size_t i = 0; i < fit.n_sinusoids; ++i) {
       const SinusoidTerm& st = fit.sinusoids[i];

@@ -11,6 +11,8 @@
 #include <limits>
 #include <numbers>
 
+#include "confidence.hpp"
+
 namespace gyrochar {
 
 namespace {
@@ -57,11 +59,11 @@ std::string fit_summary(const CurveFit& f) {
   return s;
 }
 
-// "+- 61 s", or why there is no uncertainty (a time whose chi2 has no curvature).
-// A correlation time with its 68 % interval: "s (68 %: 250 .. 1620 s)" (tc_interval(): known to a factor).
+// The unit of a correlation time and its 68 % interval, "s (68 %: 250 .. 1620 s)", or that no
+// uncertainty was determined.
 std::string with_interval(double tc_s, double sd_s) {
-  const auto [low, high] = tc_interval(tc_s, sd_s);
-  return high > 0 ? fmt::format("s (68 %: {:.3g} .. {:.3g} s)", low, high) : std::string("s (uncertainty not determined)");
+  const std::string interval = correlation_time_interval(tc_s, sd_s);
+  return interval.empty() ? std::string("s (uncertainty not determined)") : "s (" + interval + ")";
 }
 
 // "5 terms + filter + 1 Markov (criterion 41.2); runner-up 5 terms + filter (criterion 96.3, chi2/dof 2.6)"

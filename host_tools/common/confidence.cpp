@@ -1,7 +1,11 @@
 #include "confidence.hpp"
 
+#include <fmt/format.h>
+
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
+
+#include "gyrochar/ieee952.hpp"
 
 namespace gyrochar {
 
@@ -33,6 +37,11 @@ Interval ConfidenceIntervals::operator()(double dev, double edf) {
   if (it == unit_intervals_.end()) it = unit_intervals_.emplace(edf, confidence_interval(1.0, edf, confidence_)).first;
   const Interval& unit = it->second;
   return unit.valid ? Interval{dev * unit.low, dev * unit.high, true} : Interval{};
+}
+
+std::string correlation_time_interval(double tc_s, double uncertainty_s) {
+  const auto [low, high] = tc_interval(tc_s, uncertainty_s);
+  return high > 0 ? fmt::format("68 %: {:.3g} .. {:.3g} s", low, high) : std::string();
 }
 
 }  // namespace gyrochar

@@ -6,6 +6,7 @@
 // matched): dev / sqrt(a + b chi2_nu3(1-p)) .. dev / sqrt(a + b chi2_nu3(p)). Where the EDF is small
 // (the last octaves) that interval holds the truth 66-69 % of the time, the plain one 72-75 %.
 // Quantiles from Boost.Math. ConfidenceIntervals memoizes them per EDF for a stream of values.
+#include <string>
 #include <unordered_map>
 
 namespace gyrochar {
@@ -37,5 +38,9 @@ class ConfidenceIntervals {
   double confidence_;
   std::unordered_map<double, Interval> unit_intervals_;  // by edf, for dev = 1
 };
+
+/// A correlation time's 68 % interval as text, "68 %: 101 .. 286 s": stated to a factor, Tc
+/// exp(-+u / Tc) (tc_interval(), gyrochar/ieee952.hpp); empty where u is not known.
+std::string correlation_time_interval(double tc_s, double uncertainty_s);
 
 }  // namespace gyrochar

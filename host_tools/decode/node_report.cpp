@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "gyrochar/ieee952.hpp"
+#include "confidence.hpp"
 #include "html_report.hpp"
 #include "plot_data.hpp"
 
@@ -196,12 +196,10 @@ GyroSummary node_summary(const NodeView& node, const std::string& source, const 
 
 namespace {
 
-// A correlation time's 68 % interval, "68 %: 101 .. 286 s" (tc_interval(): known to a factor);
-// empty for the other parameters.
+// A correlation time's 68 % interval, "68 %: 101 .. 286 s"; empty for the other parameters.
 std::string time_note(protocol::FitParameter kind, const FitModelRow::Parameter& q) {
   if (kind != protocol::FitParameter::markov_tc && kind != protocol::FitParameter::filter_tf) return {};
-  const auto [low, high] = tc_interval(q.value, q.rel_uncertainty * q.value);
-  return high > 0 ? fmt::format("68 %: {:.3g} .. {:.3g} s", low, high) : std::string();
+  return correlation_time_interval(q.value, q.rel_uncertainty * q.value);
 }
 
 // The model beyond the five terms (protocol version 4: Markov terms, the sensor's filter,

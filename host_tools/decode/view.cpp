@@ -5,7 +5,7 @@
 #include <cmath>
 #include <iterator>
 
-#include "gyrochar/ieee952.hpp"
+#include "confidence.hpp"
 
 namespace gyrochar::decoding {
 
@@ -113,12 +113,11 @@ std::string parameter_text(const FitModelRow::Parameter& p, const char* unit, bo
   return s;
 }
 
-/// A correlation time with its 68 % interval, "170 s (68 %: 101 .. 286 s)" (tc_interval(): known to
-/// a factor; the relative uncertainty sent is sd(ln Tc)).
+/// A correlation time with its 68 % interval, "170 s (68 %: 101 .. 286 s)" (the relative
+/// uncertainty sent is sd(ln Tc)).
 std::string time_text(const FitModelRow::Parameter& p) {
-  const auto [low, high] = tc_interval(p.value, p.rel_uncertainty * p.value);
-  return high > 0 ? fmt::format("{:.4g} s (68 %: {:.3g} .. {:.3g} s)", p.value, low, high)
-                  : fmt::format("{:.4g} s", p.value);
+  const std::string interval = correlation_time_interval(p.value, p.rel_uncertainty * p.value);
+  return fmt::format("{:.4g} s", p.value) + (interval.empty() ? "" : " (" + interval + ")");
 }
 
 /// The model's line (protocol version 4): the Markov terms, the sensor's filter and the sinusoids
