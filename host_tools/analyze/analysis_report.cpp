@@ -294,8 +294,9 @@ std::string format_table(const Report& r) {
     fmt::format_to(to, "# {}\n", fit_summary(f));
     if (!f.fit.quantization_white)
       fmt::format_to(to,
-                     "#   quantization is not white (the short taus do not follow white quantization: a steady rate "
-                     "makes a periodic pattern without dither): points it reaches left out ({}), Q held at "
+                     "#   quantization is not white (the angle moves too little between samples: a steady rate "
+                     "quantizes into a pattern, white rate noise of less than about a pulse a sample into a "
+                     "correlated error; dither whitens it): points it reaches left out ({}), Q held at "
                      "pulse weight / sqrt(12)\n",
                      excluded_text(f.fit));
     if (f.fit.status == FitStatus::too_few_points || f.fit.status == FitStatus::singular) continue;

@@ -269,11 +269,30 @@ TEST(Ieee952, PeriodicQuantizationIsDetectedAndItsTausLeftOut) {
   EXPECT_GT(f.excluded_below_tau_s[0], tau0);
   EXPECT_FALSE(f.p[0].fitted);
   EXPECT_NEAR(f.p[1].value / truth[1], 1.0, 1e-3);  // N from the taus quantization leaves alone
-  // The same curve without the deficit: white, nothing left out.
-  const Ieee952Fit white = fit(exact_points(p), FitCurve::both, qw);
+  // The same curve without the deficit, from pulses half as large (Q = 2 Q_w: white angle noise of
+  // half a pulse rms whitens them): white, nothing left out.
+  const Ieee952Fit white = fit(exact_points(p), FitCurve::both, qw / 2);
   EXPECT_TRUE(white.quantization_white);
   EXPECT_EQ(white.excluded_below_tau_s[0], 0.0);
   EXPECT_EQ(white.excluded_below_tau_s[1], 0.0);
+}
+
+TEST(Ieee952, QuantizationOfAnAngleMovingLessThanAPulseASampleIsNotWhite) {
+  // The white model's own curve, but every bit of Q is quantization (Q = Q_w) and N moves the angle
+  // by N sqrt(tau0) = 0.16 pulse rms a sample. Oracle: the sawtooth's Fourier series (the comment
+  // above quantization_correlated(), docs/metrology.md): the error's lag-1 correlation can reach
+  // 0.6 exp(-2 pi^2 0.16^2) = 0.36, far beyond what points this precise allow, so Q is held and its
+  // taus left out. Four times the N (0.64 pulse a sample: exp(-2 pi^2 0.41) = 3e-4) stays white.
+  const double qw = truth[0];
+  const Ieee952Fit f = fit(exact_points(truth), FitCurve::both, qw);
+  EXPECT_FALSE(f.quantization_white);
+  EXPECT_FALSE(f.p[0].fitted);
+  EXPECT_NEAR(f.p[1].value / truth[1], 1.0, 1e-3);
+  auto moving = truth;
+  moving[1] *= 4;
+  const Ieee952Fit white = fit(exact_points(moving), FitCurve::both, qw);
+  EXPECT_TRUE(white.quantization_white);
+  EXPECT_NEAR(white.p[0].value / truth[0], 1.0, 1e-3);
 }
 
 TEST(Ieee952, APatternAboveTheWhiteLevelIsFoundAfterTheFit) {
