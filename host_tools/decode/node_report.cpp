@@ -351,7 +351,7 @@ std::string decode_html(const Decoder& decoder, const InputCounters& input, cons
     const auto& s = node.ieee952_summary;
     doc.table(id + "-fit",
               s ? fmt::format("IEEE-952 fit: {}, chi2/dof {:.3g}, {} points, quantization {}", protocol::name(s->status),
-                              s->chi2_per_dof, s->points, s->quantization_white ? "white" : "periodic")
+                              s->chi2_per_dof, s->points, s->quantization_white ? "white" : "not white (Q held)")
                 : std::string("IEEE-952 fit: no summary received"),
               {"term", "value", "standard uncertainty", "unit", "status"}, terms);
     model_table(doc, node, u, id);

@@ -194,7 +194,7 @@ struct Ieee952Fit {
   std::size_t dof = 0;                           // points used minus terms fitted
   double birge = 1;                              // factor applied to the uncertainties (>= 1)
   std::size_t points = 0;                        // points used
-  bool quantization_white = true;                // false: periodic quantization detected (counts only)
+  bool quantization_white = true;                // false: non-white quantization found (counts only)
   std::array<double, 2> excluded_below_tau_s{};  // AVAR, MVAR points below these taus left out (non-white)
   std::array<MarkovTerm, max_markov> markov{};   // the first n_markov are in the model
   std::size_t n_markov = 0;

@@ -243,7 +243,7 @@ struct Ieee952SummaryMsg {
   float chi2_per_dof = 0.0f;       // generalized chi-squared per degree of freedom; finite, >= 0
                                    // (0 when no fit was made or no degree of freedom was left)
   std::uint32_t points = 0;        // points (AVAR and MVAR estimates) the fit used; 8 bits, saturates
-  bool quantization_white = true;  // false: periodic quantization of the counts was detected, the
+  bool quantization_white = true;  // false: the quantization of the counts is not white, the
                                    // short taus it reaches were left out and Q was held at
                                    // pulse weight / sqrt(12) rather than fitted
   /// AVAR [0] and MVAR [1] points with averaging factor m < 2^c were left out of the fit because of
