@@ -43,6 +43,9 @@ constexpr int band_octaves = 10;
 constexpr double quantization_left_out = 0.01;  // share of a point that makes it unusable (non-white)
 constexpr double bandwidth_left_out = 0.01;     // change of white rate noise by the sensor's filter, likewise
 constexpr double pi = 3.14159265358979323846;
+// A criterion difference of 2 ln 19: the runner-up keeps 1/20 of the chosen model's weight (the
+// Bayesian information criterion's approximation of the evidence), the odds of a 2-sigma result.
+constexpr double model_doubt = 5.8888779583328805;
 
 // The terms of one candidate model beyond the five: columns 5.. are its Markov terms, then its
 // sinusoids; the filter changes N's column.
@@ -154,5 +157,6 @@ bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const 
                    Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd, bool with_profile = true);
 void profile_markov_terms(Problem& pr, const Flags& free, const Terms& fixed, std::array<double, max_markov + 1>& nl_sd);
 bool markov_terms_hold(const Candidate& more, const Candidate& fewer);
+bool column_significant(const Candidate& c, std::size_t t);
 
 }  // namespace gyrochar::ieee952_fit

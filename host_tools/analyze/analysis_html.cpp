@@ -111,6 +111,7 @@ void fit_tables(html::Document& doc, const Report& r) {
                       p.fitted ? number(p.uncertainty / u.si) : Cell{}, text(u.name),
                       text(!p.fitted    ? "not in model"
                            : p.resolved ? "resolved"
+                           : p.doubted  ? "not resolved (the runner-up model does without it)"
                                         : "not resolved")});
       if (r.truth && f == 0) rows.back().push_back(truth);
     }

@@ -325,7 +325,10 @@ std::string format_table(const Report& r) {
         fmt::format_to(to, "#   {} = {:.4g} {}  (held, not fitted){}\n", fu.letter, p.value / fu.si, fu.name, truth);
       else
         fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}{}\n", fu.letter, p.value / fu.si, p.uncertainty / fu.si, fu.name,
-                       p.resolved ? "" : "  (not resolved)", truth);
+                       p.resolved  ? ""
+                       : p.doubted ? "  (not resolved: the runner-up model, close by the criterion, does without it)"
+                                   : "  (not resolved)",
+                       truth);
     }
     const FitUnit& rate = fit_units(u)[2];  // B's unit: a rate
     if (f.fit.bandwidth_tc_s > 0)
@@ -495,11 +498,9 @@ nlohmann::json to_json(const Report& r) {
       for (std::size_t i = 0; i < 5; ++i) {
         const FitUnit& fu = fit_units(u)[i];
         const Ieee952Parameter& p = fit.p[i];
-        one[fu.letter] = {{"value", p.value / fu.si},
-                          {"uncertainty", p.uncertainty / fu.si},
-                          {"fitted", p.fitted},
-                          {"resolved", p.resolved},
-                          {"unit", fu.name}};
+        one[fu.letter] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si},
+                          {"fitted", p.fitted},       {"resolved", p.resolved},
+                          {"doubted", p.doubted},     {"unit", fu.name}};
         if (p.unconstrained_uncertainty > 0)  // what a verdict judges (docs/metrology.md, "Acceptance limits")
           one[fu.letter]["unconstrained"] = {{"value", p.unconstrained / fu.si},
                                              {"uncertainty", p.unconstrained_uncertainty / fu.si}};

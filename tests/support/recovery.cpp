@@ -237,12 +237,21 @@ void tally_markov(std::array<TermTally, tallied_terms>& terms, const Ieee952Fit&
     tally_value(terms[6], 0, f.ok(), f.n_markov > 0, resolved, 0, 0);
     return;
   }
+  // Each fitted term stands for the simulated one nearest to it in ln Tc, and each simulated term
+  // takes the nearest of the fitted terms that stand for it: with one fitted term (20 s) for two
+  // simulated ones (20 s and 1 500 s), the 1 500 s term is not found, rather than compared with
+  // the 20 s one a second time.
+  auto distance = [](double a, double b) { return std::fabs(std::log(a / b)); };
   for (const MarkovRate& m : truth_si.markov) {
     std::size_t nearest = f.n_markov;
-    for (std::size_t j = 0; j < f.n_markov; ++j)
-      if (nearest == f.n_markov ||
-          std::fabs(std::log(f.markov[j].tc_s / m.tc_s)) < std::fabs(std::log(f.markov[nearest].tc_s / m.tc_s)))
+    for (std::size_t j = 0; j < f.n_markov; ++j) {
+      bool stands_for_m = true;
+      for (const MarkovRate& other : truth_si.markov)
+        if (distance(f.markov[j].tc_s, other.tc_s) < distance(f.markov[j].tc_s, m.tc_s)) stands_for_m = false;
+      if (stands_for_m &&
+          (nearest == f.n_markov || distance(f.markov[j].tc_s, m.tc_s) < distance(f.markov[nearest].tc_s, m.tc_s)))
         nearest = j;
+    }
     const bool found = nearest < f.n_markov;
     const MarkovTerm fitted = found ? f.markov[nearest] : MarkovTerm{};
     tally_value(terms[5], m.sigma_rad_s, f.ok(), found, found && fitted.sigma.resolved, fitted.sigma.value,

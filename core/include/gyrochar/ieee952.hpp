@@ -32,7 +32,10 @@
 // A term is "resolved" when it is fitted, its square lies more than two standard uncertainties
 // above zero, and it is the largest of the five contributions at one of the taus used at least (for R,
 // at the tau of an Allan or modified Allan point: a total-family point's expectation takes AVAR's
-// ramp response, which is not its own).
+// ramp response, which is not its own). B, K and R must also survive the choice of model: where the
+// runner-up of the model selection comes within 2 ln 19 of the chosen model by the criterion and
+// does without the term (not two standard uncertainties above zero there), it is not resolved
+// (`doubted`).
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
 // A steady rate without dither (and with too little random angle per sample to spread it) makes a
@@ -40,7 +43,9 @@
 // level 3 Q_w^2 / tau^2. Quantization is declared not white when, before the fit, a point the
 // white level alone would dominate lies below it, or when, after the fit (Q free: white angle
 // noise beyond quantization is in the model), a point the fitted Q dominates departs from the
-// model either way; both by three standard deviations and 2 %. Then every point with a
+// model either way; both by three standard deviations and 2 %; or when the angle moves so little
+// between samples (the fitted N, Q's excess over Q_w) that the quantization error's correlation
+// could move a point by half its standard deviation. Then every point with a
 // quantization share of 1 % or more is left out, Q is held at Q_w (not fitted) and the rest is
 // fitted again.
 //
@@ -138,6 +143,9 @@ struct Ieee952Parameter {
   double uncertainty = 0;  // standard uncertainty, same unit (scaled by the Birge ratio)
   bool fitted = false;     // part of the model the fit kept (false: left out, or held fixed)
   bool resolved = false;   // see the header
+  // B, K or R that the chosen model resolves but the runner-up, within model_doubt of it by the
+  // criterion, does without: not resolved (see the header).
+  bool doubted = false;
   // The same term in the model with every free term, its square not held non-negative: unbiased
   // where the model holds (the non-negative value above leans low or high where another term is
   // clipped at zero); 0 and 0 where the term was not free. What acceptance verdicts judge.
