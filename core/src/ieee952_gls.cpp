@@ -375,25 +375,39 @@ void pair_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache
 // The exact Markov sums of every pair of points for the Markov terms of pr.model (the power-law
 // noises' sums where pair_sums_of_points() kept them; the Markov terms' own at every pair: their c
 // is an exponential, without the rounding that far-apart power-law sums suffer). O(P^2 x nodes).
+// Rows are independent: row i writes the pairs (i, j), j <= i, alone, so a FitRowRunner may run
+// them on several threads. The longest rows first, so that threads finish together.
 void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
-  NoiseSet set;
-  for (std::size_t t = 0; t < noises; ++t) set.alpha[t] = alphas[t];
-  set.count = noises;
-  const std::span<const double> rates(pr.model.a.data(), pr.model.markov);
-  for (std::size_t i = 0; i < pr.n; ++i) {
-    const FitPoint& a = *pr.point[i];
-    const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
-    for (std::size_t j = 0; j <= i; ++j) {
-      const FitPoint& b = *pr.point[j];
-      const MarkovPairSums s = markov_pair_sums(set, rates, ga, unbroken_grid(b.stat, b.m, b.stride, setup.n_phase));
-      const double* g = pr.pair_at(i, j);
-      double* mg = pr.markov_pair_at(i, j);
-      for (std::size_t k = 0; k < max_markov; ++k) {
-        for (std::size_t t = 0; t < noises; ++t) mg[k * noises + t] = t == 0 || g[cc_index(t, t)] != 0 ? s.cm[k][t] : 0.0;
-        for (std::size_t l = 0; l < max_markov; ++l) mg[max_markov * noises + k * max_markov + l] = s.mm[k][l];
-        mg[max_markov * noises + max_markov * max_markov + k] = s.c[k];
+  struct Rows final : FitRows {
+    Problem& pr;
+    const FitSetup& setup;
+    NoiseSet set;
+    Rows(Problem& p, const FitSetup& s) : pr(p), setup(s) {
+      for (std::size_t t = 0; t < noises; ++t) set.alpha[t] = alphas[t];
+      set.count = noises;
+    }
+    void row(std::size_t r) override {
+      const std::span<const double> rates(pr.model.a.data(), pr.model.markov);
+      const std::size_t i = pr.n - 1 - r;
+      const FitPoint& a = *pr.point[i];
+      const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
+      for (std::size_t j = 0; j <= i; ++j) {
+        const FitPoint& b = *pr.point[j];
+        const MarkovPairSums s = markov_pair_sums(set, rates, ga, unbroken_grid(b.stat, b.m, b.stride, setup.n_phase));
+        const double* g = pr.pair_at(i, j);
+        double* mg = pr.markov_pair_at(i, j);
+        for (std::size_t k = 0; k < max_markov; ++k) {
+          for (std::size_t t = 0; t < noises; ++t) mg[k * noises + t] = t == 0 || g[cc_index(t, t)] != 0 ? s.cm[k][t] : 0.0;
+          for (std::size_t l = 0; l < max_markov; ++l) mg[max_markov * noises + k * max_markov + l] = s.mm[k][l];
+          mg[max_markov * noises + max_markov * max_markov + k] = s.c[k];
+        }
       }
     }
+  } rows(pr, setup);
+  if (setup.rows != nullptr) {
+    setup.rows->run(rows, pr.n);
+  } else {
+    for (std::size_t r = 0; r < pr.n; ++r) rows.row(r);
   }
   pr.exact_markov = true;
 }

@@ -1,10 +1,12 @@
 // The IEEE-952 fits of an analysis (analysis_report.hpp): the points of its Allan and modified
 // Allan curves, at long tau from the total family when asked (LongTau), the three fits, and a
 // simulation's truth read back from the file's header.
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <future>
 #include <initializer_list>
+#include <utility>
 
 #include "analysis_report.hpp"
 #include "gyrochar/greenhall_edf.hpp"
@@ -61,6 +63,66 @@ void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& 
   }
 }
 
+// The power-law pair sums of every two fit points, computed once, on two threads, before the fits,
+// which then only read them (a PairSumSource their caches ask first). Each pair is what
+// PairSumCache::get() makes for a fresh entry, so the fits see the same bits as when each cache made
+// its own. The fit of both curves needs every pair, and its Allan-with-modified-Allan pairs are the
+// dear ones: on one thread they were most of its time (perf, 10^6 counts).
+class PointPairSums final : public PairSumSource {
+ public:
+  PointPairSums(std::span<const FitPoint> points, std::uint64_t n_phase) {
+    for (const FitPoint& p : points) grids_.push_back(unbroken_grid(p.stat, p.m, p.stride, n_phase));
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t i = 0; i < grids_.size(); ++i)
+      for (std::size_t j = 0; j <= i; ++j) pairs.emplace_back(i, j);
+    sums_.resize(pairs.size());
+    std::atomic<std::size_t> next{0};  // the next pair either thread takes
+    const auto work = [&] {
+      std::vector<PairSumCache::Entry> entry(1);
+      PairSumCache cache(entry);
+      for (std::size_t k = next++; k < pairs.size(); k = next++) {
+        cache.clear();
+        sums_[k] = cache.get(grids_[pairs[k].first], grids_[pairs[k].second]);
+      }
+    };
+    auto helper = std::async(std::launch::async, work);
+    work();
+    helper.get();
+  }
+  // The sums of grids a and b as pairs (i, j), i >= j, of the points give them.
+  bool find(const TermGrid& a, const TermGrid& b, PairSums& out) const override {
+    const std::size_t i = index(a), j = index(b);
+    if (i == grids_.size() || j == grids_.size() || i < j) return false;
+    out = sums_[i * (i + 1) / 2 + j];
+    return true;
+  }
+
+ private:
+  std::size_t index(const TermGrid& g) const {
+    std::size_t i = 0;
+    while (i < grids_.size() && !(grids_[i].stat == g.stat && grids_[i].m == g.m && grids_[i].stride == g.stride &&
+                                  grids_[i].first == g.first && grids_[i].n == g.n))
+      ++i;
+    return i;
+  }
+  std::vector<TermGrid> grids_;
+  std::vector<PairSums> sums_;  // pair (i, j), i >= j, at i (i + 1) / 2 + j
+};
+
+// A fit's rows on this thread and one more, each thread taking the next row not yet taken.
+class TwoThreadRows final : public FitRowRunner {
+ public:
+  void run(FitRows& rows, std::size_t count) const override {
+    std::atomic<std::size_t> next{0};
+    const auto work = [&] {
+      for (std::size_t i = next++; i < count; i = next++) rows.row(i);
+    };
+    auto helper = std::async(std::launch::async, work);
+    work();
+    helper.get();
+  }
+};
+
 }  // namespace
 
 std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s, LongTau long_tau,
@@ -84,21 +146,24 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   if (points.empty()) return fits;
   FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
   setup.sinusoid_hz = sinusoid_hz;
+  const TwoThreadRows rows;
+  setup.rows = &rows;
   const int used = long_tau != LongTau::oadev && !record.phase.empty() ? static_cast<int>(long_tau) : 0;
-  // Fits in turn that share the covariance sums of their points (and the sinusoids' with them),
-  // computed once in a cache with room for every pair.
+  const PointPairSums sums(points, a.n_phase);
+  // Fits in turn that read those sums and share the sinusoids' (computed once in a cache with room
+  // for every pair).
   const auto fit_in_turn = [&](std::initializer_list<FitCurve> curves) {
     std::vector<CurveFit> out;
     std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
     std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
     std::vector<PairSumCache::SinusoidEntry> sinusoid_entries(points.size() * points.size() + 16);
     PairSumCache cache(entries, sinusoid_entries);
+    cache.attach(&sums);
     for (const FitCurve curve : curves)
       out.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache), curve == FitCurve::mvar ? 0 : used});
     return out;
   };
-  // Each curve alone on a second thread while this one fits both: the alone fits make the sums of
-  // their points again (the same to the last bit as the shared cache gave them), in the meantime.
+  // Each curve alone on a second thread while this one fits both.
   auto alone = std::async(std::launch::async, [&] { return fit_in_turn({FitCurve::avar, FitCurve::mvar}); });
   fits = fit_in_turn({FitCurve::both});
   for (CurveFit& f : alone.get()) fits.push_back(std::move(f));

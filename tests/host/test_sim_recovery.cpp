@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "analysis.hpp"
 #include "analysis_report.hpp"
@@ -33,6 +34,16 @@ Ieee952Fit recommended_fit(const SimOptions& s, const Analysis& a) {
   units.gyro = true;
   units.phase_unit_si = s.pulse_arcsec * units::arcsec;
   return fit_curves(a, units, s.tau0_s, units.phase_unit_si / std::sqrt(12.0)).at(0).fit;
+}
+
+// gyrochar-sim --duration 28800 --tau0 0.1 --arw 0.02 --markov 0.5,300 (seed 1).
+SimOptions markov_gyro() {
+  SimOptions s;
+  s.duration_s = 28800;
+  s.tau0_s = 0.1;
+  s.arw_deg_per_sqrt_h = 0.02;
+  s.markov = {{0.5, 300}};
+  return s;
 }
 
 TEST(SimulatedGyro, FitRecoversTheKnownParameters) {
@@ -98,15 +109,10 @@ TEST(SimulatedGyro, APatternAboveThePulseRateIsFoundAfterTheFit) {
 }
 
 TEST(SimulatedGyro, AMarkovTermComesBackBesideTheFiveTerms) {
-  // The documented Markov case: gyrochar-sim --duration 28800 --tau0 0.1 --arw 0.02 --markov 0.5,300 (seed 1)
-  // through the analyzer (octave taus, stride factor 8 here). The five terms alone take the hump for
-  // rate random walk; the selection must add the Markov term, within 3 stated sigma and 30 % of
-  // the simulated sigma and Tc.
-  SimOptions s;
-  s.duration_s = 28800;
-  s.tau0_s = 0.1;
-  s.arw_deg_per_sqrt_h = 0.02;
-  s.markov = {{0.5, 300}};
+  // The documented Markov case (markov_gyro()) through the analyzer (octave taus, stride factor 8
+  // here). The five terms alone take the hump for rate random walk; the selection must add the
+  // Markov term, within 3 stated sigma and 30 % of the simulated sigma and Tc.
+  const SimOptions s = markov_gyro();
   const Ieee952Fit f = recommended_fit(s, analyze(s));
   ASSERT_TRUE(f.ok()) << f.chi2_per_dof();
   ASSERT_EQ(f.n_markov, 1u);
@@ -123,6 +129,48 @@ TEST(SimulatedGyro, AMarkovTermComesBackBesideTheFiveTerms) {
   // as white, Q came out 2.6 % high at 5 stated sigma and N 1.5 % low at 3: Q is held instead.
   EXPECT_FALSE(f.quantization_white);
   EXPECT_FALSE(f.p[0].fitted);
+}
+
+TEST(SimulatedGyro, TheAnalyzersFitsOnThreadsGiveTheBitsOfEachFitAlone) {
+  // fit_curves() computes the power-law sums of every pair of points once, on two threads, and runs
+  // each fit's exact Markov sums on two threads. Oracle: each of its three fits made alone, in turn,
+  // with a cache of its own (how the analyzer made them before): every sum is computed the same
+  // way, so every figure must be the same to the last bit. The Markov gyro of the test above, whose
+  // model holds a Markov term (the exact Markov sums run).
+  const SimOptions s = markov_gyro();
+  const Analysis a = analyze(s);
+  ReportUnits units;
+  units.gyro = true;
+  units.phase_unit_si = s.pulse_arcsec * units::arcsec;
+  const double qw = units.phase_unit_si / std::sqrt(12.0);
+  const std::vector<CurveFit> threaded = fit_curves(a, units, s.tau0_s, qw);
+  ASSERT_EQ(threaded.size(), 3u);
+  const std::vector<FitPoint> points = fit_points(a, units, s.tau0_s);
+  for (const CurveFit& got : threaded) {
+    std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
+    std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
+    std::vector<PairSumCache::SinusoidEntry> sinusoid_entries(points.size() * points.size() + 16);
+    PairSumCache cache(entries, sinusoid_entries);
+    const Ieee952Fit want = fit_ieee952(points, {s.tau0_s, a.n_phase, qw}, got.curve, workspace, &cache);
+    const Ieee952Fit& f = got.fit;
+    SCOPED_TRACE(name(got.curve));
+    EXPECT_EQ(f.status, want.status);
+    EXPECT_EQ(f.chi2, want.chi2);
+    EXPECT_EQ(f.points, want.points);
+    for (std::size_t k = 0; k < 5; ++k) {
+      EXPECT_EQ(f.p[k].fitted, want.p[k].fitted) << k;
+      EXPECT_EQ(f.p[k].value, want.p[k].value) << k;
+      EXPECT_EQ(f.p[k].uncertainty, want.p[k].uncertainty) << k;
+    }
+    ASSERT_EQ(f.n_markov, want.n_markov);
+    for (std::size_t k = 0; k < f.n_markov; ++k) {
+      EXPECT_EQ(f.markov[k].sigma.value, want.markov[k].sigma.value) << k;
+      EXPECT_EQ(f.markov[k].sigma.uncertainty, want.markov[k].sigma.uncertainty) << k;
+      EXPECT_EQ(f.markov[k].tc_s, want.markov[k].tc_s) << k;
+      EXPECT_EQ(f.markov[k].tc_uncertainty_s, want.markov[k].tc_uncertainty_s) << k;
+    }
+  }
+  EXPECT_EQ(threaded[0].fit.n_markov, 1u) << "the recommended fit's model holds the Markov term";
 }
 
 }  // namespace
