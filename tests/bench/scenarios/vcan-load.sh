@@ -1,5 +1,5 @@
 #!/bin/bash
-# bench: timeout 260
+# bench: timeout 540
 # The decoder under load (vcan0, the kernel's vcan driver): 8 gyrochard nodes, each fed by its own
 # simulated gyro electronics, plus a flood of unrelated frames (can-utils' cangen, random 11-bit
 # identifiers, lengths and data) on the same bus; gyrochar-decode records from vcan0.
