@@ -66,7 +66,8 @@ const char* curve_title(FitCurve c);
 /// points in place of OADEV at long tau (an empty record: OADEV alone). white_quantization_si:
 /// the white-quantization level Q_w = pulse weight / sqrt(12) in rad for counts, 0 otherwise.
 /// O(points^2) covariance sums, on two threads (the same bits as each fit alone, in turn),
-/// allocates the workspace; empty when the analysis has neither curve. A fit that fails says why in its status.
+/// allocates the workspace; empty when the analysis has neither curve. A fit that fails says why
+/// in its status.
 /// sinusoid_hz: frequencies of sinusoids the model selection may add (Spectrum::fit_hz(); 0: none).
 std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, double tau0_s, double white_quantization_si,
                                  LongTau long_tau = LongTau::oadev, const PhaseRecord& record = {},
