@@ -378,15 +378,11 @@ void pair_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache
 // Rows are independent: row i writes the pairs (i, j), j <= i, alone, so a FitRowRunner may run
 // them on several threads. The longest rows first, so that threads finish together.
 void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
-  struct Rows final : FitRows {
+  struct Rows {
     Problem& pr;
     const FitSetup& setup;
     NoiseSet set;
-    Rows(Problem& p, const FitSetup& s) : pr(p), setup(s) {
-      for (std::size_t t = 0; t < noises; ++t) set.alpha[t] = alphas[t];
-      set.count = noises;
-    }
-    void row(std::size_t r) override {
+    void row(std::size_t r) const {
       const std::span<const double> rates(pr.model.a.data(), pr.model.markov);
       const std::size_t i = pr.n - 1 - r;
       const FitPoint& a = *pr.point[i];
@@ -403,11 +399,14 @@ void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
         }
       }
     }
-  } rows(pr, setup);
+  } rows{pr, setup, {}};
+  for (std::size_t t = 0; t < noises; ++t) rows.set.alpha[t] = alphas[t];
+  rows.set.count = noises;
+  const FitRows work{[](void* context, std::size_t r) { static_cast<const Rows*>(context)->row(r); }, &rows};
   if (setup.rows != nullptr) {
-    setup.rows->run(rows, pr.n);
+    setup.rows->run(work, pr.n);
   } else {
-    for (std::size_t r = 0; r < pr.n; ++r) rows.row(r);
+    for (std::size_t r = 0; r < pr.n; ++r) work.row(r);
   }
   pr.exact_markov = true;
 }

@@ -112,7 +112,7 @@ class PointPairSums final : public PairSumSource {
 // A fit's rows on this thread and one more, each thread taking the next row not yet taken.
 class TwoThreadRows final : public FitRowRunner {
  public:
-  void run(FitRows& rows, std::size_t count) const override {
+  void run(const FitRows& rows, std::size_t count) const override {
     std::atomic<std::size_t> next{0};
     const auto work = [&] {
       for (std::size_t i = next++; i < count; i = next++) rows.row(i);

@@ -116,20 +116,20 @@ inline constexpr std::size_t max_sinusoids = 2;  // sinusoids a model may have
 inline constexpr std::size_t max_fit_points = 128;
 
 /// Work a fit splits into independent rows (the exact Markov sums of every pair of points, a row
-/// of pairs at a time): row(i) for each i < count, each once, in any order, on any thread.
-class FitRows {
- public:
-  virtual void row(std::size_t i) = 0;
-
- protected:
-  ~FitRows() = default;
+/// of pairs at a time): row(i) for each i < count, each once, in any order, on any thread. A plain
+/// function and its context, not a virtual call: core is built without RTTI, and the sanitizers'
+/// type check in a host built with it would take a core object's vtable for an invalid one.
+struct FitRows {
+  void (*run_row)(void* context, std::size_t i) = nullptr;
+  void* context = nullptr;
+  void row(std::size_t i) const { run_row(context, i); }
 };
 
 /// What runs a fit's rows: a host that has threads spreads them over its cores; without one (the
 /// board, the MCU) the fit runs them in turn. run() returns once every row is done.
 class FitRowRunner {
  public:
-  virtual void run(FitRows& rows, std::size_t count) const = 0;
+  virtual void run(const FitRows& rows, std::size_t count) const = 0;
 
  protected:
   ~FitRowRunner() = default;
