@@ -1,6 +1,7 @@
 // The IEEE-952 fits of an analysis (analysis_report.hpp): the points of its Allan and modified
 // Allan curves, at long tau from the total family when asked (LongTau), the three fits, and a
 // simulation's truth read back from the file's header.
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -63,6 +64,18 @@ void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& 
   }
 }
 
+// body(i) for every i < count, on this thread and one more, each taking the next i not yet taken.
+template <class Body>
+void on_two_threads(std::size_t count, const Body& body) {
+  std::atomic<std::size_t> next{0};
+  const auto work = [&] {
+    for (std::size_t i = next++; i < count; i = next++) body(i);
+  };
+  auto helper = std::async(std::launch::async, work);
+  work();
+  helper.get();
+}
+
 // The power-law pair sums of every two fit points, computed once, on two threads, before the fits,
 // which then only read them (a PairSumSource their caches ask first). Each pair is what
 // PairSumCache::get() makes for a fresh entry, so the fits see the same bits as when each cache made
@@ -76,18 +89,11 @@ class PointPairSums final : public PairSumSource {
     for (std::size_t i = 0; i < grids_.size(); ++i)
       for (std::size_t j = 0; j <= i; ++j) pairs.emplace_back(i, j);
     sums_.resize(pairs.size());
-    std::atomic<std::size_t> next{0};  // the next pair either thread takes
-    const auto work = [&] {
-      std::vector<PairSumCache::Entry> entry(1);
+    on_two_threads(pairs.size(), [&](std::size_t k) {
+      std::array<PairSumCache::Entry, 1> entry{};
       PairSumCache cache(entry);
-      for (std::size_t k = next++; k < pairs.size(); k = next++) {
-        cache.clear();
-        sums_[k] = cache.get(grids_[pairs[k].first], grids_[pairs[k].second]);
-      }
-    };
-    auto helper = std::async(std::launch::async, work);
-    work();
-    helper.get();
+      sums_[k] = cache.get(grids_[pairs[k].first], grids_[pairs[k].second]);
+    });
   }
   // The sums of grids a and b as pairs (i, j), i >= j, of the points give them.
   bool find(const TermGrid& a, const TermGrid& b, PairSums& out) const override {
@@ -109,17 +115,11 @@ class PointPairSums final : public PairSumSource {
   std::vector<PairSums> sums_;  // pair (i, j), i >= j, at i (i + 1) / 2 + j
 };
 
-// A fit's rows on this thread and one more, each thread taking the next row not yet taken.
+// A fit's rows on two threads.
 class TwoThreadRows final : public FitRowRunner {
  public:
   void run(const FitRows& rows, std::size_t count) const override {
-    std::atomic<std::size_t> next{0};
-    const auto work = [&] {
-      for (std::size_t i = next++; i < count; i = next++) rows.row(i);
-    };
-    auto helper = std::async(std::launch::async, work);
-    work();
-    helper.get();
+    on_two_threads(count, [&](std::size_t i) { rows.row(i); });
   }
 };
 
