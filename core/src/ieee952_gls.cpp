@@ -375,10 +375,10 @@ void pair_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache
 // The exact Markov sums of every pair of points for the Markov terms of pr.model (the power-law
 // noises' sums where pair_sums_of_points() kept them; the Markov terms' own at every pair: their c
 // is an exponential, without the rounding that far-apart power-law sums suffer). O(P^2 x nodes).
-// Rows are independent: row i writes the pairs (i, j), j <= i, alone, so a FitRowRunner may run
+// Rows are independent: row i writes the pairs (i, j), j <= i, alone, so a RowRunner may run
 // them on several threads. The longest rows first, so that threads finish together.
 void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
-  struct Rows {
+  struct MarkovRows {
     Problem& pr;
     const FitSetup& setup;
     NoiseSet set;
@@ -402,12 +402,7 @@ void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
   } rows{pr, setup, {}};
   for (std::size_t t = 0; t < noises; ++t) rows.set.alpha[t] = alphas[t];
   rows.set.count = noises;
-  const FitRows work{[](void* context, std::size_t r) { static_cast<const Rows*>(context)->row(r); }, &rows};
-  if (setup.rows != nullptr) {
-    setup.rows->run(work, pr.n);
-  } else {
-    for (std::size_t r = 0; r < pr.n; ++r) work.row(r);
-  }
+  run_rows(setup.rows, {[](void* context, std::size_t r) { static_cast<const MarkovRows*>(context)->row(r); }, &rows}, pr.n);
   pr.exact_markov = true;
 }
 

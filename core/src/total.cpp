@@ -172,7 +172,7 @@ std::uint64_t theo_bias_index(std::uint64_t j, std::uint64_t count, std::uint64_
 }
 
 TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
-                              std::uint64_t ratio_taus) {
+                              std::uint64_t ratio_taus, const RowRunner* runner) {
   const std::uint64_t N = x.size();
   if (N < 24 || ratio_taus < 2 || !(tau0_s > 0)) return {};
   const std::uint64_t last = theo_bias_last(N);
@@ -180,14 +180,33 @@ TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uin
   TheoBiasRatio out;
   out.defined = last + 1;
   out.exact = count == last + 1 && stride_factor == 0;
+  // The taus a batch at a time, each AVAR / Theo1 in its slot (no heap), then summed in order.
+  constexpr std::uint64_t batch = 64;
+  struct Batch {
+    std::span<const double> x;
+    double tau0_s;
+    std::uint32_t S;
+    std::uint64_t count, last, first = 0;
+    double term[batch] = {};
+    bool defined[batch] = {};
+    void row(std::size_t k) {
+      const std::uint64_t i = theo_bias_index(first + k, count, last);
+      const std::uint64_t mt = 12 + 4 * i, ma = 9 + 3 * i;
+      const TotalVariance t = theo1(x, mt, tau0_s, S == 0 || mt <= S ? 1 : mt / S);
+      const TotalVariance a = oavar(x, ma, tau0_s, S == 0 || ma <= S ? 1 : ma / S);
+      defined[k] = t.n != 0 && a.n != 0 && t.var > 0;
+      term[k] = defined[k] ? a.var / t.var : 0.0;
+    }
+  } taus{x, tau0_s, stride_factor, count, last};
+  const Rows rows{[](void* context, std::size_t k) { static_cast<Batch*>(context)->row(k); }, &taus};
   double sum = 0.0;
-  for (std::uint64_t j = 0; j < count; ++j) {
-    const std::uint64_t i = theo_bias_index(j, count, last);
-    const std::uint64_t mt = 12 + 4 * i, ma = 9 + 3 * i;
-    const TotalVariance t = theo1(x, mt, tau0_s, stride_factor == 0 || mt <= stride_factor ? 1 : mt / stride_factor);
-    const TotalVariance a = oavar(x, ma, tau0_s, stride_factor == 0 || ma <= stride_factor ? 1 : ma / stride_factor);
-    if (t.n == 0 || a.n == 0 || !(t.var > 0)) return {};
-    sum += a.var / t.var;
+  for (; taus.first < count; taus.first += batch) {
+    const std::uint64_t size = count - taus.first < batch ? count - taus.first : batch;
+    run_rows(runner, rows, size);
+    for (std::uint64_t k = 0; k < size; ++k) {
+      if (!taus.defined[k]) return {};
+      sum += taus.term[k];
+    }
   }
   out.ratio = sum / as_double(count);
   out.taus = count;

@@ -2,16 +2,15 @@
 // Allan curves, at long tau from the total family when asked (LongTau), the three fits, and a
 // simulation's truth read back from the file's header.
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
-#include <future>
 #include <initializer_list>
 #include <utility>
 
 #include "analysis_report.hpp"
 #include "gyrochar/greenhall_edf.hpp"
 #include "gyrochar/total.hpp"
+#include "threads.hpp"
 
 namespace gyrochar {
 
@@ -51,7 +50,8 @@ void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& 
   const std::uint64_t k = theoh_switch(x.size());
   std::erase_if(points, [&](const FitPoint& p) { return p.stat == Stat::avar && p.m >= k; });
   constexpr std::uint32_t S = 16;
-  const double ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(x.size(), S)).ratio;
+  const ThreadRows threads(2);
+  const double ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(x.size(), S), &threads).ratio;
   if (!(ratio > 0)) return;
   for (std::uint64_t mt = 2 * k; 2 * (3 * mt / 4) + 1 <= x.size(); mt *= 2) {
     const std::uint64_t m = 3 * mt / 4;  // tau = 0.75 mt tau0: the Allan geometry at m
@@ -62,18 +62,6 @@ void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& 
     const double var = theo1(x, mt, tau0, theo1_stride(mt, x.size(), S)).var * ratio * unit * unit;
     points.push_back({Stat::avar, m, 1, x.size() - 2 * m, var, edf, edf_a / edf});
   }
-}
-
-// body(i) for every i < count, on this thread and one more, each taking the next i not yet taken.
-template <class Body>
-void on_two_threads(std::size_t count, const Body& body) {
-  std::atomic<std::size_t> next{0};
-  const auto work = [&] {
-    for (std::size_t i = next++; i < count; i = next++) body(i);
-  };
-  auto helper = std::async(std::launch::async, work);
-  work();
-  helper.get();
 }
 
 // The power-law pair sums of every two fit points, computed once, on two threads, before the fits,
@@ -89,7 +77,7 @@ class PointPairSums final : public PairSumSource {
     for (std::size_t i = 0; i < grids_.size(); ++i)
       for (std::size_t j = 0; j <= i; ++j) pairs.emplace_back(i, j);
     sums_.resize(pairs.size());
-    on_two_threads(pairs.size(), [&](std::size_t k) {
+    on_threads(2, pairs.size(), [&](unsigned, std::size_t k) {
       std::array<PairSumCache::Entry, 1> entry{};
       PairSumCache cache(entry);
       sums_[k] = cache.get(grids_[pairs[k].first], grids_[pairs[k].second]);
@@ -115,14 +103,6 @@ class PointPairSums final : public PairSumSource {
   std::vector<PairSums> sums_;  // pair (i, j), i >= j, at i (i + 1) / 2 + j
 };
 
-// A fit's rows on two threads.
-class TwoThreadRows final : public FitRowRunner {
- public:
-  void run(const FitRows& rows, std::size_t count) const override {
-    on_two_threads(count, [&](std::size_t i) { rows.row(i); });
-  }
-};
-
 }  // namespace
 
 std::vector<FitPoint> fit_points(const Analysis& a, const ReportUnits& units, double tau0_s, LongTau long_tau,
@@ -146,7 +126,7 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   if (points.empty()) return fits;
   FitSetup setup{tau0_s, a.n_phase, white_quantization_si};
   setup.sinusoid_hz = sinusoid_hz;
-  const TwoThreadRows rows;
+  const ThreadRows rows(2);
   setup.rows = &rows;
   const int used = long_tau != LongTau::oadev && !record.phase.empty() ? static_cast<int>(long_tau) : 0;
   const PointPairSums sums(points, a.n_phase);

@@ -2,6 +2,7 @@
 
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -12,6 +13,7 @@
 #include "gyrochar/total.hpp"
 #include "gyrochar/total_fast.hpp"
 #include "plan.hpp"
+#include "threads.hpp"
 
 namespace gyrochar {
 namespace {
@@ -47,6 +49,18 @@ AnalysisRow make_row(DevStat stat, std::uint64_t m, double tau_s, const TotalVar
 // Whether the Allan row has an identified (or given) alpha: else no bias correction, no EDF.
 bool known(const AnalysisRow* r) { return r != nullptr && r->alpha.has_value(); }
 
+// estimate(worker, m) at every m, the largest first (the dearest: threads then finish together), on
+// `threads` threads. Each m's estimate is the same bits on any thread.
+template <class Estimate>
+std::vector<TotalVariance> estimates(const std::vector<std::uint64_t>& ms, unsigned threads, const Estimate& estimate) {
+  std::vector<TotalVariance> v(ms.size());
+  on_threads(threads, ms.size(), [&](unsigned worker, std::size_t i) {
+    const std::size_t k = ms.size() - 1 - i;
+    v[k] = estimate(worker, ms[k]);
+  });
+  return v;
+}
+
 // Theo1, or TheoH (the overlapping ADEV rows below its switch point, TheoBR above): k2 is
 // phase_scale squared.
 std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, double k2, const AnalysisOptions& o,
@@ -56,6 +70,7 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
   const double n = static_cast<double>(N), tau0 = o.tau0_s;
   const std::uint32_t S = o.total_stride_factor;
   const std::uint64_t k = theoh_switch(N);
+  const unsigned threads = std::min(thread_count(o.threads), 2u);
   double ratio = 1.0;
   if (stat == DevStat::theoh) {
     for (const AnalysisRow& r : allan)
@@ -64,25 +79,32 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
         a.stat = DevStat::theoh;
         rows.push_back(a);
       }
-    ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S)).ratio;
+    const ThreadRows runner(threads);
+    ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S), &runner).ratio;
     if (!(ratio > 0)) return rows;
   }
   // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for or its
   // workspace would pass the memory budget (plan.hpp): the record prepared once for the run
   // (O(N log N), 4 N + 2 fft_length(2 N) doubles and the twiddle table, shared with MTOTDEV), then
-  // each tau. The rows' stride says which estimator ran.
+  // each tau, on a view of its own per thread. The rows' stride says which estimator ran.
   const bool decimated = o.theo_decimated || 8 * static_cast<std::uint64_t>(theo1_workspace_size(N)) > memory_budget();
-  auto estimate = [&](std::uint64_t m) {
-    if (decimated) return theo1(x, m, tau0, theo1_stride(m, N, S));
-    return theo1_fast(lag_sums.prepared(x, false), m, tau0);
-  };
-  for (const std::uint64_t m : o.theo_m_list) {
-    if (stat == DevStat::theoh && 3 * m < 4 * k) continue;  // 0.75 m < k: ADEV's part
-    const TotalVariance v = estimate(m);
-    if (v.n == 0) continue;
+  std::vector<std::uint64_t> ms;
+  for (const std::uint64_t m : o.theo_m_list)
+    if (stat != DevStat::theoh || 3 * m >= 4 * k) ms.push_back(m);  // TheoH: 0.75 m < k is ADEV's part
+  if (ms.empty()) return rows;
+  std::vector<TotalVariance> v;
+  if (decimated) {
+    v = estimates(ms, threads, [&](unsigned, std::uint64_t m) { return theo1(x, m, tau0, theo1_stride(m, N, S)); });
+  } else {
+    const std::span<LagSumView> views = lag_sums.views(x, false, threads);
+    v = estimates(ms, views.size(), [&](unsigned t, std::uint64_t m) { return theo1_fast(*views[t].work, m, tau0); });
+  }
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    const std::uint64_t m = ms[i];
+    if (v[i].n == 0) continue;
     const AnalysisRow* a = allan_row(allan, DevStat::oadev, 0.75 * static_cast<double>(m));
     const double edf = known(a) ? edf_theo1(*a->alpha, n, static_cast<double>(m)) : 0.0;
-    rows.push_back(make_row(stat, m, 0.75 * static_cast<double>(m) * tau0, v, v.var * ratio * k2, a, edf, o));
+    rows.push_back(make_row(stat, m, 0.75 * static_cast<double>(m) * tau0, v[i], v[i].var * ratio * k2, a, edf, o));
   }
   return rows;
 }
@@ -94,68 +116,67 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
   const std::uint64_t N = x.size();
   const double n = static_cast<double>(N), tau0 = o.tau0_s;
   const std::uint32_t S = o.total_stride_factor;
-  std::vector<double> blocks, scratch;
+  const unsigned threads = std::min(thread_count(o.threads), 2u);
+  const bool hadamard = stat == DevStat::htotdev;
+  std::vector<std::uint64_t> ms;  // the taus the record allows
+  for (const std::uint64_t m : o.m_list) {
+    if (stat == DevStat::totdev ? m > N / 2 : 3 * m > (hadamard ? N - 1 : N)) break;
+    ms.push_back(m);
+  }
+  if (ms.empty()) return rows;
 
   // MTOTVAR (and TTOTVAR) and HTOTVAR exact at every tau by lag sums (total_fast.hpp) unless the
   // decimated plan is asked for or the workspace would pass the memory budget: the record (for
-  // HTOTVAR its frequencies) prepared once as for Theo1, then O(m log m) a tau. The rows' stride
-  // says which estimator ran.
-  const bool hadamard = stat == DevStat::htotdev;
+  // HTOTVAR its frequencies) prepared once as for Theo1, then O(m log m) a tau, on a view of its own
+  // per thread. TOTVAR reads the record alone (O(N) a tau): its taus go on the threads too. The
+  // decimated plan's taus share their buffers and go in turn. The rows' stride says which estimator ran.
   const std::size_t n_fast = hadamard ? N - 1 : N, fast_size = theo1_workspace_size(n_fast) + mtotvar_scratch_size(n_fast);
   const bool total_decimated = o.total_decimated || N < 2 ||
                                8 * (static_cast<std::uint64_t>(fast_size) + N) > memory_budget();
-  auto exact = [&](std::uint64_t m) {
-    Theo1Workspace& prepared = lag_sums.prepared(x, hadamard);  // HTOTVAR: the frequencies times tau0
-    return hadamard ? htotvar_fast(prepared, lag_sums.scratch(), m, tau0)
-                    : mtotvar_fast(prepared, lag_sums.scratch(), m, tau0);
-  };
-  auto mtot_estimate = [&](std::uint64_t m) {
-    if (!total_decimated) return exact(m);
-    const std::uint64_t b = total_block(m, N, S);
-    scratch.resize(total_scratch_size(m, b));
-    if (b > 1 && blocks.empty()) blocks.resize(N / 2);
-    return b == 1 ? mtotvar(x, 1, m, tau0, scratch) : mtotvar(block_sums(x, b, blocks), b, m, tau0, scratch);
-  };
-  auto htot_estimate = [&](std::uint64_t m) {  // m = 1: the overlapping Hadamard variance, O(N)
-    if (!total_decimated && m > 1) return exact(m);
-    const std::uint64_t b = total_block(m, N, S);
-    scratch.resize(total_scratch_size(m, b));
-    return htotvar(x, b, m, tau0, scratch);
-  };
+  std::vector<TotalVariance> v;
+  if (stat == DevStat::totdev) {
+    v = estimates(ms, threads, [&](unsigned, std::uint64_t m) { return totvar(x, m, tau0); });
+  } else if (!total_decimated) {
+    const std::span<LagSumView> views = lag_sums.views(x, hadamard, threads);  // HTOTVAR: the frequencies times tau0
+    v = estimates(ms, views.size(), [&](unsigned t, std::uint64_t m) {
+      const LagSumView& view = views[t];
+      if (!hadamard) return mtotvar_fast(*view.work, view.scratch, m, tau0);
+      if (m > 1) return htotvar_fast(*view.work, view.scratch, m, tau0);
+      std::vector<double> scratch(total_scratch_size(1, 1));  // m = 1: the overlapping Hadamard variance, O(N)
+      return htotvar(x, 1, 1, tau0, scratch);
+    });
+  } else {
+    std::vector<double> blocks, scratch;
+    v = estimates(ms, 1, [&](unsigned, std::uint64_t m) {
+      const std::uint64_t b = total_block(m, N, S);
+      scratch.resize(total_scratch_size(m, b));
+      if (hadamard) return htotvar(x, b, m, tau0, scratch);
+      if (b > 1 && blocks.empty()) blocks.resize(N / 2);
+      return b == 1 ? mtotvar(x, 1, m, tau0, scratch) : mtotvar(block_sums(x, b, blocks), b, m, tau0, scratch);
+    });
+  }
 
-  for (const std::uint64_t m : o.m_list) {
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    const std::uint64_t m = ms[i];
     const double md = static_cast<double>(m);
-    TotalVariance v;
+    if (v[i].n == 0) continue;
     if (stat == DevStat::totdev) {
-      if (m > N / 2) break;
-      v = totvar(x, m, tau0);
-      if (v.n == 0) continue;
       const AnalysisRow* a = allan_row(allan, DevStat::oadev, md);
       const double bias = known(a) ? totvar_bias(*a->alpha, n, md) : 1.0;
       double edf = known(a) ? edf_totvar(*a->alpha, n, md) : 0.0;
       if (!(edf > 0) && a != nullptr && a->m == m) edf = a->edf;  // PM noise: the OADEV estimate's
-      rows.push_back(make_row(stat, m, md * tau0, v, v.var / bias * k2, a, edf, o));
-      continue;
-    }
-    if (stat == DevStat::mtotdev || stat == DevStat::ttotdev) {
-      if (3 * m > N) break;
-      v = mtot_estimate(m);
-      if (v.n == 0) continue;
+      rows.push_back(make_row(stat, m, md * tau0, v[i], v[i].var / bias * k2, a, edf, o));
+    } else if (!hadamard) {
       const AnalysisRow* a = allan_row(allan, DevStat::mdev, md);
       const double edf = known(a) ? edf_mtotvar(*a->alpha, n, md) : 0.0;
       const double tdev = stat == DevStat::ttotdev ? md * tau0 * md * tau0 / 3.0 : 1.0;
-      rows.push_back(make_row(stat, m, md * tau0, v, v.var * tdev * k2, a, edf, o));
-      continue;
-    }
-    if (stat == DevStat::htotdev) {
-      if (3 * m > N - 1) break;
-      v = htot_estimate(m);
-      if (v.n == 0) continue;
+      rows.push_back(make_row(stat, m, md * tau0, v[i], v[i].var * tdev * k2, a, edf, o));
+    } else {
       const AnalysisRow* a = allan_row(allan, DevStat::ohdev, md);
       const double bias = known(a) ? htotvar_bias(*a->alpha, m) : 1.0;
       double edf = known(a) && m >= 16 ? edf_htotvar(*a->alpha, n, md) : 0.0;
       if (!(edf > 0) && a != nullptr && a->m == m) edf = a->edf;  // below m = 16, or PM noise: OHDEV's
-      rows.push_back(make_row(stat, m, md * tau0, v, v.var / bias * k2, a, edf, o));
+      rows.push_back(make_row(stat, m, md * tau0, v[i], v[i].var / bias * k2, a, edf, o));
     }
   }
   return rows;
@@ -181,30 +202,38 @@ HugeArray huge_array(std::size_t n) {
   return HugeArray(static_cast<double*>(p));
 }
 
-Theo1Workspace& LagSumRecord::prepared(std::span<const double> x, bool frequencies) {
+std::span<LagSumView> LagSumRecord::views(std::span<const double> x, bool frequencies, unsigned threads) {
   const std::size_t n = frequencies ? x.size() - 1 : x.size();
-  if (w_.ready && frequencies_ == frequencies && w_.r.size() == n) return w_;
-  w_ = {};
-  work_.reset();  // the other kind's preparation goes before this one's is allocated
-  y_.clear();
-  if (frequencies) {
-    y_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) y_[i] = x[i + 1] - x[i];
-  }
-  work_ = huge_array(theo1_workspace_size(n));
-  w_ = theo1_prepare(frequencies ? std::span<const double>(y_) : x, {work_.get(), theo1_workspace_size(n)});
-  frequencies_ = frequencies;
-  return w_;
-}
-
-std::span<double> LagSumRecord::scratch() {
-  const std::size_t size = mtotvar_scratch_size(w_.r.size());
-  if (scratch_size_ < size) {
+  if (!(w_.ready && frequencies_ == frequencies && w_.r.size() == n)) {
+    w_ = second_ = {};
+    views_ = {};
+    work_.reset();  // the other kind's preparation goes before this one's is allocated
     scratch_.reset();
-    scratch_ = huge_array(size);
-    scratch_size_ = size;
+    second_buffer_.reset();
+    second_scratch_.reset();
+    y_.clear();
+    if (frequencies) {
+      y_.resize(n);
+      for (std::size_t i = 0; i < n; ++i) y_[i] = x[i + 1] - x[i];
+    }
+    work_ = huge_array(theo1_workspace_size(n));
+    w_ = theo1_prepare(frequencies ? std::span<const double>(y_) : x, {work_.get(), theo1_workspace_size(n)});
+    scratch_ = huge_array(mtotvar_scratch_size(n));
+    views_[0] = {&w_, {scratch_.get(), mtotvar_scratch_size(n)}};
+    frequencies_ = frequencies;
   }
-  return {scratch_.get(), size};
+  // A second thread's buffer and scratch, where the budget holds them beside the record and the
+  // preparation (its fixed-term layout depends on the buffer's size: the same size, the same bits).
+  const std::uint64_t both = 8 * (static_cast<std::uint64_t>(theo1_workspace_size(n)) + 2 * mtotvar_scratch_size(n) +
+                                  w_.buffer.size() + x.size() + y_.size());
+  if (threads >= 2 && views_[1].work == nullptr && w_.ready && both <= memory_budget()) {
+    second_buffer_ = huge_array(w_.buffer.size());
+    second_scratch_ = huge_array(mtotvar_scratch_size(n));
+    second_ = w_;
+    second_.buffer = {second_buffer_.get(), w_.buffer.size()};
+    views_[1] = {&second_, {second_scratch_.get(), mtotvar_scratch_size(n)}};
+  }
+  return std::span<LagSumView>(views_).first(threads >= 2 && views_[1].work != nullptr ? 2 : 1);
 }
 
 std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, double phase_scale, const AnalysisOptions& o,

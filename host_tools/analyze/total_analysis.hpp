@@ -10,6 +10,7 @@
 // HTOTDEV below m = 16 or for PM noise). Where alpha is known the deviations carry Stable32's bias
 // corrections (TOTDEV for flicker and random-walk FM, HTOTDEV for alpha <= 0). TheoH's rows below
 // its switch point are the overlapping ADEV rows themselves.
+#include <array>
 #include <memory>
 #include <span>
 #include <vector>
@@ -29,23 +30,31 @@ struct FreeDoubles {
 using HugeArray = std::unique_ptr<double[], FreeDoubles>;
 HugeArray huge_array(std::size_t n);
 
+/// One thread's access to the prepared record: the preparation itself, or a copy of it with an FFT
+/// buffer of its own (the rest is read only by the taus), and its MTOTVAR scratch.
+struct LagSumView {
+  Theo1Workspace* work = nullptr;
+  std::span<double> scratch;
+};
+
 /// The record prepared for the lag sums (total_fast.hpp), kept between the statistics of one run:
 /// Theo1, TheoH, MTOTDEV and TTOTDEV share the preparation of the phase points, HTOTDEV prepares
-/// their first differences. One preparation is held at a time (at 10^7 points 1.5 GB), the other
-/// kind replacing it; MTOTVAR's scratch is allocated beside it on first use.
+/// their first differences. One preparation is held at a time (at 10^7 points 0.9 GB), the other
+/// kind replacing it. A second thread's FFT buffer and scratch are allocated beside it on first
+/// use, when the memory budget has room for them (2 fft_length(2 N) + N doubles: 0.6 GB at 10^7,
+/// touched only as far as that thread's taus reach).
 class LagSumRecord {
  public:
-  /// The preparation of x (frequencies: of y[k] = x[k+1] - x[k]), made on first use.
-  Theo1Workspace& prepared(std::span<const double> x, bool frequencies);
-  /// mtotvar_scratch_size of the prepared record's length, allocated on first use.
-  std::span<double> scratch();
+  /// The preparation of x (frequencies: of y[k] = x[k+1] - x[k]), made on first use, as one view per
+  /// thread for up to `threads` threads (1 or 2). The first view is the preparation's own.
+  std::span<LagSumView> views(std::span<const double> x, bool frequencies, unsigned threads);
 
  private:
-  HugeArray work_, scratch_;  // not zero-filled: prepare writes before it reads
+  HugeArray work_, scratch_, second_buffer_, second_scratch_;  // not zero-filled: each writes before it reads
   std::vector<double> y_;
-  Theo1Workspace w_;
+  Theo1Workspace w_, second_;
+  std::array<LagSumView, 2> views_{};
   bool frequencies_ = false;
-  std::size_t scratch_size_ = 0;
 };
 
 /// The rows of total statistic `stat` (is_total(stat)) of phase points `phase` (phase unit /

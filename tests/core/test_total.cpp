@@ -241,6 +241,26 @@ TEST(Total, TheoBiasRatioIsTheMeanOfAvarOverTheo1) {
   EXPECT_EQ(theo_bias_ratio(record(24, 1), 1.0, 0, 10).taus, 1u);  // n = 1, whose AVAR (m = 12) needs 25 points
 }
 
+TEST(Total, TheoBiasRatioOnARowRunnerIsTheSameBits) {
+  // Oracle: the ratio with no runner (its taus in turn). A runner may run the taus in any order
+  // (rows.hpp): this one runs each batch backwards and counts them. The taus are summed in order
+  // all the same, so the ratio is the same bits; 150 taus make three batches of at most 64.
+  struct Backwards final : RowRunner {
+    mutable std::size_t rows = 0;
+    void run(const Rows& r, std::size_t count) const override {
+      for (std::size_t i = count; i-- > 0;) r.row(i);
+      rows += count;
+    }
+  } backwards;
+  const auto x = record(940, 8);
+  const TheoBiasRatio in_turn = theo_bias_ratio(x, 1.0, 4, 150), run = theo_bias_ratio(x, 1.0, 4, 150, &backwards);
+  EXPECT_EQ(in_turn.taus, 150u);
+  EXPECT_EQ(backwards.rows, 150u);
+  EXPECT_EQ(run.taus, in_turn.taus);
+  EXPECT_EQ(run.ratio, in_turn.ratio);
+  EXPECT_GT(run.ratio, 0.0);
+}
+
 TEST(Total, TheoHSwitchIsTheLargestOctaveWithinTenPercent) {
   EXPECT_EQ(theoh_switch(1001), 64u);   // 100 samples: 64
   EXPECT_EQ(theoh_switch(1281), 128u);  // 128 exactly

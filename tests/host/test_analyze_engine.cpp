@@ -1,7 +1,7 @@
 // The analysis engine's own contract, beside the reference sets: the tau lists and the stride
 // factor, what it refuses, strided taus above the "full" cap against a brute-force strided
 // estimator, the floating phase reference (a line added to phase changes nothing), and the lag
-// sums' workspace memory.
+// sums' workspace memory, the same bits on one thread or two.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -404,6 +404,44 @@ TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
             << q.dev;
       }
     }
+}
+
+TEST(AnalyzeEngine, TheTotalFamilyOnTwoThreadsGivesTheBitsOfOne) {
+  // Oracle: the same analysis on one thread. Each tau's estimate is made alone, on its own view of
+  // the prepared record (its own FFT buffer and scratch) or reading the record only, and TheoBR's
+  // ratio sums its taus in order (rows.hpp), so every row is the same bits on two threads: a shared
+  // buffer or a sum in another order would show here. Both the lag sums and the decimated plan.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g;
+  std::vector<double> x;
+  double walk = 0;
+  for (int k = 0; k < 6000; ++k) x.push_back((walk += g(rng)) + 10 * g(rng));
+  for (const bool decimated : {false, true}) {
+    const auto analysis = [&](unsigned threads) {
+      AnalysisOptions o;
+      o.type = DataType::phase;
+      o.stats = {DevStat::oadev,   DevStat::mdev,    DevStat::totdev, DevStat::mtotdev,
+                 DevStat::ttotdev, DevStat::htotdev, DevStat::theo1,  DevStat::theoh};
+      o.m_list = octave_taus(x.size());
+      o.theo_m_list = theo_taus("octave", o.m_list, x.size());
+      o.total_stride_factor = 4;  // the decimated plan decimates from m = 8 on
+      o.theo_decimated = o.total_decimated = decimated;
+      o.threads = threads;
+      o.values_hint = x.size();
+      Analyzer a(o);
+      for (const double v : x) a.add(v);
+      return a.result();
+    };
+    const Analysis one = analysis(1), two = analysis(2);
+    ASSERT_EQ(one.rows.size(), two.rows.size());
+    ASSERT_GT(one.rows.size(), 60u);
+    for (std::size_t i = 0; i < one.rows.size(); ++i) {
+      EXPECT_EQ(one.rows[i].m, two.rows[i].m);
+      EXPECT_EQ(one.rows[i].stride, two.rows[i].stride);
+      EXPECT_EQ(one.rows[i].dev, two.rows[i].dev)
+          << name(one.rows[i].stat) << " m=" << one.rows[i].m << (decimated ? " (decimated)" : "");
+    }
+  }
 }
 
 TEST(AnalyzeEngine, LagSumWorkspacesAreWholeAndLargeOnesStartOnAHugePage) {

@@ -89,6 +89,7 @@
 #include <span>
 
 #include "gyrochar/noise_model.hpp"
+#include "gyrochar/rows.hpp"
 #include "gyrochar/stat.hpp"
 
 namespace gyrochar {
@@ -115,26 +116,6 @@ inline constexpr std::size_t max_markov = 2;     // Markov terms a model may hav
 inline constexpr std::size_t max_sinusoids = 2;  // sinusoids a model may have
 inline constexpr std::size_t max_fit_points = 128;
 
-/// Work a fit splits into independent rows (the exact Markov sums of every pair of points, a row
-/// of pairs at a time): row(i) for each i < count, each once, in any order, on any thread. A plain
-/// function and its context, not a virtual call: core is built without RTTI, and the sanitizers'
-/// type check in a host built with it would take a core object's vtable for an invalid one.
-struct FitRows {
-  void (*run_row)(void* context, std::size_t i) = nullptr;
-  void* context = nullptr;
-  void row(std::size_t i) const { run_row(context, i); }
-};
-
-/// What runs a fit's rows: a host that has threads spreads them over its cores; without one (the
-/// board, the MCU) the fit runs them in turn. run() returns once every row is done.
-class FitRowRunner {
- public:
-  virtual void run(const FitRows& rows, std::size_t count) const = 0;
-
- protected:
-  ~FitRowRunner() = default;
-};
-
 struct FitSetup {
   double tau0_s = 1.0;
   std::uint64_t n_phase = 0;                        // phase points of the run (the unbroken grids)
@@ -143,7 +124,7 @@ struct FitSetup {
   bool select_model = true;                         // false: the five terms only, as IEEE 952's basic model
   std::size_t markov_terms = max_markov;            // at most this many Markov terms (<= max_markov)
   std::array<double, max_sinusoids> sinusoid_hz{};  // candidate sinusoid frequencies (0: none)
-  const FitRowRunner* rows = nullptr;               // runs the rows of the exact sums (null: in turn, here)
+  const RowRunner* rows = nullptr;                  // runs the rows of the exact Markov sums (null: in turn, here)
 };
 
 /// The curve(s) a fit reads: the overlapping Allan deviation's (avar), the modified Allan

@@ -49,6 +49,8 @@
 #include <cstdint>
 #include <span>
 
+#include "gyrochar/rows.hpp"
+
 namespace gyrochar {
 
 struct TotalVariance {
@@ -101,9 +103,11 @@ struct TheoBiasRatio {
 /// estimate is exact; otherwise Theo1 at m and AVAR at 0.75 m use the sub-sequence strides m / S
 /// and 0.75 m / S (1 below S): the ratio averages many taus, each need not be exact. At most
 /// `ratio_taus` (>= 2) of the n + 1 taus, evenly spread (all when
-/// ratio_taus >= n + 1). O(taus N S) when decimated, O(N^3) exact; no allocation.
+/// ratio_taus >= n + 1). The taus' estimates are rows for `runner` (rows.hpp; null: in turn, here),
+/// summed in the same order either way: the same bits. O(taus N S) when decimated, O(N^3) exact; no
+/// allocation.
 TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
-                              std::uint64_t ratio_taus);
+                              std::uint64_t ratio_taus, const RowRunner* runner = nullptr);
 
 /// The last index i of TheoBR's definition for N >= 24 phase points: floor(N / 6 - 3), less one when
 /// AVAR(9 + 3 i) would need N + 1 points. O(1).
