@@ -365,23 +365,23 @@ struct Triangles {
   }
 };
 
-// All four triangles (even and odd residuals of the first m and of the last m reversed): the end
-// corrections H + T of docs/total.md.
-double end_corrections(std::span<const double> r, Index M, Theo1Workspace& w) {
-  const Index N = r.size(), h = M / 2;
-  // The four sequences (4 h - 2 values) go in the FFT buffer past the triangles' largest FFTs (4 n
+// Whether Theo1 at m is defined on the prepared record (even, 2 <= m <= N - 1).
+bool theo1_defined(const Theo1Workspace& w, std::uint64_t m) {
+  return w.ready && m >= 2 && m % 2 == 0 && m <= w.r.size() - 1;
+}
+
+// One parity's two triangles (every other residual, even: r[2p], odd: r[2p+1], of the first m and
+// of the last m reversed): their share of the end corrections H + T of docs/total.md.
+Sums end_triangles(std::span<const double> r, Index M, bool odd, Theo1Workspace& w) {
+  const Index N = r.size(), h = M / 2, c = odd ? h - 1 : h, o = odd ? 1 : 0;
+  // The two sequences (2 c values) go in the FFT buffer past the triangles' largest FFTs (4 n
   // doubles, n = fft_length(2 ceil(h / 2)) <= Q = fft_length(h + 1), that of the first square):
   // memory theo1_fast's end autocorrelations have touched already. There is room: h <= (N - 1) / 2,
   // so the buffer's 2 fft_length(2 N) >= 2 fft_length(4 h + 2) = 8 Q >= 4 n + 4 (h + 1).
   const Index used = 4 * fft_length(2 * ((h + 1) / 2));
-  const std::span<double> ends = w.buffer.subspan(used, 4 * h);
-  const std::span<double> head_even = ends.first(h), tail_even = ends.subspan(h, h);
-  const std::span<double> head_odd = ends.subspan(2 * h, h - 1), tail_odd = ends.subspan(3 * h - 1, h - 1);
-  for (Index p = 0; p < h; ++p) head_even[p] = r[2 * p], tail_even[p] = r[N - 1 - 2 * p];
-  for (Index p = 0; p + 1 < h; ++p) head_odd[p] = r[2 * p + 1], tail_odd[p] = r[N - 2 - 2 * p];
-  const Sums even = Triangles{head_even, tail_even, h, h, w}.half();
-  const Sums odd = Triangles{head_odd, tail_odd, h - 1, h, w}.half();
-  return even.head + even.tail + odd.head + odd.tail;
+  const std::span<double> head = w.buffer.subspan(used, c), tail = w.buffer.subspan(used + c, c);
+  for (Index p = 0; p < c; ++p) head[p] = r[2 * p + o], tail[p] = r[N - 1 - 2 * p - o];
+  return Triangles{head, tail, c, h, w}.half();
 }
 
 }  // namespace
@@ -538,10 +538,18 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) 
   return w;
 }
 
-TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s) {
-  const Index N = w.r.size();
-  if (!w.ready || m < 2 || m % 2 != 0 || m > N - 1 || !(tau0_s > 0)) return {};
-  const Index M = static_cast<Index>(m), h = M / 2, L = N - M;
+void theo1_piece(Theo1Workspace& w, std::uint64_t m, int piece, Theo1Pieces& out) {
+  if (!theo1_defined(w, m)) return;
+  const Index N = w.r.size(), M = static_cast<Index>(m);
+  if (piece == 1 || piece == 2) {
+    // The product r[i+k] r[i+m-k] over i in [k, k + L) is the whole record's lag sum less the pairs
+    // at either end (midpoint in the first or last m / 2 points), weighted 1 / k: the triangles.
+    const Sums t = end_triangles(w.r, M, piece == 2, w);
+    double* to = piece == 1 ? out.even : out.odd;
+    to[0] = t.head, to[1] = t.tail;
+    return;
+  }
+  const Index h = M / 2, L = N - M;
   const std::span<const double> r = w.r, s1 = w.s1, s2 = w.s2, R = w.ac;
   // The autocorrelations of the first and the last m residuals at lags below m: one FFT pair.
   const Index n = fft_length(2 * M);
@@ -567,12 +575,21 @@ TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s) {
     const double linear = sum1(0) - sum1(k) - sum1(M - k) + sum1(M);
     sum += (squares + 2.0 * products + 2.0 * gamma * linear + as_double(L) * gamma * gamma) / as_double(k);
   }
-  // The product r[i+k] r[i+m-k] over i in [k, k + L) is the whole record's lag sum less the pairs at
-  // either end (midpoint in the first or last m / 2 points), weighted 1 / k: two triangles.
-  // (The end autocorrelations above live in the buffer, which the triangles' FFTs now reuse.)
-  sum -= 2.0 * end_corrections(r, M, w);
-  const double tau = as_double(m) * tau0_s;
-  return {sum / (0.75 * as_double(L) * tau * tau), static_cast<std::uint64_t>(L) * h, 1};
+  out.sums = sum;
+}
+
+TotalVariance theo1_from_pieces(const Theo1Workspace& w, std::uint64_t m, double tau0_s, const Theo1Pieces& p) {
+  if (!theo1_defined(w, m) || !(tau0_s > 0)) return {};
+  const Index L = w.r.size() - static_cast<Index>(m);
+  const double ends = p.even[0] + p.even[1] + p.odd[0] + p.odd[1];
+  const double sum = p.sums - 2.0 * ends, tau = as_double(m) * tau0_s;
+  return {sum / (0.75 * as_double(L) * tau * tau), static_cast<std::uint64_t>(L) * (m / 2), 1};
+}
+
+TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s) {
+  Theo1Pieces p;
+  for (int piece = 0; piece < theo1_pieces; ++piece) theo1_piece(w, m, piece, p);
+  return theo1_from_pieces(w, m, tau0_s, p);
 }
 
 TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s, std::uint64_t ratio_taus) {

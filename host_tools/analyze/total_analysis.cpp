@@ -96,8 +96,15 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
   if (decimated) {
     v = estimates(ms, threads, [&](unsigned, std::uint64_t m) { return theo1(x, m, tau0, theo1_stride(m, N, S)); });
   } else {
+    // Each tau in its pieces (total_fast.hpp): the largest tau's two triangles, its dearest work,
+    // go on both threads at once.
     const std::span<LagSumView> views = lag_sums.views(x, false, threads);
-    v = estimates(ms, views.size(), [&](unsigned t, std::uint64_t m) { return theo1_fast(*views[t].work, m, tau0); });
+    std::vector<Theo1Pieces> pieces(ms.size());
+    on_threads(views.size(), theo1_pieces * ms.size(), [&](unsigned t, std::size_t i) {
+      const std::size_t k = ms.size() - 1 - i / theo1_pieces;  // the largest m first, its triangles first
+      theo1_piece(*views[t].work, ms[k], static_cast<int>(i % theo1_pieces + 1) % theo1_pieces, pieces[k]);
+    });
+    for (std::size_t k = 0; k < ms.size(); ++k) v.push_back(theo1_from_pieces(*views[0].work, ms[k], tau0, pieces[k]));
   }
   for (std::size_t i = 0; i < ms.size(); ++i) {
     const std::uint64_t m = ms[i];

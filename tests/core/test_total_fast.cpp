@@ -162,6 +162,32 @@ TEST(TotalFast, TheoBiasRatioEqualsTheExactOne) {
   }
 }
 
+TEST(TotalFast, Theo1InPiecesOnBuffersOfTheirOwnIsTheSameBits) {
+  // Oracle: theo1_fast. Its pieces, each on a copy of the workspace with an FFT buffer of its own
+  // (as a thread each would run them), in another order, combined: the same bits at every even m,
+  // the smallest (no triangle square by FFT) to N - 1 (the largest triangles, ends meeting).
+  const std::vector<double> x = record(3000, 9, 0.3, 1.0, 2.5, 1e-4);
+  std::vector<double> work(theo1_workspace_size(x.size()));
+  Theo1Workspace w = theo1_prepare(x, work);
+  ASSERT_TRUE(w.ready);
+  std::vector<double> other_buffer(w.buffer.size()), third_buffer(w.buffer.size());
+  Theo1Workspace other = w, third = w;
+  other.buffer = other_buffer, third.buffer = third_buffer;
+  for (std::uint64_t m = 2; m <= x.size() - 1; m += m < 64 ? 2 : 98) {
+    Theo1Pieces p;
+    theo1_piece(other, m, 2, p);
+    theo1_piece(third, m, 1, p);
+    theo1_piece(w, m, 0, p);
+    const TotalVariance fast = theo1_fast(w, m, 1.0), pieces = theo1_from_pieces(w, m, 1.0, p);
+    EXPECT_EQ(pieces.var, fast.var) << m;
+    EXPECT_EQ(pieces.n, fast.n) << m;
+  }
+  Theo1Pieces untouched;
+  theo1_piece(w, 11, 0, untouched);  // odd m: nothing written, no estimate
+  EXPECT_EQ(untouched.sums, 0.0);
+  EXPECT_EQ(theo1_from_pieces(w, 11, 1.0, untouched).n, 0u);
+}
+
 TEST(TotalFast, UndefinedInputGivesNoTerms) {
   const std::vector<double> x = record(40, 1, 0.3, 1.0, 2.5, 0.0);
   std::vector<double> work(theo1_workspace_size(x.size()));

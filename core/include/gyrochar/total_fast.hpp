@@ -56,6 +56,20 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work);
 /// a few passes over the lags below m). Undefined input gives n = 0.
 TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s);
 
+/// theo1_fast in pieces that may run on different threads, each on a workspace of its own: a copy
+/// of the prepared one with an FFT buffer of the same size (the rest is only read). Piece 0: the
+/// lag sums over the whole record with the end autocorrelations; 1 and 2: the triangles of the
+/// even and of the odd residuals at the ends (docs/total.md), the dearest two for large m. Each
+/// piece writes its own fields; theo1_from_pieces then gives theo1_fast's bits (theo1_fast is the
+/// pieces in turn). Undefined m leaves the pieces untouched and gives n = 0.
+inline constexpr int theo1_pieces = 3;
+struct Theo1Pieces {
+  double sums = 0.0;
+  double even[2] = {}, odd[2] = {};  // the head's and the tail's triangles
+};
+void theo1_piece(Theo1Workspace& w, std::uint64_t m, int piece, Theo1Pieces& out);
+TotalVariance theo1_from_pieces(const Theo1Workspace& w, std::uint64_t m, double tau0_s, const Theo1Pieces& pieces);
+
 /// The cross-correlation c(e) = sum_p a[p] b[p+e] of two real sequences by FFT of length n (a power
 /// of two, at most w.P, n >= a.size() + b.size() for no wrap-around): c(e) for e in (-n, n) left at
 /// w.buffer[e mod n]. O(n log n).
