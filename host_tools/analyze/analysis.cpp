@@ -315,6 +315,7 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
     const auto total = total_rows(stat, record, options.unit, o, allan, lag_sums);
     a.rows.insert(a.rows.end(), total.begin(), total.end());
   }
+  a.theoh_bias = lag_sums.theoh_bias;
 }
 
 namespace {

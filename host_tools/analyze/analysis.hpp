@@ -157,11 +157,20 @@ struct PhaseRecord {
   double phase_scale = 1.0;
 };
 
+/// TheoBR's bias ratio of the record (theo_bias_ratio, decimated with stride factor S) as TheoH's
+/// rows computed it, for the fit's long-tau points to reuse: at 10^7 points its 64 decimated taus
+/// cost about 4 s of CPU. ratio 0: none computed.
+struct TheoBias {
+  double ratio = 0.0;
+  std::uint32_t stride_factor = 0;
+};
+
 struct Analysis {
   std::uint64_t n_values = 0;       // values read
   std::uint64_t n_phase = 0;        // phase points (values + 1 for freq and counts)
   std::uint32_t stride_factor = 0;  // S used
   std::vector<AnalysisRow> rows;    // by stat (in the order asked), then by m; no row when n = 0
+  TheoBias theoh_bias;              // TheoH's bias ratio, when TheoH was asked for
 };
 
 /// A value Analyzer::add() refused: its index in the block, and why (what()).

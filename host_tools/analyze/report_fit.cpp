@@ -51,7 +51,9 @@ void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& 
   std::erase_if(points, [&](const FitPoint& p) { return p.stat == Stat::avar && p.m >= k; });
   constexpr std::uint32_t S = 16;
   const ThreadRows threads(2);
-  const double ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(x.size(), S), &threads).ratio;
+  const double ratio = a.theoh_bias.stride_factor == S && a.theoh_bias.ratio > 0  // TheoH's rows made it
+                           ? a.theoh_bias.ratio
+                           : theo_bias_ratio(x, tau0, S, theo_bias_taus(x.size(), S), &threads).ratio;
   if (!(ratio > 0)) return;
   for (std::uint64_t mt = 2 * k; 2 * (3 * mt / 4) + 1 <= x.size(); mt *= 2) {
     const std::uint64_t m = 3 * mt / 4;  // tau = 0.75 mt tau0: the Allan geometry at m

@@ -82,6 +82,7 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
     const ThreadRows runner(threads);
     ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S), &runner).ratio;
     if (!(ratio > 0)) return rows;
+    lag_sums.theoh_bias = {ratio, S};
   }
   // Exact Theo1 by lag sums (total_fast.hpp) unless the decimated estimator is asked for or its
   // workspace would pass the memory budget (plan.hpp): the record prepared once for the run

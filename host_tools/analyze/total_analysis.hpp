@@ -48,6 +48,8 @@ class LagSumRecord {
   /// The preparation of x (frequencies: of y[k] = x[k+1] - x[k]), made on first use, as one view per
   /// thread for up to `threads` threads (1 or 2). The first view is the preparation's own.
   std::span<LagSumView> views(std::span<const double> x, bool frequencies, unsigned threads);
+  /// TheoBR's bias ratio as TheoH's rows computed it (analysis.hpp).
+  TheoBias theoh_bias;
 
  private:
   HugeArray work_, scratch_, second_buffer_, second_scratch_;  // not zero-filled: each writes before it reads

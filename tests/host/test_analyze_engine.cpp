@@ -1,7 +1,7 @@
 // The analysis engine's own contract, beside the reference sets: the tau lists and the stride
 // factor, what it refuses, strided taus above the "full" cap against a brute-force strided
 // estimator, the floating phase reference (a line added to phase changes nothing), and the lag
-// sums' workspace memory, the same bits on one thread or two.
+// sums' workspace memory, the same bits on one thread or two, TheoH's bias ratio shared with the fit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "analysis.hpp"
+#include "analysis_report.hpp"
 #include "datafile.hpp"
 #include "plan.hpp"
 #include "total_analysis.hpp"
@@ -442,6 +443,44 @@ TEST(AnalyzeEngine, TheTotalFamilyOnTwoThreadsGivesTheBitsOfOne) {
           << name(one.rows[i].stat) << " m=" << one.rows[i].m << (decimated ? " (decimated)" : "");
     }
   }
+}
+
+TEST(AnalyzeEngine, TheFitsLongTauPointsReuseTheoHsBiasRatio) {
+  // Oracle: the fit's TheoBR points with the bias ratio computed afresh (an Analysis that kept
+  // none). TheoH's rows keep their ratio (Analysis::theoh_bias, at their stride factor, 16 by
+  // default); the fit's long-tau points, whose stride factor is 16 too, reuse it: the same bits. A
+  // different ratio kept changes those points in proportion, so it is the one they read.
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> g;
+  std::vector<double> x;
+  double walk = 0;
+  for (int k = 0; k < 20000; ++k) x.push_back((walk += g(rng)) + 3 * g(rng));
+  AnalysisOptions o;
+  o.type = DataType::phase;
+  o.stats = {DevStat::oadev, DevStat::mdev, DevStat::theoh};
+  o.m_list = octave_taus(x.size());
+  o.theo_m_list = theo_taus("octave", o.m_list, x.size());
+  Analyzer analyzer(o);
+  for (const double v : x) analyzer.add(v);
+  const Analysis kept = analyzer.result();
+  ASSERT_GT(kept.theoh_bias.ratio, 0.0);
+  EXPECT_EQ(kept.theoh_bias.stride_factor, 16u);
+  Analysis fresh = kept, doubled = kept;
+  fresh.theoh_bias = {};
+  doubled.theoh_bias.ratio *= 2;
+  const ReportUnits units;
+  const auto points = [&](const Analysis& a) { return fit_points(a, units, 1.0, LongTau::theoh, analyzer.record()); };
+  const std::vector<FitPoint> reused = points(kept), afresh = points(fresh), twice = points(doubled);
+  ASSERT_EQ(reused.size(), afresh.size());
+  ASSERT_EQ(twice.size(), afresh.size());
+  std::size_t long_tau = 0;
+  for (std::size_t i = 0; i < afresh.size(); ++i) {
+    EXPECT_EQ(reused[i].variance, afresh[i].variance) << i;
+    if (afresh[i].variance_scale == 1.0) continue;  // an Allan-family point: no ratio in it
+    ++long_tau;
+    EXPECT_DOUBLE_EQ(twice[i].variance, 2 * afresh[i].variance) << i;
+  }
+  EXPECT_GE(long_tau, 2u);
 }
 
 TEST(AnalyzeEngine, LagSumWorkspacesAreWholeAndLargeOnesStartOnAHugePage) {
