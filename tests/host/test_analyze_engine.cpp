@@ -407,16 +407,22 @@ TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
     }
 }
 
+// Random-walk phase (unit steps) plus white phase noise of the given size.
+std::vector<double> walk_and_white(int n, std::uint64_t seed, double white) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g;
+  std::vector<double> x;
+  double walk = 0;
+  for (int k = 0; k < n; ++k) x.push_back((walk += g(rng)) + white * g(rng));
+  return x;
+}
+
 TEST(AnalyzeEngine, TheTotalFamilyOnTwoThreadsGivesTheBitsOfOne) {
   // Oracle: the same analysis on one thread. Each tau's estimate is made alone, on its own view of
   // the prepared record (its own FFT buffer and scratch) or reading the record only, and TheoBR's
   // ratio sums its taus in order (rows.hpp), so every row is the same bits on two threads: a shared
   // buffer or a sum in another order would show here. Both the lag sums and the decimated plan.
-  std::mt19937_64 rng(11);
-  std::normal_distribution<double> g;
-  std::vector<double> x;
-  double walk = 0;
-  for (int k = 0; k < 6000; ++k) x.push_back((walk += g(rng)) + 10 * g(rng));
+  const std::vector<double> x = walk_and_white(6000, 11, 10);
   for (const bool decimated : {false, true}) {
     const auto analysis = [&](unsigned threads) {
       AnalysisOptions o;
@@ -450,11 +456,7 @@ TEST(AnalyzeEngine, TheFitsLongTauPointsReuseTheoHsBiasRatio) {
   // none). TheoH's rows keep their ratio (Analysis::theoh_bias, at their stride factor, 16 by
   // default); the fit's long-tau points, whose stride factor is 16 too, reuse it: the same bits. A
   // different ratio kept changes those points in proportion, so it is the one they read.
-  std::mt19937_64 rng(12);
-  std::normal_distribution<double> g;
-  std::vector<double> x;
-  double walk = 0;
-  for (int k = 0; k < 20000; ++k) x.push_back((walk += g(rng)) + 3 * g(rng));
+  const std::vector<double> x = walk_and_white(20000, 12, 3);
   AnalysisOptions o;
   o.type = DataType::phase;
   o.stats = {DevStat::oadev, DevStat::mdev, DevStat::theoh};
