@@ -202,7 +202,7 @@ TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uin
   double sum = 0.0;
   for (; taus.first < count; taus.first += batch) {
     const std::uint64_t size = count - taus.first < batch ? count - taus.first : batch;
-    run_rows(runner, rows, size);
+    run_rows(runner, rows, static_cast<std::size_t>(size));
     for (std::uint64_t k = 0; k < size; ++k) {
       if (!taus.defined[k]) return {};
       sum += taus.term[k];
