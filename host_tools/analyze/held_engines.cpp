@@ -11,6 +11,7 @@
 #include <sys/mman.h>
 
 #include "analysis_engine.hpp"
+#include "threads.hpp"
 #include "gyrochar/batch.hpp"
 #include "gyrochar/characterizer.hpp"
 #include "gyrochar/float_batch.hpp"
@@ -79,9 +80,7 @@ std::vector<TauSums> sum_every_tau(std::size_t taus, std::size_t block, const An
       if (tell && o.on_summed && summed < taus) o.on_summed(summed, taus);
     }
   };
-  const unsigned threads = std::min<std::size_t>(o.threads > 0 ? o.threads
-                                                               : std::max(1u, std::thread::hardware_concurrency()),
-                                                 blocks);
+  const unsigned threads = static_cast<unsigned>(std::min<std::size_t>(thread_count(o.threads), blocks));
   std::vector<std::thread> helpers;
   for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
   std::exception_ptr stopped;  // on_summed threw (the caller stops the work): the helpers end first

@@ -49,6 +49,9 @@ AnalysisRow make_row(DevStat stat, std::uint64_t m, double tau_s, const TotalVar
 // Whether the Allan row has an identified (or given) alpha: else no bias correction, no EDF.
 bool known(const AnalysisRow* r) { return r != nullptr && r->alpha.has_value(); }
 
+// The threads of the total family's taus: as --threads asks, at most two (the lag sums have two views).
+unsigned total_threads(const AnalysisOptions& o) { return std::min(thread_count(o.threads), 2u); }
+
 // estimate(worker, m) at every m, the largest first (the dearest: threads then finish together), on
 // `threads` threads. Each m's estimate is the same bits on any thread.
 template <class Estimate>
@@ -70,7 +73,7 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
   const double n = static_cast<double>(N), tau0 = o.tau0_s;
   const std::uint32_t S = o.total_stride_factor;
   const std::uint64_t k = theoh_switch(N);
-  const unsigned threads = std::min(thread_count(o.threads), 2u);
+  const unsigned threads = total_threads(o);
   double ratio = 1.0;
   if (stat == DevStat::theoh) {
     for (const AnalysisRow& r : allan)
@@ -124,7 +127,7 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
   const std::uint64_t N = x.size();
   const double n = static_cast<double>(N), tau0 = o.tau0_s;
   const std::uint32_t S = o.total_stride_factor;
-  const unsigned threads = std::min(thread_count(o.threads), 2u);
+  const unsigned threads = total_threads(o);
   const bool hadamard = stat == DevStat::htotdev;
   std::vector<std::uint64_t> ms;  // the taus the record allows
   for (const std::uint64_t m : o.m_list) {
