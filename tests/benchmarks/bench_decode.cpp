@@ -42,6 +42,14 @@ Message message(std::uint8_t node, std::uint8_t seq, ReportSlot s, std::uint64_t
     case Slot::ieee952:
       if (s.index == ieee952_summary_page) return Ieee952SummaryMsg{seq, Ieee952Status::ok, 0.9f, 15, true, {}};
       return Ieee952Msg{seq, static_cast<Ieee952Term>(s.index), true, 0.01f, 0.1, true};
+    case Slot::fit_model: return Ieee952ModelMsg{seq, 1, 0, false, 0, false, 0, 0, false, 0.0f};  // one Markov term
+    case Slot::fit_parameter: {
+      const FitParameterSlot p = fit_parameter_slot(s.index);
+      const bool in_model = p.parameter == FitParameter::markov_sigma || p.parameter == FitParameter::markov_tc;
+      return Ieee952ParameterMsg{
+          seq, p.parameter, p.index, in_model && p.index == 0, in_model ? value : 0.0f, in_model ? 0.1 : 0.0};
+    }
+    case Slot::unconstrained: return Ieee952UnconstrainedMsg{seq, static_cast<Ieee952Term>(s.index), 0.01f, 0.001};
     case Slot::window:  // no window taus
     case Slot::window_length:
     case Slot::window_dev: break;
