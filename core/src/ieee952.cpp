@@ -235,8 +235,7 @@ Ieee952Parameter parameter(const Problem& pr, const Solution& sol, const Flags& 
 }
 
 // Writes the candidate into out: status, chi2, every term, the residuals.
-void write_fit(const Problem& pr, const Candidate& c, const Flags& free, const std::array<double, max_markov + 1>& nl_sd,
-               Ieee952Fit& out) {
+void write_fit(const Problem& pr, const Candidate& c, const Flags& free, const LogSpreads& nl_sd, Ieee952Fit& out) {
   out.points = pr.n;
   out.status = c.status;
   out.chi2 = c.sol.chi2;
@@ -249,7 +248,7 @@ void write_fit(const Problem& pr, const Candidate& c, const Flags& free, const s
     MarkovTerm& m = out.markov[j];
     m.sigma = parameter(pr, c.sol, free, power_terms + j, out.birge, rejected_model);
     m.tc_s = pr.tau0 / c.model.a[j];
-    m.tc_uncertainty_s = m.tc_s * nl_sd[j] * out.birge;
+    m.tc_uncertainty_s = m.tc_s * nl_sd[j].sd() * out.birge;
   }
   out.n_sinusoids = c.model.sinusoids;
   for (std::size_t j = 0; j < c.model.sinusoids; ++j) {
@@ -257,7 +256,7 @@ void write_fit(const Problem& pr, const Candidate& c, const Flags& free, const s
     out.sinusoids[j].frequency_hz = c.model.hz[j];
   }
   out.bandwidth_tc_s = c.model.band > 0 ? pr.tau0 / c.model.band : 0;
-  out.bandwidth_tc_uncertainty_s = out.bandwidth_tc_s * nl_sd[max_markov] * out.birge;
+  out.bandwidth_tc_uncertainty_s = out.bandwidth_tc_s * nl_sd[max_markov].sd() * out.birge;
   out.n_residuals = pr.n;
   for (std::size_t i = 0; i < pr.n; ++i) {
     double model = 0;
@@ -294,7 +293,7 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
     pr.sums_made = true;
   }
   Candidate runner_up;
-  std::array<double, max_markov + 1> nl_sd{};
+  LogSpreads nl_sd{};
   const Candidate best = select_model(pr, setup, filter, free, fixed, runner_up, nl_sd);
   if (best.status == FitStatus::singular || best.status == FitStatus::too_few_points) {
     out.status = best.status;
@@ -319,7 +318,7 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
     pr.exact_markov = false;
     pr.model = runner_up.model;
     Candidate more = fit_model(pr, free, fixed, false, 12);
-    std::array<double, max_markov + 1> more_sd = nl_sd;
+    LogSpreads more_sd = nl_sd;
     Candidate none;
     bool taken = false;
     if (more.valid && refit_exactly(pr, setup, free, fixed, more, none, more_sd, false) && markov_terms_hold(more, fewer)) {
@@ -354,11 +353,11 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
     // unless it is rejected where the other is not: an accepted model is never traded for a
     // rejected one.
     const Candidate more = chosen;
-    std::array<double, max_markov + 1> fewer_sd = nl_sd;
+    LogSpreads fewer_sd = nl_sd;
     pr.exact_markov = false;
     pr.model = runner_up.model;
     Candidate fewer = fit_model(pr, free, fixed, false, 12);
-    for (std::size_t k = fewer.model.markov; k < max_markov; ++k) fewer_sd[k] = 0;
+    for (std::size_t k = fewer.model.markov; k < max_markov; ++k) fewer_sd[k] = {};
     Candidate none;
     if (fewer.valid && fewer.model.markov > 0) refit_exactly(pr, setup, free, fixed, fewer, none, fewer_sd);
     if (fewer.valid && (fewer.status == FitStatus::ok || more.status != FitStatus::ok)) {

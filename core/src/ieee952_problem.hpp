@@ -4,6 +4,7 @@
 //   ieee952_gls.cpp     the design rows, the points' covariance and the non-negative GLS solve
 //   ieee952_select.cpp  the model selection: nonlinear searches, profiles, the candidates compared
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -149,13 +150,22 @@ Candidate fit_model(Problem& pr, const Flags& free, const Terms& fixed, bool fir
 double profile_chi2(Problem& pr, const Flags& free, const Terms& fixed);
 
 // ieee952_select.cpp
+/// The spread of ln(value) of a nonlinear parameter (a Markov term's tau0 / Tc, the filter's): the
+/// half-widths of its interval below and above the fitted value. A profile's two differ (a
+/// Markov term's chi2 rises more slowly towards one side); a curvature's are equal. 0: not
+/// determined.
+struct LogSpread {
+  double down = 0, up = 0;
+  /// The standard deviation stated for ln(value): the root mean square of the two half-widths.
+  double sd() const { return std::sqrt((down * down + up * up) / 2); }
+};
+using LogSpreads = std::array<LogSpread, max_markov + 1>;  // the Markov terms', then the filter's
 Candidate select_model(Problem& pr, const FitSetup& setup, bool filter, const Flags& free, const Terms& fixed,
-                       Candidate& runner_up, std::array<double, max_markov + 1>& nonlinear_sd);
-void widen_by_nonlinear(Problem& pr, const Flags& free, const Terms& fixed, const std::array<double, max_markov + 1>& nl_sd,
-                        Solution& sol);
+                       Candidate& runner_up, LogSpreads& nonlinear_sd);
+void widen_by_nonlinear(Problem& pr, const Flags& free, const Terms& fixed, const LogSpreads& nl_sd, Solution& sol);
 bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const Terms& fixed, Candidate& chosen,
-                   Candidate& runner_up, std::array<double, max_markov + 1>& nl_sd, bool with_profile = true);
-void profile_markov_terms(Problem& pr, const Flags& free, const Terms& fixed, std::array<double, max_markov + 1>& nl_sd);
+                   Candidate& runner_up, LogSpreads& nl_sd, bool with_profile = true);
+void profile_markov_terms(Problem& pr, const Flags& free, const Terms& fixed, LogSpreads& nl_sd);
 bool markov_terms_hold(const Candidate& more, const Candidate& fewer);
 bool column_significant(const Candidate& c, std::size_t t);
 
