@@ -260,16 +260,22 @@ void widen_by_nonlinear(Problem& pr, const Flags& free, const Terms& fixed, cons
   };
   auto widen = [&](double* value, const LogSpread& spread) {
     if (!(spread.down > 0) || !(spread.up > 0) || !(*value > 0)) return;
-    constexpr double h = 0.1;  // the slope's step, where an end of the interval has no solution
-    Solution here, up, down, near_up, near_down;
+    Solution here, up, down;
     if (!solved_at(value, 0, here)) return;
-    const bool ends = solved_at(value, spread.up, up) && solved_at(value, -spread.down, down);
-    if (!ends && !(solved_at(value, h, near_up) && solved_at(value, -h, near_down))) return;
     Terms vu{}, vd{};
-    for (std::size_t t = 0; t < columns; ++t) {
-      const double slope = ends ? 0 : (near_up.theta[t] - near_down.theta[t]) / (2 * h);
-      vu[t] = ends ? up.theta[t] - here.theta[t] : slope * spread.up;
-      vd[t] = ends ? here.theta[t] - down.theta[t] : slope * spread.down;
+    if (solved_at(value, spread.up, up) && solved_at(value, -spread.down, down)) {
+      for (std::size_t t = 0; t < columns; ++t) {
+        vu[t] = up.theta[t] - here.theta[t];
+        vd[t] = here.theta[t] - down.theta[t];
+      }
+    } else {  // an end has no solution: the slope at the fitted value (a central difference)
+      constexpr double h = 0.1;
+      if (!solved_at(value, h, up) || !solved_at(value, -h, down)) return;
+      for (std::size_t t = 0; t < columns; ++t) {
+        const double slope = (up.theta[t] - down.theta[t]) / (2 * h);
+        vu[t] = slope * spread.up;
+        vd[t] = slope * spread.down;
+      }
     }
     for (std::size_t t = 0; t < columns; ++t)
       for (std::size_t u = 0; u < columns; ++u) sol.cov[t][u] += (vu[t] * vu[u] + vd[t] * vd[u]) / 2;
