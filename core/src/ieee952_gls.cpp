@@ -409,14 +409,8 @@ void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
 // The sinusoid sums of every pair of points for the given sinusoids (setup.sinusoid_hz), with the
 // power-law noises pair_sums_of_points() kept for that pair. O(P^2 x nodes).
 void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache) {
-  NoiseSet set;
-  for (std::size_t t = 0; t < noises; ++t) set.alpha[t] = alphas[t];
-  set.count = noises;
-  std::array<double, max_sinusoids> theta{};
-  for (std::size_t k = 0; k < max_sinusoids; ++k) {
-    pr.hz[k] = setup.sinusoid_hz[k] > 0 ? setup.sinusoid_hz[k] : 0.0;
-    theta[k] = 2 * pi * pr.hz[k] * setup.tau0_s;
-  }
+  const SinusoidSumInputs in = ieee952_sinusoid_inputs(setup);
+  for (std::size_t k = 0; k < max_sinusoids; ++k) pr.hz[k] = setup.sinusoid_hz[k] > 0 ? setup.sinusoid_hz[k] : 0.0;
   for (std::size_t i = 0; i < pr.n; ++i) {
     const FitPoint& a = *pr.point[i];
     const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
@@ -425,9 +419,10 @@ void sinusoid_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* c
       const double* g = pr.pair_at(i, j);
       double* sg = pr.sinusoid_pair_at(i, j);
       for (std::size_t k = 0; k < sinusoid_slots; ++k) sg[k] = 0;
-      if (!(pr.hz[0] > 0) && !(pr.hz[max_sinusoids - 1] > 0)) continue;  // none given
+      if (!in.any()) continue;
       const TermGrid gb = unbroken_grid(b.stat, b.m, b.stride, setup.n_phase);
-      const SinusoidPairSums s = cache ? cache->sinusoid_sums(set, theta, ga, gb) : sinusoid_pair_sums(set, theta, ga, gb);
+      const SinusoidPairSums s = cache ? cache->sinusoid_sums(in.set, in.thetas, ga, gb)
+                                       : sinusoid_pair_sums(in.set, in.thetas, ga, gb);
       for (std::size_t k = 0; k < max_sinusoids; ++k)
         for (std::size_t t = 0; t < noises; ++t) sg[k * noises + t] = t == 0 || g[cc_index(t, t)] != 0 ? s.cs[k][t] : 0.0;
     }

@@ -130,6 +130,9 @@ struct ManyR {
   std::size_t count = 0;
   bool flicker = false;
   void at(std::int64_t k, std::array<double, max_noises>& out) const;
+  // sum[t] += w R_t(k) for every noise: what at() gives, added as it is made (through an array
+  // of values, the scalar stores and the vector loads of the sums stalled on each other).
+  void add(std::int64_t k, double w, std::array<double, max_noises>& sum) const;
 };
 
 inline double integer_r(int twice_d, double a) {  // R for integer d >= 1, a = |k|
@@ -157,13 +160,18 @@ inline double flicker_r(int twice_d, std::int64_t ak, const std::array<double, 5
 }
 
 inline void ManyR::at(std::int64_t k, std::array<double, max_noises>& out) const {
+  out.fill(0.0);
+  add(k, 1.0, out);
+}
+
+inline void ManyR::add(std::int64_t k, double w, std::array<double, max_noises>& sum) const {
   const std::int64_t ak = k < 0 ? -k : k;
   const double a = static_cast<double>(ak);
   std::array<double, 5> psi{};
   if (flicker) digamma_row(ak, psi);
   for (std::size_t t = 0; t < count; ++t) {
     const int d = twice_d[t];
-    out[t] = d <= 0 ? (k == 0 ? 1.0 : 0.0) : d % 2 == 0 ? integer_r(d, a) : flicker_r(d, ak, psi);
+    sum[t] += w * (d <= 0 ? (k == 0 ? 1.0 : 0.0) : d % 2 == 0 ? integer_r(d, a) : flicker_r(d, ak, psi));
   }
 }
 
@@ -176,13 +184,9 @@ inline double covariance(const Kernel& k, int twice_d, std::int64_t lag) {
 
 // c_t(lag) of every noise of `r` at once.
 inline void covariances(const Kernel& k, const ManyR& r, std::int64_t lag, std::array<double, max_noises>& c) {
-  c.fill(0.0);
-  std::array<double, max_noises> values{};
-  for (int i = 0; i < k.count; ++i) {
-    r.at(lag + k.u[static_cast<std::size_t>(i)], values);
-    const double w = k.w[static_cast<std::size_t>(i)];
-    for (std::size_t t = 0; t < r.count; ++t) c[t] += w * values[t];
-  }
+  std::array<double, max_noises> sum{};
+  for (int i = 0; i < k.count; ++i) r.add(lag + k.u[static_cast<std::size_t>(i)], k.w[static_cast<std::size_t>(i)], sum);
+  c = sum;
 }
 
 inline std::int64_t floor_div(std::int64_t a, std::int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
@@ -298,31 +302,42 @@ inline double exp_remainder(int order, double s) {
 }
 
 // The generalized autocovariance of the Markov phase (level 0) or its prefix sums (level 1), see
-// noise_model.hpp. Series below a = 0.05 (their last terms are below 1e-16 of the first there).
-inline double markov_autocovariance(double a, int level, std::int64_t k) {
-  const double ak = static_cast<double>(k < 0 ? -k : k);
-  const double h = std::sinh(a / 2);
-  const double a2 = a * a, a3 = a2 * a, a5 = a3 * a2;
-  if (level == 0) {
-    const double d = a < 0.05 ? a3 * (1.0 / 6 + a2 * (1.0 / 120 + a2 * (1.0 / 5040 + a2 / 362880))) : std::sinh(a) - a;
-    return -(exp_remainder(2, a * ak) + d * ak) / (4 * h * h);
+// noise_model.hpp. What does not depend on the lag (sinh and the series in a) is made once per
+// rate: the exact Markov sums call it at every tap of every node. Series below a = 0.05 (their
+// last terms are below 1e-16 of the first there).
+struct MarkovAutocovariance {
+  double a = 0;
+  int level = 0;
+  double linear = 0, cubic = 0, denominator = 1;
+  MarkovAutocovariance() = default;
+  MarkovAutocovariance(double rate, int at_level) : a(rate), level(at_level) {
+    const double h = std::sinh(a / 2);
+    const double a2 = a * a, a3 = a2 * a, a5 = a3 * a2;
+    if (level == 0) {
+      linear = a < 0.05 ? a3 * (1.0 / 6 + a2 * (1.0 / 120 + a2 * (1.0 / 5040 + a2 / 362880))) : std::sinh(a) - a;
+      denominator = 4 * h * h;
+      return;
+    }
+    if (a < 0.05) {
+      linear = -a5 * (1.0 / 30 + a2 * (1.0 / 252 + a2 * (1.0 / 4320 + a2 * (17.0 / 1995840 + a2 * 31.0 / 141523200))));
+      cubic = a5 * (1.0 / 24 + a2 * (1.0 / 240 + a2 * (17.0 / 72576 + a2 * (31.0 / 3628800 + a2 / 4561920))));
+    } else {
+      linear = std::sinh(a) * (1 - 2 * h * h / 3) - a;
+      cubic = 2 * std::sinh(a) * h * h / 3 - a3 / 6;
+    }
+    denominator = 16 * h * h * h * h;
   }
-  double d1, d3;
-  if (a < 0.05) {
-    d1 = -a5 * (1.0 / 30 + a2 * (1.0 / 252 + a2 * (1.0 / 4320 + a2 * (17.0 / 1995840 + a2 * 31.0 / 141523200))));
-    d3 = a5 * (1.0 / 24 + a2 * (1.0 / 240 + a2 * (17.0 / 72576 + a2 * (31.0 / 3628800 + a2 / 4561920))));
-  } else {
-    d1 = std::sinh(a) * (1 - 2 * h * h / 3) - a;
-    d3 = 2 * std::sinh(a) * h * h / 3 - a3 / 6;
+  double operator()(std::int64_t k) const {
+    const double ak = static_cast<double>(k < 0 ? -k : k);
+    if (level == 0) return -(exp_remainder(2, a * ak) + linear * ak) / denominator;
+    return (exp_remainder(4, a * ak) + linear * ak + cubic * ak * ak * ak) / denominator;
   }
-  return (exp_remainder(4, a * ak) + d1 * ak + d3 * ak * ak * ak) / (16 * h * h * h * h);
-}
+};
 
-// c of Markov rate a (unit stationary variance) at `lag` under kernel k.
-inline double markov_covariance(const Kernel& k, double a, std::int64_t lag) {
+// c of Markov rate r.a (unit stationary variance) at `lag` under kernel k (r made at k.level).
+inline double markov_covariance(const Kernel& k, const MarkovAutocovariance& r, std::int64_t lag) {
   double c = 0;
-  for (int i = 0; i < k.count; ++i)
-    c += k.w[static_cast<std::size_t>(i)] * markov_autocovariance(a, k.level, lag + k.u[static_cast<std::size_t>(i)]);
+  for (int i = 0; i < k.count; ++i) c += k.w[static_cast<std::size_t>(i)] * r(lag + k.u[static_cast<std::size_t>(i)]);
   return c;
 }
 

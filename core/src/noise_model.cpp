@@ -28,7 +28,8 @@ double term_covariance(int alpha, Stat a, std::uint64_t m_a, Stat b, std::uint64
 
 double markov_term_covariance(double a, Stat a_stat, std::uint64_t m_a, Stat b_stat, std::uint64_t m_b, std::int64_t lag) {
   if (!(a > 0)) return 0.0;
-  return markov_covariance(kernel(a_stat, m_a, b_stat, m_b), a, lag);
+  const Kernel k = kernel(a_stat, m_a, b_stat, m_b);
+  return markov_covariance(k, MarkovAutocovariance(a, k.level), lag);
 }
 
 TermGrid unbroken_grid(Stat stat, std::uint64_t m, std::uint64_t stride, std::uint64_t n_phase) {
@@ -203,9 +204,11 @@ MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rat
   std::array<std::int64_t, 72> breaks{};
   const int n_breaks = pair_breaks(setup, lo, hi, breaks);
   std::array<double, max_markov_rates> edge_lo{}, edge_hi{};
+  std::array<MarkovAutocovariance, max_markov_rates> r{};
   for (std::size_t j = 0; j < markov; ++j) {
-    edge_lo[j] = markov_covariance(k, rates[j], span_lo);
-    edge_hi[j] = markov_covariance(k, rates[j], span_hi);
+    r[j] = MarkovAutocovariance(rates[j], k.level);
+    edge_lo[j] = markov_covariance(k, r[j], span_lo);
+    edge_hi[j] = markov_covariance(k, r[j], span_hi);
   }
   visit_nodes(lo, hi, step, smooth_step(a, b, step), span_lo, span_hi, breaks.data(), n_breaks,
               [&](std::int64_t lag, double weight) {
@@ -216,7 +219,7 @@ MarkovPairSums markov_pair_sums(const NoiseSet& set, std::span<const double> rat
                 const bool inside = noise.inside(lag);
                 noise.at(setup, lag, c);
                 for (std::size_t j = 0; j < markov; ++j)
-                  cm[j] = inside          ? markov_covariance(k, rates[j], lag)
+                  cm[j] = inside          ? markov_covariance(k, r[j], lag)
                           : lag < span_lo ? edge_lo[j] * std::exp(-rates[j] * static_cast<double>(span_lo - lag))
                                           : edge_hi[j] * std::exp(-rates[j] * static_cast<double>(lag - span_hi));
                 for (std::size_t j = 0; j < markov; ++j) {

@@ -203,6 +203,7 @@ bool same_grid(const TermGrid& a, const TermGrid& b) {
 
 SinusoidPairSums PairSumCache::sinusoid_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a,
                                              const TermGrid& b) {
+  if (SinusoidPairSums found; source_ != nullptr && source_->find_sinusoids(set, thetas, a, b, found)) return found;
   const std::size_t count = thetas.size() < max_sinusoid_rates ? thetas.size() : max_sinusoid_rates;
   std::uint64_t h = (a.m * 0x9E3779B97F4A7C15u) ^ (b.m * 0xC2B2AE3D27D4EB4Fu) ^ (a.n << 7) ^ (b.n << 13) ^
                     (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5);

@@ -1,6 +1,7 @@
 // The IEEE-952 fits of an analysis (analysis_report.hpp): the points of its Allan and modified
 // Allan curves, at long tau from the total family when asked (LongTau), the three fits, and a
 // simulation's truth read back from the file's header.
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -66,34 +67,54 @@ void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& 
   }
 }
 
-// The power-law pair sums of every two fit points, computed once, on two threads, before the fits,
-// which then only read them (a PairSumSource their caches ask first). Each pair is what
-// PairSumCache::get() makes for a fresh entry, so the fits see the same bits as when each cache made
-// its own. The fit of both curves needs every pair, and its Allan-with-modified-Allan pairs are the
-// dear ones: on one thread they were most of its time (perf, 10^6 counts).
+// The power-law pair sums of every two fit points, and their sinusoid sums where the fit is given
+// sinusoids, computed once, on two threads, before the fits, which then only read them (a
+// PairSumSource their caches ask first). Each pair is what PairSumCache::get() and sinusoid_sums()
+// make for a fresh entry, so the fits see the same bits as when each cache made its own. The fit of
+// both curves needs every pair, and its Allan-with-modified-Allan pairs are the dear ones: on one
+// thread they were most of its time (perf, 10^6 counts); and the fits of each curve alone, on a
+// second thread, made the sinusoid sums of their pairs again.
 class PointPairSums final : public PairSumSource {
  public:
-  PointPairSums(std::span<const FitPoint> points, std::uint64_t n_phase) {
+  PointPairSums(std::span<const FitPoint> points, std::uint64_t n_phase, const SinusoidSumInputs& sinusoids)
+      : sinusoids_(sinusoids) {
     for (const FitPoint& p : points) grids_.push_back(unbroken_grid(p.stat, p.m, p.stride, n_phase));
     std::vector<std::pair<std::size_t, std::size_t>> pairs;
     for (std::size_t i = 0; i < grids_.size(); ++i)
       for (std::size_t j = 0; j <= i; ++j) pairs.emplace_back(i, j);
     sums_.resize(pairs.size());
+    if (sinusoids_.any()) sinusoid_sums_.resize(pairs.size());
     on_threads(2, pairs.size(), [&](unsigned, std::size_t k) {
       std::array<PairSumCache::Entry, 1> entry{};
       PairSumCache cache(entry);
-      sums_[k] = cache.get(grids_[pairs[k].first], grids_[pairs[k].second]);
+      const TermGrid &a = grids_[pairs[k].first], &b = grids_[pairs[k].second];
+      sums_[k] = cache.get(a, b);
+      if (sinusoids_.any()) sinusoid_sums_[k] = sinusoid_pair_sums(sinusoids_.set, sinusoids_.thetas, a, b);
     });
   }
   // The sums of grids a and b as pairs (i, j), i >= j, of the points give them.
   bool find(const TermGrid& a, const TermGrid& b, PairSums& out) const override {
-    const std::size_t i = index(a), j = index(b);
-    if (i == grids_.size() || j == grids_.size() || i < j) return false;
-    out = sums_[i * (i + 1) / 2 + j];
+    const std::size_t k = pair_index(a, b);
+    if (k == npos) return false;
+    out = sums_[k];
+    return true;
+  }
+  bool find_sinusoids(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a, const TermGrid& b,
+                      SinusoidPairSums& out) const override {
+    const std::size_t k = sinusoid_sums_.empty() ? npos : pair_index(a, b);
+    if (k == npos || !std::ranges::equal(thetas, sinusoids_.thetas) || set.count != sinusoids_.set.count ||
+        !std::ranges::equal(set.alpha, sinusoids_.set.alpha))
+      return false;
+    out = sinusoid_sums_[k];
     return true;
   }
 
  private:
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+  std::size_t pair_index(const TermGrid& a, const TermGrid& b) const {
+    const std::size_t i = index(a), j = index(b);
+    return i == grids_.size() || j == grids_.size() || i < j ? npos : i * (i + 1) / 2 + j;
+  }
   std::size_t index(const TermGrid& g) const {
     std::size_t i = 0;
     while (i < grids_.size() && !(grids_[i].stat == g.stat && grids_[i].m == g.m && grids_[i].stride == g.stride &&
@@ -101,8 +122,10 @@ class PointPairSums final : public PairSumSource {
       ++i;
     return i;
   }
+  SinusoidSumInputs sinusoids_;
   std::vector<TermGrid> grids_;
-  std::vector<PairSums> sums_;  // pair (i, j), i >= j, at i (i + 1) / 2 + j
+  std::vector<PairSums> sums_;                   // pair (i, j), i >= j, at i (i + 1) / 2 + j
+  std::vector<SinusoidPairSums> sinusoid_sums_;  // likewise; empty where no sinusoid is given
 };
 
 }  // namespace
@@ -131,15 +154,13 @@ std::vector<CurveFit> fit_curves(const Analysis& a, const ReportUnits& units, do
   const ThreadRows rows(2);
   setup.rows = &rows;
   const int used = long_tau != LongTau::oadev && !record.phase.empty() ? static_cast<int>(long_tau) : 0;
-  const PointPairSums sums(points, a.n_phase);
-  // Fits in turn that read those sums and share the sinusoids' (computed once in a cache with room
-  // for every pair).
+  const PointPairSums sums(points, a.n_phase, ieee952_sinusoid_inputs(setup));
+  // Fits in turn that read those sums.
   const auto fit_in_turn = [&](std::initializer_list<FitCurve> curves) {
     std::vector<CurveFit> out;
     std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
     std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
-    std::vector<PairSumCache::SinusoidEntry> sinusoid_entries(points.size() * points.size() + 16);
-    PairSumCache cache(entries, sinusoid_entries);
+    PairSumCache cache(entries);
     cache.attach(&sums);
     for (const FitCurve curve : curves)
       out.push_back({curve, fit_ieee952(points, setup, curve, workspace, &cache), curve == FitCurve::mvar ? 0 : used});

@@ -235,6 +235,16 @@ constexpr std::size_t ieee952_workspace_doubles(std::size_t points) {
 Ieee952Fit fit_ieee952(std::span<const FitPoint> points, const FitSetup& setup, FitCurve curve, std::span<double> workspace,
                        PairSumCache* cache = nullptr);
 
+/// What the fit's sinusoid sums (sinusoid_pair_sums() of every two points) are made of: the
+/// noises and each given frequency's phase step 2 pi f tau0 (0: none given). A PairSumSource that
+/// makes them beforehand makes them from these. O(1).
+struct SinusoidSumInputs {
+  NoiseSet set;
+  std::array<double, max_sinusoids> thetas{};
+  bool any() const { return thetas[0] > 0 || thetas[max_sinusoids - 1] > 0; }
+};
+SinusoidSumInputs ieee952_sinusoid_inputs(const FitSetup& setup);
+
 /// The model's exact expected AVAR or MVAR at averaging factor m for parameters {Q, N, B, K, R}.
 /// O(1).
 double ieee952_variance(const std::array<double, 5>& qnbkr, Stat stat, std::uint64_t m, double tau0_s);

@@ -191,6 +191,13 @@ class PairSumSource {
   /// True, with the sums in `out`, when this source has pair_sums(allan_noises(), a, b) (or an
   /// approximation its owner vouches for).
   virtual bool find(const TermGrid& a, const TermGrid& b, PairSums& out) const = 0;
+  /// True, with the sums in `out`, when this source has sinusoid_pair_sums(set, thetas, a, b) to the
+  /// last bit. None by default.
+  virtual bool find_sinusoids(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a, const TermGrid& b,
+                              SinusoidPairSums& out) const {
+    (void)set, (void)thetas, (void)a, (void)b, (void)out;
+    return false;
+  }
 
  protected:
   ~PairSumSource() = default;
