@@ -193,44 +193,14 @@ PairSums PairSumCache::get(const TermGrid& a, const TermGrid& b) {
   return entry->sums;
 }
 
-namespace {
-
-bool same_grid(const TermGrid& a, const TermGrid& b) {
-  return a.stat == b.stat && a.m == b.m && a.stride == b.stride && a.first == b.first && a.n == b.n;
-}
-
-}  // namespace
-
 SinusoidPairSums PairSumCache::sinusoid_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a,
                                              const TermGrid& b) {
   if (SinusoidPairSums found; source_ != nullptr && source_->find_sinusoids(set, thetas, a, b, found)) return found;
-  const std::size_t count = thetas.size() < max_sinusoid_rates ? thetas.size() : max_sinusoid_rates;
-  std::uint64_t h = (a.m * 0x9E3779B97F4A7C15u) ^ (b.m * 0xC2B2AE3D27D4EB4Fu) ^ (a.n << 7) ^ (b.n << 13) ^
-                    (static_cast<std::uint64_t>(a.stat) << 3) ^ (static_cast<std::uint64_t>(b.stat) << 5);
-  for (std::size_t probe = 0; probe < sinusoids_.size() && probe < 64; ++probe) {
-    SinusoidEntry& e = sinusoids_[static_cast<std::size_t>((h + probe) % sinusoids_.size())];
-    if (e.used) {
-      bool same = e.count == count && e.set.count == set.count && same_grid(e.a, a) && same_grid(e.b, b);
-      for (std::size_t t = 0; same && t < set.count; ++t) same = e.set.alpha[t] == set.alpha[t];
-      for (std::size_t j = 0; same && j < count; ++j) same = e.thetas[j] == thetas[j];
-      if (same) return e.sums;
-      continue;
-    }
-    e.used = true;
-    e.set = set;
-    e.a = a;
-    e.b = b;
-    e.count = count;
-    for (std::size_t j = 0; j < count; ++j) e.thetas[j] = thetas[j];
-    e.sums = sinusoid_pair_sums(set, thetas, a, b);
-    return e.sums;
-  }
   return sinusoid_pair_sums(set, thetas, a, b);
 }
 
 void PairSumCache::clear() {
   for (Entry& e : entries_) e = Entry{};
-  for (SinusoidEntry& e : sinusoids_) e = SinusoidEntry{};
 }
 
 double exact_edf(int alpha, const TermGrid& g) {

@@ -69,7 +69,7 @@ void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& 
 
 // The power-law pair sums of every two fit points, and their sinusoid sums where the fit is given
 // sinusoids, computed once, on two threads, before the fits, which then only read them (a
-// PairSumSource their caches ask first). Each pair is what PairSumCache::get() and sinusoid_sums()
+// PairSumSource their caches ask first). Each pair is what PairSumCache::get() and sinusoid_pair_sums()
 // make for a fresh entry, so the fits see the same bits as when each cache made its own. The fit of
 // both curves needs every pair, and its Allan-with-modified-Allan pairs are the dear ones: on one
 // thread they were most of its time (perf, 10^6 counts); and the fits of each curve alone, on a

@@ -148,8 +148,7 @@ std::vector<CurveFit> expect_the_bits_of_each_fit_alone(const SimOptions& s, con
   for (const CurveFit& got : threaded) {
     std::vector<double> workspace(ieee952_workspace_doubles(points.size()));
     std::vector<PairSumCache::Entry> entries(points.size() * points.size() + 16);
-    std::vector<PairSumCache::SinusoidEntry> sinusoid_entries(points.size() * points.size() + 16);
-    PairSumCache cache(entries, sinusoid_entries);
+    PairSumCache cache(entries);
     FitSetup setup{s.tau0_s, a.n_phase, qw};
     setup.sinusoid_hz = hz;
     const Ieee952Fit want = fit_ieee952(points, setup, got.curve, workspace, &cache);

@@ -193,9 +193,8 @@ class PairSumSource {
   virtual bool find(const TermGrid& a, const TermGrid& b, PairSums& out) const = 0;
   /// True, with the sums in `out`, when this source has sinusoid_pair_sums(set, thetas, a, b) to the
   /// last bit. None by default.
-  virtual bool find_sinusoids(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a, const TermGrid& b,
-                              SinusoidPairSums& out) const {
-    (void)set, (void)thetas, (void)a, (void)b, (void)out;
+  virtual bool find_sinusoids(const NoiseSet&, std::span<const double>, const TermGrid&, const TermGrid&,
+                              SinusoidPairSums&) const {
     return false;
   }
 
@@ -214,22 +213,11 @@ class PairSumCache {
     std::uint64_t n_a = 0, n_b = 0;  // not linear: the term counts of `sums`
     PairSums slope, sums;            // linear: sums = slope * n + sums (the intercept)
   };
-  /// sinusoid_pair_sums() of one pair of grids at given frequencies, kept exactly as computed.
-  struct SinusoidEntry {
-    bool used = false;
-    NoiseSet set;
-    TermGrid a, b;
-    std::array<double, max_sinusoid_rates> thetas{};
-    std::size_t count = 0;
-    SinusoidPairSums sums;
-  };
-  explicit PairSumCache(std::span<Entry> storage, std::span<SinusoidEntry> sinusoids = {})
-      : entries_(storage), sinusoids_(sinusoids) {}
+  explicit PairSumCache(std::span<Entry> storage) : entries_(storage) {}
   /// pair_sums(allan_noises(), a, b), from the cache where it can. O(1) once cached.
   PairSums get(const TermGrid& a, const TermGrid& b);
-  /// sinusoid_pair_sums(set, thetas, a, b), the same to the last bit: kept in the sinusoid storage
-  /// (when there is one) for the next fit of the same grids and frequencies (the analyzer fits
-  /// both curves and each alone). O(1) once kept; a full storage computes afresh.
+  /// sinusoid_pair_sums(set, thetas, a, b), the same to the last bit: from the attached source where
+  /// it has them (the analyzer makes every pair's once for its three fits), else computed; not kept.
   SinusoidPairSums sinusoid_sums(const NoiseSet& set, std::span<const double> thetas, const TermGrid& a, const TermGrid& b);
   /// Asks `source` first from now on (null: none); it must outlive its use here.
   void attach(const PairSumSource* source) { source_ = source; }
@@ -239,7 +227,6 @@ class PairSumCache {
  private:
   Entry* slot(const TermGrid& a, const TermGrid& b);  // null: not kept
   std::span<Entry> entries_;
-  std::span<SinusoidEntry> sinusoids_;
   const PairSumSource* source_ = nullptr;
 };
 
