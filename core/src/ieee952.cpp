@@ -401,16 +401,31 @@ void fit_points(Problem& pr, const FitSetup& setup, bool filter, const Flags& fr
   write_fit(pr, widened, free, nl_sd, out);
   out.chosen = summary_of(chosen);
   out.runner_up = summary_of(runner_up);
+  for (std::size_t t = 0; t < power_terms; ++t) out.p[t].held_for_markov = (chosen.model.held >> t & 1u) != 0;
   // A term is resolved only where the evidence for it does not rest on the choice of model: a B, K
   // or R the runner-up does without (not two standard uncertainties above zero there) while it
   // comes within model_doubt of the chosen model is not resolved. With a Markov term of 1 500 s
   // in an 8 h record, one Markov term and a rate random walk (K = 0.63(14) deg/h/sqrt(h) where
   // none was simulated) beat the true two Markov terms by 4.3: the record cannot tell them apart.
-  if (!runner_up.valid || !(out.runner_up.criterion - out.chosen.criterion < model_doubt)) return;
-  for (std::size_t t = 2; t < power_terms; ++t)
-    if (out.p[t].resolved && !column_significant(runner_up, t)) {
-      out.p[t].resolved = false;
-      out.p[t].doubted = true;
+  if (runner_up.valid && out.runner_up.criterion - out.chosen.criterion < model_doubt)
+    for (std::size_t t = 2; t < power_terms; ++t)
+      if (out.p[t].resolved && !column_significant(runner_up, t)) {
+        out.p[t].resolved = false;
+        out.p[t].doubted = true;
+      }
+  // Nor is a B or K that one more Markov term in its place replaces as well (markov_in_place_of()):
+  // a Markov term's rising side is a rate random walk's, and its hump can stand for a floor. The
+  // same two Markov terms: one of them and K = 0.61(10) deg/h/sqrt(h), resolved, where the runner-up
+  // (the five terms alone) was far behind.
+  if (!setup.select_model || chosen.model.markov >= setup.markov_terms) return;
+  for (std::size_t t = 2; t < 4; ++t)
+    if (out.p[t].resolved) {
+      const double tc = markov_in_place_of(pr, free, fixed, chosen, t);
+      if (tc > 0) {
+        out.p[t].resolved = false;
+        out.p[t].doubted = true;
+        out.p[t].markov_in_place_tc_s = tc;
+      }
     }
 }
 

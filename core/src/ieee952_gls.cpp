@@ -283,6 +283,7 @@ Solution solve(const Problem& pr, const Flags& free, const Terms& fixed) {
       if (!free[t]) allowed = false;
       idx[k++] = t;
     }
+    const bool in_model = (mask & pr.model.held) == 0;  // else only the unconstrained estimates
     if (!allowed || k > n) continue;
     Matrix ata{};
     Terms atb{};
@@ -301,7 +302,7 @@ Solution solve(const Problem& pr, const Flags& free, const Terms& fixed) {
         free_theta[idx[a]] = x[a] * scale[idx[a]];
         free_variance[idx[a]] = inv[a][a] * scale[idx[a]] * scale[idx[a]];
       }
-    bool feasible = true;
+    bool feasible = in_model;
     for (std::size_t a = 0; a < k; ++a) feasible &= x[a] >= 0;
     if (!feasible) continue;
     double chi2 = 0;

@@ -55,7 +55,8 @@ struct Model {
   std::array<double, max_markov> a{};  // tau0 / Tc of each Markov term
   std::size_t sinusoids = 0;
   std::array<double, max_sinusoids> hz{};
-  double band = 0;  // tau0 / Tf of the filter on N's white noise; 0: none
+  double band = 0;    // tau0 / Tf of the filter on N's white noise; 0: none
+  unsigned held = 0;  // power terms (bit t) held at zero: a Markov term stands in B's or K's place
   std::size_t columns() const { return power_terms + markov + sinusoids; }
   std::size_t nonlinear() const { return markov + sinusoids + (band > 0 ? 1 : 0); }
 };
@@ -168,5 +169,12 @@ bool refit_exactly(Problem& pr, const FitSetup& setup, const Flags& free, const 
 void profile_markov_terms(Problem& pr, const Flags& free, const Terms& fixed, LogSpreads& nl_sd);
 bool markov_terms_hold(const Candidate& more, const Candidate& fewer);
 bool column_significant(const Candidate& c, std::size_t t);
+struct MarkovTaus {
+  double lo, hi;  // [s]
+};
+MarkovTaus markov_taus(const Problem& pr, const Solution& sol);
+bool place_markov_term(Problem& pr, const Flags& free, const Terms& fixed, std::size_t k, double lo, double hi, bool above);
+Candidate markov_in_place(Problem& pr, const Flags& free, const Terms& fixed, const Candidate& base, std::size_t t);
+double markov_in_place_of(Problem& pr, const Flags& free, const Terms& fixed, const Candidate& chosen, std::size_t t);
 
 }  // namespace gyrochar::ieee952_fit

@@ -109,10 +109,12 @@ void fit_tables(html::Document& doc, const Report& r) {
       }
       rows.push_back({text(u.letter), p.fitted ? number(p.value / u.si) : Cell{},
                       p.fitted ? number(p.uncertainty / u.si) : Cell{}, text(u.name),
-                      text(!p.fitted    ? "not in model"
-                           : p.resolved ? "resolved"
-                           : p.doubted  ? "not resolved (the runner-up model does without it)"
-                                        : "not resolved")});
+                      text(!p.fitted && p.held_for_markov ? "not in model (a Markov term in its place)"
+                           : !p.fitted                    ? "not in model"
+                           : p.resolved                   ? "resolved"
+                           : p.markov_in_place_tc_s > 0   ? "not resolved (a Markov term in its place does as well)"
+                           : p.doubted                    ? "not resolved (the runner-up model does without it)"
+                                                          : "not resolved")});
       if (r.truth && f == 0) rows.back().push_back(truth);
     }
     for (std::size_t i = 0; i < fit.n_markov; ++i) {

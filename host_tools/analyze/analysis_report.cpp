@@ -316,7 +316,9 @@ std::string format_table(const Report& r) {
       const FitUnit& fu = fit_units(u)[i];
       const Ieee952Parameter& p = f.fit.p[i];
       if (!p.fitted && !(i == 0 && !f.fit.quantization_white)) {
-        fmt::format_to(to, "#   {} not in the model (the fit is better without it){}\n", fu.letter,
+        fmt::format_to(to, "#   {} not in the model ({}){}\n", fu.letter,
+                       p.held_for_markov ? "held at zero: a Markov term stands in its place"
+                                         : "the fit is better without it",
                        r.truth ? fmt::format("   simulated {:.4g} {}", truth_values(*r.truth)[i] / fu.si, fu.name) : "");
         continue;
       }
@@ -325,7 +327,11 @@ std::string format_table(const Report& r) {
         fmt::format_to(to, "#   {} = {:.4g} {}  (held, not fitted){}\n", fu.letter, p.value / fu.si, fu.name, truth);
       else
         fmt::format_to(to, "#   {} = {:.4g} +- {:.2g} {}{}{}\n", fu.letter, p.value / fu.si, p.uncertainty / fu.si, fu.name,
-                       p.resolved  ? ""
+                       p.resolved ? ""
+                       : p.markov_in_place_tc_s > 0
+                           ? fmt::format("  (not resolved: a Markov term of Tc {:.4g} s in its place describes the curve "
+                                         "as well, close by the criterion)",
+                                         p.markov_in_place_tc_s)
                        : p.doubted ? "  (not resolved: the runner-up model, close by the criterion, does without it)"
                                    : "  (not resolved)",
                        truth);
@@ -501,6 +507,9 @@ nlohmann::json to_json(const Report& r) {
         one[fu.letter] = {{"value", p.value / fu.si}, {"uncertainty", p.uncertainty / fu.si},
                           {"fitted", p.fitted},       {"resolved", p.resolved},
                           {"doubted", p.doubted},     {"unit", fu.name}};
+        if (p.markov_in_place_tc_s > 0)  // doubted: a Markov term of this Tc in its place does as well
+          one[fu.letter]["markov_in_place"] = {{"tc", p.markov_in_place_tc_s}, {"unit", "s"}};
+        if (p.held_for_markov) one[fu.letter]["held_for_markov"] = true;  // a Markov term in its place
         if (p.unconstrained_uncertainty > 0)  // what a verdict judges (docs/metrology.md, "Acceptance limits")
           one[fu.letter]["unconstrained"] = {{"value", p.unconstrained / fu.si},
                                              {"uncertainty", p.unconstrained_uncertainty / fu.si}};

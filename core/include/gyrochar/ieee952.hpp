@@ -35,7 +35,8 @@
 // ramp response, which is not its own). B, K and R must also survive the choice of model: where the
 // runner-up of the model selection comes within 2 ln 19 of the chosen model by the criterion and
 // does without the term (not two standard uncertainties above zero there), it is not resolved
-// (`doubted`).
+// (`doubted`); nor is a B or K that one more Markov term in its place (its correlation time found
+// inside the search range, every Markov term significant) replaces within 2 ln 19.
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
 // A steady rate without dither (and with too little random angle per sample to spread it) makes a
@@ -146,8 +147,13 @@ struct Ieee952Parameter {
   bool fitted = false;     // part of the model the fit kept (false: left out, or held fixed)
   bool resolved = false;   // see the header
   // B, K or R that the chosen model resolves but the runner-up, within model_doubt of it by the
-  // criterion, does without: not resolved (see the header).
+  // criterion, does without, or (B, K) that one more Markov term in its place replaces as well
+  // within model_doubt: not resolved (see the header).
   bool doubted = false;
+  double markov_in_place_tc_s = 0;  // doubted for that Markov term: its correlation time [s]; else 0
+  // B or K held at zero in the chosen model: one of its Markov terms stands in the term's place
+  // (the term free beside it, the Markov term was not significant).
+  bool held_for_markov = false;
   // The same term in the model with every free term, its square not held non-negative: unbiased
   // where the model holds (the non-negative value above leans low or high where another term is
   // clipped at zero); 0 and 0 where the term was not free. What acceptance verdicts judge.
