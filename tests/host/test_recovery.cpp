@@ -6,6 +6,9 @@
 // usable, and the periodic quantization of a rate below one pulse per sample found.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <string>
+
 #include "support/recovery.hpp"
 
 namespace gyrochar::test_support {
@@ -74,6 +77,18 @@ TEST(Recovery, ASinusoidIsNotTakenForAQuantizationPattern) {
   EXPECT_NEAR(a.value, r.truth.sinusoids[0].amplitude_rad_s, 3 * a.uncertainty);
 }
 
+// The simulator's options of the study's scenario `name`, with the seed given.
+SimOptions study_gyro(const std::string& name, std::uint64_t seed) {
+  for (const Scenario& s : standard_scenarios())
+    if (s.name == name) {
+      SimOptions sim = s.sim;
+      sim.seed = seed;
+      return sim;
+    }
+  ADD_FAILURE() << "no scenario " << name;
+  return {};
+}
+
 TEST(Recovery, AMarkovTermThatDoesAsWellInKsPlaceLeavesKUnresolved) {
   // gyrochar-sim --duration 28800 --tau0 0.1 --white-angle 1 --arw 0.02 --markov 0.5,20
   // --markov 0.4,1500 --seed 7: one run of the study's "ARW + two Markov terms". The model chosen
@@ -81,14 +96,7 @@ TEST(Recovery, AMarkovTermThatDoesAsWellInKsPlaceLeavesKUnresolved) {
   // is far behind, so K was "resolved" where none was simulated. The second Markov term in K's
   // place describes the curve as well: K is not resolved, and says which term could stand for it.
   // Oracle: the simulator's K of zero; the Markov term's Tc within a factor 2 of its 1 500 s.
-  SimOptions sim;
-  sim.duration_s = 28800;
-  sim.tau0_s = 0.1;
-  sim.white_angle_arcsec = 1;
-  sim.arw_deg_per_sqrt_h = 0.02;
-  sim.markov = {{0.5, 20}, {0.4, 1500}};
-  sim.seed = 7;
-  const Recovery r = recover(sim);
+  const Recovery r = recover(study_gyro("ARW + two Markov terms", 7));
   const Ieee952Fit& f = r.fit();
   ASSERT_TRUE(f.ok()) << name(f.status) << ", chi2/dof " << f.chi2_per_dof();
   ASSERT_EQ(r.truth.k_rad_s_sqrt_s, 0.0);
@@ -106,14 +114,7 @@ TEST(Recovery, AMarkovTermInBsPlaceIsTheModelWhereTheCriterionPrefersIt) {
   // significant, so the model stayed at one Markov term and B, and was rejected on its exact
   // covariance (chi2/dof 49.8). With B held at zero and the second term sought above the first,
   // the criterion prefers the two terms. Oracle: the simulator's terms; the fit's own acceptance.
-  SimOptions sim;
-  sim.duration_s = 28800;
-  sim.tau0_s = 0.1;
-  sim.white_angle_arcsec = 1;
-  sim.arw_deg_per_sqrt_h = 0.02;
-  sim.markov = {{0.5, 20}, {0.4, 1500}};
-  sim.seed = 12284238937601492669u;
-  const Recovery r = recover(sim);
+  const Recovery r = recover(study_gyro("ARW + two Markov terms", 12284238937601492669u));
   const Ieee952Fit& f = r.fit();
   ASSERT_TRUE(f.ok()) << name(f.status) << ", chi2/dof " << f.chi2_per_dof();
   ASSERT_EQ(f.n_markov, 2u);
