@@ -35,8 +35,9 @@
 // ramp response, which is not its own). B, K and R must also survive the choice of model: where the
 // runner-up of the model selection comes within 2 ln 19 of the chosen model by the criterion and
 // does without the term (not two standard uncertainties above zero there), it is not resolved
-// (`doubted`); nor is a B or K that one more Markov term in its place (its correlation time found
-// inside the search range, every Markov term significant) replaces within 2 ln 19.
+// (`doubted`); nor, in a model that holds a Markov term, is a B or K that one more Markov term in
+// its place (its correlation time inside the search range, every Markov term significant) replaces
+// within 2 ln 19.
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
 // A steady rate without dither (and with too little random angle per sample to spread it) makes a
