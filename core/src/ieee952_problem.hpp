@@ -175,6 +175,6 @@ struct MarkovTaus {
 MarkovTaus markov_taus(const Problem& pr, const Solution& sol);
 bool place_markov_term(Problem& pr, const Flags& free, const Terms& fixed, std::size_t k, double lo, double hi, bool above);
 Candidate markov_in_place(Problem& pr, const Flags& free, const Terms& fixed, const Candidate& base, std::size_t t);
-double markov_in_place_of(Problem& pr, const Flags& free, const Terms& fixed, const Candidate& chosen, std::size_t t);
+Candidate markov_in_place_of(Problem& pr, const Flags& free, const Terms& fixed, const Candidate& chosen, std::size_t t);
 
 }  // namespace gyrochar::ieee952_fit

@@ -383,27 +383,25 @@ Candidate markov_in_place(Problem& pr, const Flags& free, const Terms& fixed, co
   return c;
 }
 
-// Whether the chosen model's B or K (column t) is replaced as well by a Markov term in its place
+// The chosen model's B or K (column t) replaced as well by a Markov term in its place
 // (markov_in_place()): accepted, every Markov term significant, N still in it, and its criterion
 // within model_doubt of the chosen model's, both on its covariance (as the search compares). Returns
-// that term's Tc [s], else 0. Leaves pr's model and covariance the chosen one's again (an exact
-// covariance's Markov sums are not touched).
-double markov_in_place_of(Problem& pr, const Flags& free, const Terms& fixed, const Candidate& chosen, std::size_t t) {
+// that model, else an invalid candidate. Leaves pr's model and covariance the chosen one's again
+// (an exact covariance's Markov sums are not touched).
+Candidate markov_in_place_of(Problem& pr, const Flags& free, const Terms& fixed, const Candidate& chosen, std::size_t t) {
   const bool exact = pr.exact_markov;
   pr.exact_markov = false;
   const Candidate c = markov_in_place(pr, free, fixed, chosen, t);
-  double tc = 0;
+  bool as_well = false;
   if (c.valid && c.status == FitStatus::ok && c.placed && markov_terms_hold(c, chosen)) {
-    const double a = c.model.a[c.model.markov - 1];
     pr.model = chosen.model;
-    const double incumbent = criterion_of(profile_chi2(pr, free, fixed), chosen.parameters, pr.n);
-    if (c.criterion - incumbent < model_doubt) tc = pr.tau0 / a;
+    as_well = c.criterion - criterion_of(profile_chi2(pr, free, fixed), chosen.parameters, pr.n) < model_doubt;
   }
   pr.model = chosen.model;
   pr.exact_markov = exact;
   set_rows(pr);
   weigh(pr, chosen.sol.theta);
-  return tc;
+  return as_well ? c : Candidate{};
 }
 
 }  // namespace gyrochar::ieee952_fit

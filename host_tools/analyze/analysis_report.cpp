@@ -336,6 +336,12 @@ std::string format_table(const Report& r) {
                                    : "  (not resolved)",
                        truth);
     }
+    for (std::size_t i = 2; i < 4; ++i)
+      if (f.fit.p[i].markov_in_place_tc_s > 0)
+        fmt::format_to(to,
+                       "#   the uncertainties include each term's difference to the model with a Markov term of Tc "
+                       "{:.4g} s in {}'s place (it describes the curve as well)\n",
+                       f.fit.p[i].markov_in_place_tc_s, fit_units(u)[i].letter);
     const FitUnit& rate = fit_units(u)[2];  // B's unit: a rate
     if (f.fit.bandwidth_tc_s > 0)
       fmt::format_to(to,

@@ -37,7 +37,9 @@
 // does without the term (not two standard uncertainties above zero there), it is not resolved
 // (`doubted`); nor, in a model that holds a Markov term, is a B or K that one more Markov term in
 // its place (its correlation time inside the search range, every Markov term significant) replaces
-// within 2 ln 19.
+// within 2 ln 19. Where such a model does as well (B or K resolved or not), the record cannot choose
+// between the two: each term both hold has the difference between its two values added to its
+// uncertainty.
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
 // A steady rate without dither (and with too little random angle per sample to spread it) makes a
@@ -151,7 +153,11 @@ struct Ieee952Parameter {
   // criterion, does without, or (B, K) that one more Markov term in its place replaces as well
   // within model_doubt: not resolved (see the header).
   bool doubted = false;
-  double markov_in_place_tc_s = 0;  // doubted for that Markov term: its correlation time [s]; else 0
+  // B or K in a model with a Markov term, where one more Markov term in its place describes the curve
+  // as well (within model_doubt): that term's correlation time [s], else 0. The term is not
+  // resolved, and every term both models hold has the difference between its two values added to
+  // its uncertainty (in quadrature; Tc's in ln Tc).
+  double markov_in_place_tc_s = 0;
   // B or K held at zero in the chosen model: one of its Markov terms stands in the term's place
   // (the term free beside it, the Markov term was not significant).
   bool held_for_markov = false;
