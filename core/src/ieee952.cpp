@@ -284,10 +284,13 @@ void write_fit(const Problem& pr, const Candidate& c, const Flags& free, const L
 // Markov term and B in the second one's place; there N and the 20 s term's sigma lay within two
 // stated sigma of the truth in 78 % and 69 % of the runs (the rest: 95 % and 97 %).
 void widen_by_alternative(const Candidate& alt, std::size_t shared, double tau0, Ieee952Fit& out) {
+  // "Resolved" is judged again on the wider uncertainty: the square's standard uncertainty is
+  // 2 value u, so more than two of it above zero is value > 4 u.
   auto widen = [](Ieee952Parameter& p, double theta) {
     if (!p.fitted) return;
     const double d = (theta > 0 ? std::sqrt(theta) : 0.0) - p.value;
     p.uncertainty = std::sqrt(p.uncertainty * p.uncertainty + d * d);
+    if (!(p.value > 4 * p.uncertainty)) p.resolved = false;
   };
   for (std::size_t t = 0; t < power_terms; ++t)
     if (!(alt.model.held >> t & 1u)) widen(out.p[t], alt.sol.theta[t]);

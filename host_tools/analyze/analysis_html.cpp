@@ -135,12 +135,7 @@ void fit_tables(html::Document& doc, const Report& r) {
     }
     const char* curve = curve_title(r.fits[f].curve);
     std::string other_model;  // a model the record cannot tell from this one (ieee952.hpp)
-    for (std::size_t i = 2; i < 4; ++i)
-      if (fit.p[i].markov_in_place_tc_s > 0)
-        other_model += fmt::format(
-            "; the uncertainties include each term's difference to the model with a Markov term "
-            "of Tc {:.4g} s in {}'s place",
-            fit.p[i].markov_in_place_tc_s, fit_unit(r.units, i).letter);
+    for (const std::string& note : model_difference_notes(fit, r.units)) other_model += "; " + note;
     doc.table(f == 0 ? "fit" : fmt::format("fit-{}", name(r.fits[f].curve)),
               fmt::format("Fit of {}: {}, chi2/dof {:.3g}, {} points, uncertainty scale {:.3g}{}", curve, name(fit.status),
                           fit.chi2_per_dof(), fit.points, fit.birge, other_model),

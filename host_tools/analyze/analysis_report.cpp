@@ -178,6 +178,17 @@ std::optional<bool> readoff_agrees(const ReadoffValue& v, const Ieee952Fit* fit,
   return std::fabs(v.value - p.value) <= std::hypot(p.uncertainty, half_width);
 }
 
+std::vector<std::string> model_difference_notes(const Ieee952Fit& fit, const ReportUnits& u) {
+  std::vector<std::string> notes;
+  for (std::size_t i = 2; i < 4; ++i)
+    if (fit.p[i].markov_in_place_tc_s > 0)
+      notes.push_back(
+          fmt::format("the uncertainties include each term's difference to the model with a Markov term of Tc "
+                      "{:.4g} s in {}'s place",
+                      fit.p[i].markov_in_place_tc_s, fit_unit(u, i).letter));
+  return notes;
+}
+
 namespace {
 
 // The recommended fit (both curves), or nullptr when none was made.
@@ -336,12 +347,8 @@ std::string format_table(const Report& r) {
                                    : "  (not resolved)",
                        truth);
     }
-    for (std::size_t i = 2; i < 4; ++i)
-      if (f.fit.p[i].markov_in_place_tc_s > 0)
-        fmt::format_to(to,
-                       "#   the uncertainties include each term's difference to the model with a Markov term of Tc "
-                       "{:.4g} s in {}'s place (it describes the curve as well)\n",
-                       f.fit.p[i].markov_in_place_tc_s, fit_units(u)[i].letter);
+    for (const std::string& note : model_difference_notes(f.fit, u))
+      fmt::format_to(to, "#   {} (it describes the curve as well)\n", note);
     const FitUnit& rate = fit_units(u)[2];  // B's unit: a rate
     if (f.fit.bandwidth_tc_s > 0)
       fmt::format_to(to,

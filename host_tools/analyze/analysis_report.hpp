@@ -138,6 +138,10 @@ nlohmann::json units_json(const ReportUnits& units);
 /// Empty when there is nothing to compare: no read-off value, no interval, or the term not fitted
 /// by an ok fit. O(1).
 std::optional<bool> readoff_agrees(const ReadoffValue& v, const Ieee952Fit* fit, std::size_t term);
+/// Where the record cannot choose between the fit's model and one with a Markov term in B's or K's
+/// place (ieee952.hpp), the sentence that says the uncertainties include the difference: one per such
+/// term, none otherwise. O(1).
+std::vector<std::string> model_difference_notes(const Ieee952Fit& fit, const ReportUnits& u);
 
 /// Stable32's result table, one block per statistic (in the order asked), each as Stable32 writes
 /// it: the header ("# STATISTICS FOR FILE:", data points, maximum, minimum, average of the values,

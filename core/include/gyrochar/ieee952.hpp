@@ -39,7 +39,7 @@
 // its place (its correlation time inside the search range, every Markov term significant) replaces
 // within 2 ln 19. Where such a model does as well (B or K resolved or not), the record cannot choose
 // between the two: each term both hold has the difference between its two values added to its
-// uncertainty.
+// uncertainty, and is resolved only where its square stays two of the wider uncertainties above zero.
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
 // A steady rate without dither (and with too little random angle per sample to spread it) makes a
