@@ -276,7 +276,7 @@ void write_fit(const Problem& pr, const Candidate& c, const Flags& free, const L
   }
 }
 
-// Where a model the record cannot tell from the chosen one (within model_doubt) gives a term
+// Where a model the record cannot tell from the chosen one (chi2 within model_doubt) gives a term
 // another value, the difference is part of the term's uncertainty: added in quadrature to each
 // term both models hold (the five terms, the chosen model's Markov terms and sinusoids; the
 // alternative `alt` holds `shared` Markov terms in the same places and one more). With two Markov

@@ -341,7 +341,7 @@ std::string format_table(const Report& r) {
                        p.resolved ? ""
                        : p.markov_in_place_tc_s > 0
                            ? fmt::format("  (not resolved: a Markov term of Tc {:.4g} s in its place describes the curve "
-                                         "as well, close by the criterion)",
+                                         "as well, its chi2 within 2 ln 19)",
                                          p.markov_in_place_tc_s)
                        : p.doubted ? "  (not resolved: the runner-up model, close by the criterion, does without it)"
                                    : "  (not resolved)",

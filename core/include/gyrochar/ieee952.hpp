@@ -37,7 +37,7 @@
 // does without the term (not two standard uncertainties above zero there), it is not resolved
 // (`doubted`); nor, in a model that holds a Markov term, is a B or K that one more Markov term in
 // its place (its correlation time inside the search range, every Markov term significant) replaces
-// within 2 ln 19. Where such a model does as well (B or K resolved or not), the record cannot choose
+// with a chi2 within 2 ln 19 of the chosen model's. Where such a model does as well (B or K resolved or not), the record cannot choose
 // between the two: each term both hold has the difference between its two values added to its
 // uncertainty, and is resolved only where its square stays two of the wider uncertainties above zero.
 //
@@ -151,10 +151,10 @@ struct Ieee952Parameter {
   bool resolved = false;   // see the header
   // B, K or R that the chosen model resolves but the runner-up, within model_doubt of it by the
   // criterion, does without, or (B, K) that one more Markov term in its place replaces as well
-  // within model_doubt: not resolved (see the header).
+  // (chi2 within model_doubt): not resolved (see the header).
   bool doubted = false;
   // B or K in a model with a Markov term, where one more Markov term in its place describes the curve
-  // as well (within model_doubt): that term's correlation time [s], else 0. The term is not
+  // as well (chi2 within model_doubt): that term's correlation time [s], else 0. The term is not
   // resolved, and every term both models hold has the difference between its two values added to
   // its uncertainty (in quadrature; Tc's in ln Tc).
   double markov_in_place_tc_s = 0;
