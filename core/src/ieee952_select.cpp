@@ -389,9 +389,9 @@ Candidate markov_in_place(Problem& pr, const Flags& free, const Terms& fixed, co
 // by the criterion: the question is whether the record tells the two apart, not which of them is
 // the simpler. By the criterion, which charges the Markov term's three parameters (3 ln 34 = 10.6
 // on 34 points), two Markov terms of 20 s and 1 500 s gave B resolved in 12 of 200 runs where the
-// Markov term in its place had about the same chi2 (from 4.4 less to 3.8 more). Returns that model, else an
-// invalid candidate. Leaves pr's model and covariance the chosen one's again
-// (an exact covariance's Markov sums are not touched).
+// Markov term in its place had about the same chi2 (from 4.4 less to 3.8 more). Returns that
+// model, else an invalid candidate. Leaves pr's model and covariance the chosen one's again (an
+// exact covariance's Markov sums are not touched).
 Candidate markov_in_place_of(Problem& pr, const Flags& free, const Terms& fixed, const Candidate& chosen, std::size_t t) {
   const bool exact = pr.exact_markov;
   pr.exact_markov = false;

@@ -37,9 +37,10 @@
 // does without the term (not two standard uncertainties above zero there), it is not resolved
 // (`doubted`); nor, in a model that holds a Markov term, is a B or K that one more Markov term in
 // its place (its correlation time inside the search range, every Markov term significant) replaces
-// with a chi2 within 2 ln 19 of the chosen model's. Where such a model does as well (B or K resolved or not), the record cannot choose
-// between the two: each term both hold has the difference between its two values added to its
-// uncertainty, and is resolved only where its square stays two of the wider uncertainties above zero.
+// with a chi2 within 2 ln 19 of the chosen model's. Where such a model does as well (B or K
+// resolved or not), the record cannot choose between the two: each term both hold has the
+// difference between its two values added to its uncertainty, and is resolved only where its
+// square stays two of the wider uncertainties above zero.
 //
 // Quantization. For counts the white-quantization level is known: Q_w = pulse weight / sqrt(12).
 // A steady rate without dither (and with too little random angle per sample to spread it) makes a
