@@ -376,13 +376,15 @@ void pair_sums_of_points(Problem& pr, const FitSetup& setup, PairSumCache* cache
 // The exact Markov sums of every pair of points for the Markov terms of pr.model (the power-law
 // noises' sums where pair_sums_of_points() kept them; the Markov terms' own at every pair: their c
 // is an exponential, without the rounding that far-apart power-law sums suffer). O(P^2 x nodes).
-// Rows are independent: row i writes the pairs (i, j), j <= i, alone, so a RowRunner may run
-// them on several threads. The longest rows first, so that threads finish together.
+// A pair's sums are made for the noises kept there alone: the nodes do not depend on the noises,
+// so the kept sums are the bits they would be beside the others, and where the flicker noise is
+// not kept its digamma values at every node are saved. Rows are independent: row i writes the
+// pairs (i, j), j <= i, alone, so a RowRunner may run them on several threads. The longest rows
+// first, so that threads finish together.
 void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
   struct MarkovRows {
     Problem& pr;
     const FitSetup& setup;
-    NoiseSet set;
     void row(std::size_t r) const {
       const std::span<const double> rates(pr.model.a.data(), pr.model.markov);
       const std::size_t i = pr.n - 1 - r;
@@ -390,19 +392,25 @@ void markov_sums_of_points(Problem& pr, const FitSetup& setup) {
       const TermGrid ga = unbroken_grid(a.stat, a.m, a.stride, setup.n_phase);
       for (std::size_t j = 0; j <= i; ++j) {
         const FitPoint& b = *pr.point[j];
-        const MarkovPairSums s = markov_pair_sums(set, rates, ga, unbroken_grid(b.stat, b.m, b.stride, setup.n_phase));
         const double* g = pr.pair_at(i, j);
+        NoiseSet kept;
+        std::array<std::size_t, noises> noise_of{};  // kept noise p is the model's noise noise_of[p]
+        for (std::size_t t = 0; t < noises; ++t)
+          if (t == 0 || g[cc_index(t, t)] != 0) {
+            noise_of[kept.count] = t;
+            kept.alpha[kept.count++] = alphas[t];
+          }
+        const MarkovPairSums s = markov_pair_sums(kept, rates, ga, unbroken_grid(b.stat, b.m, b.stride, setup.n_phase));
         double* mg = pr.markov_pair_at(i, j);
         for (std::size_t k = 0; k < max_markov; ++k) {
-          for (std::size_t t = 0; t < noises; ++t) mg[k * noises + t] = t == 0 || g[cc_index(t, t)] != 0 ? s.cm[k][t] : 0.0;
+          for (std::size_t t = 0; t < noises; ++t) mg[k * noises + t] = 0.0;
+          for (std::size_t p = 0; p < kept.count; ++p) mg[k * noises + noise_of[p]] = s.cm[k][p];
           for (std::size_t l = 0; l < max_markov; ++l) mg[max_markov * noises + k * max_markov + l] = s.mm[k][l];
           mg[max_markov * noises + max_markov * max_markov + k] = s.c[k];
         }
       }
     }
-  } rows{pr, setup, {}};
-  for (std::size_t t = 0; t < noises; ++t) rows.set.alpha[t] = alphas[t];
-  rows.set.count = noises;
+  } rows{pr, setup};
   run_rows(setup.rows, {[](void* context, std::size_t r) { static_cast<const MarkovRows*>(context)->row(r); }, &rows}, pr.n);
   pr.exact_markov = true;
 }
