@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <tuple>
 #include <vector>
 
 #include "gyrochar/ieee952.hpp"
@@ -119,6 +120,36 @@ TEST(MarkovTerms, PairSumsMatchTheDoubleSumOverEveryPairOfTerms) {
         const PairSums own = pair_sums(set, ga, gb);
         const double scale = std::sqrt(want.mm[r][r] * std::fabs(own.cc[t][t]));
         EXPECT_NEAR(got.cm[r][t], want.cm[r][t], 2e-4 * scale + 1e-300) << "m " << c.ma << "/" << c.mb << " cm " << r << t;
+      }
+    }
+  }
+}
+
+// The fit makes each pair's Markov sums for the power-law noises kept at that pair alone
+// (markov_sums_of_points()), and relies on them being the bits they would be beside the others:
+// the quadrature's nodes do not depend on the noises. Oracle: the same call with every noise.
+TEST(MarkovTerms, PairSumsOfSomeNoisesAreTheBitsTheyAreBesideTheOthers) {
+  NoiseSet all;
+  all.alpha = {2, 0, -1, -2, 0};
+  all.count = 4;
+  const std::vector<std::vector<std::size_t>> subsets = {{0, 1, 3}, {0}, {0, 2}, {1, 2, 3}};
+  const double rates[] = {0.01, 3e-4};
+  constexpr std::uint64_t n_phase = 20000;
+  for (const auto& [sa, ma, sb, mb] :
+       {std::tuple{Stat::avar, 16u, Stat::mvar, 256u}, std::tuple{Stat::mvar, 64u, Stat::mvar, 1024u},
+        std::tuple{Stat::avar, 2u, Stat::avar, 2048u}}) {
+    const TermGrid ga = unbroken_grid(sa, ma, 1, n_phase), gb = unbroken_grid(sb, mb, 1, n_phase);
+    const MarkovPairSums full = markov_pair_sums(all, rates, ga, gb);
+    ASSERT_NE(full.c[0], 0.0);
+    for (const auto& subset : subsets) {
+      NoiseSet some;
+      for (const std::size_t t : subset) some.alpha[some.count++] = all.alpha[t];
+      const MarkovPairSums got = markov_pair_sums(some, rates, ga, gb);
+      for (std::size_t r = 0; r < 2; ++r) {
+        EXPECT_EQ(got.c[r], full.c[r]) << "m " << ma << "/" << mb;
+        for (std::size_t l = 0; l < 2; ++l) EXPECT_EQ(got.mm[r][l], full.mm[r][l]) << "m " << ma << "/" << mb;
+        for (std::size_t p = 0; p < subset.size(); ++p)
+          EXPECT_EQ(got.cm[r][p], full.cm[r][subset[p]]) << "m " << ma << "/" << mb << " noise " << subset[p];
       }
     }
   }
