@@ -15,7 +15,7 @@ Index as_index(std::uint64_t v) { return static_cast<Index>(v); }  // after chec
 // (two lanes a register on SSE2 and NEON, four with AVX2, whose fused multiply-adds round once
 // where the others round twice), x_{i+M-k} read backwards.
 using Lanes = double __attribute__((vector_size(32)));
-inline constexpr Index theo1_block = 512;
+inline constexpr Index theo1_block = 8192;  // 64 KB of weights: long runs of each start's values
 // (No vector is passed by value or returned: that would change with the target's ABI.)
 [[gnu::always_inline]] inline void load(Lanes& v, const double* p) { __builtin_memcpy(&v, p, sizeof v); }
 [[gnu::always_inline]] inline void load_backwards(Lanes& v, const double* p) { v = Lanes{p[3], p[2], p[1], p[0]}; }
@@ -186,6 +186,7 @@ TotalVariance theo1(std::span<const double> x, std::uint64_t m, double tau0_s, s
   if (N < 3 || m < 2 || m % 2 != 0 || m > N - 1 || stride < 1 || !(tau0_s > 0)) return {};
   const Index M = as_index(m), h = M / 2, step = stride < N ? as_index(stride) : N;
   // The weights 1/k a block of k at a time (one division each), every start's terms of that block.
+  // (64 KB of stack: an offline estimator; the board does not call it.)
   alignas(32) double weight[theo1_block];
   double sum = 0.0;
   for (Index k0 = 1; k0 <= h; k0 += theo1_block) {

@@ -221,15 +221,15 @@ TEST(Total, Theo1EqualsTheDefinition) {
 }
 
 TEST(Total, Theo1EqualsTheDefinitionOverSeveralBlocksOfWeights) {
-  // theo1() takes the weights 1/k 512 at a time and 8 k a step: h = m / 2 of one block and a few,
-  // of two blocks and a remainder not a multiple of 8, every start and strided.
-  const auto x = record(2100, 8);
-  for (std::uint64_t m : {1024u, 1038u, 2062u, 2098u}) {
+  // theo1() takes the weights 1/k 8192 at a time and 8 k a step: h = m / 2 within one block, of
+  // one block and one k, of one block and a remainder not a multiple of 8, every start and strided.
+  const auto x = record(16600, 8);
+  for (std::uint64_t m : {1038u, 16386u, 16410u, 16598u}) {
     const TotalVariance t = theo1(x, m, 0.5);
-    EXPECT_EQ(t.n, (2100 - m) * (m / 2)) << m;
+    EXPECT_EQ(t.n, (16600 - m) * (m / 2)) << m;
     expect_rel(t.var, theo1_oracle(x, m, 0.5), 1e-11, "theo1", m);
     const TotalVariance s = theo1(x, m, 0.5, 13);
-    EXPECT_EQ(s.n, (2100 - m + 12) / 13 * (m / 2)) << m;
+    EXPECT_EQ(s.n, (16600 - m + 12) / 13 * (m / 2)) << m;
     expect_rel(s.var, theo1_oracle(x, m, 0.5, 13), 1e-11, "strided theo1", m);
   }
 }
