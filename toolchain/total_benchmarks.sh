@@ -4,7 +4,8 @@
 # and with the analysis' decimation plan) beside allantools (../shared/peers/allantools) on the
 # same file in the same run; the decimated estimators against the exact ones on the reference sets;
 # then 10^7 points of TOTDEV, MTOTDEV and TheoH with peak memory; then issue 23's RLG job (HOURS of
-# 1 kHz counts, 120 by default: about 1 GB of counts and, on the analyzer's side, many minutes).
+# 1 kHz counts, 120 by default: about 1 GB of counts and, on the analyzer's side, many minutes),
+# and allantools beside it on the record's first 10^6 samples, extrapolated to the whole.
 # allantools runs each tau in its own process with a time limit (TAU_LIMIT seconds, default 60);
 # after one tau times out the longer ones (at least as much work) are not run, and the ratio is
 # then a lower bound.
@@ -136,6 +137,22 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
   END { for (s in n) printf "%s: %d rows, %d exact (stride 1)\n", s, n[s], e[s] }' "$data/rlg_rows.csv" | sort
 echo "wall time $(awk -F': ' '/Elapsed/{print $2}' "$data/time_rlg.txt"), user $(awk -F': ' '/User time/{print $2}' "$data/time_rlg.txt") s, system $(awk -F': ' '/System time/{print $2}' "$data/time_rlg.txt") s, maximum resident set $(awk -F': ' '/Maximum resident/{printf "%.0f MiB", $2 / 1024}' "$data/time_rlg.txt")"
 echo '```'
+echo
+# allantools cannot hold or finish the whole record: it runs on the record's first 10^6 samples, one
+# tau at a time under the time limit, and its time is extrapolated from its cost per term
+# (toolchain/allantools_cut.py); gyrochar-analyze runs on the same cut for comparison (Theo1 for
+# TheoH, which allantools does not have).
+cut=1000000
+cutfile=$data/rlg_${hours}h_cut.txt
+awk -v c=$cut '/^#/ { next } { print; if (++n == c) exit }' "$rlg" > "$cutfile"
+/usr/bin/time -f "%e %U %S %M" -o "$data/time_cut.txt" build/perf/host_tools/gyrochar-analyze --type counts --tau0 0.001 \
+    --pulse-weight 1arcsec --stats oadev,mdev,ohdev,totdev,mtotdev,theo1 --format csv "$cutfile" > /dev/null
+echo "The first $cut samples of the record: gyrochar-analyze, every octave tau of oadev, mdev, ohdev, totdev,"
+echo "mtotdev and theo1 exact, $(awk '{printf "%.2f s of wall, %.2f s of CPU, %.0f MiB", $1, $2 + $3, $4 / 1024}' "$data/time_cut.txt");"
+echo "allantools at most $limit s a tau:"
+echo
+/usr/bin/python3 toolchain/allantools_cut.py "$peers" "$rlg" 0.001 $cut $((hours * 3600000)) "$limit" \
+    oadev,mdev,ohdev,totdev,mtotdev,theo1
 echo "<!-- total:end -->"
 } > "$section"
 
