@@ -22,7 +22,7 @@ std::size_t default_psd_segment(std::size_t n) {
   return std::bit_floor(n / 16);
 }
 
-Psd welch_psd(std::span<const double> rate, double tau0_s, std::size_t segment, double confidence) {
+Psd welch_psd(RateView rate, double tau0_s, std::size_t segment, double confidence) {
   const std::size_t L = segment;
   if (L < 8 || L % 2 != 0 || L > rate.size())
     throw std::invalid_argument("the segment must be an even number of values from 8 to the record's length");
@@ -192,7 +192,7 @@ std::pair<double, double> PulsePattern::band(int k, double bin_hz, double offset
 
 double PulsePattern::line_half_width(int k) const { return std::numbers::pi * k * k * diffusion / tau0_s; }
 
-PulsePattern pulse_pattern(std::span<const double> pulses_per_s, double tau0_s, std::size_t block) {
+PulsePattern pulse_pattern(RateView pulses_per_s, double tau0_s, std::size_t block) {
   PulsePattern p;
   p.tau0_s = tau0_s;
   const std::size_t blocks = block ? pulses_per_s.size() / block : 0;
@@ -235,7 +235,7 @@ void mark_pulse_lines(PeakSearch& search, const PulsePattern& pattern, double bi
 
 Spectrum spectrum_of(const RateRecord& rates, double tau0_s, std::size_t segment, double confidence, bool search) {
   Spectrum sp;
-  const std::vector<double>& rate = rates.rate();
+  const RateView rate = rates.rate();
   if (segment == 0) segment = default_psd_segment(rate.size());
   sp.psd = welch_psd(rate, tau0_s, segment, confidence);
   sp.searched = search;
@@ -250,6 +250,16 @@ Spectrum spectrum_of(const RateRecord& rates, double tau0_s, std::size_t segment
 
 void RateRecord::add(std::span<const double> values) {
   for (const double v : values) {
+    if (counts_ && rate_.empty()) {
+      const bool fits = v >= std::numeric_limits<std::int32_t>::min() && v <= std::numeric_limits<std::int32_t>::max();
+      if (fits && static_cast<double>(static_cast<std::int32_t>(v)) == v) {
+        narrow_.push_back(static_cast<std::int32_t>(v));
+        continue;
+      }
+      rate_.reserve(narrow_.size() + values.size());  // the first count that does not fit: rates from here
+      for (const std::int32_t c : narrow_) rate_.push_back(c / tau0_s_);
+      narrow_ = {};
+    }
     if (!phase_) {
       rate_.push_back(counts_ ? v / tau0_s_ : v);
       continue;

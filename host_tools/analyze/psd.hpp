@@ -26,6 +26,7 @@
 // background's (the median's sampling error, the same for every bin of the peak).
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <utility>
 #include <span>
@@ -54,10 +55,26 @@ struct Psd {
 /// Allan curve's longer taus see a sinusoid), at least 16; 0 when n < 64 (too short). O(1).
 std::size_t default_psd_segment(std::size_t n);
 
+/// Rate values as an analysis holds them: doubles, or counts at 4 bytes a value, each rate
+/// count / tau0_s (the same double as dividing the count read from the file). Views, O(1).
+class RateView {
+ public:
+  RateView(std::span<const double> rate) : rate_(rate) {}
+  RateView(const std::vector<double>& rate) : rate_(rate) {}
+  RateView(std::span<const std::int32_t> counts, double tau0_s) : counts_(counts), tau0_s_(tau0_s) {}
+  std::size_t size() const { return counts_.empty() ? rate_.size() : counts_.size(); }
+  double operator[](std::size_t i) const { return counts_.empty() ? rate_[i] : counts_[i] / tau0_s_; }
+
+ private:
+  std::span<const double> rate_;
+  std::span<const std::int32_t> counts_;
+  double tau0_s_ = 1;
+};
+
 /// Welch's PSD of `rate` (any unit u; the result in u^2/Hz) sampled every tau0_s, in segments of
 /// `segment` values (even, >= 8, <= rate.size()), with its band at `confidence`. O(n log L),
 /// allocates O(L). Throws std::invalid_argument for a segment that does not fit.
-Psd welch_psd(std::span<const double> rate, double tau0_s, std::size_t segment, double confidence);
+Psd welch_psd(RateView rate, double tau0_s, std::size_t segment, double confidence);
 
 /// A sinusoid found in a PSD (units: the PSD's rate unit, Hz).
 struct SpectralPeak {
@@ -116,7 +133,7 @@ struct PulsePattern {
   /// half widths, 3 bins).
   std::pair<double, double> band(int k, double bin_hz, double offset_hz = 0) const;
 };
-PulsePattern pulse_pattern(std::span<const double> pulses_per_s, double tau0_s, std::size_t block);
+PulsePattern pulse_pattern(RateView pulses_per_s, double tau0_s, std::size_t block);
 /// Marks the peaks of `search` that lie in the band of one of the first `harmonics` harmonics of
 /// the pattern whose line half width stays under 64 bins (wider, the search's neighbourhood
 /// follows the line and finds no peak on it), and then their sidebands: a rate line at f
@@ -127,12 +144,14 @@ void mark_pulse_lines(PeakSearch& search, const PulsePattern& pattern, double bi
 
 /// Rate values from the analyzer's input: freq values as they are, counts divided by tau0 (pulses
 /// per second), phase points differenced over tau0. The result is in the engine's rate unit
-/// (analysis.hpp: phase unit per second). add() is O(n), allocates.
+/// (analysis.hpp: phase unit per second). Counts are held as they are, 4 bytes a value, while
+/// every one is an int32 (a 120-hour record at 1 kHz: 1.7 GB instead of 3.5), else as rates from
+/// the first one that is not. add() is O(n), allocates.
 class RateRecord {
  public:
   RateRecord(bool phase, bool counts, double tau0_s) : phase_(phase), counts_(counts), tau0_s_(tau0_s) {}
   void add(std::span<const double> values);
-  const std::vector<double>& rate() const { return rate_; }
+  RateView rate() const { return narrow_.empty() ? RateView(rate_) : RateView(narrow_, tau0_s_); }
   bool counts() const { return counts_; }
 
  private:
@@ -140,6 +159,7 @@ class RateRecord {
   double tau0_s_;
   bool have_last_ = false;
   double last_ = 0;
+  std::vector<std::int32_t> narrow_;  // counts while every one fits
   std::vector<double> rate_;
 };
 

@@ -137,7 +137,7 @@ void read_values(const Request& r, RunPlan& p, DataRange& range, std::optional<R
 // The rate's PSD (--psd, the static plot, the fit's sinusoid search), with the Allan curve's
 // nulls checked against its peaks. Nothing when the rate is too short and no PSD was asked for.
 std::optional<Spectrum> spectrum_of_run(const Request& r, const RateRecord& rates, const Analysis& a) {
-  const std::vector<double>& rate = rates.rate();
+  const RateView rate = rates.rate();
   const std::size_t segment = r.psd_segment ? r.psd_segment : default_psd_segment(rate.size());
   if (segment > rate.size() || segment == 0) {
     if (!r.psd_path.empty() || r.psd_segment != 0)

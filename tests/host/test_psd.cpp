@@ -201,3 +201,33 @@ TEST(PulseLines, ThePulsePatternsHumpIsNotOfferedToTheFitButARateSinusoidIs) {
   EXPECT_NEAR(hz[0], 2.0, 0.01);
   for (std::size_t j = 1; j < hz.size(); ++j) EXPECT_EQ(hz[j], 0.0);
 }
+
+TEST(RateRecord, CountsHeldAtFourBytesGiveTheRatesOfTheCountsAsRead) {
+  // Oracle: the definition, rate = count / tau0 with the count as read (a double). The counts are
+  // held as int32 until one is not an int32; from there the record holds rates, the same doubles.
+  const double tau0 = 0.003;
+  const std::vector<double> counts = {3602, -7, 0, 2147483647, -2147483648.0, 12, 2147483648.0, 5, 0.5, 9};
+  // The first six fit; the seventh (2^31) does not: held as counts, switched within one add() and
+  // between two.
+  for (const auto& [size, first] : {std::pair<std::size_t, std::size_t>{6, 6}, {10, 10}, {10, 3}, {10, 6}}) {
+    RateRecord r(false, true, tau0);
+    r.add(std::span(counts.data(), first));
+    r.add(std::span(counts.data() + first, size - first));
+    const RateView v = r.rate();
+    ASSERT_EQ(v.size(), size) << first;
+    for (std::size_t i = 0; i < size; ++i) EXPECT_EQ(v[i], counts[i] / tau0) << size << " " << first << " " << i;
+  }
+  // The PSD of counts held at 4 bytes is the same bits as that of the rates in doubles.
+  std::mt19937_64 rng(11);
+  std::poisson_distribution<int> pulses(40);
+  RateRecord r(false, true, tau0);
+  std::vector<double> rates;
+  for (int k = 0; k < 4096; ++k) {
+    const double c = pulses(rng);
+    r.add(std::span(&c, 1));
+    rates.push_back(c / tau0);
+  }
+  const Psd held = welch_psd(r.rate(), tau0, 256, 0.683), doubles = welch_psd(rates, tau0, 256, 0.683);
+  ASSERT_EQ(held.psd.size(), doubles.psd.size());
+  for (std::size_t k = 0; k < held.psd.size(); ++k) EXPECT_EQ(held.psd[k], doubles.psd[k]) << k;
+}
