@@ -60,8 +60,15 @@ TEST(LiveBrowser, PageShowsTheDecodersCsvValues) {
                   temp("demo.err"));
   const std::uint16_t port = demo.port();
   ASSERT_NE(port, 0) << demo.err();
-  for (int k = 0; k < 100 && body_of(get(port, "/data.json")).find("\"rows\":[{") == std::string::npos; ++k)
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  // The browser is started once both nodes' ADEV at 10.24 s is decided in the server's snapshot (it
+  // needs 20.48 s of gyro time, later than the first rows on a loaded machine or under sanitizers).
+  const auto decided = [&] {
+    const std::string body = body_of(get(port, "/data.json"));
+    std::size_t n = 0;
+    for (std::size_t at = 0; (at = body.find("\"verdict\":\"fail\",\"why\"", at)) != std::string::npos; ++at) ++n;
+    return n == 2;
+  };
+  for (int k = 0; k < 600 && !decided(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   // ?updates=3: the page follows the event stream for 3 snapshots, then closes it and goes idle,
   // so that the headless browser's virtual time runs out and it prints the page.
   const std::string url = "'http://127.0.0.1:" + std::to_string(port) + "/?updates=3'";
