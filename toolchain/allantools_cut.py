@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""allantools on the first CUT samples of a counts file, for the RLG job of
+"""allantools on the cut of a record (a counts file of its first CUT samples), for the RLG job of
 toolchain/total_benchmarks.sh (allantools cannot hold or finish the whole record): each statistic
 at the octave taus of the cut, one tau at a time under a time limit of LIMIT seconds, and its time
 extrapolated to the octave taus of the whole record (WHOLE samples) from its time per term over
 the taus it finished. Once a tau runs out of time, the statistic's longer taus are not run but
 extrapolated too. Prints a Markdown table and a summary line.
 
-    allantools_cut.py PEERS_DIR FILE TAU0 CUT WHOLE LIMIT STATS   e.g. ... 0.001 1000000 432000000 60 oadev,mdev
+    allantools_cut.py PEERS_DIR CUT_FILE TAU0 CUT WHOLE LIMIT STATS   e.g. ... 0.001 1000000 432000000 60 oadev,mdev
 
 The work of a tau (allantools' time is about proportional to it): the Allan family and TOTDEV one
 vectorized pass over the n phase points; MTOTDEV 6m terms for each of n - 3m + 1 sub-sequences;
@@ -15,7 +15,6 @@ Theo1 m/2 terms for each of n - m starts.
 import signal
 import sys
 import time
-import warnings
 
 
 def work(stat, n, m):
@@ -52,8 +51,9 @@ def main():
     import numpy as np
     import allantools
 
-    warnings.filterwarnings("ignore", message="Input line")  # numpy's note on max_rows and comment lines
-    counts = np.loadtxt(path, comments="#", dtype=np.float64, max_rows=cut)
+    counts = np.loadtxt(path, comments="#", dtype=np.float64)
+    if len(counts) != cut:
+        sys.exit(f"allantools_cut.py: {path} holds {len(counts)} samples, not the cut's {cut}")
     phase = np.concatenate(([0.0], np.cumsum(counts)))  # what --type counts means, in pulses
     n, n_whole = len(phase), whole + 1
     signal.signal(signal.SIGALRM, on_alarm)

@@ -151,7 +151,7 @@ echo "The first $cut samples of the record: gyrochar-analyze, every octave tau o
 echo "mtotdev and theo1 exact, $(awk '{printf "%.2f s of wall, %.2f s of CPU, %.0f MiB", $1, $2 + $3, $4 / 1024}' "$data/time_cut.txt");"
 echo "allantools at most $limit s a tau:"
 echo
-/usr/bin/python3 toolchain/allantools_cut.py "$peers" "$rlg" 0.001 $cut $((hours * 3600000)) "$limit" \
+/usr/bin/python3 toolchain/allantools_cut.py "$peers" "$cutfile" 0.001 $cut $((hours * 3600000)) "$limit" \
     oadev,mdev,ohdev,totdev,mtotdev,theo1
 echo "<!-- total:end -->"
 } > "$section"
