@@ -461,6 +461,8 @@ Analysis Analyzer::result() const { return impl_->engine->result(impl_->options)
 
 PhaseRecord Analyzer::record() const { return impl_->engine->record(impl_->options); }
 
+HeldCounts Analyzer::held_counts() const { return impl_->engine->held_counts(); }
+
 std::vector<std::byte> Analyzer::checkpoint() const { return impl_->engine->checkpoint(); }
 
 std::string Analyzer::restore(std::span<const std::byte> bytes) { return impl_->engine->restore(bytes); }

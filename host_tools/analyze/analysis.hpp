@@ -157,6 +157,17 @@ struct PhaseRecord {
   double phase_scale = 1.0;
 };
 
+/// The counts as the analyzer holds them when it sums every tau over the held record (hold_counts):
+/// the phase's residuals from the line of the first count, x_0 = 0 first, in int32 while every one
+/// fits (`narrow`), else in int64 (`wide`, modulo 2^64). Count i = r[i+1] - r[i] + slope, exactly
+/// (modulo 2^64). `held` false: this analyzer does not hold counts.
+struct HeldCounts {
+  bool held = false;
+  std::span<const std::int32_t> narrow;
+  std::span<const std::int64_t> wide;
+  std::int64_t slope = 0;
+};
+
 /// TheoBR's bias ratio of the record (theo_bias_ratio, decimated with stride factor S) as TheoH's
 /// rows computed it, for the fit's long-tau points to reuse: at 10^7 points its 64 decimated taus
 /// cost about 4 s of CPU. ratio 0: none computed.
@@ -210,6 +221,9 @@ class Analyzer {
   /// The record held for the total family (empty unless a total statistic or keep_record was
   /// asked for); valid until the next add(). O(1).
   PhaseRecord record() const;
+  /// The counts held (HeldCounts; `held` is known from construction on); valid until the next
+  /// add(). O(1).
+  HeldCounts held_counts() const;
   /// The state as the core characterizer's checkpoint (characterizer.hpp: header with the format
   /// version, stride factor, taus and checkpoint_tag, the run state, history and tau states, a
   /// CRC-32; native byte order), the bytes the board writes for its characterizer. Throws

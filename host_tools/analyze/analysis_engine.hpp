@@ -22,6 +22,7 @@ struct EngineBase {
   virtual void add(std::span<const double> values) = 0;
   virtual Analysis result(const AnalysisOptions& o) const = 0;
   virtual PhaseRecord record(const AnalysisOptions& o) const = 0;
+  virtual HeldCounts held_counts() const { return {}; }
   virtual std::vector<std::byte> checkpoint() const { throw std::invalid_argument(no_checkpoint); }
   virtual std::string restore(std::span<const std::byte>) { throw std::invalid_argument(no_checkpoint); }
   static constexpr const char* no_checkpoint =

@@ -139,6 +139,7 @@ class CountBatchEngine final : public EngineBase {
   }
 
   PhaseRecord record(const AnalysisOptions&) const override { return {record_, 1.0}; }
+  HeldCounts held_counts() const override { return {true, narrow_, wide_, slope_}; }
 
  private:
   // The common case in one tight loop: counts whose residuals stay within int32, from values[i]

@@ -233,15 +233,14 @@ void mark_pulse_lines(PeakSearch& search, const PulsePattern& pattern, double bi
   }
 }
 
-Spectrum spectrum_of(const RateRecord& rates, double tau0_s, std::size_t segment, double confidence, bool search) {
+Spectrum spectrum_of(RateView rate, bool counts, double tau0_s, std::size_t segment, double confidence, bool search) {
   Spectrum sp;
-  const RateView rate = rates.rate();
   if (segment == 0) segment = default_psd_segment(rate.size());
   sp.psd = welch_psd(rate, tau0_s, segment, confidence);
   sp.searched = search;
   if (!search) return sp;
   sp.search = find_sinusoids(sp.psd);
-  if (rates.counts() && rate.size() / segment >= 2) {  // the pattern needs two blocks' means
+  if (counts && rate.size() / segment >= 2) {  // the pattern needs two blocks' means
     sp.pattern = pulse_pattern(rate, tau0_s, segment);
     mark_pulse_lines(sp.search, *sp.pattern, sp.psd.bin_hz());
   }

@@ -35,6 +35,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis.hpp"
 #include "gyrochar/ieee952.hpp"
 
 namespace gyrochar {
@@ -55,19 +56,38 @@ struct Psd {
 /// Allan curve's longer taus see a sinusoid), at least 16; 0 when n < 64 (too short). O(1).
 std::size_t default_psd_segment(std::size_t n);
 
-/// Rate values as an analysis holds them: doubles, or counts at 4 bytes a value, each rate
-/// count / tau0_s (the same double as dividing the count read from the file). Views, O(1).
+/// Rate values as an analysis holds them: doubles, counts at 4 bytes a value, or the analyzer's
+/// own held counts (HeldCounts: no copy), each rate count / tau0_s (the same double as dividing
+/// the count read from the file). Views, O(1).
 class RateView {
  public:
   RateView(std::span<const double> rate) : rate_(rate) {}
   RateView(const std::vector<double>& rate) : rate_(rate) {}
   RateView(std::span<const std::int32_t> counts, double tau0_s) : counts_(counts), tau0_s_(tau0_s) {}
-  std::size_t size() const { return counts_.empty() ? rate_.size() : counts_.size(); }
-  double operator[](std::size_t i) const { return counts_.empty() ? rate_[i] : counts_[i] / tau0_s_; }
+  RateView(const HeldCounts& held, double tau0_s)
+      : narrow_(held.narrow), wide_(held.wide), slope_(held.slope), tau0_s_(tau0_s) {}
+  std::size_t size() const {
+    if (!counts_.empty()) return counts_.size();
+    if (!narrow_.empty() || !wide_.empty()) return narrow_.size() + wide_.size() - 1;
+    return rate_.size();
+  }
+  double operator[](std::size_t i) const {
+    if (!counts_.empty()) return counts_[i] / tau0_s_;
+    if (!narrow_.empty()) return count(narrow_[i], narrow_[i + 1]) / tau0_s_;
+    if (!wide_.empty()) return count(wide_[i], wide_[i + 1]) / tau0_s_;
+    return rate_[i];
+  }
 
  private:
+  // The count between two residuals, modulo 2^64 as they are held: an int32, exact in a double.
+  double count(std::int64_t from, std::int64_t to) const {
+    return static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(to) - static_cast<std::uint64_t>(from) +
+                                                         static_cast<std::uint64_t>(slope_)));
+  }
   std::span<const double> rate_;
-  std::span<const std::int32_t> counts_;
+  std::span<const std::int32_t> counts_, narrow_;
+  std::span<const std::int64_t> wide_;
+  std::int64_t slope_ = 0;
   double tau0_s_ = 1;
 };
 
@@ -146,13 +166,13 @@ void mark_pulse_lines(PeakSearch& search, const PulsePattern& pattern, double bi
 /// per second), phase points differenced over tau0. The result is in the engine's rate unit
 /// (analysis.hpp: phase unit per second). Counts are held as they are, 4 bytes a value, while
 /// every one is an int32 (a 120-hour record at 1 kHz: 1.7 GB instead of 3.5), else as rates from
-/// the first one that is not. add() is O(n), allocates.
+/// the first one that is not. add() is O(n), allocates. The analyzer keeps one only where it does
+/// not hold the counts itself (Analyzer::held_counts(): a RateView reads those, no copy).
 class RateRecord {
  public:
   RateRecord(bool phase, bool counts, double tau0_s) : phase_(phase), counts_(counts), tau0_s_(tau0_s) {}
   void add(std::span<const double> values);
   RateView rate() const { return narrow_.empty() ? RateView(rate_) : RateView(narrow_, tau0_s_); }
-  bool counts() const { return counts_; }
 
  private:
   bool phase_, counts_;
@@ -184,8 +204,8 @@ struct Spectrum {
 /// CSV of every bin: freq,psd,ci_low,ci_high (Hz, the output unit^2/Hz). O(bins).
 std::string spectrum_csv(const Spectrum& s);
 /// Welch's PSD and the search with the analyzer's defaults (`segment` 0: default_psd_segment()),
-/// pulse lines marked when `rates` are counts. Throws std::invalid_argument as welch_psd().
-Spectrum spectrum_of(const RateRecord& rates, double tau0_s, std::size_t segment, double confidence, bool search);
+/// pulse lines marked when the rates are of `counts`. Throws std::invalid_argument as welch_psd().
+Spectrum spectrum_of(RateView rate, bool counts, double tau0_s, std::size_t segment, double confidence, bool search);
 
 /// The table's lines ("# PSD ..." and one per peak). O(peaks).
 std::string spectrum_table(const Spectrum& s);

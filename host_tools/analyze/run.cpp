@@ -136,8 +136,7 @@ void read_values(const Request& r, RunPlan& p, DataRange& range, std::optional<R
 
 // The rate's PSD (--psd, the static plot, the fit's sinusoid search), with the Allan curve's
 // nulls checked against its peaks. Nothing when the rate is too short and no PSD was asked for.
-std::optional<Spectrum> spectrum_of_run(const Request& r, const RateRecord& rates, const Analysis& a) {
-  const RateView rate = rates.rate();
+std::optional<Spectrum> spectrum_of_run(const Request& r, RateView rate, const Analysis& a) {
   const std::size_t segment = r.psd_segment ? r.psd_segment : default_psd_segment(rate.size());
   if (segment > rate.size() || segment == 0) {
     if (!r.psd_path.empty() || r.psd_segment != 0)
@@ -146,7 +145,8 @@ std::optional<Spectrum> spectrum_of_run(const Request& r, const RateRecord& rate
     print_error(program, "note", fmt::format("no PSD: {} rate values are too few for a spectrum", rate.size()));
     return std::nullopt;
   }
-  Spectrum sp = spectrum_of(rates, r.options.tau0_s, segment, r.options.confidence, r.sinusoid_search);
+  Spectrum sp = spectrum_of(rate, r.options.type == DataType::counts, r.options.tau0_s, segment, r.options.confidence,
+                            r.sinusoid_search);
   if (sp.searched) {
     std::vector<std::pair<double, double>> oadev;  // the Allan curve's nulls at tau = 1/f, on dense taus
     for (const AnalysisRow& row : a.rows)
@@ -238,8 +238,11 @@ std::string kalibr_text(const Request& r, const Report& report) {
 void run_analysis(const Request& r, RunPlan& p, RunOutcome& out) {
   const AnalysisOptions& o = r.options;
   DataRange range;
-  std::optional<RateRecord> rates;  // the rate, held for the PSD (8 bytes a value)
-  if (r.want_psd) rates.emplace(o.type == DataType::phase, o.type == DataType::counts, o.tau0_s);
+  // The rate for the PSD: the counts the analyzer holds where it holds them (no copy), else a
+  // record of its own.
+  std::optional<RateRecord> rates;
+  if (r.want_psd && !p.analyzer->held_counts().held)
+    rates.emplace(o.type == DataType::phase, o.type == DataType::counts, o.tau0_s);
   InputShape shape(o.type, r.nominal_hz);
   read_values(r, p, range, rates, shape);
   shape.check_conversion();
@@ -247,8 +250,8 @@ void run_analysis(const Request& r, RunPlan& p, RunOutcome& out) {
   const std::vector<std::string>& header = p.file->header();
 
   std::optional<Spectrum> spectrum;
-  if (rates) {
-    spectrum = spectrum_of_run(r, *rates, a);
+  if (r.want_psd) {
+    spectrum = spectrum_of_run(r, rates ? rates->rate() : RateView(p.analyzer->held_counts(), o.tau0_s), a);
     rates.reset();
   }
   std::array<double, max_sinusoids> offered_hz{};

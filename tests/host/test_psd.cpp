@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "analysis.hpp"
 #include "psd.hpp"
 
 namespace {
@@ -182,7 +183,7 @@ TEST(PulseLines, ThePulsePatternsHumpIsNotOfferedToTheFitButARateSinusoidIs) {
     last = now;
     r.add(std::span(&count, 1));
   }
-  const Spectrum sp = spectrum_of(r, tau0, 0, 0.683, true);
+  const Spectrum sp = spectrum_of(r.rate(), true, tau0, 0, 0.683, true);
   ASSERT_TRUE(sp.pattern.has_value());
   std::size_t lines = 0;
   bool rate_line_found = false;
@@ -230,4 +231,34 @@ TEST(RateRecord, CountsHeldAtFourBytesGiveTheRatesOfTheCountsAsRead) {
   const Psd held = welch_psd(r.rate(), tau0, 256, 0.683), doubles = welch_psd(rates, tau0, 256, 0.683);
   ASSERT_EQ(held.psd.size(), doubles.psd.size());
   for (std::size_t k = 0; k < held.psd.size(); ++k) EXPECT_EQ(held.psd[k], doubles.psd[k]) << k;
+}
+
+TEST(RateView, TheAnalyzersHeldCountsGiveTheRatesOfTheCountsAsRead) {
+  // Oracle: the definition, rate = count / tau0 with the count as read. The analyzer that holds
+  // counts (hold_counts) keeps them as residuals from the line of the first count, int32 while
+  // they fit: the PSD reads them there instead of a copy of its own.
+  const double tau0 = 0.004;
+  AnalysisOptions o;
+  o.type = DataType::counts;
+  o.stats = {DevStat::oadev};
+  o.m_list = {1};
+  o.hold_counts = true;
+  // Residuals within int32 throughout; then leaving it at the fourth count (held in int64 from
+  // there, modulo 2^64, the counts still exact): switched within one add() and between two.
+  const std::vector<double> narrow = {3602, -7, 0, 2147483647, -2147483647, 12, 3601, 3603};
+  const std::vector<double> wide = {5, 2147483647, 2147483647, 2147483647, -2147483647, -2147483647, 0, 9};
+  for (const std::vector<double>* counts : {&narrow, &wide})
+    for (const std::size_t first : {std::size_t{1}, std::size_t{3}, counts->size()}) {
+      Analyzer a(o);
+      ASSERT_TRUE(a.held_counts().held) << "known before the first count";
+      a.add(std::span(counts->data(), first));
+      a.add(std::span(counts->data() + first, counts->size() - first));
+      const HeldCounts held = a.held_counts();
+      EXPECT_EQ(held.wide.empty(), counts == &narrow) << first;
+      const RateView v(held, tau0);
+      ASSERT_EQ(v.size(), counts->size()) << first;
+      for (std::size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], (*counts)[i] / tau0) << first << " " << i;
+    }
+  o.hold_counts = false;  // the characterizer's engine holds no counts: the PSD keeps a record
+  EXPECT_FALSE(Analyzer(o).held_counts().held);
 }

@@ -148,7 +148,7 @@ Recovery recover(const SimOptions& sim, bool long_tau) {
     // FFTW's planner is not thread-safe and the study's workers run recover() side by side.
     static std::mutex fftw_planner;
     const std::lock_guard lock(fftw_planner);
-    offered_hz = spectrum_of(rates, sim.tau0_s, segment, 0.683, true).fit_hz();
+    offered_hz = spectrum_of(rates.rate(), true, sim.tau0_s, segment, 0.683, true).fit_hz();
   }
   ReportUnits units;
   units.gyro = true;
