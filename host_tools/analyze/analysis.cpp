@@ -18,8 +18,6 @@
 #include <thread>
 #include <type_traits>
 
-#include <sys/mman.h>
-
 #include "gyrochar/batch.hpp"
 #include "edf_table.hpp"
 #include "gyrochar/characterizer.hpp"

@@ -1,7 +1,5 @@
 #include "total_analysis.hpp"
 
-#include <sys/mman.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -198,17 +196,8 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
 void FreeDoubles::operator()(double* p) const noexcept { std::free(p); }
 
 HugeArray huge_array(std::size_t n) {
-  constexpr std::size_t huge_page = std::size_t{1} << 21;
-  if (n > (std::numeric_limits<std::size_t>::max() - huge_page) / sizeof(double)) throw std::bad_alloc();
-  const std::size_t bytes = n * sizeof(double);
-  void* p = nullptr;
-  if (bytes < 4 * huge_page) {
-    p = std::malloc(bytes ? bytes : 1);
-  } else {
-    const std::size_t rounded = (bytes + huge_page - 1) / huge_page * huge_page;  // aligned_alloc's rule
-    p = std::aligned_alloc(huge_page, rounded);
-    if (p != nullptr) madvise(p, rounded, MADV_HUGEPAGE);
-  }
+  if (n > std::numeric_limits<std::size_t>::max() / sizeof(double)) throw std::bad_alloc();
+  void* p = std::malloc(n ? n * sizeof(double) : 1);
   if (p == nullptr) throw std::bad_alloc();
   return HugeArray(static_cast<double*>(p));
 }

@@ -20,10 +20,10 @@
 
 namespace gyrochar {
 
-/// Memory for the lag sums' workspaces, not zero-filled: from 8 MiB up aligned to 2 MiB and offered
-/// to transparent huge pages (madvise; a hint the kernel may refuse), so that first touching the
-/// 0.9 GB of a 10^7-point record costs one fault every 2 MiB, not every 4 KiB (BENCHMARKS.md, the
-/// exact MTOTDEV at 10^7). Throws std::bad_alloc.
+/// Memory for the lag sums' workspaces (0.9 GB at 10^7 points), not zero-filled: each writes before
+/// it reads. Not offered to transparent huge pages: on this machine first touching them cost more
+/// system time than the faults they save (BENCHMARKS.md, "Transparent huge pages, measured
+/// again"). Throws std::bad_alloc.
 struct FreeDoubles {
   void operator()(double* p) const noexcept;
 };
