@@ -13,18 +13,26 @@ Index as_index(std::uint64_t v) { return static_cast<Index>(v); }  // after chec
 // Theo1's terms (x_i - x_{i+k} - x_{i+M-k} + x_{i+M})^2 / k of the starts i = 0, step, ... < end
 // and the k of one block [k0, k0 + len), w[j] = 1 / (k0 + j): eight k a step in two vectors of four
 // (two lanes a register on SSE2 and NEON, four with AVX2, whose fused multiply-adds round once
-// where the others round twice), x_{i+M-k} read backwards.
+// where the others round twice), x_{i+M-k} read backwards. Integers are converted as they load.
 using Lanes = double __attribute__((vector_size(32)));
 inline constexpr Index theo1_block = 8192;  // 64 KB of weights: long runs of each start's values
 // (No vector is passed by value or returned: that would change with the target's ABI.)
 [[gnu::always_inline]] inline void load(Lanes& v, const double* p) { __builtin_memcpy(&v, p, sizeof v); }
-[[gnu::always_inline]] inline void load_backwards(Lanes& v, const double* p) { v = Lanes{p[3], p[2], p[1], p[0]}; }
-[[gnu::always_inline]] inline double theo1_terms(const double* x, Index end, Index step, Index M, Index k0, Index len,
+template <class T>
+[[gnu::always_inline]] inline void load(Lanes& v, const T* p) {
+  v = Lanes{static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]), static_cast<double>(p[3])};
+}
+template <class T>
+[[gnu::always_inline]] inline void load_backwards(Lanes& v, const T* p) {
+  v = Lanes{static_cast<double>(p[3]), static_cast<double>(p[2]), static_cast<double>(p[1]), static_cast<double>(p[0])};
+}
+template <class T>
+[[gnu::always_inline]] inline double theo1_terms(const T* x, Index end, Index step, Index M, Index k0, Index len,
                                                  const double* w) {
   double sum = 0.0;
   for (Index i = 0; i < end; i += step) {
-    const double* p = x + i;
-    const double first = p[0], last = p[M];
+    const T* p = x + i;
+    const double first = static_cast<double>(p[0]), last = static_cast<double>(p[M]);
     Lanes s0 = {}, s1 = {};
     Index j = 0;
     for (; j + 8 <= len; j += 8) {
@@ -44,7 +52,7 @@ inline constexpr Index theo1_block = 8192;  // 64 KB of weights: long runs of ea
     double inner = (s[0] + s[1]) + (s[2] + s[3]);
     for (; j < len; ++j) {
       const Index k = k0 + j;
-      const double t = ((first - p[k]) - p[M - k]) + last;
+      const double t = ((first - static_cast<double>(p[k])) - static_cast<double>(p[M - k])) + last;
       inner += t * t * w[j];
     }
     sum += inner;
@@ -52,12 +60,14 @@ inline constexpr Index theo1_block = 8192;  // 64 KB of weights: long runs of ea
   return sum;
 }
 #if defined(__x86_64__)
-[[gnu::target("avx2,fma")]] double theo1_terms_avx2(const double* x, Index end, Index step, Index M, Index k0, Index len,
+template <class T>
+[[gnu::target("avx2,fma")]] double theo1_terms_avx2(const T* x, Index end, Index step, Index M, Index k0, Index len,
                                                     const double* w) {
   return theo1_terms(x, end, step, M, k0, len, w);
 }
 #endif
-double theo1_block_terms(const double* x, Index end, Index step, Index M, Index k0, Index len, const double* w) {
+template <class T>
+double theo1_block_terms(const T* x, Index end, Index step, Index M, Index k0, Index len, const double* w) {
 #if defined(__x86_64__)
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return theo1_terms_avx2(x, end, step, M, k0, len, w);
 #endif
@@ -65,32 +75,36 @@ double theo1_block_terms(const double* x, Index end, Index step, Index M, Index 
 }
 
 // The record's values seen through a sequence: v(k), k in [0, size).
-struct Values {  // x itself, or its block sums
-  std::span<const double> v;
+template <class T>
+struct Values {  // x itself
+  std::span<const T> v;
   Index size() const { return v.size(); }
-  double operator()(Index k) const { return v[k]; }
+  double operator()(Index k) const { return static_cast<double>(v[k]); }
 };
+template <class T>
 struct Increments {  // x[(k+1) b] - x[k b]: frequencies summed over blocks of b samples, times tau0
-  std::span<const double> x;
+  std::span<const T> x;
   Index b;
   Index size() const { return (x.size() - 1) / b; }
-  double operator()(Index k) const { return x[(k + 1) * b] - x[k * b]; }
+  double operator()(Index k) const { return static_cast<double>(x[(k + 1) * b]) - static_cast<double>(x[k * b]); }
+};
+struct Window {  // a window of block sums: v(k) for k from `from` on
+  const double* sums;
+  Index from;
+  double operator()(Index k) const { return sums[k - from]; }
 };
 
 // The kernel MTOTVAR and HTOTVAR share: over every run of 3S consecutive values v (the
-// sub-sequences), remove the line through the means of its halves, mirror it at both ends to 9S
-// values e, and average z_k^2 = (E[k+3S] - 3E[k+2S] + 3E[k+S] - E[k])^2 over k in [0, 6S), E the
-// prefix sums of e. Returns the sum of those averages; `runs` gets their number.
-// E (scratch) holds 9S + 1 prefix sums. O(15 S) per sub-sequence.
+// sub-sequences) starting in [n0, n1), remove the line through the means of its halves, mirror it at
+// both ends to 9S values e, and add the average of z_k^2 = (E[k+3S] - 3E[k+2S] + 3E[k+S] - E[k])^2
+// over k in [0, 6S) to `sum`, E the prefix sums of e (a range at a time, the same additions in the
+// same order as all at once). E (scratch) holds 9S + 1 prefix sums. O(15 S) per sub-sequence.
 template <class Seq>
-double total_kernel(const Seq& v, Index S, std::span<double> E, std::uint64_t& runs) {
-  const Index len = 3 * S, total = v.size();
-  const Index starts = total >= len ? total - len + 1 : 0;
-  runs = starts;
+void total_kernel(const Seq& v, Index S, Index n0, Index n1, std::span<double> E, double& sum) {
+  const Index len = 3 * S;
   const Index half = len / 2;                // points in each half; the middle one of an odd run is in neither
   const double run = as_double(len - half);  // distance between the centres of the halves
-  double sum = 0.0;
-  for (Index n = 0; n < starts; ++n) {
+  for (Index n = n0; n < n1; ++n) {
     double first = 0.0, second = 0.0;
     for (Index t = 0; t < half; ++t) {
       first += v(n + t);
@@ -123,65 +137,85 @@ double total_kernel(const Seq& v, Index S, std::span<double> E, std::uint64_t& r
     if (len % 2 == 0) acc += z2(3 * len / 2);
     sum += acc / as_double(2 * len);
   }
-  return sum;
 }
 
 bool block_ok(std::uint64_t block, std::uint64_t m) {
   return block >= 1 && m >= 1 && m % block == 0 && (block == 1 || (m / block) % 2 == 0);
 }
 
-}  // namespace
-
-TotalVariance totvar(std::span<const double> x, std::uint64_t m, double tau0_s) {
+template <class T>
+TotalVariance totvar_of(std::span<const T> x, std::uint64_t m, double tau0_s) {
   const Index N = x.size();
   if (N < 3 || m < 1 || m > N - 1 || !(tau0_s > 0)) return {};
   const Index M = as_index(m), last = N - 1;
+  auto at = [&](Index i) { return static_cast<double>(x[i]); };
   // x* by odd reflection about the end points; i - M and i + M stay within (-(N-1), 2(N-1)).
-  auto left = [&](Index i) { return i >= M ? x[i - M] : 2.0 * x[0] - x[M - i]; };
-  auto right = [&](Index i) { return i + M <= last ? x[i + M] : 2.0 * x[last] - x[2 * last - i - M]; };
+  auto left = [&](Index i) { return i >= M ? at(i - M) : 2.0 * at(0) - at(M - i); };
+  auto right = [&](Index i) { return i + M <= last ? at(i + M) : 2.0 * at(last) - at(2 * last - i - M); };
   double sum = 0.0;
   for (Index i = 1; i < last; ++i) {
-    const double t = left(i) - 2.0 * x[i] + right(i);
+    const double t = left(i) - 2.0 * at(i) + right(i);
     sum += t * t;
   }
   const double tau = as_double(m) * tau0_s;
   return {sum / (2.0 * tau * tau * as_double(N - 2)), N - 2, 1};
 }
 
-TotalVariance mtotvar(std::span<const double> block_sums, std::uint64_t block, std::uint64_t m, double tau0_s,
-                      std::span<double> scratch) {
+template <class T>
+TotalVariance mtotvar_of(std::span<const T> x, std::uint64_t block, std::uint64_t m, double tau0_s,
+                         std::span<double> scratch) {
   if (!block_ok(block, m) || !(tau0_s > 0)) return {};
-  const std::uint64_t S = m / block;
-  if (block_sums.size() < 3 * S || scratch.size() < total_scratch_size(m, block)) return {};
-  std::uint64_t runs = 0;
-  const double sum = total_kernel(Values{block_sums}, as_index(S), scratch, runs);
+  const Index S = as_index(m / block), b = as_index(block), len = 3 * S, count = x.size() / b;
+  if (count < len || scratch.size() < total_scratch_size(m, block)) return {};
+  const Index starts = count - len + 1;
+  const std::span<double> E = scratch.first(9 * S + 1);
+  double sum = 0.0;
+  if (b == 1) {
+    total_kernel(Values<T>{x}, S, 0, starts, E, sum);
+  } else {
+    // The block sums of total_window starts at a time, with the 3S - 1 more the last one reaches.
+    double* sums = scratch.data() + E.size();
+    for (Index n0 = 0; n0 < starts; n0 += total_window) {
+      const Index n1 = starts - n0 < total_window ? starts : n0 + total_window;
+      for (Index k = n0; k < n1 + len - 1; ++k) {
+        double s = 0.0;
+        for (Index t = 0; t < b; ++t) s += static_cast<double>(x[k * b + t]);
+        sums[k - n0] = s;
+      }
+      total_kernel(Window{sums, n0}, S, n0, n1, E, sum);
+    }
+  }
   const double tau = as_double(m) * tau0_s;
-  return {sum / (as_double(runs) * 2.0 * as_double(m) * as_double(m) * tau * tau), runs, block};
+  return {sum / (as_double(starts) * 2.0 * as_double(m) * as_double(m) * tau * tau), starts, block};
 }
 
-TotalVariance htotvar(std::span<const double> x, std::uint64_t block, std::uint64_t m, double tau0_s,
-                      std::span<double> scratch) {
+template <class T>
+TotalVariance htotvar_of(std::span<const T> x, std::uint64_t block, std::uint64_t m, double tau0_s,
+                         std::span<double> scratch) {
   const Index N = x.size();
   if (!block_ok(block, m) || !(tau0_s > 0) || N < 4 || block >= N) return {};
   if (m == 1) {  // the overlapping Hadamard variance (SP 1065 eq. 18)
+    auto at = [&](Index i) { return static_cast<double>(x[i]); };
     double sum = 0.0;
     for (Index i = 0; i + 3 < N; ++i) {
-      const double h = x[i + 3] - 3.0 * x[i + 2] + 3.0 * x[i + 1] - x[i];
+      const double h = at(i + 3) - 3.0 * at(i + 2) + 3.0 * at(i + 1) - at(i);
       sum += h * h;
     }
     return {sum / (6.0 * as_double(N - 3) * tau0_s * tau0_s), N - 3, 1};
   }
-  const std::uint64_t S = m / block;
-  const Increments y{x, as_index(block)};
+  const Index S = as_index(m / block);
+  const Increments<T> y{x, as_index(block)};
   if (y.size() < 3 * S || scratch.size() < total_scratch_size(m, block)) return {};
-  std::uint64_t runs = 0;
-  const double sum = total_kernel(y, as_index(S), scratch, runs);
+  const Index starts = y.size() - 3 * S + 1;
+  double sum = 0.0;
+  total_kernel(y, S, 0, starts, scratch, sum);
   // z sums m frequencies times tau0: H = z / (m tau0).
   const double scale = as_double(m) * tau0_s;
-  return {sum / (as_double(runs) * 6.0 * scale * scale), runs, block};
+  return {sum / (as_double(starts) * 6.0 * scale * scale), starts, block};
 }
 
-TotalVariance theo1(std::span<const double> x, std::uint64_t m, double tau0_s, std::uint64_t stride) {
+template <class T>
+TotalVariance theo1_of(std::span<const T> x, std::uint64_t m, double tau0_s, std::uint64_t stride) {
   const Index N = x.size();
   if (N < 3 || m < 2 || m % 2 != 0 || m > N - 1 || stride < 1 || !(tau0_s > 0)) return {};
   const Index M = as_index(m), h = M / 2, step = stride < N ? as_index(stride) : N;
@@ -199,18 +233,42 @@ TotalVariance theo1(std::span<const double> x, std::uint64_t m, double tau0_s, s
   return {sum / (0.75 * as_double(starts) * tau * tau), starts * h, stride};
 }
 
-TotalVariance oavar(std::span<const double> x, std::uint64_t m, double tau0_s, std::uint64_t stride) {
+template <class T>
+TotalVariance oavar_of(std::span<const T> x, std::uint64_t m, double tau0_s, std::uint64_t stride) {
   const Index N = x.size();
   if (m < 1 || N < 2 * m + 1 || stride < 1 || !(tau0_s > 0)) return {};
   const Index M = as_index(m), step = stride < N ? as_index(stride) : N;
+  auto at = [&](Index i) { return static_cast<double>(x[i]); };
   double sum = 0.0;
   std::uint64_t n = 0;
   for (Index i = 0; i + 2 * M < N; i += step, ++n) {
-    const double t = x[i + 2 * M] - 2.0 * x[i + M] + x[i];
+    const double t = at(i + 2 * M) - 2.0 * at(i + M) + at(i);
     sum += t * t;
   }
   const double tau = as_double(m) * tau0_s;
   return {sum / (2.0 * as_double(n) * tau * tau), n, stride};
+}
+
+}  // namespace
+
+TotalVariance totvar(PhaseSpan x, std::uint64_t m, double tau0_s) {
+  return x.visit([&](auto v) { return totvar_of(v, m, tau0_s); });
+}
+
+TotalVariance mtotvar(PhaseSpan x, std::uint64_t block, std::uint64_t m, double tau0_s, std::span<double> scratch) {
+  return x.visit([&](auto v) { return mtotvar_of(v, block, m, tau0_s, scratch); });
+}
+
+TotalVariance htotvar(PhaseSpan x, std::uint64_t block, std::uint64_t m, double tau0_s, std::span<double> scratch) {
+  return x.visit([&](auto v) { return htotvar_of(v, block, m, tau0_s, scratch); });
+}
+
+TotalVariance theo1(PhaseSpan x, std::uint64_t m, double tau0_s, std::uint64_t stride) {
+  return x.visit([&](auto v) { return theo1_of(v, m, tau0_s, stride); });
+}
+
+TotalVariance oavar(PhaseSpan x, std::uint64_t m, double tau0_s, std::uint64_t stride) {
+  return x.visit([&](auto v) { return oavar_of(v, m, tau0_s, stride); });
 }
 
 std::uint64_t theo_bias_last(std::uint64_t n_phase) {
@@ -224,8 +282,8 @@ std::uint64_t theo_bias_index(std::uint64_t j, std::uint64_t count, std::uint64_
   return count == last + 1 ? j : (j * last + (count - 1) / 2) / (count - 1);
 }
 
-TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
-                              std::uint64_t ratio_taus, const RowRunner* runner) {
+TheoBiasRatio theo_bias_ratio(PhaseSpan x, double tau0_s, std::uint32_t stride_factor, std::uint64_t ratio_taus,
+                              const RowRunner* runner) {
   const std::uint64_t N = x.size();
   if (N < 24 || ratio_taus < 2 || !(tau0_s > 0)) return {};
   const std::uint64_t last = theo_bias_last(N);
@@ -236,7 +294,7 @@ TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uin
   // The taus a batch at a time, each AVAR / Theo1 in its slot (no heap), then summed in order.
   constexpr std::uint64_t batch = 64;
   struct Batch {
-    std::span<const double> x;
+    PhaseSpan x;
     double tau0_s;
     std::uint32_t S;
     std::uint64_t count, last, first = 0;
@@ -264,17 +322,6 @@ TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uin
   out.ratio = sum / as_double(count);
   out.taus = count;
   return out;
-}
-
-std::span<double> block_sums(std::span<const double> x, std::uint64_t block, std::span<double> out) {
-  if (block == 0 || out.size() < x.size() / block) return {};
-  const Index b = as_index(block), count = x.size() / b;
-  for (Index k = 0; k < count; ++k) {
-    double sum = 0.0;
-    for (Index t = 0; t < b; ++t) sum += x[k * b + t];
-    out[k] = sum;
-  }
-  return out.first(count);
 }
 
 std::uint64_t theo_bias_taus(std::uint64_t n_phase, std::uint32_t S) {

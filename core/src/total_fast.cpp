@@ -488,12 +488,42 @@ void ends_correlations(std::span<const double> a, std::span<const double> b, std
   inverse_from_bitreversed(d, n, w.twiddle.data());
 }
 
+namespace {
+
+// Least-squares quadratic of d = x - x[0] in the orthogonal basis 1, t, t^2 - mean(t^2) (t centred,
+// symmetric), fitted and removed in long double: the residual r then carries the rounding of its
+// own size, not that of the phase values (a 1e-3 ramp over 1e-12 noise keeps its noise). Returns
+// the quadratic's coefficient of t^2.
+template <class T>
+double remove_quadratic(std::span<const T> x, std::span<double> r) {
+  const Index N = x.size();
+  using Wide = long double;
+  auto d = [&](Index i) { return static_cast<Wide>(x[i]) - static_cast<Wide>(x[0]); };
+  const Wide c = 0.5L * static_cast<Wide>(N - 1);
+  Wide t2 = 0, p22 = 0, mean = 0, dt = 0, dp = 0;
+  for (Index i = 0; i < N; ++i) t2 += (static_cast<Wide>(i) - c) * (static_cast<Wide>(i) - c);
+  const Wide mt2 = t2 / static_cast<Wide>(N);
+  for (Index i = 0; i < N; ++i) {
+    const Wide t = static_cast<Wide>(i) - c, p = t * t - mt2, di = d(i);
+    mean += di, dt += di * t, dp += di * p, p22 += p * p;
+  }
+  mean /= static_cast<Wide>(N);
+  const Wide a1 = dt / t2, a2 = p22 > 0 ? dp / p22 : 0.0L;
+  for (Index i = 0; i < N; ++i) {
+    const Wide t = static_cast<Wide>(i) - c;
+    r[i] = static_cast<double>(d(i) - mean - a1 * t - a2 * (t * t - mt2));
+  }
+  return static_cast<double>(a2);
+}
+
+}  // namespace
+
 std::size_t theo1_workspace_size(std::size_t n_phase) {
   const std::size_t P = fft_length(2 * n_phase);
   return 4 * n_phase + 2 + fft_twiddle_size(P) + 2 * P;
 }
 
-Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) {
+Theo1Workspace theo1_prepare(PhaseSpan x, std::span<double> work) {
   const Index N = x.size();
   Theo1Workspace w;
   if (N < 3 || work.size() < theo1_workspace_size(N)) return w;
@@ -506,25 +536,7 @@ Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work) 
   };
   w.r = take(N), w.s1 = take(N + 1), w.s2 = take(N + 1), w.ac = take(N);
   w.twiddle = take(fft_twiddle_size(w.P)), w.buffer = take(2 * w.P);
-  // Least-squares quadratic of d = x - x[0] in the orthogonal basis 1, t, t^2 - mean(t^2) (t centred,
-  // symmetric), fitted and removed in long double: the residual then carries the rounding of its
-  // own size, not that of the phase values (a 1e-3 ramp over 1e-12 noise keeps its noise).
-  using Wide = long double;
-  const Wide c = 0.5L * static_cast<Wide>(N - 1);
-  Wide t2 = 0, p22 = 0, mean = 0, dt = 0, dp = 0;
-  for (Index i = 0; i < N; ++i) t2 += (static_cast<Wide>(i) - c) * (static_cast<Wide>(i) - c);
-  const Wide mt2 = t2 / static_cast<Wide>(N);
-  for (Index i = 0; i < N; ++i) {
-    const Wide t = static_cast<Wide>(i) - c, p = t * t - mt2, d = static_cast<Wide>(x[i]) - x[0];
-    mean += d, dt += d * t, dp += d * p, p22 += p * p;
-  }
-  mean /= static_cast<Wide>(N);
-  const Wide a1 = dt / t2, a2 = p22 > 0 ? dp / p22 : 0.0L;
-  w.curvature = static_cast<double>(a2);
-  for (Index i = 0; i < N; ++i) {
-    const Wide t = static_cast<Wide>(i) - c;
-    w.r[i] = static_cast<double>(static_cast<Wide>(x[i]) - x[0] - mean - a1 * t - a2 * (t * t - mt2));
-  }
+  w.curvature = x.visit([&](auto v) { return remove_quadratic(v, w.r); });
   w.s1[0] = w.s2[0] = 0.0;
   for (Index i = 0; i < N; ++i) {
     w.s1[i + 1] = w.s1[i] + w.r[i];
@@ -592,7 +604,7 @@ TotalVariance theo1_fast(Theo1Workspace& w, std::uint64_t m, double tau0_s) {
   return theo1_from_pieces(w, m, tau0_s, p);
 }
 
-TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s, std::uint64_t ratio_taus) {
+TheoBiasRatio theo_bias_ratio_fast(PhaseSpan x, Theo1Workspace& w, double tau0_s, std::uint64_t ratio_taus) {
   const std::uint64_t N = x.size();
   if (N < 24 || ratio_taus < 2 || !(tau0_s > 0) || !w.ready || w.r.size() != N) return {};
   const std::uint64_t last = theo_bias_last(N);

@@ -238,8 +238,7 @@ unsigned sums_needed(const AnalysisOptions& o) {
 // curves, each where a statistic asked for needs it), then each statistic's rows with their EDF and
 // interval, and the total family from the record. `a` has its counts filled in; the rows are
 // appended.
-void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, const AnalysisOptions& o,
-              std::span<const double> record) {
+void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, const AnalysisOptions& o, PhaseSpan record) {
   const std::size_t taus = sums.size();
   std::vector<NoiseId> noise2(taus), noise3(taus);
   // The identification and the EDF need the same covariance sums of each tau's Allan and

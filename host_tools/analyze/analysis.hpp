@@ -23,6 +23,7 @@
 
 #include "confidence.hpp"
 #include "gyrochar/estimates.hpp"
+#include "gyrochar/total.hpp"
 
 namespace gyrochar {
 
@@ -150,10 +151,12 @@ struct AnalysisRow {
 
 /// The phase record the analyzer holds for the total family: points in the engine's representation
 /// (phase relative to the first point; for freq the running sum of the values less the first value,
-/// a line less, which the total family does not see; for counts the running sum of the counts) and
-/// the factor that makes them phase units (tau0 for frequency data, else 1). Empty when not held.
+/// a line less, which the total family does not see; for counts the running sum of the counts, or
+/// where the batch engine holds them its residuals from the line of the first count, in int32 or
+/// int64: a line less again) and the factor that makes them phase units (tau0 for frequency data,
+/// else 1). Empty when not held.
 struct PhaseRecord {
-  std::span<const double> phase;
+  PhaseSpan phase;
   double phase_scale = 1.0;
 };
 

@@ -33,8 +33,7 @@ struct EngineBase {
 // The read-out every engine shares: the noise identification of every tau (Allan and Hadamard
 // curves), then each statistic's rows with their EDF and interval, and the total family from the
 // record. `a` has its counts filled in; the rows are appended.
-void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, const AnalysisOptions& o,
-              std::span<const double> record);
+void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, const AnalysisOptions& o, PhaseSpan record);
 
 // The sums the read-out of `o` needs, as phase_batch_taus()' kinds (float_batch.hpp): those of
 // each statistic asked for; AVAR, MVAR (R(n)) and the noise sums of the decimated series (lag-1,

@@ -114,11 +114,6 @@ class CountBatchEngine final : public EngineBase {
     if (i == 1) add_one(values[0], 0);
     if (wide_.empty()) i = add_narrow(values, i);
     for (; i < values.size(); ++i) add_one(values[i], i);
-    if (keep_record_)  // as the characterizer's engine keeps it
-      for (const double v : values) {
-        if (record_.empty()) record_.push_back(0.0);
-        record_.push_back(record_.back() + v);
-      }
   }
 
   Analysis result(const AnalysisOptions& o) const override {
@@ -134,11 +129,11 @@ class CountBatchEngine final : public EngineBase {
       if (counts_ > 0 && !wide_.empty()) tau.add_segment(PhaseSegment<std::int64_t>{wide_, 0, slope_, 0, spread});
       out[0] = tau_sums(tau.result(), tau.noise());
     });
-    read_out(a, sums, DataType::counts, o, record_);
+    read_out(a, sums, DataType::counts, o, record());
     return a;
   }
 
-  PhaseRecord record(const AnalysisOptions&) const override { return {record_, 1.0}; }
+  PhaseRecord record(const AnalysisOptions&) const override { return {record(), 1.0}; }
   HeldCounts held_counts() const override { return {true, narrow_, wide_, slope_}; }
 
  private:
@@ -205,6 +200,13 @@ class CountBatchEngine final : public EngineBase {
 
   std::uint32_t stride_factor_;
   std::vector<std::uint64_t> m_list_;
+  // The record the total family reads (keep_record): the residuals, no copy (total.hpp: the
+  // statistics do not see the line).
+  PhaseSpan record() const {
+    if (!keep_record_ || counts_ == 0) return {};
+    return wide_.empty() ? PhaseSpan(narrow_) : PhaseSpan(wide_);
+  }
+
   bool keep_record_;
   std::uint64_t counts_ = 0;
   std::int64_t x_ = 0;                                     // the phase reached, in pulses
@@ -213,7 +215,6 @@ class CountBatchEngine final : public EngineBase {
   std::int32_t lowest_ = INT32_MAX, highest_ = INT32_MIN;  // the counts' range: it bounds the terms
   Held<std::int32_t> narrow_;                              // the residuals while they fit in int32, x_0 first
   Held<std::int64_t> wide_;                                // all of them from the first that does not
-  std::vector<double> record_;                             // the phase for the total family (keep_record)
 };
 
 // Phase or frequency with the record held: the points as the characterizer stages them (relative

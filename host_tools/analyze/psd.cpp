@@ -12,6 +12,8 @@
 #include <memory>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "confidence.hpp"
 
@@ -30,43 +32,56 @@ Psd welch_psd(RateView rate, double tau0_s, std::size_t segment, double confiden
   out.segment = L;
   out.tau0_s = tau0_s;
   out.confidence = confidence;
-  std::vector<double> window(L);
-  double window_power = 0;
-  for (std::size_t n = 0; n < L; ++n) {
-    const double s = std::sin(std::numbers::pi * static_cast<double>(n) / static_cast<double>(L));
-    window[n] = s * s;
-    window_power += window[n] * window[n];
-  }
-  const auto free_double = [](double* p) { fftw_free(p); };
-  const auto free_complex = [](fftw_complex* p) { fftw_free(p); };
-  std::unique_ptr<double, decltype(free_double)> in(fftw_alloc_real(L), free_double);
-  std::unique_ptr<fftw_complex, decltype(free_complex)> spectrum(fftw_alloc_complex(L / 2 + 1), free_complex);
-  if (!in || !spectrum) throw std::bad_alloc();
-  const fftw_plan plan = fftw_plan_dft_r2c_1d(static_cast<int>(L), in.get(), spectrum.get(), FFTW_ESTIMATE);
+  // The periodograms' sum, and the transform's one buffer (in place: L + 2 doubles) while they are
+  // summed. The Hann window is not an array of L values: sin(pi n / L) by angle addition from two
+  // tables of about sqrt(L) angles (within a few units of rounding of std::sin).
   std::vector<double> sum(L / 2 + 1, 0.0);
   std::size_t k_segments = 0;
-  for (std::size_t start = 0; start + L <= rate.size(); start += L / 2, ++k_segments) {
-    double mean = 0;
-    for (std::size_t n = 0; n < L; ++n) mean += rate[start + n];
-    mean /= static_cast<double>(L);
-    for (std::size_t n = 0; n < L; ++n) in.get()[n] = (rate[start + n] - mean) * window[n];
-    fftw_execute(plan);
-    for (std::size_t k = 0; k <= L / 2; ++k)
-      sum[k] += spectrum.get()[k][0] * spectrum.get()[k][0] + spectrum.get()[k][1] * spectrum.get()[k][1];
+  const std::size_t fine = std::max<std::size_t>(std::bit_floor(static_cast<std::size_t>(std::sqrt(static_cast<double>(L)))),
+                                                 1);
+  std::vector<double> sin_fine(fine), cos_fine(fine), sin_coarse(L / fine + 1), cos_coarse(L / fine + 1);
+  for (std::size_t j = 0; j < fine; ++j) {
+    sin_fine[j] = std::sin(std::numbers::pi * static_cast<double>(j) / static_cast<double>(L));
+    cos_fine[j] = std::cos(std::numbers::pi * static_cast<double>(j) / static_cast<double>(L));
   }
-  fftw_destroy_plan(plan);
+  for (std::size_t j = 0; j < sin_coarse.size(); ++j) {
+    sin_coarse[j] = std::sin(std::numbers::pi * static_cast<double>(j * fine) / static_cast<double>(L));
+    cos_coarse[j] = std::cos(std::numbers::pi * static_cast<double>(j * fine) / static_cast<double>(L));
+  }
+  const auto window = [&](std::size_t n) {
+    const std::size_t c = n / fine, f = n % fine;
+    const double s = sin_coarse[c] * cos_fine[f] + cos_coarse[c] * sin_fine[f];
+    return s * s;
+  };
+  double window_power = 0;
+  for (std::size_t n = 0; n < L; ++n) window_power += window(n) * window(n);
+  {
+    const auto free_double = [](double* p) { fftw_free(p); };
+    const std::unique_ptr<double, decltype(free_double)> buffer(fftw_alloc_real(L + 2), free_double);
+    if (!buffer) throw std::bad_alloc();
+    double* in = buffer.get();
+    auto* spectrum = reinterpret_cast<fftw_complex*>(in);  // FFTW's in-place layout: L / 2 + 1 complex values
+    const fftw_plan plan = fftw_plan_dft_r2c_1d(static_cast<int>(L), in, spectrum, FFTW_ESTIMATE);
+    for (std::size_t start = 0; start + L <= rate.size(); start += L / 2, ++k_segments) {
+      double mean = 0;
+      for (std::size_t n = 0; n < L; ++n) mean += rate[start + n];
+      mean /= static_cast<double>(L);
+      for (std::size_t n = 0; n < L; ++n) in[n] = (rate[start + n] - mean) * window(n);
+      fftw_execute(plan);
+      for (std::size_t k = 0; k <= L / 2; ++k) sum[k] += spectrum[k][0] * spectrum[k][0] + spectrum[k][1] * spectrum[k][1];
+    }
+    fftw_destroy_plan(plan);
+  }
   out.segments = k_segments;
   const double K = static_cast<double>(k_segments);
   out.edf = 36 * K * K / (19 * K - 1);
   const Interval unit = confidence_interval(1.0, out.edf, confidence);  // of a deviation: square it
   const double scale = 2 * tau0_s / (window_power * K);
-  for (std::size_t k = 1; k < L / 2; ++k) {
-    const double p = sum[k] * scale;
-    out.freq_hz.push_back(static_cast<double>(k) / (static_cast<double>(L) * tau0_s));
-    out.psd.push_back(p);
-    out.ci_low.push_back(unit.valid ? p * unit.low * unit.low : std::numeric_limits<double>::quiet_NaN());
-    out.ci_high.push_back(unit.valid ? p * unit.high * unit.high : std::numeric_limits<double>::quiet_NaN());
-  }
+  if (unit.valid) out.low = unit.low, out.high = unit.high;
+  // The bins k = 1 .. L / 2 - 1, in the sum's own storage.
+  for (std::size_t k = 1; k < L / 2; ++k) sum[k - 1] = sum[k] * scale;
+  sum.resize(L / 2 - 1);
+  out.psd = std::move(sum);
   return out;
 }
 
@@ -75,6 +90,7 @@ namespace {
 constexpr std::size_t lobe = 2;       // a Hann main lobe: within 2 bins of the sinusoid's frequency
 constexpr std::size_t span_half = 3;  // the bins summed for a peak: its highest +- 3
 constexpr std::size_t max_neighbours = 64;
+static_assert(2 * max_neighbours < 256);
 constexpr std::size_t first_bin = 7;  // index 7: the 8th bin, k = 8
 
 }  // namespace
@@ -91,7 +107,7 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
   // The neighbours' count: at most 64 each side, no further than the first bin below, and the same
   // count above (the last bins test with fewer).
   std::vector<double> near;
-  std::vector<std::size_t> neighbours(bins, 0);
+  std::vector<std::uint8_t> neighbours(bins, 0);  // at most 2 (max_neighbours - lobe): a byte a bin
   for (std::size_t i = first_bin; i < bins; ++i) {
     const std::size_t m = std::min({max_neighbours, i, bins - 1 - i});
     if (m < lobe + 1 + 3) continue;  // at least 4 neighbours each side
@@ -103,7 +119,7 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
     const auto mid = near.begin() + static_cast<std::ptrdiff_t>(near.size() / 2);
     std::nth_element(near.begin(), mid, near.end());
     out.background[i] = *mid / median_factor;
-    neighbours[i] = near.size();
+    neighbours[i] = static_cast<std::uint8_t>(near.size());
     ++out.bins_tested;
   }
   if (out.bins_tested == 0) return out;
@@ -129,7 +145,7 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
     for (std::size_t j = lo; j <= hi; ++j) {
       const double s = psd.psd[j] - b;
       excess += s * df;
-      moment += s * df * psd.freq_hz[j];
+      moment += s * df * psd.freq_hz(j);
       var_sum += (2 * b * b + 4 * std::max(s, 0.0) * b) / nu * df * df;
     }
     if (!(excess > 0)) continue;
@@ -140,7 +156,7 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
     double var_moment = 0;
     for (std::size_t j = lo; j <= hi; ++j) {
       const double s = std::max(psd.psd[j] - b, 0.0);
-      const double d = (psd.freq_hz[j] - f) * df / excess;
+      const double d = (psd.freq_hz(j) - f) * df / excess;
       var_moment += d * d * (2 * b * b + 4 * s * b) / nu;
     }
     var_moment *= 2;
@@ -286,7 +302,7 @@ std::string spectrum_csv(const Spectrum& s) {
   const double k = s.factor * s.factor;
   auto to = std::back_inserter(out);
   for (std::size_t i = 0; i < s.psd.psd.size(); ++i)
-    fmt::format_to(to, "{},{},{},{}\n", s.psd.freq_hz[i], s.psd.psd[i] * k, s.psd.ci_low[i] * k, s.psd.ci_high[i] * k);
+    fmt::format_to(to, "{},{},{},{}\n", s.psd.freq_hz(i), s.psd.psd[i] * k, s.psd.ci_low(i) * k, s.psd.ci_high(i) * k);
   return out;
 }
 
@@ -297,7 +313,7 @@ std::string spectrum_table(const Spectrum& s) {
   fmt::format_to(to,
                  "# PSD of the rate (Welch, Hann, 50 % overlap): {} segments of {} values, bins of {:.4g} Hz from "
                  "{:.4g} to {:.4g} Hz, EDF {:.4g} per bin, in {}\n",
-                 p.segments, p.segment, p.bin_hz(), p.freq_hz.front(), p.freq_hz.back(), p.edf, s.psd_unit());
+                 p.segments, p.segment, p.bin_hz(), p.freq_hz(0), p.freq_hz(p.psd.size() - 1), p.edf, s.psd_unit());
   for (const double f : s.given_hz) fmt::format_to(to, "#   sinusoid offered to the fit at {:.6g} Hz (--sinusoid-hz)\n", f);
   if (!s.searched) return out;
   const PeakSearch& r = s.search;
@@ -327,12 +343,12 @@ nlohmann::json spectrum_json(const Spectrum& s) {
   json freq = json::array(), psd = json::array(), low = json::array(), high = json::array();
   double next = 0;  // the next frequency on a grid of 20 a decade
   for (std::size_t i = 0; i < p.psd.size(); ++i) {
-    if (p.freq_hz[i] < next) continue;
-    freq.push_back(p.freq_hz[i]);
+    if (p.freq_hz(i) < next) continue;
+    freq.push_back(p.freq_hz(i));
     psd.push_back(p.psd[i] * k);
-    low.push_back(std::isfinite(p.ci_low[i]) ? json(p.ci_low[i] * k) : json(nullptr));
-    high.push_back(std::isfinite(p.ci_high[i]) ? json(p.ci_high[i] * k) : json(nullptr));
-    next = p.freq_hz[i] * std::pow(10.0, 0.05);
+    low.push_back(std::isfinite(p.ci_low(i)) ? json(p.ci_low(i) * k) : json(nullptr));
+    high.push_back(std::isfinite(p.ci_high(i)) ? json(p.ci_high(i) * k) : json(nullptr));
+    next = p.freq_hz(i) * std::pow(10.0, 0.05);
   }
   const auto measured = [](double value, double uncertainty, const std::string& unit) {
     return json{{"value", value}, {"uncertainty", uncertainty}, {"unit", unit}};

@@ -27,6 +27,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <utility>
 #include <span>
@@ -45,10 +46,16 @@ struct Psd {
   std::size_t segment = 0;   // L, values per segment
   std::size_t segments = 0;  // K
   double tau0_s = 0;
-  double edf = 0;                                     // nu of every bin
-  double confidence = 0;                              // of the band
-  std::vector<double> freq_hz, psd, ci_low, ci_high;  // rate unit^2 / Hz
+  double edf = 0;           // nu of every bin
+  double confidence = 0;    // of the band
+  std::vector<double> psd;  // rate unit^2 / Hz, bin k = i + 1
+  // A deviation's interval at `edf` over its value (NaN: none): a bin's band is psd times their squares.
+  double low = std::numeric_limits<double>::quiet_NaN(), high = std::numeric_limits<double>::quiet_NaN();
   double bin_hz() const { return segment ? 1.0 / (static_cast<double>(segment) * tau0_s) : 0.0; }
+  // Bin i's frequency and band, computed as read (the record may have 2^23 bins: no more arrays of them).
+  double freq_hz(std::size_t i) const { return static_cast<double>(i + 1) / (static_cast<double>(segment) * tau0_s); }
+  double ci_low(std::size_t i) const { return psd[i] * low * low; }
+  double ci_high(std::size_t i) const { return psd[i] * high * high; }
 };
 
 /// The default segment length for n values: the largest power of two <= n / 16 (so 31 to 63

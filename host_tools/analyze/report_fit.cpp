@@ -28,8 +28,7 @@ const AnalysisRow* oadev_row(const Analysis& a, std::uint64_t m) {  // the row a
 // the phase in engine units; unit: one of them in SI. Points keep the Allan geometry and carry
 // variance_scale = the Allan estimate's EDF over their own (Greenhall's and SP 1065's formulas for
 // the identified alpha).
-void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& a, std::span<const double> x, double tau0,
-                  double unit) {
+void use_long_tau(std::vector<FitPoint>& points, LongTau input, const Analysis& a, PhaseSpan x, double tau0, double unit) {
   const double N = static_cast<double>(x.size());
   auto allan_edf = [&](int alpha, std::uint64_t m) {
     const double md = static_cast<double>(m);

@@ -199,21 +199,22 @@ void draw_psd_panel(plstream& pls, const Report& r) {
   std::vector<PLFLT> x, y, band_x, band_y;
   for (std::size_t i = 0; i < p.psd.size(); ++i) {
     if (!(p.psd[i] > 0)) continue;
-    x.push_back(std::log10(p.freq_hz[i]));
+    x.push_back(std::log10(p.freq_hz(i)));
     y.push_back(std::log10(p.psd[i] * k2));
     lo = std::min(lo, p.psd[i] * k2);
     hi = std::max(hi, p.psd[i] * k2);
   }
   if (x.empty()) return draw_empty_panel(pls, title, "no positive PSD");
-  const bool band = std::all_of(p.ci_low.begin(), p.ci_low.end(), [](double v) { return v > 0 && std::isfinite(v); });
+  const bool band = std::isfinite(p.low) && p.low > 0 &&
+                    std::all_of(p.psd.begin(), p.psd.end(), [](double v) { return v > 0; });
   if (band) {  // the band's polygon: up along the upper bound, back along the lower
     for (std::size_t i = 0; i < p.psd.size(); ++i)
-      band_x.push_back(std::log10(p.freq_hz[i])), band_y.push_back(std::log10(p.ci_high[i] * k2));
+      band_x.push_back(std::log10(p.freq_hz(i))), band_y.push_back(std::log10(p.ci_high(i) * k2));
     for (std::size_t i = p.psd.size(); i-- > 0;)
-      band_x.push_back(std::log10(p.freq_hz[i])), band_y.push_back(std::log10(p.ci_low[i] * k2));
-    lo = std::min(lo, *std::min_element(p.ci_low.begin(), p.ci_low.end()) * k2);
+      band_x.push_back(std::log10(p.freq_hz(i))), band_y.push_back(std::log10(p.ci_low(i) * k2));
+    lo = std::min(lo, *std::min_element(p.psd.begin(), p.psd.end()) * p.low * p.low * k2);
   }
-  const double x_lo = std::log10(p.freq_hz.front()) - 0.1, x_hi = std::log10(p.freq_hz.back()) + 0.1;
+  const double x_lo = std::log10(p.freq_hz(0)) - 0.1, x_hi = std::log10(p.freq_hz(p.psd.size() - 1)) + 0.1;
   const double y_lo = std::floor(std::log10(lo) - 0.05), y_hi = std::ceil(std::log10(hi) + 0.3);
   draw_log_frame(pls, x_lo, x_hi, y_lo, y_hi, "frequency [Hz]",
                  fmt::format("PSD [{}], band: {:.1f}% confidence", s.psd_unit(), 100 * r.confidence), title);
@@ -230,7 +231,7 @@ void draw_psd_panel(plstream& pls, const Report& r) {
   if (s.searched) {
     std::vector<double> f, b;
     for (std::size_t i = 0; i < p.psd.size(); ++i)
-      if (std::isfinite(s.search.background[i])) f.push_back(p.freq_hz[i]), b.push_back(s.search.background[i] * k2);
+      if (std::isfinite(s.search.background[i])) f.push_back(p.freq_hz(i)), b.push_back(s.search.background[i] * k2);
     draw_log_line(pls, f, b, sum_colour, 2, 1.2);
     legend.line("background (running median)", sum_colour, 2);
     for (std::size_t i = 0; i < b.size(); ++i) b[i] *= s.search.threshold;
@@ -248,7 +249,7 @@ void draw_psd_panel(plstream& pls, const Report& r) {
   if (fit != nullptr && fit->ok() && fit->p[1].value > 0) {  // white rate noise: one-sided PSD 2 N^2
     const double n_out = fit->p[1].value * r.units.factor() / r.units.phase_unit_si;
     const double level = 2 * n_out * n_out;
-    draw_log_line(pls, {p.freq_hz.front(), p.freq_hz.back()}, {level, level}, n_colour, 2, 1.5);
+    draw_log_line(pls, {p.freq_hz(0), p.freq_hz(p.psd.size() - 1)}, {level, level}, n_colour, 2, 1.5);
     legend.line("2 N^2: the fit's white rate noise", n_colour, 2);
   }
   legend.draw(pls);

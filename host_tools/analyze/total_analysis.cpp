@@ -64,7 +64,7 @@ std::vector<TotalVariance> estimates(const std::vector<std::uint64_t>& ms, unsig
 
 // Theo1, or TheoH (the overlapping ADEV rows below its switch point, TheoBR above): k2 is
 // phase_scale squared.
-std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, double k2, const AnalysisOptions& o,
+std::vector<AnalysisRow> theo_rows(DevStat stat, PhaseSpan x, double k2, const AnalysisOptions& o,
                                    const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums) {
   std::vector<AnalysisRow> rows;
   const std::uint64_t N = x.size();
@@ -119,7 +119,7 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, std::span<const double> x, doub
 }
 
 // TOTDEV, MTOTDEV, TTOTDEV or HTOTDEV at o.m_list: k2 is phase_scale squared.
-std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double> x, double k2, const AnalysisOptions& o,
+std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2, const AnalysisOptions& o,
                                            const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums) {
   std::vector<AnalysisRow> rows;
   const std::uint64_t N = x.size();
@@ -155,13 +155,11 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
       return htotvar(x, 1, 1, tau0, scratch);
     });
   } else {
-    std::vector<double> blocks, scratch;
+    std::vector<double> scratch;
     v = estimates(ms, 1, [&](unsigned, std::uint64_t m) {
       const std::uint64_t b = total_block(m, N, S);
       scratch.resize(total_scratch_size(m, b));
-      if (hadamard) return htotvar(x, b, m, tau0, scratch);
-      if (b > 1 && blocks.empty()) blocks.resize(N / 2);
-      return b == 1 ? mtotvar(x, 1, m, tau0, scratch) : mtotvar(block_sums(x, b, blocks), b, m, tau0, scratch);
+      return hadamard ? htotvar(x, b, m, tau0, scratch) : mtotvar(x, b, m, tau0, scratch);
     });
   }
 
@@ -195,14 +193,14 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, std::span<const double>
 
 void FreeDoubles::operator()(double* p) const noexcept { std::free(p); }
 
-HugeArray huge_array(std::size_t n) {
+UninitializedDoubles uninitialized_doubles(std::size_t n) {
   if (n > std::numeric_limits<std::size_t>::max() / sizeof(double)) throw std::bad_alloc();
   void* p = std::malloc(n ? n * sizeof(double) : 1);
   if (p == nullptr) throw std::bad_alloc();
-  return HugeArray(static_cast<double*>(p));
+  return UninitializedDoubles(static_cast<double*>(p));
 }
 
-std::span<LagSumView> LagSumRecord::views(std::span<const double> x, bool frequencies, unsigned threads) {
+std::span<LagSumView> LagSumRecord::views(PhaseSpan x, bool frequencies, unsigned threads) {
   const std::size_t n = frequencies ? x.size() - 1 : x.size();
   if (!(w_.ready && frequencies_ == frequencies && w_.r.size() == n)) {
     w_ = second_ = {};
@@ -214,11 +212,13 @@ std::span<LagSumView> LagSumRecord::views(std::span<const double> x, bool freque
     y_.clear();
     if (frequencies) {
       y_.resize(n);
-      for (std::size_t i = 0; i < n; ++i) y_[i] = x[i + 1] - x[i];
+      x.visit([&](auto v) {
+        for (std::size_t i = 0; i < n; ++i) y_[i] = static_cast<double>(v[i + 1]) - static_cast<double>(v[i]);
+      });
     }
-    work_ = huge_array(theo1_workspace_size(n));
-    w_ = theo1_prepare(frequencies ? std::span<const double>(y_) : x, {work_.get(), theo1_workspace_size(n)});
-    scratch_ = huge_array(mtotvar_scratch_size(n));
+    work_ = uninitialized_doubles(theo1_workspace_size(n));
+    w_ = theo1_prepare(frequencies ? PhaseSpan(y_) : x, {work_.get(), theo1_workspace_size(n)});
+    scratch_ = uninitialized_doubles(mtotvar_scratch_size(n));
     views_[0] = {&w_, {scratch_.get(), mtotvar_scratch_size(n)}};
     frequencies_ = frequencies;
   }
@@ -227,8 +227,8 @@ std::span<LagSumView> LagSumRecord::views(std::span<const double> x, bool freque
   const std::uint64_t both = 8 * (static_cast<std::uint64_t>(theo1_workspace_size(n)) + 2 * mtotvar_scratch_size(n) +
                                   w_.buffer.size() + x.size() + y_.size());
   if (threads >= 2 && views_[1].work == nullptr && w_.ready && both <= memory_budget()) {
-    second_buffer_ = huge_array(w_.buffer.size());
-    second_scratch_ = huge_array(mtotvar_scratch_size(n));
+    second_buffer_ = uninitialized_doubles(w_.buffer.size());
+    second_scratch_ = uninitialized_doubles(mtotvar_scratch_size(n));
     second_ = w_;
     second_.buffer = {second_buffer_.get(), w_.buffer.size()};
     views_[1] = {&second_, {second_scratch_.get(), mtotvar_scratch_size(n)}};
@@ -236,7 +236,7 @@ std::span<LagSumView> LagSumRecord::views(std::span<const double> x, bool freque
   return std::span<LagSumView>(views_).first(threads >= 2 && views_[1].work != nullptr ? 2 : 1);
 }
 
-std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> x, double phase_scale, const AnalysisOptions& o,
+std::vector<AnalysisRow> total_rows(DevStat stat, PhaseSpan x, double phase_scale, const AnalysisOptions& o,
                                     const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums) {
   const double k2 = phase_scale * phase_scale;
   if (stat == DevStat::theo1 || stat == DevStat::theoh) return theo_rows(stat, x, k2, o, allan, lag_sums);

@@ -1,8 +1,10 @@
 #pragma once
 // The total and Theo family in gyrochar-analyze (core/include/gyrochar/total.hpp, docs/total.md):
 // TOTDEV, MTOTDEV, TTOTDEV, HTOTDEV, Theo1 and TheoH rows from the phase record the analyzer holds
-// when one of them is asked for (8 bytes a point: the record as doubles; counts stay exact up to
-// 2^53 pulses), beside one buffer of block sums (4 bytes a point) for the decimated MTOTDEV.
+// when one of them is asked for: a counter's residuals as the batch engine holds them (4 bytes a
+// point while they fit in int32), else the phase as doubles (8 bytes a point; counts stay exact up
+// to 2^53 pulses). Nothing else the size of the record: the decimated MTOTDEV sums its blocks a
+// window at a time.
 //
 // Each row borrows from the Allan-family row of the same run at the same tau (for Theo1 and
 // TheoBR, at the largest tau at or below 0.75 m tau0): its noise identification, and its EDF where
@@ -27,8 +29,8 @@ namespace gyrochar {
 struct FreeDoubles {
   void operator()(double* p) const noexcept;
 };
-using HugeArray = std::unique_ptr<double[], FreeDoubles>;
-HugeArray huge_array(std::size_t n);
+using UninitializedDoubles = std::unique_ptr<double[], FreeDoubles>;
+UninitializedDoubles uninitialized_doubles(std::size_t n);
 
 /// One thread's access to the prepared record: the preparation itself, or a copy of it with an FFT
 /// buffer of its own (the rest is read only by the taus), and its MTOTVAR scratch.
@@ -47,12 +49,12 @@ class LagSumRecord {
  public:
   /// The preparation of x (frequencies: of y[k] = x[k+1] - x[k]), made on first use, as one view per
   /// thread for up to `threads` threads (1 or 2). The first view is the preparation's own.
-  std::span<LagSumView> views(std::span<const double> x, bool frequencies, unsigned threads);
+  std::span<LagSumView> views(PhaseSpan x, bool frequencies, unsigned threads);
   /// TheoBR's bias ratio as TheoH's rows computed it (analysis.hpp).
   TheoBias theoh_bias;
 
  private:
-  HugeArray work_, scratch_, second_buffer_, second_scratch_;  // not zero-filled: each writes before it reads
+  UninitializedDoubles work_, scratch_, second_buffer_, second_scratch_;  // not zero-filled: each writes before it reads
   std::vector<double> y_;
   Theo1Workspace w_, second_;
   std::array<LagSumView, 2> views_{};
@@ -66,10 +68,10 @@ class LagSumRecord {
 /// Theo1 (and TheoBR's Theo1 factor) exact at every tau by lag sums (total_fast.hpp) unless
 /// o.theo_decimated, and MTOTDEV/TTOTDEV/HTOTDEV the same unless o.total_decimated (each also falls
 /// back to the plan when its lag-sum workspace would pass the memory budget).
-/// `allan`: the run's oadev, mdev and ohdev rows at its taus. Allocates the block-sum buffer and the
+/// `allan`: the run's oadev, mdev and ohdev rows at its taus. Allocates the kernels' scratch and the
 /// rows; O(N) per tau for TOTDEV, O(N S) to O(N S^2 / m) for the others (docs/total.md).
 /// `lag_sums`: the run's one LagSumRecord.
-std::vector<AnalysisRow> total_rows(DevStat stat, std::span<const double> phase, double phase_scale,
-                                    const AnalysisOptions& o, const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums);
+std::vector<AnalysisRow> total_rows(DevStat stat, PhaseSpan phase, double phase_scale, const AnalysisOptions& o,
+                                    const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums);
 
 }  // namespace gyrochar

@@ -54,13 +54,11 @@ long peak_rss_kib() {
   return u.ru_maxrss;
 }
 
-// MTOTVAR at m with the plan for S; `blocks` is the reused block-sum buffer (N / 2 doubles).
-TotalVariance mtot(const std::vector<double>& x, std::uint64_t m, std::uint32_t S, std::vector<double>& blocks,
-                   std::vector<double>& scratch) {
+// MTOTVAR at m with the plan for S.
+TotalVariance mtot(const std::vector<double>& x, std::uint64_t m, std::uint32_t S, std::vector<double>& scratch) {
   const std::uint64_t b = total_block(m, x.size(), S);
   scratch.resize(total_scratch_size(m, b));
-  if (b == 1) return mtotvar(x, 1, m, 1.0, scratch);
-  return mtotvar(block_sums(x, b, blocks), b, m, 1.0, scratch);
+  return mtotvar(x, b, m, 1.0, scratch);
 }
 
 // The values of a file, one per line ('#' lines skipped); frequencies in Hz of a 10 MHz
@@ -92,7 +90,7 @@ double lag_sum_octaves(Theo1Workspace& w) {
 // their seconds returned.
 double mtot_lag_sum_octaves(Theo1Workspace& w) {
   const std::size_t size = mtotvar_scratch_size(w.r.size());
-  const auto scratch = huge_array(size);  // as the analyzer allocates it (not zero-filled)
+  const auto scratch = uninitialized_doubles(size);  // as the analyzer allocates it (not zero-filled)
   double total = 0;
   for (std::uint64_t m = 1; 3 * m <= w.r.size(); m *= 2) {
     const auto t0 = Clock::now();
@@ -110,11 +108,11 @@ int octave(const char* file, std::uint32_t S) {
     std::fprintf(stderr, "bench_total: %s: too few values\n", file);
     return 1;
   }
-  std::vector<double> blocks(x.size() / 2), scratch;
+  std::vector<double> scratch;
   double total = 0;
   for (std::uint64_t m = 1; 3 * m <= x.size(); m *= 2) {
     const auto t0 = Clock::now();
-    const TotalVariance v = mtot(x, m, S, blocks, scratch);
+    const TotalVariance v = mtot(x, m, S, scratch);
     const double s = seconds_since(t0);
     total += s;
     std::printf("mtotdev,%llu,%.9f,%.6e,%llu\n", static_cast<unsigned long long>(m), s, std::sqrt(v.var),
@@ -133,7 +131,7 @@ int octave(const char* file, std::uint32_t S) {
   std::printf("theo1,total,%.9f\n", total);
   auto t0 = Clock::now();  // the exact lag-sum Theo1 (total_fast.hpp), its preparation included
   const std::size_t size = theo1_workspace_size(x.size());
-  const auto work = huge_array(size);  // as the analyzer allocates it (not zero-filled)
+  const auto work = uninitialized_doubles(size);  // as the analyzer allocates it (not zero-filled)
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   total = seconds_since(t0);
   std::printf("theo1-lagsums,prepare,%.9f\n", total);
@@ -162,7 +160,7 @@ int lag_sums(std::uint64_t n, std::uint32_t S) {
   auto t0 = Clock::now();
   double c0 = cpu_seconds();
   const std::size_t size = theo1_workspace_size(n);
-  const auto work = huge_array(size);  // as the analyzer allocates it (not zero-filled)
+  const auto work = uninitialized_doubles(size);  // as the analyzer allocates it (not zero-filled)
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   const double prepare = seconds_since(t0), prepare_cpu = cpu_seconds() - c0;
   std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace)\n", prepare, prepare_cpu,
@@ -194,7 +192,7 @@ int mtot_lag_sums(std::uint64_t n) {
   auto t0 = Clock::now();
   double c0 = cpu_seconds();
   const std::size_t size = theo1_workspace_size(n);
-  const auto work = huge_array(size);  // as the analyzer allocates it (not zero-filled)
+  const auto work = uninitialized_doubles(size);  // as the analyzer allocates it (not zero-filled)
   Theo1Workspace w = theo1_prepare(x, {work.get(), size});
   const double prepare = seconds_since(t0), prepare_cpu = cpu_seconds() - c0;
   std::printf("prepare: %.2f s, CPU %.2f s (%.0f MB of workspace, %.0f MB of scratch)\n", prepare, prepare_cpu,
@@ -225,9 +223,9 @@ int long_record(std::uint64_t n, std::uint32_t S) {
   std::printf("totdev: %d taus in %.2f s\n", rows, seconds_since(t0));
 
   t0 = Clock::now();
-  std::vector<double> blocks(n / 2), scratch;
+  std::vector<double> scratch;
   rows = 0;
-  for (std::uint64_t m = 1; 3 * m <= n; m *= 2, ++rows) mtot(x, m, S, blocks, scratch);
+  for (std::uint64_t m = 1; 3 * m <= n; m *= 2, ++rows) mtot(x, m, S, scratch);
   std::printf("mtotdev: %d taus in %.2f s\n", rows, seconds_since(t0));
 
   t0 = Clock::now();
@@ -249,7 +247,7 @@ int decimation(const char* file, std::uint32_t S, bool frequency_hz) {
   const std::vector<double> x = read_phase(file, frequency_hz);
   const std::uint64_t N = x.size();
   const double n = static_cast<double>(N);
-  std::vector<double> blocks(N / 2), scratch, exact_scratch;
+  std::vector<double> scratch, exact_scratch;
   std::printf("| m | block | MTOTDEV | HTOTDEV | Theo1 stride | Theo1 |\n|---:|---:|---|---|---:|---|\n");
   auto cell = [](double exact, double fast, double edf) {
     const double rel = std::sqrt(fast / exact) - 1.0;
@@ -265,8 +263,7 @@ int decimation(const char* file, std::uint32_t S, bool frequency_hz) {
       exact_scratch.resize(total_scratch_size(m, 1));
       scratch.resize(total_scratch_size(m, b));
       const double md = static_cast<double>(m);
-      mt = cell(mtotvar(x, 1, m, 1.0, exact_scratch).var, mtotvar(block_sums(x, b, blocks), b, m, 1.0, scratch).var,
-                edf_mtotvar(0, n, md));
+      mt = cell(mtotvar(x, 1, m, 1.0, exact_scratch).var, mtotvar(x, b, m, 1.0, scratch).var, edf_mtotvar(0, n, md));
       ht = cell(htotvar(x, 1, m, 1.0, exact_scratch).var, htotvar(x, b, m, 1.0, scratch).var, edf_htotvar(0, n, md));
     }
     th = cell(theo1(x, m, 1.0).var, theo1(x, m, 1.0, d).var, edf_theo1(0, n, static_cast<double>(m)));

@@ -160,14 +160,11 @@ TEST(Total, MtotvarAndTtotvarEqualTheDefinition) {
 TEST(Total, DecimatedMtotvarAndHtotvarComputeTheirSubsetExactly) {
   const auto x = record(1001, 3);
   for (std::uint64_t b : {2u, 4u, 8u}) {
-    std::vector<double> blocks(x.size() / b);
-    for (std::size_t k = 0; k < blocks.size(); ++k)
-      for (std::size_t t = 0; t < b; ++t) blocks[k] += x[k * b + t];
     for (std::uint64_t m : {2 * b, 4 * b, 16 * b}) {
       std::vector<double> scratch(total_scratch_size(m, b));
       std::uint64_t runs = 0;
       const LD mtot = mtotvar_oracle(x, m, 1.0, b, &runs);
-      const TotalVariance t = mtotvar(blocks, b, m, 1.0, scratch);
+      const TotalVariance t = mtotvar(x, b, m, 1.0, scratch);
       EXPECT_EQ(t.n, runs);
       EXPECT_EQ(t.stride, b);
       expect_rel(t.var, mtot, 1e-10, "decimated mtotvar", m);
@@ -282,14 +279,24 @@ TEST(Total, TheoHSwitchIsTheLargestOctaveWithinTenPercent) {
   EXPECT_EQ(theoh_switch(10000001), 524288u);
 }
 
-TEST(Total, BlockSumsAndTheDecimationPlan) {
-  const std::vector<double> x{1, 2, 3, 4, 5, 6, 7};
-  std::vector<double> out(3);
-  const auto sums = block_sums(x, 2, out);
-  ASSERT_EQ(sums.size(), 3u);
-  EXPECT_EQ(sums[0], 3.0);
-  EXPECT_EQ(sums[2], 11.0);
-  EXPECT_TRUE(block_sums(x, 2, std::span<double>(out).first(2)).empty());
+TEST(Total, DecimatedMtotvarSumsItsBlocksAWindowAtATime) {
+  // Three windows of block sums (total_window starts each) and a part of one: the oracle is the
+  // definition on the blocks (mtotvar_oracle), as with one window above.
+  const auto x = record(2 * (2 * total_window + 1000) + 7, 5);
+  for (std::uint64_t m : {4u, 8u}) {
+    std::vector<double> scratch(total_scratch_size(m, 2));
+    std::uint64_t runs = 0;
+    const LD want = mtotvar_oracle(x, m, 1.0, 2, &runs);
+    const TotalVariance t = mtotvar(x, 2, m, 1.0, scratch);
+    EXPECT_EQ(t.n, runs);
+    EXPECT_EQ(t.n, x.size() / 2 - 3 * m / 2 + 1);
+    expect_rel(t.var, want, 1e-10, "windowed mtotvar", m);
+    scratch.pop_back();  // one double short: refused, not overrun
+    EXPECT_EQ(mtotvar(x, 2, m, 1.0, scratch).n, 0u);
+  }
+}
+
+TEST(Total, TheDecimationPlan) {
   // Exact below the budget (2^26 operations), m <= S or S = 0; the cost is 15 m (N - 3m + 1).
   EXPECT_EQ(total_block(1024, 1001, 16), 1u);  // cannot be formed, exact (cost 0)
   EXPECT_EQ(total_block(128, 100000, 0), 1u);

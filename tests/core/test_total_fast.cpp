@@ -412,5 +412,68 @@ TEST(MtotFast, UndefinedInputGivesNoTerms) {
   EXPECT_EQ(mtotvar_fast(none, scratch, 4, 1.0).n, 0u);
 }
 
+// A counter's phase read three ways (total.hpp, PhaseSpan): as doubles, as int64 pulses and as
+// int32 residuals from the line of the first count, as the analyzer holds them. Oracle: the doubles
+// (each estimator is tested against its definition above). The int64 phase converts to the same
+// doubles: the same bits. The statistics are blind to a line: the residuals give the same
+// variances to the rounding of the doubles path, whose terms are differences of values near 3e6
+// (2^-53 of 3e6 against terms of order 10: below 1e-10 relative; the tolerance is 1e-9).
+TEST(TotalFast, CountsAndTheirResidualsFromALineGiveThePhasesVariances) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> z;
+  constexpr std::size_t N = 3001;
+  std::vector<std::int64_t> pulses(N);
+  std::vector<std::int32_t> residuals(N);
+  std::vector<double> x(N);
+  double walk = 0;
+  std::int64_t slope = 0;
+  for (std::size_t i = 0; i + 1 < N; ++i) {
+    walk += 0.5 * z(rng);
+    const auto count = static_cast<std::int64_t>(std::lround(1000.0 + walk + 3.0 * z(rng)));
+    if (i == 0) slope = count;
+    pulses[i + 1] = pulses[i] + count;
+  }
+  for (std::size_t i = 0; i < N; ++i) {
+    residuals[i] = static_cast<std::int32_t>(pulses[i] - slope * static_cast<std::int64_t>(i));
+    x[i] = static_cast<double>(pulses[i]);
+  }
+  const auto same = [&](const char* what, std::uint64_t m, auto of) {
+    const TotalVariance d = of(PhaseSpan(x)), p = of(PhaseSpan(pulses)), r = of(PhaseSpan(residuals));
+    ASSERT_GT(d.n, 0u) << what << " m = " << m;
+    EXPECT_EQ(p.var, d.var) << what << " m = " << m;
+    EXPECT_EQ(p.n, d.n);
+    EXPECT_EQ(r.n, d.n);
+    EXPECT_NEAR(r.var, d.var, 1e-9 * d.var) << what << " m = " << m;
+  };
+  std::vector<double> scratch(total_scratch_size(256, 2));
+  for (const std::uint64_t m : {1u, 4u, 16u, 64u, 256u, 1000u}) {
+    same("totvar", m, [&](PhaseSpan v) { return totvar(v, m, 0.5); });
+    same("oavar", m, [&](PhaseSpan v) { return oavar(v, m, 0.5, m > 8 ? m / 8 : 1); });
+    if (m <= 256) {
+      same("mtotvar", m, [&](PhaseSpan v) { return mtotvar(v, 1, m, 0.5, scratch); });
+      same("htotvar", m, [&](PhaseSpan v) { return htotvar(v, 1, m, 0.5, scratch); });
+    }
+    if (m >= 4 && m <= 256) same("decimated mtotvar", m, [&](PhaseSpan v) { return mtotvar(v, 2, m, 0.5, scratch); });
+    if (m >= 4) same("theo1", m, [&](PhaseSpan v) { return theo1(v, m, 0.5, m > 16 ? m / 16 : 1); });
+  }
+  const TheoBiasRatio bd = theo_bias_ratio(x, 0.5, 8, 16), bp = theo_bias_ratio(pulses, 0.5, 8, 16),
+                      br = theo_bias_ratio(residuals, 0.5, 8, 16);
+  ASSERT_GT(bd.ratio, 0.0);
+  EXPECT_EQ(bp.ratio, bd.ratio);
+  EXPECT_NEAR(br.ratio, bd.ratio, 1e-9 * bd.ratio);
+  // The lag sums: the prepared record is the residual from a quadratic, whichever form it came in.
+  std::vector<double> work(theo1_workspace_size(N)), fast_scratch(mtotvar_scratch_size(N));
+  for (const std::uint64_t m : {16u, 600u}) {
+    same("theo1_fast", m, [&](PhaseSpan v) {
+      Theo1Workspace w = theo1_prepare(v, work);
+      return theo1_fast(w, m, 0.5);
+    });
+    same("mtotvar_fast", m, [&](PhaseSpan v) {
+      Theo1Workspace w = theo1_prepare(v, work);
+      return mtotvar_fast(w, fast_scratch, m, 0.5);
+    });
+  }
+}
+
 }  // namespace
 }  // namespace gyrochar

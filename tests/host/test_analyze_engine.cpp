@@ -486,16 +486,16 @@ TEST(AnalyzeEngine, TheFitsLongTauPointsReuseTheoHsBiasRatio) {
 }
 
 TEST(AnalyzeEngine, LagSumWorkspacesAreWholeOrRefused) {
-  // huge_array()'s contract (total_analysis.hpp): n doubles, every one writable; an impossible size
+  // uninitialized_doubles()'s contract (total_analysis.hpp): n doubles, every one writable; an impossible size
   // is std::bad_alloc, never a short buffer.
   for (const std::size_t n :
        {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{1} << 20, (std::size_t{3} << 20) + 5}) {
-    const HugeArray a = huge_array(n);
+    const UninitializedDoubles a = uninitialized_doubles(n);
     ASSERT_NE(a.get(), nullptr) << n;
     for (std::size_t i = 0; i < n; i += 4096) a[i] = static_cast<double>(i);
     if (n > 0) a[n - 1] = 1.0;
   }
-  EXPECT_THROW(huge_array(std::numeric_limits<std::size_t>::max() / 4), std::bad_alloc);
+  EXPECT_THROW(uninitialized_doubles(std::numeric_limits<std::size_t>::max() / 4), std::bad_alloc);
 }
 
 }  // namespace

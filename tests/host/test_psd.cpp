@@ -67,7 +67,7 @@ TEST(WelchPsd, WhiteNoiseIsFlatAt2Sigma2Tau0WithinWelchsBand) {
   for (std::size_t k = 0; k < p.psd.size(); ++k) {
     mean += p.psd[k] / truth;
     var += std::pow(p.psd[k] / truth - 1, 2);
-    inside += p.ci_low[k] <= truth && truth <= p.ci_high[k];
+    inside += p.ci_low(k) <= truth && truth <= p.ci_high(k);
   }
   const double bins = static_cast<double>(p.psd.size());
   mean /= bins;

@@ -48,10 +48,51 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 
 #include "gyrochar/rows.hpp"
 
 namespace gyrochar {
+
+template <class R, class T>
+concept SpanOf = std::is_convertible_v<const R&, std::span<const T>>;
+
+/// The phase record as every function here reads it: doubles, or integers (a counter's phase in
+/// pulses, 4 or 8 bytes a point). Each statistic here is blind to a line in the phase (a constant
+/// frequency), so a counter's residuals from any line give the same variances as its phase, to
+/// rounding (fewer roundings: the residuals are smaller). Integers convert to double exactly up to
+/// 2^53. A view: it holds no values.
+class PhaseSpan {
+ public:
+  PhaseSpan() = default;
+  /// Any contiguous range of doubles, int32 or int64 values (a std::span, a std::vector).
+  template <class R>
+  requires SpanOf<R, double> PhaseSpan(const R& r) : PhaseSpan(std::span<const double>(r), Kind::f64) {}
+  template <class R>
+  requires SpanOf<R, std::int32_t> PhaseSpan(const R& r) : PhaseSpan(std::span<const std::int32_t>(r), Kind::i32) {}
+  template <class R>
+  requires SpanOf<R, std::int64_t> PhaseSpan(const R& r) : PhaseSpan(std::span<const std::int64_t>(r), Kind::i64) {}
+
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  /// f(std::span<const T>) on the values as they are held; returns what f returns.
+  template <class F>
+  decltype(auto) visit(F&& f) const {
+    switch (kind_) {
+      case Kind::i32: return f(std::span<const std::int32_t>(static_cast<const std::int32_t*>(data_), size_));
+      case Kind::i64: return f(std::span<const std::int64_t>(static_cast<const std::int64_t*>(data_), size_));
+      default: return f(std::span<const double>(static_cast<const double*>(data_), size_));
+    }
+  }
+
+ private:
+  enum class Kind { f64, i32, i64 };
+  template <class T>
+  PhaseSpan(std::span<const T> s, Kind kind) : data_(s.data()), size_(s.size()), kind_(kind) {}
+  const void* data_ = nullptr;
+  std::size_t size_ = 0;
+  Kind kind_ = Kind::f64;
+};
 
 struct TotalVariance {
   double var = 0.0;          // variance (units above)
@@ -61,36 +102,41 @@ struct TotalVariance {
 
 /// TOTVAR of phase x at averaging factor m (1 <= m <= N - 1, N >= 3). O(N), reads x only.
 /// Undefined input (N < 3, m out of range, tau0_s <= 0) gives n = 0.
-TotalVariance totvar(std::span<const double> x, std::uint64_t m, double tau0_s);
+TotalVariance totvar(PhaseSpan x, std::uint64_t m, double tau0_s);
+
+/// The block sums MTOTVAR's decimated variant holds at a time: those of this many sub-sequence
+/// starts (and the 3 m / block - 1 more the last one reaches), not the whole record's.
+inline constexpr std::size_t total_window = 65536;
 
 /// Scratch (doubles) MTOTVAR and HTOTVAR need for averaging factor m on blocks of `block` samples:
-/// 9 m / block + 1.
+/// 9 m / block + 1, and for MTOTVAR on blocks of more than one sample a window of block sums,
+/// total_window + 3 m / block.
 constexpr std::size_t total_scratch_size(std::uint64_t m, std::uint64_t block) {
-  return static_cast<std::size_t>(9 * (m / block) + 1);
+  const std::uint64_t S = m / block;
+  return static_cast<std::size_t>(9 * S + 1 + (block > 1 ? total_window + 3 * S : 0));
 }
 
-/// MTOTVAR at averaging factor m from `block_sums`: the sums of x over consecutive blocks of
-/// `block` samples (block = 1: x itself, the exact estimator; block must divide m and m / block be
-/// even when block > 1). Needs floor(N / block) >= 3 m / block; scratch of total_scratch_size().
-/// O((N / block) (m / block)), no allocation. Undefined input gives n = 0.
-TotalVariance mtotvar(std::span<const double> block_sums, std::uint64_t block, std::uint64_t m, double tau0_s,
-                      std::span<double> scratch);
+/// MTOTVAR at averaging factor m of phase x, on the sums of x over consecutive blocks of `block`
+/// samples (block = 1: x itself, the exact estimator; block must divide m and m / block be even
+/// when block > 1), summed a window at a time into the scratch: the record is never copied. Needs
+/// floor(N / block) >= 3 m / block; scratch of total_scratch_size(). O((N / block) (m / block) + N),
+/// no allocation. Undefined input gives n = 0.
+TotalVariance mtotvar(PhaseSpan x, std::uint64_t block, std::uint64_t m, double tau0_s, std::span<double> scratch);
 
 /// HTOTVAR at averaging factor m of phase x, on the phase points every `block` samples (block = 1:
 /// exact; block must divide m and m / block be even when block > 1). m = 1 gives the overlapping
 /// Hadamard variance, as Stable32. Needs N - 1 >= 3 m; scratch of total_scratch_size().
 /// O((N / block) (m / block)), no allocation. Undefined input gives n = 0.
-TotalVariance htotvar(std::span<const double> x, std::uint64_t block, std::uint64_t m, double tau0_s,
-                      std::span<double> scratch);
+TotalVariance htotvar(PhaseSpan x, std::uint64_t block, std::uint64_t m, double tau0_s, std::span<double> scratch);
 
 /// Theo1 at averaging factor m (even, 10 <= m <= N - 1; smaller even m >= 2 are computed too) at
 /// tau = 0.75 m tau0_s, with sub-sequences every `stride` samples (1: exact). O((N - m) m / (2
 /// stride)), reads x only. Undefined input gives n = 0.
-TotalVariance theo1(std::span<const double> x, std::uint64_t m, double tau0_s, std::uint64_t stride = 1);
+TotalVariance theo1(PhaseSpan x, std::uint64_t m, double tau0_s, std::uint64_t stride = 1);
 
 /// Overlapping AVAR (SP 1065 eq. 11) with terms every `stride` samples (1: every one, the fully
 /// overlapped estimator). O((N - 2m) / stride). Undefined input gives n = 0.
-TotalVariance oavar(std::span<const double> x, std::uint64_t m, double tau0_s, std::uint64_t stride = 1);
+TotalVariance oavar(PhaseSpan x, std::uint64_t m, double tau0_s, std::uint64_t stride = 1);
 
 struct TheoBiasRatio {
   double ratio = 0.0;         // (1 / taus) sum AVAR(9 + 3i) / Theo1(12 + 4i); 0: undefined
@@ -106,8 +152,8 @@ struct TheoBiasRatio {
 /// ratio_taus >= n + 1). The taus' estimates are rows for `runner` (rows.hpp; null: in turn, here),
 /// summed in the same order either way: the same bits. O(taus N S) when decimated, O(N^3) exact; no
 /// allocation.
-TheoBiasRatio theo_bias_ratio(std::span<const double> x, double tau0_s, std::uint32_t stride_factor,
-                              std::uint64_t ratio_taus, const RowRunner* runner = nullptr);
+TheoBiasRatio theo_bias_ratio(PhaseSpan x, double tau0_s, std::uint32_t stride_factor, std::uint64_t ratio_taus,
+                              const RowRunner* runner = nullptr);
 
 /// The last index i of TheoBR's definition for N >= 24 phase points: floor(N / 6 - 3), less one when
 /// AVAR(9 + 3 i) would need N + 1 points. O(1).
@@ -119,11 +165,6 @@ std::uint64_t theo_bias_index(std::uint64_t j, std::uint64_t count, std::uint64_
 /// TheoH's switch point k in samples: the largest power of two at or below (N - 1) / 10 (at least 1).
 /// AVAR rows below it (m < k), TheoBR rows at 0.75 m >= k.
 std::uint64_t theoh_switch(std::uint64_t n_phase);
-
-/// Sums of x over consecutive blocks of `block` samples (the record MTOTVAR's decimated variant
-/// reads): floor(N / block) of them written to the front of `out` (which must hold them), that part
-/// returned; an empty span when out is too small or block is 0. O(N).
-std::span<double> block_sums(std::span<const double> x, std::uint64_t block, std::span<double> out);
 
 // The estimator the offline analysis runs: the exact one where it costs at most
 // total_exact_budget operations (about a tenth of a second), the decimated one with stride

@@ -49,7 +49,7 @@ struct Theo1Workspace {
 };
 
 /// Prepares x (N >= 3) in `work` (theo1_workspace_size(N) doubles). O(N log N).
-Theo1Workspace theo1_prepare(std::span<const double> x, std::span<double> work);
+Theo1Workspace theo1_prepare(PhaseSpan x, std::span<double> work);
 
 /// Theo1 at averaging factor m (even, 2 <= m <= N - 1), exactly the estimator theo1(x, m, tau0_s, 1)
 /// computes (same n, stride 1), to rounding. O(N + m log^2 m) on a prepared record (the O(N) part is
@@ -107,6 +107,6 @@ TotalVariance htotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::ui
 
 /// theo_bias_ratio with every Theo1 and AVAR exact, Theo1 by theo1_fast: at most `ratio_taus` of the
 /// definition's taus, evenly spread (all when ratio_taus >= n + 1). O(taus (N + m log^2 m)).
-TheoBiasRatio theo_bias_ratio_fast(std::span<const double> x, Theo1Workspace& w, double tau0_s, std::uint64_t ratio_taus);
+TheoBiasRatio theo_bias_ratio_fast(PhaseSpan x, Theo1Workspace& w, double tau0_s, std::uint64_t ratio_taus);
 
 }  // namespace gyrochar
