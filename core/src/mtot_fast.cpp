@@ -390,32 +390,40 @@ Wide fixed_terms(const Geometry& g, std::span<const double> head, std::span<cons
 }
 
 // The sum over every window of 3m values of the prepared sequence of the 6m squared terms z_k
-// (MTOTVAR's kernel; HTOTVAR's on the frequencies). Valid input checked by the caller.
-Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
+// (MTOTVAR's kernel; HTOTVAR's on the frequencies), in two pieces (total_fast.hpp): piece 0 the
+// whole record's autocorrelation weighted, less the windows' moving products past both ends, and
+// the removed quadratic's terms; piece 1 the products at fixed positions (fixed_terms, the FFTs).
+// Valid input checked by the caller.
+void window_piece(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, int piece, MtotPieces& out) {
   const Index N = w.r.size();
   const Geometry g(static_cast<Pos>(m));
   const Index len = static_cast<Index>(g.len), windows = N - len + 1;
   // The arrays needed while the FFT buffer is free live in it (its first P doubles are already
   // touched by the preparation): on this scale first touching fresh memory costs as much as the
   // arithmetic (docs/total.md). The caller's scratch holds the end's prefix sums (the start's are the
-  // record's, w.s1).
-  const std::span<double> A = w.buffer.first(len + 1), B = w.buffer.subspan(len + 1, len + 1);
+  // record's, w.s1): each piece makes them in its own.
   const std::span<const double> head = w.s1.first(len);
   const std::span<double> tail = scratch.first(len);
+  tail[0] = 0.0;
+  for (Index i = 1; i < len; ++i) tail[i] = tail[i - 1] + w.r[N - i];
+  if (piece == 1) {
+    out.fixed = fixed_terms(g, head, tail, w);
+    return;
+  }
   // Every window that meets the record, the residual zero outside: the autocorrelation weighted.
+  const std::span<double> A = w.buffer.first(len + 1), B = w.buffer.subspan(len + 1, len + 1);
   kernel_autocorrelation(g, A, B, w.buffer.subspan(2 * len + 2, static_cast<Index>(g.m)));
   Wide sum = static_cast<Wide>(A[0]) * w.ac[0];
   for (Index d = 1; d < len; ++d) sum += 2 * static_cast<Wide>(A[d]) * w.ac[d];
   // Less the windows that stick out at the start, and at the end (the sum of a window's squares does
   // not change when the window is reversed: the end's residuals are read backwards).
-  tail[0] = 0.0;
-  for (Index i = 1; i < len; ++i) tail[i] = tail[i - 1] + w.r[N - i];
   sum -= same_way_terms(g, head, tail);
   // A and B no longer needed: T2 of both ends in their place.
   sum -= opposite_way_terms(g, head, tail, w.buffer.first(len + 2), w.buffer.subspan(len + 2, len + 2));
-  sum -= fixed_terms(g, head, tail, w);
+  out.moving = sum;
   // The removed quadratic c i^2 adds the same q_k (z_k of the window t^2) to every window.
   const Wide c = w.curvature;
+  out.quadratic = 0;
   if (c != 0) {
     const std::span<double> G = w.buffer.first(len + 1);  // G[t] = sum over windows of U_n[t]
     G[0] = 0.0;
@@ -429,31 +437,55 @@ Wide window_sum(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m) {
         square += weight * q * q;
       }
     });
-    sum += 2 * c * cross + static_cast<Wide>(windows) * c * c * square;
+    out.quadratic = 2 * c * cross + static_cast<Wide>(windows) * c * c * square;
   }
-  return sum;
 }
+
+bool window_defined(const Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, std::uint64_t least) {
+  return w.ready && m >= least && 3 * m <= w.r.size() && scratch.size() >= mtotvar_scratch_size(w.r.size());
+}
+
+// The pieces' sum, in the order of one pass.
+Wide window_sum(const MtotPieces& p) { return p.moving - p.fixed + p.quadratic; }
 
 }  // namespace
 
 std::size_t mtotvar_scratch_size(std::size_t n_phase) { return n_phase; }  // the end's prefix sums
 
-TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+void mtotvar_piece(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, int piece, MtotPieces& out) {
+  if (window_defined(w, scratch, m, 1)) window_piece(w, scratch, m, piece, out);
+}
+
+TotalVariance mtotvar_from_pieces(const Theo1Workspace& w, std::uint64_t m, double tau0_s, const MtotPieces& p) {
   const std::uint64_t N = w.r.size();
-  if (!w.ready || m < 1 || 3 * m > N || !(tau0_s > 0) || scratch.size() < mtotvar_scratch_size(w.r.size())) return {};
+  if (!w.ready || m < 1 || 3 * m > N || !(tau0_s > 0)) return {};
   // The mean over windows of the mean of the 6m squares, / (2 m^2 tau^2).
   const double windows = static_cast<double>(N - 3 * m + 1), md = static_cast<double>(m), tau = md * tau0_s;
-  const double var = static_cast<double>(window_sum(w, scratch, m)) / (6.0 * md * windows * 2.0 * md * md * tau * tau);
+  const double var = static_cast<double>(window_sum(p)) / (6.0 * md * windows * 2.0 * md * md * tau * tau);
   return {var, N - 3 * m + 1, 1};
 }
 
-TotalVariance htotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+TotalVariance htotvar_from_pieces(const Theo1Workspace& w, std::uint64_t m, double tau0_s, const MtotPieces& p) {
   const std::uint64_t N = w.r.size();  // frequencies
-  if (!w.ready || m < 2 || 3 * m > N || !(tau0_s > 0) || scratch.size() < mtotvar_scratch_size(w.r.size())) return {};
+  if (!w.ready || m < 2 || 3 * m > N || !(tau0_s > 0)) return {};
   // z sums m frequencies: H = z / (m tau0); the mean over windows of the mean of the 6m squares / 6.
   const double windows = static_cast<double>(N - 3 * m + 1), md = static_cast<double>(m), scale = md * tau0_s;
-  const double var = static_cast<double>(window_sum(w, scratch, m)) / (6.0 * md * windows * 6.0 * scale * scale);
+  const double var = static_cast<double>(window_sum(p)) / (6.0 * md * windows * 6.0 * scale * scale);
   return {var, N - 3 * m + 1, 1};
+}
+
+TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+  if (!window_defined(w, scratch, m, 1)) return {};
+  MtotPieces p;
+  for (int piece = 0; piece < mtotvar_pieces; ++piece) window_piece(w, scratch, m, piece, p);
+  return mtotvar_from_pieces(w, m, tau0_s, p);
+}
+
+TotalVariance htotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s) {
+  if (!window_defined(w, scratch, m, 2)) return {};
+  MtotPieces p;
+  for (int piece = 0; piece < mtotvar_pieces; ++piece) window_piece(w, scratch, m, piece, p);
+  return htotvar_from_pieces(w, m, tau0_s, p);
 }
 
 }  // namespace gyrochar

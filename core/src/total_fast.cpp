@@ -115,18 +115,18 @@ Quad quad_twiddles(const StageTwiddles& whole, const StageTwiddles& halves, Inde
   if (forward) t.w1i = -t.w1i, t.w2i = -t.w2i, t.vi = -t.vi;  // forward: exp(-2 pi i k / len)
   return t;
 }
-void forward_two_stages(double* d, Index n, const double* table) {
+// Stage n and n / 2 over the whole of d, where the block does not fit the cache: the quarter values
+// k in [k0, k1) of [0, n / 4) (each k's butterflies touch only its own four values).
+void forward_two_stages(double* d, Index n, const double* table, Index k0 = 0, Index k1 = ~Index{0}) {
   const Index q = n / 4;
   const StageTwiddles whole(table, n), halves(table, n / 2);
-  for (Index k = 0; k < q; ++k) forward_quad(d + 2 * k, q, quad_twiddles(whole, halves, k, q, true));
+  for (Index k = k0; k < q && k < k1; ++k) forward_quad(d + 2 * k, q, quad_twiddles(whole, halves, k, q, true));
 }
-void inverse_two_stages(double* d, Index n, const double* table) {
+void inverse_two_stages(double* d, Index n, const double* table, Index k0 = 0, Index k1 = ~Index{0}) {
   const Index q = n / 4;
   const StageTwiddles whole(table, n), halves(table, n / 2);
-  for (Index k = 0; k < q; ++k) inverse_quad(d + 2 * k, q, quad_twiddles(whole, halves, k, q, false));
+  for (Index k = k0; k < q && k < k1; ++k) inverse_quad(d + 2 * k, q, quad_twiddles(whole, halves, k, q, false));
 }
-// (forward_two_stages and inverse_two_stages: stage n and n / 2 over the whole of d, where the
-// block does not fit the cache.)
 
 // The stages of a block that fits the cache (n <= cached, whole twiddles), two at a time: stage len
 // and len / 2 on every block of len values, each pair of twiddles read once for all the blocks
@@ -196,6 +196,39 @@ void inverse_from_bitreversed(double* d, Index n, const double* table) {
   inverse_cached(d, n, table);
 }
 
+// The same transforms as rows for a host's threads (rows.hpp): the two stages over the whole in
+// two halves of their quarter values, the four quarters each a row. Each butterfly does the same
+// operations on the same values as in turn: the same bits. Below 4 cached, in turn.
+struct ParallelFft {
+  double* d;
+  Index n;
+  const double* table;
+  bool forward;
+  void two_stages(std::size_t half) const {
+    const Index q = n / 4, k0 = half == 0 ? 0 : q / 2, k1 = half == 0 ? q / 2 : q;
+    if (forward) forward_two_stages(d, n, table, k0, k1);
+    else inverse_two_stages(d, n, table, k0, k1);
+  }
+  void quarter(std::size_t i) const {
+    double* at = d + 2 * i * (n / 4);
+    if (forward) forward_bitreversed(at, n / 4, table);
+    else inverse_from_bitreversed(at, n / 4, table);
+  }
+};
+void transform(double* d, Index n, const double* table, bool forward, const RowRunner* runner) {
+  if (runner == nullptr || n < 4 * cached) {
+    if (forward) forward_bitreversed(d, n, table);
+    else inverse_from_bitreversed(d, n, table);
+    return;
+  }
+  ParallelFft job{d, n, table, forward};
+  const Rows stages{[](void* c, std::size_t i) { static_cast<ParallelFft*>(c)->two_stages(i); }, &job};
+  const Rows quarters{[](void* c, std::size_t i) { static_cast<ParallelFft*>(c)->quarter(i); }, &job};
+  if (forward) run_rows(runner, stages, 2);
+  run_rows(runner, quarters, 4);
+  if (!forward) run_rows(runner, stages, 2);
+}
+
 // Calls f(p, q, k) once for every pair of frequencies k and n - k (k = 0 .. n / 2) of a
 // bit-reversed spectrum of length n (a power of two, n >= 2), p and q their positions. With 2^b the
 // highest bit of p, k = rev(p) and rev(n - k) = (n - 1) ^ rev(k - 1) = p ^ (2^b - 1): the pairs are
@@ -255,11 +288,12 @@ void load(double* d, Index n, std::span<const double> a, std::span<const double>
 // E = (Z_k + conj Z_{n-k}) / 2 and O = (Z_k - conj Z_{n-k}) / (2i) are the spectra of the even and
 // the odd values, X_k = E + W^k O and X_{k+n} = E - W^k O (W = exp(-2 pi i / P)) the whole one, and
 // the autocorrelation's even and odd values come back together as the inverse of
-// (S_k + S_{k+n}) + i W^-k (S_k - S_{k+n}), S = |X|^2. The twiddle table is that of length P.
-void real_autocorrelation(std::span<const double> x, Index P, double* d, const double* table) {
+// (S_k + S_{k+n}) + i W^-k (S_k - S_{k+n}), S = |X|^2. The twiddle table is that of length P. The
+// transforms' work goes on `runner` (null: in turn), the same bits either way.
+void real_autocorrelation(std::span<const double> x, Index P, double* d, const double* table, const RowRunner* runner) {
   const Index n = P / 2;
   for (Index p = 0; p < P; ++p) d[p] = p < x.size() ? x[p] : 0.0;
-  forward_bitreversed(d, n, table);
+  transform(d, n, table, true, runner);
   // From Z_k = z and Z_{n-k} = v: E, O, then S_k, S_{k+n} and the inverse's input y at k; W^k =
   // wr + i wi (the table's cos, -sin of pi k / n).
   auto power = [](double zr, double zi, double vr, double vi, double wr, double wi, double& yr, double& yi) {
@@ -281,7 +315,7 @@ void real_autocorrelation(std::span<const double> x, Index P, double* d, const d
     d[2 * p] = yr, d[2 * p + 1] = yi;
     if (q != p) d[2 * q] = ur, d[2 * q + 1] = ui;
   });
-  inverse_from_bitreversed(d, n, table);
+  transform(d, n, table, false, runner);
 }
 
 // Theo1's end correction (docs/total.md): with v every other residual of one end of the record
@@ -523,7 +557,7 @@ std::size_t theo1_workspace_size(std::size_t n_phase) {
   return 4 * n_phase + 2 + fft_twiddle_size(P) + 2 * P;
 }
 
-Theo1Workspace theo1_prepare(PhaseSpan x, std::span<double> work) {
+Theo1Workspace theo1_prepare(PhaseSpan x, std::span<double> work, const RowRunner* runner) {
   const Index N = x.size();
   Theo1Workspace w;
   if (N < 3 || work.size() < theo1_workspace_size(N)) return w;
@@ -543,7 +577,7 @@ Theo1Workspace theo1_prepare(PhaseSpan x, std::span<double> work) {
     w.s2[i + 1] = w.s2[i] + w.r[i] * w.r[i];
   }
   fft_twiddles(w.twiddle, w.P);
-  real_autocorrelation(w.r, w.P, w.buffer.data(), w.twiddle.data());
+  real_autocorrelation(w.r, w.P, w.buffer.data(), w.twiddle.data(), runner);
   const double* d = w.buffer.data();
   for (Index lag = 0; lag < N; ++lag) w.ac[lag] = d[lag] / as_double(w.P);
   w.ready = true;

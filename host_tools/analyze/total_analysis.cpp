@@ -146,14 +146,25 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
   if (stat == DevStat::totdev) {
     v = estimates(ms, threads, [&](unsigned, std::uint64_t m) { return totvar(x, m, tau0); });
   } else if (!total_decimated) {
+    // Each tau in its two pieces (total_fast.hpp), the largest tau first and its FFTs first: its two
+    // pieces, the dearest work, go on both threads at once.
     const std::span<LagSumView> views = lag_sums.views(x, hadamard, threads);  // HTOTVAR: the frequencies times tau0
-    v = estimates(ms, views.size(), [&](unsigned t, std::uint64_t m) {
-      const LagSumView& view = views[t];
-      if (!hadamard) return mtotvar_fast(*view.work, view.scratch, m, tau0);
-      if (m > 1) return htotvar_fast(*view.work, view.scratch, m, tau0);
-      std::vector<double> scratch(total_scratch_size(1, 1));  // m = 1: the overlapping Hadamard variance, O(N)
-      return htotvar(x, 1, 1, tau0, scratch);
+    std::vector<MtotPieces> pieces(ms.size());
+    on_threads(views.size(), mtotvar_pieces * ms.size(), [&](unsigned t, std::size_t i) {
+      const std::size_t k = ms.size() - 1 - i / mtotvar_pieces;
+      const int piece = mtotvar_pieces - 1 - static_cast<int>(i % mtotvar_pieces);
+      mtotvar_piece(*views[t].work, views[t].scratch, ms[k], piece, pieces[k]);
     });
+    for (std::size_t k = 0; k < ms.size(); ++k) {
+      if (!hadamard) {
+        v.push_back(mtotvar_from_pieces(*views[0].work, ms[k], tau0, pieces[k]));
+      } else if (ms[k] > 1) {
+        v.push_back(htotvar_from_pieces(*views[0].work, ms[k], tau0, pieces[k]));
+      } else {
+        std::vector<double> scratch(total_scratch_size(1, 1));  // m = 1: the overlapping Hadamard variance, O(N)
+        v.push_back(htotvar(x, 1, 1, tau0, scratch));
+      }
+    }
   } else {
     std::vector<double> scratch;
     v = estimates(ms, 1, [&](unsigned, std::uint64_t m) {
@@ -217,7 +228,8 @@ std::span<LagSumView> LagSumRecord::views(PhaseSpan x, bool frequencies, unsigne
       });
     }
     work_ = uninitialized_doubles(theo1_workspace_size(n));
-    w_ = theo1_prepare(frequencies ? PhaseSpan(y_) : x, {work_.get(), theo1_workspace_size(n)});
+    const ThreadRows runner(threads);  // the preparation's FFTs on the run's threads
+    w_ = theo1_prepare(frequencies ? PhaseSpan(y_) : x, {work_.get(), theo1_workspace_size(n)}, &runner);
     scratch_ = uninitialized_doubles(mtotvar_scratch_size(n));
     views_[0] = {&w_, {scratch_.get(), mtotvar_scratch_size(n)}};
     frequencies_ = frequencies;

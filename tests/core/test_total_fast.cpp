@@ -188,6 +188,73 @@ TEST(TotalFast, Theo1InPiecesOnBuffersOfTheirOwnIsTheSameBits) {
   EXPECT_EQ(theo1_from_pieces(w, 11, 1.0, untouched).n, 0u);
 }
 
+// Rows in reverse order, as no thread would run them in turn: each row's work must not depend on
+// another's.
+class ReverseRows final : public RowRunner {
+ public:
+  void run(const Rows& rows, std::size_t count) const override {
+    for (std::size_t i = count; i-- > 0;) rows.row(i);
+  }
+};
+
+TEST(TotalFast, ThePreparationsFftAsRowsIsTheSameBits) {
+  // Oracle: theo1_prepare in turn. On a runner (rows in reverse order), its transforms (2^15
+  // complex points: the split into halves and quarters applies from 4 x 2048) give the same
+  // autocorrelation to the last bit at every lag.
+  const std::vector<double> x = record(20000, 12, 0.3, 1.0, 2.5, 1e-4);
+  std::vector<double> a(theo1_workspace_size(x.size())), b(a.size());
+  const ReverseRows reverse;
+  const Theo1Workspace in_turn = theo1_prepare(x, a), as_rows = theo1_prepare(x, b, &reverse);
+  ASSERT_TRUE(in_turn.ready && as_rows.ready);
+  ASSERT_GE(in_turn.P / 2, 4u * 2048u);
+  std::size_t differ = 0;
+  for (std::size_t d = 0; d < x.size(); ++d) differ += in_turn.ac[d] != as_rows.ac[d];
+  EXPECT_EQ(differ, 0u);
+}
+
+TEST(MtotFast, InPiecesOnBuffersOfTheirOwnIsTheSameBits) {
+  // Oracle: mtotvar_fast (htotvar_fast). Its two pieces, piece 1 on a copy of the workspace with an
+  // FFT buffer and scratch of its own, in reverse order, combined: the same bits at every m from 1
+  // to N / 3 (the largest: the fixed terms by three autocorrelation sums), the record curved (the
+  // quadratic's terms).
+  const std::vector<double> x = record(3000, 10, 0.3, 1.0, 2.5, 1e-4);
+  std::vector<double> work(theo1_workspace_size(x.size())), scratch(mtotvar_scratch_size(x.size()));
+  Theo1Workspace w = theo1_prepare(x, work);
+  ASSERT_TRUE(w.ready);
+  ASSERT_NE(w.curvature, 0.0);
+  std::vector<double> other_buffer(w.buffer.size()), other_scratch(scratch.size());
+  Theo1Workspace other = w;
+  other.buffer = other_buffer;
+  for (std::uint64_t m = 1; 3 * m <= x.size(); m += m < 40 ? 1 : 97) {
+    MtotPieces p;
+    mtotvar_piece(other, other_scratch, m, 1, p);
+    mtotvar_piece(w, scratch, m, 0, p);
+    const TotalVariance fast = mtotvar_fast(w, scratch, m, 1.0), pieces = mtotvar_from_pieces(w, m, 1.0, p);
+    EXPECT_EQ(pieces.var, fast.var) << m;
+    EXPECT_EQ(pieces.n, fast.n) << m;
+  }
+  MtotPieces last;
+  mtotvar_piece(other, other_scratch, 1000, 1, last);
+  mtotvar_piece(w, scratch, 1000, 0, last);
+  EXPECT_EQ(mtotvar_from_pieces(w, 1000, 1.0, last).var, mtotvar_fast(w, scratch, 1000, 1.0).var);  // 3m = N
+  // HTOTVAR: the same kernel on the frequencies.
+  std::vector<double> y(x.size() - 1);
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) y[i] = x[i + 1] - x[i];
+  Theo1Workspace f = theo1_prepare(y, work);
+  Theo1Workspace f_other = f;
+  f_other.buffer = other_buffer;
+  for (const std::uint64_t m : {2u, 17u, 333u, 999u}) {
+    MtotPieces p;
+    mtotvar_piece(f_other, other_scratch, m, 1, p);
+    mtotvar_piece(f, scratch, m, 0, p);
+    EXPECT_EQ(htotvar_from_pieces(f, m, 1.0, p).var, htotvar_fast(f, scratch, m, 1.0).var) << m;
+  }
+  MtotPieces untouched;
+  mtotvar_piece(w, scratch, 1001, 0, untouched);  // 3m > N: nothing written, no estimate
+  EXPECT_EQ(untouched.moving, 0.0L);
+  EXPECT_EQ(mtotvar_from_pieces(w, 1001, 1.0, untouched).n, 0u);
+}
+
 TEST(TotalFast, UndefinedInputGivesNoTerms) {
   const std::vector<double> x = record(40, 1, 0.3, 1.0, 2.5, 0.0);
   std::vector<double> work(theo1_workspace_size(x.size()));

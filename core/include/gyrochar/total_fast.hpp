@@ -48,8 +48,9 @@ struct Theo1Workspace {
   bool ready = false;      // false: N < 3 or the workspace too small
 };
 
-/// Prepares x (N >= 3) in `work` (theo1_workspace_size(N) doubles). O(N log N).
-Theo1Workspace theo1_prepare(PhaseSpan x, std::span<double> work);
+/// Prepares x (N >= 3) in `work` (theo1_workspace_size(N) doubles). O(N log N). The FFT's work goes
+/// as rows to `runner` (rows.hpp; null: in turn, here), the same bits either way.
+Theo1Workspace theo1_prepare(PhaseSpan x, std::span<double> work, const RowRunner* runner = nullptr);
 
 /// Theo1 at averaging factor m (even, 2 <= m <= N - 1), exactly the estimator theo1(x, m, tau0_s, 1)
 /// computes (same n, stride 1), to rounding. O(N + m log^2 m) on a prepared record (the O(N) part is
@@ -97,6 +98,21 @@ std::size_t mtotvar_scratch_size(std::size_t n_phase);
 /// (docs/total.md, "MTOTVAR exactly, from lag sums"). O(m log m) a tau on a prepared record.
 /// Undefined input (or scratch smaller than mtotvar_scratch_size(N)) gives n = 0.
 TotalVariance mtotvar_fast(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, double tau0_s);
+
+/// mtotvar_fast (and htotvar_fast) in pieces that may run on different threads, each on a workspace
+/// and scratch of its own (as theo1_piece): piece 0 the whole record's lag sums weighted, less the
+/// windows' moving products past the ends, and the removed quadratic's terms; piece 1 the products
+/// at fixed positions past the ends (three FFTs of fft_length(6 m): the dearest near the largest
+/// m). Each piece writes its own fields; mtotvar_from_pieces (htotvar_from_pieces on the prepared
+/// frequencies) then gives mtotvar_fast's (htotvar_fast's) bits. Undefined m leaves the pieces
+/// untouched; from_pieces gives n = 0.
+inline constexpr int mtotvar_pieces = 2;
+struct MtotPieces {
+  long double moving = 0, fixed = 0, quadratic = 0;
+};
+void mtotvar_piece(Theo1Workspace& w, std::span<double> scratch, std::uint64_t m, int piece, MtotPieces& out);
+TotalVariance mtotvar_from_pieces(const Theo1Workspace& w, std::uint64_t m, double tau0_s, const MtotPieces& pieces);
+TotalVariance htotvar_from_pieces(const Theo1Workspace& w, std::uint64_t m, double tau0_s, const MtotPieces& pieces);
 
 /// HTOTVAR at averaging factor m (2 <= m <= (N - 1) / 3), exactly the estimator htotvar(x, 1, m,
 /// tau0_s, .) computes (same n, stride 1), to rounding: MTOTVAR's kernel on the N - 1 frequencies,
