@@ -59,11 +59,63 @@ template <class T>
   }
   return sum;
 }
+// The same terms in another order, for starts far apart (step >= theo1_block / 2, where one start's
+// block shares nothing with the next one's): a pass over a span of theo1_span positions p = i + k at
+// a time, every start whose run of k reaches the span summing its terms there. Each start's
+// x_{i+k} then come from the cache, read by the one before; only x_{i+M-k} stream from memory
+// (half the traffic of a block at a time; measured in BENCHMARKS.md). The weights 1 / k are
+// divided where they are used (correctly rounded: the table's values), four a step.
+inline constexpr Index theo1_span = 16384;
+template <class T>
+[[gnu::always_inline]] inline double theo1_run(const T* p, Index M, Index k0, Index k1) {
+  const double first = static_cast<double>(p[0]), last = static_cast<double>(p[M]);
+  Lanes s0 = {}, s1 = {};
+  Lanes k = {static_cast<double>(k0), static_cast<double>(k0 + 1), static_cast<double>(k0 + 2), static_cast<double>(k0 + 3)};
+  Index j = k0;
+  for (; j + 7 <= k1; j += 8) {
+    Lanes a0, a1, b0, b1;
+    load(a0, p + j);
+    load(a1, p + j + 4);
+    load_backwards(b0, p + M - j - 3);
+    load_backwards(b1, p + M - j - 7);
+    const Lanes w0 = 1.0 / k, w1 = 1.0 / (k + 4.0);
+    k += 8.0;
+    const Lanes t0 = ((first - a0) - b0) + last, t1 = ((first - a1) - b1) + last;
+    s0 += t0 * t0 * w0;
+    s1 += t1 * t1 * w1;
+  }
+  const Lanes s = s0 + s1;
+  double inner = (s[0] + s[1]) + (s[2] + s[3]);
+  for (; j <= k1; ++j) {
+    const double t = ((first - static_cast<double>(p[j])) - static_cast<double>(p[M - j])) + last;
+    inner += t * t * (1.0 / static_cast<double>(j));
+  }
+  return inner;
+}
+template <class T>
+[[gnu::always_inline]] inline double theo1_spans(const T* x, Index end, Index step, Index M) {
+  const Index h = M / 2;
+  double sum = 0.0;
+  Index first = 0;  // the first start whose run still reaches the span
+  for (Index p0 = 1; p0 < end + h; p0 += theo1_span) {
+    const Index p1 = p0 + theo1_span - 1;  // the span [p0, p1]
+    while (first < end && first + h < p0) first += step;
+    for (Index i = first; i < end && i < p1; i += step) {
+      const Index k0 = p0 > i ? p0 - i : 1, k1 = p1 - i < h ? p1 - i : h;
+      if (k0 <= k1) sum += theo1_run(x + i, M, k0, k1);
+    }
+  }
+  return sum;
+}
 #if defined(__x86_64__)
 template <class T>
 [[gnu::target("avx2,fma")]] double theo1_terms_avx2(const T* x, Index end, Index step, Index M, Index k0, Index len,
                                                     const double* w) {
   return theo1_terms(x, end, step, M, k0, len, w);
+}
+template <class T>
+[[gnu::target("avx2,fma")]] double theo1_spans_avx2(const T* x, Index end, Index step, Index M) {
+  return theo1_spans(x, end, step, M);
 }
 #endif
 template <class T>
@@ -72,6 +124,13 @@ double theo1_block_terms(const T* x, Index end, Index step, Index M, Index k0, I
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return theo1_terms_avx2(x, end, step, M, k0, len, w);
 #endif
   return theo1_terms(x, end, step, M, k0, len, w);
+}
+template <class T>
+double theo1_span_terms(const T* x, Index end, Index step, Index M) {
+#if defined(__x86_64__)
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return theo1_spans_avx2(x, end, step, M);
+#endif
+  return theo1_spans(x, end, step, M);
 }
 
 // The record's values seen through a sequence: v(k), k in [0, size).
@@ -219,6 +278,12 @@ TotalVariance theo1_of(std::span<const T> x, std::uint64_t m, double tau0_s, std
   const Index N = x.size();
   if (N < 3 || m < 2 || m % 2 != 0 || m > N - 1 || stride < 1 || !(tau0_s > 0)) return {};
   const Index M = as_index(m), h = M / 2, step = stride < N ? as_index(stride) : N;
+  const std::uint64_t starts = (N - M + step - 1) / step;
+  const double tau = as_double(m) * tau0_s;  // the definition's scale (tau is 0.75 of it)
+  auto variance = [&](double sum) {
+    return TotalVariance{sum / (0.75 * as_double(starts) * tau * tau), starts * h, stride};
+  };
+  if (2 * step >= theo1_block) return variance(theo1_span_terms(x.data(), N - M, step, M));  // starts far apart
   // The weights 1/k a block of k at a time (one division each), every start's terms of that block.
   // (64 KB of stack: an offline estimator; the board does not call it.)
   alignas(32) double weight[theo1_block];
@@ -228,9 +293,7 @@ TotalVariance theo1_of(std::span<const T> x, std::uint64_t m, double tau0_s, std
     for (Index j = 0; j < len; ++j) weight[j] = 1.0 / static_cast<double>(k0 + j);
     sum += theo1_block_terms(x.data(), N - M, step, M, k0, len, weight);
   }
-  const std::uint64_t starts = (N - M + step - 1) / step;
-  const double tau = as_double(m) * tau0_s;  // the definition's scale (tau is 0.75 of it)
-  return {sum / (0.75 * as_double(starts) * tau * tau), starts * h, stride};
+  return variance(sum);
 }
 
 template <class T>

@@ -231,6 +231,19 @@ TEST(Total, Theo1EqualsTheDefinitionOverSeveralBlocksOfWeights) {
   }
 }
 
+TEST(Total, Theo1EqualsTheDefinitionWithItsStartsFarApart) {
+  // From a stride of 4096 on, theo1() sums a span of 16384 positions at a time: runs of k that end
+  // within the first span, cross several and end on a span's border, one start or many.
+  const auto x = record(60000, 9);
+  const std::uint64_t cases[][2] = {{9000, 4096},  {40000, 4096}, {40000, 5001},
+                                    {32770, 8192}, {59998, 4096}, {20000, 60000}};
+  for (const auto& [m, stride] : cases) {
+    const TotalVariance t = theo1(x, m, 0.5, stride);
+    EXPECT_EQ(t.n, (60000 - m + stride - 1) / stride * (m / 2)) << m;
+    expect_rel(t.var, theo1_oracle(x, m, 0.5, stride), 1e-11, "theo1, starts far apart", m);
+  }
+}
+
 TEST(Total, TheoBiasRatioIsTheMeanOfAvarOverTheo1) {
   const auto x = record(400, 7);
   const TheoBiasRatio r = theo_bias_ratio(x, 1.0, 0, 1000);
