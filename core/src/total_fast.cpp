@@ -151,31 +151,45 @@ struct QuadPair {
   if (forward) t.w1 = conjugated(t.w1), t.w2 = conjugated(t.w2), t.v = conjugated(t.v);
   return t;
 }
-[[gnu::target("avx2")]] inline void forward_quad_pair(double* u0, Index q, const QuadPair& t) {
-  double* u1 = u0 + 2 * q;
-  double* u2 = u1 + 2 * q;
-  double* u3 = u2 + 2 * q;
-  const Pair x0 = load_pair(u0), x1 = load_pair(u1), x2 = load_pair(u2), x3 = load_pair(u3);
-  const Pair a0 = _mm256_add_pd(x0, x2), e0 = _mm256_sub_pd(x0, x2);
-  const Pair a1 = _mm256_add_pd(x1, x3), e1 = _mm256_sub_pd(x1, x3);
+struct Values4 {
+  Pair x0, x1, x2, x3;
+};
+[[gnu::target("avx2")]] inline void forward_quad_values(Values4& u, const QuadPair& t) {
+  const Pair a0 = _mm256_add_pd(u.x0, u.x2), e0 = _mm256_sub_pd(u.x0, u.x2);
+  const Pair a1 = _mm256_add_pd(u.x1, u.x3), e1 = _mm256_sub_pd(u.x1, u.x3);
   const Pair a2 = times(e0, t.w1), a3 = times(e1, t.w2);
-  store_pair(u0, _mm256_add_pd(a0, a1));
-  store_pair(u1, times(_mm256_sub_pd(a0, a1), t.v));
-  store_pair(u2, _mm256_add_pd(a2, a3));
-  store_pair(u3, times(_mm256_sub_pd(a2, a3), t.v));
+  u = {_mm256_add_pd(a0, a1), times(_mm256_sub_pd(a0, a1), t.v), _mm256_add_pd(a2, a3), times(_mm256_sub_pd(a2, a3), t.v)};
 }
-[[gnu::target("avx2")]] inline void inverse_quad_pair(double* u0, Index q, const QuadPair& t) {
-  double* u1 = u0 + 2 * q;
-  double* u2 = u1 + 2 * q;
-  double* u3 = u2 + 2 * q;
-  const Pair x0 = load_pair(u0), x2 = load_pair(u2);
-  const Pair b0 = times(load_pair(u1), t.v), b1 = times(load_pair(u3), t.v);
-  const Pair a0 = _mm256_add_pd(x0, b0), a1 = _mm256_sub_pd(x0, b0);
-  const Pair c0 = times(_mm256_add_pd(x2, b1), t.w1), c1 = times(_mm256_sub_pd(x2, b1), t.w2);
-  store_pair(u0, _mm256_add_pd(a0, c0));
-  store_pair(u2, _mm256_sub_pd(a0, c0));
-  store_pair(u1, _mm256_add_pd(a1, c1));
-  store_pair(u3, _mm256_sub_pd(a1, c1));
+[[gnu::target("avx2")]] inline void inverse_quad_values(Values4& u, const QuadPair& t) {
+  const Pair b0 = times(u.x1, t.v), b1 = times(u.x3, t.v);
+  const Pair a0 = _mm256_add_pd(u.x0, b0), a1 = _mm256_sub_pd(u.x0, b0);
+  const Pair c0 = times(_mm256_add_pd(u.x2, b1), t.w1), c1 = times(_mm256_sub_pd(u.x2, b1), t.w2);
+  u = {_mm256_add_pd(a0, c0), _mm256_add_pd(a1, c1), _mm256_sub_pd(a0, c0), _mm256_sub_pd(a1, c1)};
+}
+[[gnu::target("avx2")]] inline void quad_pair(double* u0, Index q, const QuadPair& t, bool forward) {
+  Values4 u{load_pair(u0), load_pair(u0 + 2 * q), load_pair(u0 + 4 * q), load_pair(u0 + 6 * q)};
+  if (forward) forward_quad_values(u, t);
+  else inverse_quad_values(u, t);
+  store_pair(u0, u.x0), store_pair(u0 + 2 * q, u.x1), store_pair(u0 + 4 * q, u.x2), store_pair(u0 + 6 * q, u.x3);
+}
+// The pair of stages 4 and 2 (q = 1: each block's four values adjacent), two blocks at a time:
+// register j holds value j of one block and of the next, both with the one twiddle of each kind.
+[[gnu::target("avx2")]] void smallest_quads_avx2(double* d, Index n, const double* table, bool forward) {
+  const Quad s = quad_twiddles(StageTwiddles(table, 4), StageTwiddles(table, 2), 0, 1, forward);
+  const QuadPair t{_mm256_setr_pd(s.w1r, s.w1i, s.w1r, s.w1i), _mm256_setr_pd(s.w2r, s.w2i, s.w2r, s.w2i),
+                   _mm256_setr_pd(s.vr, s.vi, s.vr, s.vi)};
+  for (Index i = 0; i < n; i += 8) {
+    double* a = d + 2 * i;
+    const Pair a01 = load_pair(a), a23 = load_pair(a + 4), b01 = load_pair(a + 8), b23 = load_pair(a + 12);
+    Values4 u{_mm256_permute2f128_pd(a01, b01, 0x20), _mm256_permute2f128_pd(a01, b01, 0x31),
+              _mm256_permute2f128_pd(a23, b23, 0x20), _mm256_permute2f128_pd(a23, b23, 0x31)};
+    if (forward) forward_quad_values(u, t);
+    else inverse_quad_values(u, t);
+    store_pair(a, _mm256_permute2f128_pd(u.x0, u.x1, 0x20));
+    store_pair(a + 4, _mm256_permute2f128_pd(u.x2, u.x3, 0x20));
+    store_pair(a + 8, _mm256_permute2f128_pd(u.x0, u.x1, 0x31));
+    store_pair(a + 12, _mm256_permute2f128_pd(u.x2, u.x3, 0x31));
+  }
 }
 // The quarter values k in [k0, k1) (both even) of every block of len = 4q values in d[0 .. n).
 [[gnu::target("avx2")]] void quads_avx2(double* d, Index n, Index len, const double* table, bool forward, Index k0,
@@ -184,10 +198,7 @@ struct QuadPair {
   const StageTwiddles whole(table, len), halves(table, len / 2);
   for (Index k = k0; k < k1; k += 2) {
     const QuadPair t = quad_twiddle_pair(whole, halves, k, q, forward);
-    for (Index i = 0; i < n; i += len) {
-      if (forward) forward_quad_pair(d + 2 * (i + k), q, t);
-      else inverse_quad_pair(d + 2 * (i + k), q, t);
-    }
+    for (Index i = 0; i < n; i += len) quad_pair(d + 2 * (i + k), q, t, forward);
   }
 }
 // One stage's butterflies (half even, whole twiddles).
@@ -258,6 +269,10 @@ void forward_cached(double* d, Index n, const double* table) {
       quads_avx2(d, n, len, table, true, 0, q);
       continue;
     }
+    if (q == 1 && n % 8 == 0 && fft_avx2()) {
+      smallest_quads_avx2(d, n, table, true);
+      continue;
+    }
 #endif
     const StageTwiddles whole(table, len), halves(table, len / 2);
     for (Index k = 0; k < q; ++k) {
@@ -275,6 +290,10 @@ void inverse_cached(double* d, Index n, const double* table) {
 #ifdef GYROCHAR_FFT_AVX
     if (q % 2 == 0 && fft_avx2()) {
       quads_avx2(d, n, len, table, false, 0, q);
+      continue;
+    }
+    if (q == 1 && n % 8 == 0 && fft_avx2()) {
+      smallest_quads_avx2(d, n, table, false);
       continue;
     }
 #endif
