@@ -142,14 +142,25 @@ using Pair = __m256d;
   const double* c = s.at + 2 * fine + 2 * (k / fine);
   return times(load_pair(s.at + 2 * (k % fine)), _mm256_broadcast_pd(reinterpret_cast<const __m128d*>(c)));
 }
-struct QuadPair {
-  Pair w1, w2, v;
+// A twiddle pair as times() uses it, split once for all the blocks it multiplies: w_r in both lanes of
+// each value, then w_i.
+struct Split {
+  Pair re, im;
 };
+[[gnu::target("avx2")]] inline Split split(Pair w) { return {_mm256_movedup_pd(w), _mm256_permute_pd(w, 0xF)}; }
+[[gnu::target("avx2")]] inline Pair times(Pair e, const Split& w) {
+  return _mm256_addsub_pd(_mm256_mul_pd(e, w.re), _mm256_mul_pd(_mm256_permute_pd(e, 0x5), w.im));
+}
+struct QuadPair {
+  Split w1, w2, v;
+};
+[[gnu::target("avx2")]] inline QuadPair quad_pair_of(Pair w1, Pair w2, Pair v, bool forward) {
+  if (forward) w1 = conjugated(w1), w2 = conjugated(w2), v = conjugated(v);
+  return {split(w1), split(w2), split(v)};
+}
 [[gnu::target("avx2")]] inline QuadPair quad_twiddle_pair(const StageTwiddles& whole, const StageTwiddles& halves, Index k,
                                                           Index q, bool forward) {
-  QuadPair t{twiddle_pair(whole, k), twiddle_pair(whole, k + q), twiddle_pair(halves, k)};
-  if (forward) t.w1 = conjugated(t.w1), t.w2 = conjugated(t.w2), t.v = conjugated(t.v);
-  return t;
+  return quad_pair_of(twiddle_pair(whole, k), twiddle_pair(whole, k + q), twiddle_pair(halves, k), forward);
 }
 struct Values4 {
   Pair x0, x1, x2, x3;
@@ -176,8 +187,8 @@ struct Values4 {
 // register j holds value j of one block and of the next, both with the one twiddle of each kind.
 [[gnu::target("avx2")]] void smallest_quads_avx2(double* d, Index n, const double* table, bool forward) {
   const Quad s = quad_twiddles(StageTwiddles(table, 4), StageTwiddles(table, 2), 0, 1, forward);
-  const QuadPair t{_mm256_setr_pd(s.w1r, s.w1i, s.w1r, s.w1i), _mm256_setr_pd(s.w2r, s.w2i, s.w2r, s.w2i),
-                   _mm256_setr_pd(s.vr, s.vi, s.vr, s.vi)};
+  const QuadPair t = quad_pair_of(_mm256_setr_pd(s.w1r, s.w1i, s.w1r, s.w1i), _mm256_setr_pd(s.w2r, s.w2i, s.w2r, s.w2i),
+                                  _mm256_setr_pd(s.vr, s.vi, s.vr, s.vi), false);  // conjugated already
   for (Index i = 0; i < n; i += 8) {
     double* a = d + 2 * i;
     const Pair a01 = load_pair(a), a23 = load_pair(a + 4), b01 = load_pair(a + 8), b23 = load_pair(a + 12);
