@@ -66,7 +66,7 @@ bool all_zero(const std::vector<AnalysisRow>& rows) {
 
 Progress::~Progress() { end_progress_line(); }
 
-void Progress::values(std::size_t n) {
+void Progress::values(std::size_t n, std::uint64_t bytes_read) {
   values_ += n;
   if (!enabled_ || values_ < next_) return;
   next_ = values_ + (1u << 20);
@@ -74,7 +74,7 @@ void Progress::values(std::size_t n) {
   const std::uint64_t size = file_.size_bytes();
   if (size > 0)
     std::fprintf(stderr, "\rgyrochar-analyze: reading: %5.1f %%",
-                 100.0 * static_cast<double>(file_.bytes_read()) / static_cast<double>(size));
+                 100.0 * static_cast<double>(bytes_read) / static_cast<double>(size));
   else std::fprintf(stderr, "\rgyrochar-analyze: reading: %llu values", static_cast<unsigned long long>(values_));
 }
 

@@ -55,7 +55,8 @@ class Progress {
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
-  void values(std::size_t n);
+  /// n more values read, the file's bytes_read() after them.
+  void values(std::size_t n, std::uint64_t bytes_read);
 
  private:
   bool enabled_;

@@ -18,6 +18,7 @@
 #include "analysis_html.hpp"
 #include "html_report.hpp"
 #include "psd.hpp"
+#include "read_ahead.hpp"
 #include "read_pass.hpp"
 #include "static_plot.hpp"
 #include "verdict_output.hpp"
@@ -122,11 +123,17 @@ void read_values(const Request& r, RunPlan& p, DataRange& range, std::optional<R
         const std::size_t n = std::min<std::size_t>(p.kept.size() - i, 1 << 14);
         add({p.kept.data() + i, n}, [&](std::size_t k) { return p.kept_lines[i + k]; });
       }
-    } else {
+    } else if (p.file->size_bytes() > 0) {  // a file: parsed on a thread of its own, ahead of the checks and the analyzer
+      ReadAhead ahead(*p.file, 1 << 14);
+      for (std::span<double> values; !(values = ahead.next()).empty();) {
+        add(values, [&](std::size_t k) { return ahead.line_of(k); });
+        progress.values(values.size(), ahead.bytes_read());
+      }
+    } else {  // standard input or a pipe: in turn (a thread blocked on it could not be stopped)
       std::vector<double> block(1 << 14);
       while (const std::size_t n = p.file->read(block)) {
         add({block.data(), n}, [&](std::size_t k) { return p.file->line_of(k); });
-        progress.values(n);
+        progress.values(n, p.file->bytes_read());
       }
     }
   } catch (const DataFileError& e) {

@@ -51,7 +51,7 @@ DynamicOutcome run_dynamic(const Request& r, DynamicPlan& p) {
         bad(r.source, fmt::format("by line {}: {}", file.line_of(n - 1), e.what()));
       }
       for (WindowAnalysis& w : p.analyzer->take_completed()) out.windows.push_back(std::move(w));
-      progress.values(n);
+      progress.values(n, file.bytes_read());
     }
   } catch (const DataFileError& e) {
     bad_data(r.source, e);

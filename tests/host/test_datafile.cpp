@@ -11,12 +11,14 @@
 #include <vector>
 
 #include "datafile.hpp"
+#include "read_ahead.hpp"
 #include "support/shell.hpp"
 
 namespace {
 
 using gyrochar::DataFile;
 using gyrochar::DataFileError;
+using gyrochar::ReadAhead;
 
 std::string file_with(const std::string& name, const std::string& content) {
   const std::string path = gyrochar::test_support::temp_path(name);
@@ -178,3 +180,81 @@ TEST(DataFile, ValuesBoundFromTheFileLength) {
 }
 
 }  // namespace
+
+// ReadAhead: the oracle is the DataFile read in turn, block by block, on the same file.
+namespace {
+
+std::string long_file(std::size_t values, std::size_t bad_at = 0) {
+  std::string text = "# a header\n";
+  for (std::size_t i = 1; i <= values; ++i) {
+    if (i % 97 == 0) text += "\n# a comment\n";
+    text += i == bad_at ? "1.5x\n" : std::to_string(i) + "." + std::to_string(i % 7) + "\n";
+  }
+  return text;
+}
+
+struct Read {
+  std::vector<double> values;
+  std::vector<std::uint64_t> lines;
+};
+
+Read ahead_of(const std::string& path, std::size_t block, std::size_t depth) {
+  DataFile file(path);
+  ReadAhead ahead(file, block, depth);
+  Read r;
+  for (std::span<double> v; !(v = ahead.next()).empty();) {
+    EXPECT_LE(v.size(), block);
+    for (std::size_t i = 0; i < v.size(); ++i) r.values.push_back(v[i]), r.lines.push_back(ahead.line_of(i));
+  }
+  EXPECT_TRUE(ahead.next().empty());  // the end stays the end
+  return r;
+}
+
+}  // namespace
+
+TEST(ReadAhead, TheSameValuesAndLinesAsTheFileInTurn) {
+  const std::string path = file_with("ahead.txt", long_file(50000));
+  Read want;
+  {
+    DataFile file(path);
+    std::vector<double> out(1000);
+    while (const std::size_t n = file.read(out))
+      for (std::size_t i = 0; i < n; ++i) want.values.push_back(out[i]), want.lines.push_back(file.line_of(i));
+  }
+  ASSERT_EQ(want.values.size(), 50000u);
+  for (const auto& [block, depth] : {std::pair<std::size_t, std::size_t>{7, 2}, {1000, 4}, {1 << 14, 3}, {100000, 2}}) {
+    const Read got = ahead_of(path, block, depth);
+    EXPECT_EQ(got.values, want.values) << block << " " << depth;
+    EXPECT_EQ(got.lines, want.lines) << block << " " << depth;
+  }
+  EXPECT_TRUE(ahead_of(file_with("empty.txt", "# nothing\n\n"), 16, 2).values.empty());
+}
+
+TEST(ReadAhead, AnErrorComesAfterEveryBlockBeforeIt) {
+  // Value 30001 is on line 1 + 30001 + 2 * floor(30001 / 97) (the header, the values, each
+  // comment's blank line and its own line): the error names it, after the blocks before its own.
+  const std::string path = file_with("ahead_bad.txt", long_file(40000, 30001));
+  DataFile file(path);
+  ReadAhead ahead(file, 1000, 4);
+  std::size_t values = 0;
+  std::uint64_t line = 0;
+  try {
+    for (std::span<double> v; !(v = ahead.next()).empty();) values += v.size();
+    ADD_FAILURE() << "no error";
+  } catch (const DataFileError& e) {
+    line = e.line();
+  }
+  EXPECT_EQ(values, 30000u);  // the blocks of 1000 before the failing one
+  EXPECT_EQ(line, 1u + 30001u + 2u * (30001u / 97u));
+  EXPECT_THROW(ahead.next(), DataFileError);  // and again
+}
+
+TEST(ReadAhead, StopsWhenLeftEarly) {
+  // The reading thread waits for room after `depth` blocks: leaving after one must end it.
+  const std::string path = file_with("ahead_early.txt", long_file(200000));
+  for (int round = 0; round < 20; ++round) {
+    DataFile file(path);
+    ReadAhead ahead(file, 512, 2);
+    ASSERT_EQ(ahead.next().size(), 512u);
+  }
+}
