@@ -3,8 +3,7 @@
 
 namespace gyrochar {
 
-ReadAhead::ReadAhead(DataFile& file, std::size_t block, std::size_t depth)
-    : file_(file), ring_(depth < 2 ? 2 : depth) {
+ReadAhead::ReadAhead(DataFile& file, std::size_t block, std::size_t depth) : file_(file), ring_(depth < 2 ? 2 : depth) {
   for (Block& b : ring_) b.values.resize(block < 1 ? 1 : block);
   thread_ = std::jthread([this](std::stop_token stop) { read(stop); });
 }
@@ -16,7 +15,8 @@ void ReadAhead::read(std::stop_token stop) {
     std::size_t slot = 0;
     {
       std::unique_lock lock(mutex_);
-      if (!changed_.wait(lock, stop, [&] { return filled_ < ring_.size(); })) return;  // stopped
+      changed_.wait(lock, stop, [&] { return filled_ < ring_.size(); });
+      if (stop.stop_requested()) return;  // left early: no more blocks
       slot = (head_ + filled_) % ring_.size();
     }
     Block& b = ring_[slot];  // not the held block, nor one filled: only this thread touches it
