@@ -1,7 +1,8 @@
 #pragma once
 // A data file read on a thread of its own, a few blocks ahead of the pass that uses the values:
 // parsing the text overlaps what the pass does with each block (on a long file each is about half
-// of the read pass's time; BENCHMARKS.md, "The read pass on two threads").
+// of the read pass's time; BENCHMARKS.md, "The bias ratio a span at a time, the read pass on two
+// threads").
 //
 // Only the reading thread touches the DataFile while a ReadAhead lives. The blocks come in the
 // file's order, each with the lines of its values and the bytes read when it was read; an error
