@@ -1,6 +1,7 @@
 #include "total_analysis.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <future>
@@ -144,8 +145,8 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
   // MTOTVAR (and TTOTVAR) and HTOTVAR exact at every tau by lag sums (total_fast.hpp) unless the
   // decimated plan is asked for or the workspace would pass the memory budget: the record (for
   // HTOTVAR its frequencies) prepared once as for Theo1, then O(m log m) a tau, on a view of its own
-  // per thread. TOTVAR reads the record alone (O(N) a tau): its taus go on the threads too. The
-  // decimated plan's taus share their buffers and go in turn. The rows' stride says which estimator ran.
+  // per thread. TOTVAR reads the record alone (O(N) a tau) and the decimated plan's taus each with
+  // scratch of its own: their taus go on the threads too. The rows' stride says which estimator ran.
   const std::size_t n_fast = hadamard ? N - 1 : N, fast_size = theo1_workspace_size(n_fast) + mtotvar_scratch_size(n_fast);
   const bool total_decimated = o.total_decimated || N < 2 ||
                                8 * (static_cast<std::uint64_t>(fast_size) + N) > memory_budget();
@@ -173,11 +174,12 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
       }
     }
   } else {
-    std::vector<double> scratch;
-    v = estimates(ms, 1, [&](unsigned, std::uint64_t m) {
+    std::array<std::vector<double>, 2> scratch;  // the plan's block sums and prefix sums, one per thread
+    v = estimates(ms, threads, [&](unsigned worker, std::uint64_t m) {
       const std::uint64_t b = total_block(m, N, S);
-      scratch.resize(total_scratch_size(m, b));
-      return hadamard ? htotvar(x, b, m, tau0, scratch) : mtotvar(x, b, m, tau0, scratch);
+      std::vector<double>& own = scratch[worker];
+      own.resize(total_scratch_size(m, b));
+      return hadamard ? htotvar(x, b, m, tau0, own) : mtotvar(x, b, m, tau0, own);
     });
   }
 
