@@ -12,6 +12,7 @@
 #include "confidence.hpp"
 #include "gyrochar/total.hpp"
 #include "gyrochar/total_fast.hpp"
+#include "gyrochar/total_lags.hpp"
 #include "plan.hpp"
 #include "threads.hpp"
 
@@ -174,10 +175,31 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
       }
     }
   } else {
-    std::array<std::vector<double>, 2> scratch;  // the plan's block sums and prefix sums, one per thread
+    // The plan: the exact estimator where it costs at most 2^26 operations; for counts, exact from
+    // the lag table of their differences (total_lags.hpp: one pass, then O(m^3) a tau) up to
+    // lag_table_max_m beyond that; decimated from there on.
+    const auto from_table = [&](std::uint64_t m) {
+      return x.integers() && m <= lag_table_max_m && (!hadamard || m > 1) &&
+             total_exact_cost(false, m, n_fast) > total_exact_budget;
+    };
+    std::uint64_t table_m = 0;
+    for (const std::uint64_t m : ms)
+      if (from_table(m)) table_m = m;
+    std::vector<ExactSum> table_work(table_m > 0 ? lag_table_size(3 * table_m - 2) : 0);
+    LagTable table;
+    if (table_m > 0) {
+      const ThreadRows runner(threads);
+      table = lag_table(x, hadamard ? 3 : 2, 3 * table_m - 2, table_work, &runner);
+    }
+    std::array<std::vector<double>, 2>
+        scratch;  // per thread: the plan's block sums and prefix sums, or the table's coefficients
     v = estimates(ms, threads, [&](unsigned worker, std::uint64_t m) {
-      const std::uint64_t b = total_block(m, N, S);
       std::vector<double>& own = scratch[worker];
+      if (table.ready && from_table(m)) {
+        own.resize(lagged_scratch_size(m));
+        return hadamard ? htotvar_lagged(table, m, tau0, own) : mtotvar_lagged(table, m, tau0, own);
+      }
+      const std::uint64_t b = total_block(m, N, S);
       own.resize(total_scratch_size(m, b));
       return hadamard ? htotvar(x, b, m, tau0, own) : mtotvar(x, b, m, tau0, own);
     });

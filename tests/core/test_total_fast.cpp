@@ -19,6 +19,7 @@
 
 #include "gyrochar/total.hpp"
 #include "gyrochar/total_fast.hpp"
+#include "gyrochar/total_lags.hpp"
 
 namespace gyrochar {
 namespace {
@@ -540,6 +541,126 @@ TEST(TotalFast, CountsAndTheirResidualsFromALineGiveThePhasesVariances) {
       return mtotvar_fast(w, fast_scratch, m, 0.5);
     });
   }
+}
+
+// MTOTVAR and HTOTVAR at short taus from the exact lag products of an integer record's differences
+// (total_lags.hpp), the estimator for counts too long for the lag sums' workspace. Records: the ones
+// above times 1000, rounded to integers (a counter's phase). Oracle: MTOTVAR's definition in long
+// double on their doubles (mtotvar_oracle; HTOTVAR's on the frequencies, as htot_every_m). The
+// table's sums are exact and the estimate is formed in double-double from exact coefficients, then
+// rounded: a relative tolerance of 1e-14, a few units of the oracle's own rounding (largest
+// measured printed).
+std::vector<std::int64_t> counted(const std::vector<double>& x) {
+  std::vector<std::int64_t> c(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) c[i] = std::llround(1000.0 * x[i]);
+  return c;
+}
+
+double lagged_every_m(const std::vector<std::int64_t>& counts, bool hadamard, const char* what) {
+  const std::vector<double> x(counts.begin(), counts.end());
+  const std::size_t n_seq = hadamard ? x.size() - 1 : x.size(), last = std::min<std::size_t>(n_seq / 3, lag_table_max_m);
+  if (last < (hadamard ? 2u : 1u)) return 0;
+  std::vector<ExactSum> work(lag_table_size(3 * last - 2));
+  std::vector<double> scratch(lagged_scratch_size(last));
+  const LagTable t = lag_table(counts, hadamard ? 3 : 2, 3 * last - 2, work);
+  EXPECT_TRUE(t.ready) << what;
+  std::vector<double> y(x.size() - 1), direct_scratch(total_scratch_size(last, 1));
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) y[i] = x[i + 1] - x[i];
+  double worst = 0;
+  for (std::size_t m = hadamard ? 2 : 1; m <= last; ++m) {
+    if (!checked_m(m, last)) continue;
+    const double scale = hadamard ? static_cast<double>(m * m) / 3.0 : 1.0;
+    const double oracle = static_cast<double>(mtotvar_oracle(hadamard ? y : x, m)) * scale;
+    const TotalVariance direct = hadamard ? htotvar(x, 1, m, 1.0, direct_scratch) : mtotvar(x, 1, m, 1.0, direct_scratch);
+    const TotalVariance lagged = hadamard ? htotvar_lagged(t, m, 1.0, scratch) : mtotvar_lagged(t, m, 1.0, scratch);
+    EXPECT_EQ(lagged.n, direct.n) << what << " m=" << m;
+    EXPECT_EQ(lagged.stride, 1u);
+    EXPECT_NEAR(lagged.var, oracle, 1e-14 * oracle) << what << " N=" << x.size() << " m=" << m;
+    worst = std::max(worst, std::abs(lagged.var / oracle - 1));
+  }
+  std::printf("%s N=%zu: %s from the lag table, worst relative error %.2e\n", what, x.size(),
+              hadamard ? "HTOTVAR" : "MTOTVAR", worst);
+  return worst;
+}
+
+TEST(TotalLags, EqualsTheDefinitionAtEveryM) {
+  for (const bool hadamard : {false, true}) {
+    for (const std::size_t n : {3u, 4u, 5u, 6u, 7u, 8u, 12u, 31u, 97u, 256u, 1000u})
+      lagged_every_m(counted(record(n, n, 0.3, 1.0, 2.5, 0.0)), hadamard, "walk+white+drift");
+    lagged_every_m(counted(record(2000, 11, 0.0, 1.0, 0.0, 0.0)), hadamard, "white");
+    lagged_every_m(counted(record(2000, 12, 1.0, 0.0, 0.0, 0.0)), hadamard, "walk");
+    lagged_every_m(counted(record(1500, 7, 0.0, 1.0, 1e3, 0.0)), hadamard, "ramp");  // phase up to 1.5e9
+    lagged_every_m(counted(record(1200, 8, 1e-3, 0.0, 1.0, 1e-3)), hadamard, "quadratic+walk");
+  }
+}
+
+TEST(TotalLags, CountsGiveExactSumsOnAnyThreads) {
+  // A counter's phase as int32 residuals from a line (the analyzer's record): the differences are
+  // integers, so every sum of the table is exact. Oracle: the same sums in int64, written out; the
+  // table built on a runner (its stripes in reverse order) against the table built in turn: the
+  // same bits.
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> z;
+  std::vector<std::int32_t> x(40000);
+  double walk = 0;
+  std::int64_t phase = 0;
+  for (std::size_t i = 1; i < x.size(); ++i) {
+    walk += 0.5 * z(rng);
+    phase += std::lround(walk + 3.0 * z(rng));
+    x[i] = static_cast<std::int32_t>(phase);
+  }
+  constexpr std::size_t lags = 3 * 64 - 2;
+  std::vector<ExactSum> work(lag_table_size(lags)), again(lag_table_size(lags));
+  const LagTable t = lag_table(x, 2, lags, work);
+  const ReverseRows reverse;
+  const LagTable u = lag_table(x, 2, lags, again, &reverse);
+  ASSERT_TRUE(t.ready && u.ready);
+  std::vector<std::int64_t> w(x.size() - 2);
+  for (std::size_t j = 0; j < w.size(); ++j) w[j] = std::int64_t{x[j + 2]} - 2 * std::int64_t{x[j + 1]} + x[j];
+  const auto value = [](ExactSum e) { return static_cast<std::int64_t>(e.hi) + static_cast<std::int64_t>(e.lo); };
+  for (std::size_t d = 0; d < lags; ++d) {
+    std::int64_t total = 0, head = 0, tail = 0;
+    for (std::size_t j = 0; j + d < w.size(); ++j) total += w[j] * w[j + d];
+    EXPECT_EQ(value(t.total[d]), total) << d;
+    for (std::size_t c = 0; c < lags; ++c) {
+      EXPECT_EQ(value(t.head[d * lags + c]), head) << d << " " << c;
+      EXPECT_EQ(value(t.tail[d * lags + c]), tail) << d << " " << c;
+      head += w[c] * w[c + d], tail += w[w.size() - 1 - d - c] * w[w.size() - 1 - c];
+    }
+  }
+  for (std::size_t i = 0; i < work.size(); ++i) ASSERT_TRUE(work[i].hi == again[i].hi && work[i].lo == again[i].lo) << i;
+  std::vector<double> scratch(lagged_scratch_size(64));
+  std::vector<double> phase_doubles(x.begin(), x.end()), direct_scratch(total_scratch_size(64, 1));
+  for (const std::uint64_t m : {1u, 2u, 7u, 16u, 64u}) {
+    const TotalVariance lagged = mtotvar_lagged(t, m, 0.5, scratch), direct = mtotvar(x, 1, m, 0.5, direct_scratch);
+    ASSERT_GT(lagged.n, 0u);
+    EXPECT_EQ(lagged.n, direct.n);
+    EXPECT_NEAR(lagged.var, direct.var, 1e-12 * direct.var) << m;  // the direct sums' own rounding
+  }
+  // Differences too large for exact chunk sums (8192 |w|^2 >= 2^53): no table.
+  std::vector<std::int64_t> wide(100);
+  wide[50] = std::int64_t{1} << 40;
+  EXPECT_FALSE(lag_table(wide, 2, lags, work).ready);
+}
+
+TEST(TotalLags, UndefinedInputGivesNoTerms) {
+  const std::vector<std::int64_t> x = counted(record(40, 1, 0.3, 1.0, 2.5, 0.0));
+  std::vector<ExactSum> work(lag_table_size(37));
+  std::vector<double> scratch(lagged_scratch_size(13));
+  EXPECT_FALSE(lag_table(x, 1, 37, work).ready);                                  // order 2 or 3
+  EXPECT_FALSE(lag_table(record(40, 1, 0.3, 1.0, 2.5, 0.0), 2, 37, work).ready);  // doubles
+  EXPECT_FALSE(lag_table(x, 2, 3 * lag_table_max_m - 1, work).ready);
+  EXPECT_FALSE(lag_table(x, 2, 37, std::span<ExactSum>(work).first(work.size() - 1)).ready);
+  EXPECT_FALSE(lag_table(std::vector<std::int64_t>{1, 2}, 2, 1, work).ready);
+  const LagTable t = lag_table(x, 2, 37, work);
+  ASSERT_TRUE(t.ready);
+  EXPECT_GT(mtotvar_lagged(t, 13, 1.0, scratch).n, 0u);  // 3m = 39 <= N, 3m - 2 <= 37 lags
+  EXPECT_EQ(mtotvar_lagged(t, 0, 1.0, scratch).n, 0u);
+  EXPECT_EQ(mtotvar_lagged(t, 4, 0.0, scratch).n, 0u);
+  EXPECT_EQ(mtotvar_lagged(t, 4, 1.0, std::span<double>(scratch).first(lagged_scratch_size(4) - 1)).n, 0u);
+  EXPECT_EQ(htotvar_lagged(t, 4, 1.0, scratch).n, 0u);  // a table of second differences
+  const LagTable short_table = lag_table(x, 2, 30, work);
+  EXPECT_EQ(mtotvar_lagged(short_table, 11, 1.0, scratch).n, 0u);  // 3m - 2 = 31 lags
 }
 
 }  // namespace

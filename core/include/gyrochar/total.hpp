@@ -75,6 +75,7 @@ class PhaseSpan {
 
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
+  bool integers() const { return kind_ != Kind::f64; }
   /// f(std::span<const T>) on the values as they are held; returns what f returns.
   template <class F>
   decltype(auto) visit(F&& f) const {
