@@ -118,6 +118,47 @@ template <class T>
   return theo1_spans(x, end, step, M);
 }
 #endif
+// TOTVAR's terms (x_{i-M} - 2 x_i + x_{i+M})^2 of i in [from, to), none of them reflected: eight a
+// step in two vectors of four (two lanes a register on SSE2 and NEON, four with AVX2, whose fused
+// multiply-adds round once where the others round twice).
+template <class T>
+[[gnu::always_inline]] inline double totvar_terms(const T* x, Index from, Index to, Index M) {
+  Lanes s0 = {}, s1 = {};
+  Index i = from;
+  for (; i + 8 <= to; i += 8) {
+    Lanes a0, a1, b0, b1, c0, c1;
+    load(a0, x + i - M);
+    load(a1, x + i - M + 4);
+    load(b0, x + i);
+    load(b1, x + i + 4);
+    load(c0, x + i + M);
+    load(c1, x + i + M + 4);
+    const Lanes t0 = (a0 - 2.0 * b0) + c0, t1 = (a1 - 2.0 * b1) + c1;
+    s0 += t0 * t0;
+    s1 += t1 * t1;
+  }
+  const Lanes s = s0 + s1;
+  double sum = (s[0] + s[1]) + (s[2] + s[3]);
+  for (; i < to; ++i) {
+    const double t = (static_cast<double>(x[i - M]) - 2.0 * static_cast<double>(x[i])) + static_cast<double>(x[i + M]);
+    sum += t * t;
+  }
+  return sum;
+}
+#if defined(__x86_64__)
+template <class T>
+[[gnu::target("avx2,fma")]] double totvar_terms_avx2(const T* x, Index from, Index to, Index M) {
+  return totvar_terms(x, from, to, M);
+}
+#endif
+template <class T>
+double totvar_interior(const T* x, Index from, Index to, Index M) {
+#if defined(__x86_64__)
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return totvar_terms_avx2(x, from, to, M);
+#endif
+  return totvar_terms(x, from, to, M);
+}
+
 template <class T>
 double theo1_block_terms(const T* x, Index end, Index step, Index M, Index k0, Index len, const double* w) {
 #if defined(__x86_64__)
@@ -211,10 +252,22 @@ TotalVariance totvar_of(std::span<const T> x, std::uint64_t m, double tau0_s) {
   // x* by odd reflection about the end points; i - M and i + M stay within (-(N-1), 2(N-1)).
   auto left = [&](Index i) { return i >= M ? at(i - M) : 2.0 * at(0) - at(M - i); };
   auto right = [&](Index i) { return i + M <= last ? at(i + M) : 2.0 * at(last) - at(2 * last - i - M); };
+  auto terms = [&](Index from, Index to) {
+    double sum = 0.0;
+    for (Index i = from; i < to; ++i) {
+      const double t = left(i) - 2.0 * at(i) + right(i);
+      sum += t * t;
+    }
+    return sum;
+  };
+  // The terms that reflect at the start (i < M), those in between in vector lanes, those that
+  // reflect at the end (i > last - M).
   double sum = 0.0;
-  for (Index i = 1; i < last; ++i) {
-    const double t = left(i) - 2.0 * at(i) + right(i);
-    sum += t * t;
+  if (M <= last - M) {
+    sum = terms(1, M) + totvar_interior(x.data(), M, last - M + 1, M);
+    sum += terms(last - M + 1, last);
+  } else {
+    sum = terms(1, last);
   }
   const double tau = as_double(m) * tau0_s;
   return {sum / (2.0 * tau * tau * as_double(N - 2)), N - 2, 1};

@@ -7,7 +7,7 @@
 namespace gyrochar {
 namespace {
 
-using Index = std::size_t;  // indices into the record (32 bits on the MCU builds)
+using Index = std::size_t;                             // indices into the record (32 bits on the MCU builds)
 constexpr Index stripes = 16;                          // the pass's rows
 constexpr Index chunk = 8192;                          // products added in double, then exactly
 constexpr Index block = 512;                           // values whose products go lag by lag, in the cache
@@ -197,8 +197,8 @@ ExactSum window_sum(const LagTable& t, Index m, std::span<double> scratch) {
 
 bool lagged_defined(const LagTable& t, int order, std::uint64_t m, std::uint64_t least, double tau0_s,
                     std::span<double> scratch) {
-  return t.ready && t.order == order && m >= least && m <= lag_table_max_m && 3 * m - 2 <= t.lags &&
-         3 * m <= t.values + 2 && tau0_s > 0 && scratch.size() >= lagged_scratch_size(m);
+  return t.ready && t.order == order && m >= least && m <= lag_table_max_m && 3 * m - 2 <= t.lags && 3 * m <= t.values + 2 &&
+         tau0_s > 0 && scratch.size() >= lagged_scratch_size(m);
 }
 
 // The mean over the windows of the mean of their 6m squared terms.
@@ -215,8 +215,8 @@ std::size_t lag_table_size(std::size_t lags) { return lags * (2 * lags + 1 + str
 
 LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum> work, const RowRunner* runner) {
   LagTable t;
-  if ((order != 2 && order != 3) || !x.integers() || x.size() <= static_cast<Index>(order) ||
-      lags < 1 || lags > max_lags || work.size() < lag_table_size(lags))
+  if ((order != 2 && order != 3) || !x.integers() || x.size() <= static_cast<Index>(order) || lags < 1 || lags > max_lags ||
+      work.size() < lag_table_size(lags))
     return t;
   const Index values = x.size() - static_cast<Index>(order);
   ExactSum* total = work.data();

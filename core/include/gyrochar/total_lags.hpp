@@ -47,13 +47,14 @@ struct ExactSum {
 
 struct LagTable {
   std::size_t lags = 0;
-  std::size_t values = 0;            // the differences, N - order
-  int order = 0;                     // of the differences: 2 or 3
-  std::span<const ExactSum> total;   // total[d] = sum_j w[j] w[j + d]
-  std::span<const ExactSum> head;    // head[d lags + c]: the first c products of lag d
-  std::span<const ExactSum> tail;    // tail[d lags + c]: the last c
-  bool ready = false;  // false: doubles, too few values, too many lags, too small a workspace, or too
-                       // large differences for exact sums (8192 |w|^2 >= 2^53)
+  std::size_t values = 0;           // the differences, N - order
+  int order = 0;                    // of the differences: 2 or 3
+  std::span<const ExactSum> total;  // total[d] = sum_j w[j] w[j + d]
+  std::span<const ExactSum> head;   // head[d lags + c]: the first c products of lag d
+  std::span<const ExactSum> tail;   // tail[d lags + c]: the last c
+  // false: doubles, too few values, too many lags, too small a workspace, or differences too large
+  // for exact sums (8192 |w|^2 >= 2^53)
+  bool ready = false;
 };
 
 /// ExactSums of workspace lag_table needs: the three tables, and the sums of 16 stripes.
@@ -63,8 +64,7 @@ std::size_t lag_table_size(std::size_t lags);
 /// record x, at every lag below `lags` (at most 3 lag_table_max_m - 2), in `work`
 /// (lag_table_size(lags)), exactly. The record goes in 16 stripes, run as rows on `runner` (null: in
 /// turn): exact sums, the same on any number of threads. O(N lags), 150 KB of stack a row.
-LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum> work,
-                   const RowRunner* runner = nullptr);
+LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum> work, const RowRunner* runner = nullptr);
 
 /// Doubles of scratch mtotvar_lagged and htotvar_lagged need at averaging factor m.
 std::size_t lagged_scratch_size(std::uint64_t m);
