@@ -191,8 +191,8 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
       const ThreadRows runner(threads);
       table = lag_table(x, hadamard ? 3 : 2, 3 * table_m - 2, table_work, &runner);
     }
-    std::array<std::vector<double>, 2>
-        scratch;  // per thread: the plan's block sums and prefix sums, or the table's coefficients
+    // Per thread: the plan's block sums and prefix sums, or the table's coefficients.
+    std::array<std::vector<double>, 2> scratch;
     v = estimates(ms, threads, [&](unsigned worker, std::uint64_t m) {
       std::vector<double>& own = scratch[worker];
       if (table.ready && from_table(m)) {
