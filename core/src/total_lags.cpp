@@ -11,7 +11,7 @@ using Index = std::size_t;                             // indices into the recor
 constexpr Index stripes = 16;                          // the pass's rows
 constexpr Index chunk = 8192;                          // products added in double, then exactly
 constexpr Index block = 512;                           // values whose products go lag by lag, in the cache
-constexpr Index max_lags = 3 * lag_table_max_m - 2;    // 190
+constexpr Index max_lags = 3 * lag_table_max_m - 2;    // 382
 constexpr Index padded_lags = (max_lags + 3) / 4 * 4;  // the lags four at a time
 constexpr double exact_products = 0x1p53 / chunk;      // |w|^2 below this: a chunk's sums are exact
 

@@ -106,7 +106,7 @@ the same way (lag sums, about O(m log m) per tau, holding 4 N doubles more than 
 ttotdev, htotdev under --total-decimated), are exact where that costs at most 2^26 operations at their
 tau and decimated beyond (blocks or sub-sequences every m/S samples, S from
 --total-stride-factor, 16 by default; 'exact' never decimates), except that for counts mtotdev,
-ttotdev and htotdev rows up to m = 64 stay exact (one pass over the record's differences, then
+ttotdev and htotdev rows up to m = 128 stay exact (one pass over the record's differences, then
 O(m^3) a tau): the stride column says which. Where the noise is identified the deviations carry Stable32's bias
 corrections (totdev for flicker and random-walk FM, htotdev for alpha <= 0) and the EDF is NIST
 SP 1065's for the statistic. --fit-long-tau totdev or theoh lets the IEEE-952 fit take TOTDEV or

@@ -539,12 +539,13 @@ TEST(AnalyzeCli, MtotRowsAreExactUnlessTheDecimatedEstimatorIsAsked) {
   }
 }
 
-TEST(AnalyzeCli, CountsKeepExactMtotRowsUpToM64UnderThePlan) {
+TEST(AnalyzeCli, CountsKeepExactMtotRowsUpToM128UnderThePlan) {
   // 80000 counts of a random-walk rate plus white noise under --total-decimated: MTOTDEV and HTOTDEV
-  // at m = 64 cost over 2^26 operations directly, so the plan took them decimated (stride 4); for
-  // counts they now come exact from the lag table of the differences (total_lags.hpp), stride 1;
-  // m = 128 stays decimated. Oracle: the direct exact mtotvar and htotvar (total.hpp) on the phase,
-  // as the ratio of the m = 64 row to the m = 16 row (direct and exact either way), free of units.
+  // at m = 64 and 128 cost over 2^26 operations directly, so the plan took them decimated (stride 4
+  // and 8); for counts they now come exact from the lag table of the differences (total_lags.hpp),
+  // stride 1; m = 256 stays decimated. Oracle: the direct exact mtotvar and htotvar (total.hpp) on
+  // the phase, as the ratio of the m = 64 and 128 rows to the m = 16 row (direct and exact either
+  // way), free of units.
   std::mt19937_64 rng(8);
   std::normal_distribution<double> z;
   std::string s;
@@ -565,19 +566,22 @@ TEST(AnalyzeCli, CountsKeepExactMtotRowsUpToM64UnderThePlan) {
   std::map<std::string, std::map<std::uint64_t, nlohmann::json>> rows;
   const auto j = nlohmann::json::parse(r.out);
   for (const auto& row : j["results"]) rows[row["stat"].get<std::string>()][row["m"].get<std::uint64_t>()] = row;
-  std::vector<double> scratch(gyrochar::total_scratch_size(64, 1));
+  std::vector<double> scratch(gyrochar::total_scratch_size(128, 1));
   for (const std::string stat : {"mtotdev", "htotdev"}) {
     const bool h = stat == "htotdev";
     EXPECT_EQ(rows[stat][64]["stride"], 1) << stat;
-    EXPECT_EQ(rows[stat][128]["stride"], gyrochar::total_block(128, x.size(), 16)) << stat;
+    EXPECT_EQ(rows[stat][128]["stride"], 1) << stat;
+    EXPECT_EQ(rows[stat][256]["stride"], gyrochar::total_block(256, x.size(), 16)) << stat;
     const auto var = [&](std::uint64_t m) {  // HTOTDEV with Stable32's bias correction for the row's alpha
       const nlohmann::json& alpha = rows[stat][m]["alpha"];
       if (!h) return gyrochar::mtotvar(x, 1, m, 1.0, scratch).var;
       return gyrochar::htotvar(x, 1, m, 1.0, scratch).var / (alpha.is_null() ? 1.0 : gyrochar::htotvar_bias(alpha, m));
     };
-    const double want = std::sqrt(var(64) / var(16));
-    const double got = rows[stat][64]["dev"].get<double>() / rows[stat][16]["dev"].get<double>();
-    EXPECT_NEAR(got / want, 1.0, 1e-11) << stat;  // the direct sums' rounding
+    for (const std::uint64_t m : {64u, 128u}) {
+      const double want = std::sqrt(var(m) / var(16));
+      const double got = rows[stat][m]["dev"].get<double>() / rows[stat][16]["dev"].get<double>();
+      EXPECT_NEAR(got / want, 1.0, 1e-11) << stat << " m=" << m;  // the direct sums' rounding
+    }
   }
 }
 

@@ -35,7 +35,7 @@
 namespace gyrochar {
 
 /// The largest averaging factor the lag tables serve: 3 m - 2 lags, O(N (3 m - 2)) for the pass.
-inline constexpr std::uint64_t lag_table_max_m = 64;
+inline constexpr std::uint64_t lag_table_max_m = 128;
 
 /// The products of the differences w (of order 2 or 3) of a record at every lag d < lags: over the
 /// whole record, and its first and last c of each lag (c < lags).
