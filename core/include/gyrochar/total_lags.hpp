@@ -20,7 +20,7 @@
 // - h), h = floor(3m / 2) (the half means' slope), so D c_k[v] are integers too, and the estimate is
 // the sum of their products with the table's: formed in double-double (about 106 bits), rounded
 // once. That matters: the coefficients grow like m^2 while the terms do not, so the sum cancels by
-// a factor that grows like m^5 (HTOTVAR, 10^8 at m = 32). In double (or in long double, on phase
+// a factor that grows like m^5 (HTOTVAR: about 10^8 at m = 32). In double (or in long double, on phase
 // given as doubles) that cost up to 8 digits; in double-double on exact sums, the estimate keeps
 // about 15 of them. Phase given as doubles takes total_fast.hpp or the direct estimators instead.
 //
@@ -37,14 +37,14 @@ namespace gyrochar {
 /// The largest averaging factor the lag tables serve: 3 m - 2 lags, O(N (3 m - 2)) for the pass.
 inline constexpr std::uint64_t lag_table_max_m = 128;
 
-/// The products of the differences w (of order 2 or 3) of a record at every lag d < lags: over the
-/// whole record, and its first and last c of each lag (c < lags).
 /// An integer held exactly as two doubles, hi + lo (|lo| at most half a unit of hi's last place):
 /// every integer below 2^106.
 struct ExactSum {
   double hi = 0, lo = 0;
 };
 
+/// The products of the differences w (of order 2 or 3) of a record at every lag d < lags: over the
+/// whole record, and its first and last c of each lag (c < lags).
 struct LagTable {
   std::size_t lags = 0;
   std::size_t values = 0;           // the differences, N - order
