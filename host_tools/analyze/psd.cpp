@@ -48,8 +48,9 @@ Psd welch_psd(RateView rate, double tau0_s, std::size_t segment, double confiden
     sin_coarse[j] = std::sin(std::numbers::pi * static_cast<double>(j * fine) / static_cast<double>(L));
     cos_coarse[j] = std::cos(std::numbers::pi * static_cast<double>(j * fine) / static_cast<double>(L));
   }
+  const int fine_bits = std::countr_zero(fine);  // fine is a power of two: n / fine by a shift
   const auto window = [&](std::size_t n) {
-    const std::size_t c = n / fine, f = n % fine;
+    const std::size_t c = n >> fine_bits, f = n & (fine - 1);
     const double s = sin_coarse[c] * cos_fine[f] + cos_coarse[c] * sin_fine[f];
     return s * s;
   };

@@ -211,7 +211,8 @@ void add_options(CLI::App& app, OptionText& t, Request& r) {
   app.add_option(
          "--threads", t.threads,
          "threads summing the taus of counts at --stride-factor full and of --taus all, and (up to 2) the total and Theo "
-         "family's taus and TheoBR's bias ratio; the same results on any number (default: one per core)")
+         "family's taus and TheoBR's bias ratio; from 2, the PSD beside the analysis; the same results on any number "
+         "(default: one per core)")
       ->check(CLI::Range(1u, 1024u));
   app.add_option("--limits", r.limits_path, "acceptance limits: a verdict per limit (see below)")->option_text("FILE");
   app.add_option("--summary", r.summary_path, "with --limits: append the file's production summary row to FILE.csv")

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <future>
 #include <iterator>
 #include <new>
 #include <span>
@@ -21,6 +22,7 @@
 #include "read_ahead.hpp"
 #include "read_pass.hpp"
 #include "static_plot.hpp"
+#include "threads.hpp"
 #include "verdict_output.hpp"
 #include "hal/program/exit_codes.hpp"
 
@@ -141,29 +143,39 @@ void read_values(const Request& r, RunPlan& p, DataRange& range, std::optional<R
   }
 }
 
-// The rate's PSD (--psd, the static plot, the fit's sinusoid search), with the Allan curve's
-// nulls checked against its peaks. Nothing when the rate is too short and no PSD was asked for.
-std::optional<Spectrum> spectrum_of_run(const Request& r, RateView rate, const Analysis& a) {
-  const std::size_t segment = r.psd_segment ? r.psd_segment : default_psd_segment(rate.size());
-  if (segment > rate.size() || segment == 0) {
-    if (!r.psd_path.empty() || r.psd_segment != 0)
-      bad(r.psd_segment ? "--psd-segment" : "--psd",
-          fmt::format("{} rate values are too few for a segment of {}", rate.size(), segment ? segment : 16));
-    print_error(program, "note", fmt::format("no PSD: {} rate values are too few for a spectrum", rate.size()));
-    return std::nullopt;
-  }
+// The Welch segment of the rate's PSD (--psd, the static plot, the fit's sinusoid search); 0 when the
+// rate is too short for one.
+std::size_t psd_segment_of_run(const Request& r, std::size_t rate_values) {
+  const std::size_t segment = r.psd_segment ? r.psd_segment : default_psd_segment(rate_values);
+  return segment <= rate_values ? segment : 0;
+}
+
+// No PSD: refused when one was asked for, else a note.
+void no_spectrum(const Request& r, std::size_t rate_values) {
+  const std::size_t segment = r.psd_segment ? r.psd_segment : default_psd_segment(rate_values);
+  if (!r.psd_path.empty() || r.psd_segment != 0)
+    bad(r.psd_segment ? "--psd-segment" : "--psd",
+        fmt::format("{} rate values are too few for a segment of {}", rate_values, segment ? segment : 16));
+  print_error(program, "note", fmt::format("no PSD: {} rate values are too few for a spectrum", rate_values));
+}
+
+// The rate's PSD with its sinusoid search, in the run's units.
+Spectrum spectrum_of_run(const Request& r, RateView rate, std::size_t segment) {
   Spectrum sp = spectrum_of(rate, r.options.type == DataType::counts, r.options.tau0_s, segment, r.options.confidence,
                             r.sinusoid_search);
-  if (sp.searched) {
-    std::vector<std::pair<double, double>> oadev;  // the Allan curve's nulls at tau = 1/f, on dense taus
-    for (const AnalysisRow& row : a.rows)
-      if (row.stat == DevStat::oadev) oadev.emplace_back(row.tau_s, row.dev);
-    check_adev_nulls(sp.search, oadev);
-  }
   sp.given_hz = r.sinusoid_hz;
   sp.factor = r.units.factor();
   sp.unit = r.units.unit(DevStat::oadev);
   return sp;
+}
+
+// The Allan curve's nulls at tau = 1/f of the peaks found, on the analysis' dense taus.
+void check_nulls(Spectrum& sp, const Analysis& a) {
+  if (!sp.searched) return;
+  std::vector<std::pair<double, double>> oadev;
+  for (const AnalysisRow& row : a.rows)
+    if (row.stat == DevStat::oadev) oadev.emplace_back(row.tau_s, row.dev);
+  check_adev_nulls(sp.search, oadev);
 }
 
 // A tau asked for by number but too long for the data has no row: say so. (The octave, decade
@@ -253,14 +265,29 @@ void run_analysis(const Request& r, RunPlan& p, RunOutcome& out) {
   InputShape shape(o.type, r.nominal_hz);
   read_values(r, p, range, rates, shape);
   shape.check_conversion();
+  // The PSD reads the record the analysis reads, and neither writes it: on a thread of its own
+  // while the analysis runs, unless one thread was asked for (the 120 h record: its transforms are
+  // about 25 s of one core, which the analysis leaves idle in its single-threaded parts).
+  std::future<Spectrum> spectrum_job;
+  std::size_t rate_values = 0;
+  if (r.want_psd) {
+    const RateView rate = rates ? rates->rate() : RateView(p.analyzer->held_counts(), o.tau0_s);
+    rate_values = rate.size();
+    if (const std::size_t segment = psd_segment_of_run(r, rate_values))
+      spectrum_job = std::async(thread_count(o.threads) > 1 ? std::launch::async : std::launch::deferred,
+                                [&r, rate, segment] { return spectrum_of_run(r, rate, segment); });
+  }
   Analysis a = checked_result(r, p, shape);
   const std::vector<std::string>& header = p.file->header();
 
   std::optional<Spectrum> spectrum;
-  if (r.want_psd) {
-    spectrum = spectrum_of_run(r, rates ? rates->rate() : RateView(p.analyzer->held_counts(), o.tau0_s), a);
-    rates.reset();
+  if (spectrum_job.valid()) {
+    spectrum = spectrum_job.get();
+    check_nulls(*spectrum, a);
+  } else if (r.want_psd) {
+    no_spectrum(r, rate_values);
   }
+  rates.reset();
   std::array<double, max_sinusoids> offered_hz{};
   for (std::size_t k = 0; k < r.sinusoid_hz.size(); ++k) offered_hz[k] = r.sinusoid_hz[k];
   if (spectrum) offered_hz = spectrum->fit_hz();

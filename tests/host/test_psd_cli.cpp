@@ -110,6 +110,27 @@ TEST(AnalyzePsd, WritesEveryBinToTheCsvAndTurnsTheSearchOff) {
   EXPECT_DOUBLE_EQ(freq, (4096.0 / 2 - 1) / 40.96);  // the last: k / (L tau0)
 }
 
+// The PSD runs on a thread of its own beside the analysis (run.cpp), unless one thread is asked
+// for: the report, the PSD file and the notes are the same bytes either way. Oracle: the run on
+// one thread, the spectrum after the analysis.
+TEST(AnalyzePsd, ThePsdBesideTheAnalysisGivesTheBytesOfOneThread) {
+  std::string out[2], err[2], csv[2];
+  for (const int threads : {1, 2}) {
+    const std::string path = temp("psd_threads" + std::to_string(threads) + ".csv");
+    const Outcome r = run_shell(tool + " --threads " + std::to_string(threads) +
+                                " --type counts --tau0 0.01 --pulse-weight 1 --stats oadev,mdev,totdev,theoh "
+                                "--fit ieee952 --fit-long-tau theoh --format json --psd " +
+                                path + " " + sinusoid_counts());
+    ASSERT_EQ(r.code, 0) << r.err;
+    out[threads - 1] = r.out, err[threads - 1] = r.err, csv[threads - 1] = slurp(path);
+  }
+  EXPECT_EQ(nlohmann::json::parse(out[1]).at("psd").at("peaks").size(), 1u);  // the simulated sinusoid
+  EXPECT_EQ(out[0], out[1]);
+  EXPECT_EQ(err[0], err[1]);
+  EXPECT_GT(csv[0].size(), 1000u);
+  EXPECT_EQ(csv[0], csv[1]);
+}
+
 TEST(AnalyzePsd, GivenFrequenciesAreOfferedToTheFitAndCheckedFirst) {
   const Outcome r = run_shell(tool +
                               " --type counts --tau0 0.01 --pulse-weight 1 --fit ieee952 --format json "
