@@ -60,11 +60,15 @@ template <class T>
   return sum;
 }
 // The same terms in another order, for starts far apart (step >= theo1_block / 2, where one start's
-// block shares nothing with the next one's): a pass over a span of theo1_span positions p = i + k at
-// a time, every start whose run of k reaches the span summing its terms there. Each start's
-// x_{i+k} then come from the cache, read by the one before; only x_{i+M-k} stream from memory
-// (half the traffic of a block at a time; measured in BENCHMARKS.md). The weights 1 / k are
-// divided where they are used (correctly rounded: the table's values), four a step.
+// block shares nothing with the next one's): a span of at most theo1_span positions p = i + k at a
+// time, every start whose run of k reaches the span summing its terms there. Each start's x_{i+k}
+// then come from the cache, read by the one before. The backward values x_{i+M-k} of start i at p
+// are those of start i + step at p + 2 step, so the spans go in that order: the positions cut into
+// periods of 2 step, the spans at the same offset of every period one after the other. Of a span's
+// S / 2 backward runs (S = M / step) all but one were read by the span before: per term about
+// 2 / S values stream from memory where it was 1 + 2 / S (measured in BENCHMARKS.md). The weights
+// are divided where they are used, one division for 1 / k = (k + 4) r and 1 / (k + 4) = k r,
+// r = 1 / (k (k + 4)): three roundings, each weight within 1.5 ulp of the quotient.
 inline constexpr Index theo1_span = 16384;
 template <class T>
 [[gnu::always_inline]] inline double theo1_run(const T* p, Index M, Index k0, Index k1) {
@@ -78,7 +82,7 @@ template <class T>
     load(a1, p + j + 4);
     load_backwards(b0, p + M - j - 3);
     load_backwards(b1, p + M - j - 7);
-    const Lanes w0 = 1.0 / k, w1 = 1.0 / (k + 4.0);
+    const Lanes k4 = k + 4.0, r = 1.0 / (k * k4), w0 = k4 * r, w1 = k * r;
     k += 8.0;
     const Lanes t0 = ((first - a0) - b0) + last, t1 = ((first - a1) - b1) + last;
     s0 += t0 * t0 * w0;
@@ -94,15 +98,17 @@ template <class T>
 }
 template <class T>
 [[gnu::always_inline]] inline double theo1_spans(const T* x, Index end, Index step, Index M) {
-  const Index h = M / 2;
+  const Index h = M / 2, period = 2 * step, stop = end + h;  // the positions p in [1, stop)
   double sum = 0.0;
-  Index first = 0;  // the first start whose run still reaches the span
-  for (Index p0 = 1; p0 < end + h; p0 += theo1_span) {
-    const Index p1 = p0 + theo1_span - 1;  // the span [p0, p1]
-    while (first < end && first + h < p0) first += step;
-    for (Index i = first; i < end && i < p1; i += step) {
-      const Index k0 = p0 > i ? p0 - i : 1, k1 = p1 - i < h ? p1 - i : h;
-      if (k0 <= k1) sum += theo1_run(x + i, M, k0, k1);
+  for (Index offset = 0; offset < period; offset += theo1_span) {
+    const Index width = period - offset < theo1_span ? period - offset : theo1_span;
+    for (Index p0 = 1 + offset; p0 < stop; p0 += period) {
+      const Index p1 = p0 + width - 1;  // the span [p0, p1]
+      // The starts i (multiples of step) whose run [i + 1, i + h] reaches the span.
+      for (Index i = p0 > h ? (p0 - h + step - 1) / step * step : 0; i < end && i < p1; i += step) {
+        const Index k0 = p0 > i ? p0 - i : 1, k1 = p1 - i < h ? p1 - i : h;
+        sum += theo1_run(x + i, M, k0, k1);
+      }
     }
   }
   return sum;

@@ -143,16 +143,9 @@ void read_values(const Request& r, RunPlan& p, DataRange& range, std::optional<R
   }
 }
 
-// The Welch segment of the rate's PSD (--psd, the static plot, the fit's sinusoid search); 0 when the
-// rate is too short for one.
-std::size_t psd_segment_of_run(const Request& r, std::size_t rate_values) {
-  const std::size_t segment = r.psd_segment ? r.psd_segment : default_psd_segment(rate_values);
-  return segment <= rate_values ? segment : 0;
-}
-
-// No PSD: refused when one was asked for, else a note.
-void no_spectrum(const Request& r, std::size_t rate_values) {
-  const std::size_t segment = r.psd_segment ? r.psd_segment : default_psd_segment(rate_values);
+// No PSD (the rate is shorter than the Welch segment, or too short for any): refused when one was
+// asked for, else a note.
+void no_spectrum(const Request& r, std::size_t rate_values, std::size_t segment) {
   if (!r.psd_path.empty() || r.psd_segment != 0)
     bad(r.psd_segment ? "--psd-segment" : "--psd",
         fmt::format("{} rate values are too few for a segment of {}", rate_values, segment ? segment : 16));
@@ -270,10 +263,12 @@ void run_analysis(const Request& r, RunPlan& p, RunOutcome& out) {
   // about 25 s of one core, which the analysis leaves idle in its single-threaded parts).
   std::future<Spectrum> spectrum_job;
   std::size_t rate_values = 0;
+  std::size_t segment = 0;  // the Welch segment of the PSD (--psd, the static plot, the sinusoid search)
   if (r.want_psd) {
     const RateView rate = rates ? rates->rate() : RateView(p.analyzer->held_counts(), o.tau0_s);
     rate_values = rate.size();
-    if (const std::size_t segment = psd_segment_of_run(r, rate_values))
+    segment = r.psd_segment ? r.psd_segment : default_psd_segment(rate_values);
+    if (segment != 0 && segment <= rate_values)
       spectrum_job = std::async(thread_count(o.threads) > 1 ? std::launch::async : std::launch::deferred,
                                 [&r, rate, segment] { return spectrum_of_run(r, rate, segment); });
   }
@@ -285,7 +280,7 @@ void run_analysis(const Request& r, RunPlan& p, RunOutcome& out) {
     spectrum = spectrum_job.get();
     check_nulls(*spectrum, a);
   } else if (r.want_psd) {
-    no_spectrum(r, rate_values);
+    no_spectrum(r, rate_values, segment);
   }
   rates.reset();
   std::array<double, max_sinusoids> offered_hz{};

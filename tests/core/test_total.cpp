@@ -232,11 +232,12 @@ TEST(Total, Theo1EqualsTheDefinitionOverSeveralBlocksOfWeights) {
 }
 
 TEST(Total, Theo1EqualsTheDefinitionWithItsStartsFarApart) {
-  // From a stride of 4096 on, theo1() sums a span of 16384 positions at a time: runs of k that end
-  // within the first span, cross several and end on a span's border, one start or many.
+  // From a stride of 4096 on, theo1() sums a span of at most 16384 positions at a time, the spans
+  // in periods of twice the stride: runs of k that end within the first span, cross several and end
+  // on a span's border, one start or many, periods shorter than a span, as long, one and a half.
   const auto x = record(60000, 9);
-  const std::uint64_t cases[][2] = {{9000, 4096},  {40000, 4096}, {40000, 5001},
-                                    {32770, 8192}, {59998, 4096}, {20000, 60000}};
+  const std::uint64_t cases[][2] = {{9000, 4096},  {40000, 4096},  {40000, 5001},  {32770, 8192},
+                                    {59998, 4096}, {20000, 60000}, {50000, 12000}, {30000, 12289}};
   for (const auto& [m, stride] : cases) {
     const TotalVariance t = theo1(x, m, 0.5, stride);
     EXPECT_EQ(t.n, (60000 - m + stride - 1) / stride * (m / 2)) << m;
