@@ -65,8 +65,9 @@ template <class T>
 // then come from the cache, read by the one before. The backward values x_{i+M-k} of start i at p
 // are those of start i + step at p + 2 step, so the spans go in that order: the positions cut into
 // periods of 2 step, the spans at the same offset of every period one after the other. Of a span's
-// S / 2 backward runs (S = M / step) all but one were read by the span before: per term about
-// 2 / S values stream from memory where it was 1 + 2 / S (measured in BENCHMARKS.md). The weights
+// S / 2 backward runs (S = M / step) all but one were read by the span before: a span reads two
+// new runs (one forward, one backward) for its S / 2 runs of terms, about 4 / S new values a term
+// where it was 1 + 2 / S (measured in BENCHMARKS.md). The weights
 // are divided where they are used, one division for 1 / k = (k + 4) r and 1 / (k + 4) = k r,
 // r = 1 / (k (k + 4)): three roundings, each weight within 1.5 ulp of the quotient.
 inline constexpr Index theo1_span = 16384;
