@@ -14,6 +14,7 @@
 #include "analysis.hpp"
 #include "gyrochar/arith.hpp"
 #include "gyrochar/estimates.hpp"
+#include "held_memory.hpp"
 
 namespace gyrochar {
 
@@ -72,7 +73,7 @@ struct KeptRecord {
   bool on;
   double first = 0.0;      // the first phase value, or the first frequency
   FloatArith::Prefix sum;  // frequency data: the running sum in double-double
-  std::vector<double> points;
+  Held<double> points;
 };
 
 /// Counts with the record held: every tau summed over it by the batch kernel (core batch.hpp).

@@ -4,13 +4,10 @@
 #include <atomic>
 #include <cstdlib>
 #include <exception>
-#include <new>
 #include <thread>
-#include <type_traits>
-
-#include <sys/mman.h>
 
 #include "analysis_engine.hpp"
+#include "held_memory.hpp"
 #include "threads.hpp"
 #include "gyrochar/batch.hpp"
 #include "gyrochar/characterizer.hpp"
@@ -19,50 +16,6 @@
 namespace gyrochar {
 
 namespace {
-
-// Storage for a held record: from 4 MiB on, in transparent huge pages (2 MiB pages fault 512
-// times less often than 4 KiB ones: at 10^7 counts the faults cost as much as reading the file);
-// the system's default for them is to be asked (madvise). Elements are left uninitialized by
-// resize(): every one is written before it is read.
-template <class T>
-struct HeldAllocator {
-  static_assert(std::is_trivially_copyable_v<T>);
-  using value_type = T;
-  static constexpr std::size_t huge_page = std::size_t{1} << 21;
-  HeldAllocator() = default;
-  template <class U>
-  HeldAllocator(const HeldAllocator<U>&) {}
-  T* allocate(std::size_t n) {
-    if (n > SIZE_MAX / sizeof(T) - huge_page) throw std::bad_alloc();
-    const std::size_t bytes = n * sizeof(T);
-    if (bytes < 2 * huge_page) return std::allocator<T>().allocate(n);
-    void* p = std::aligned_alloc(huge_page, (bytes + huge_page - 1) / huge_page * huge_page);
-    if (!p) throw std::bad_alloc();
-    madvise(p, bytes, MADV_HUGEPAGE);  // a hint: without it, 4 KiB pages
-    return static_cast<T*>(p);
-  }
-  void deallocate(T* p, std::size_t n) {
-    if (n * sizeof(T) < 2 * huge_page) {
-      std::allocator<T>().deallocate(p, n);
-    } else {
-      std::free(p);
-    }
-  }
-  template <class U>
-  void construct(U* p) {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-  template <class U>
-  bool operator==(const HeldAllocator<U>&) const {
-    return true;
-  }
-};
-template <class T>
-using Held = std::vector<T, HeldAllocator<T>>;
 
 // The sums of taus 0 .. taus - 1, `block` consecutive ones at a time by sum_block(first, out)
 // into out = sums[first .. first + block) (shorter at the end; independent: each thread takes the

@@ -130,8 +130,8 @@ struct PeakSearch {
 };
 
 /// Sinusoids in `psd` (header), at a chance `false_alarm` of finding one where there is none.
-/// Bins below the 8th are not tested (too few neighbours below them). O(bins x 128) with
-/// nth_element; allocates.
+/// Bins below the 8th are not tested (too few neighbours below them). O(bins x 128): each bin's
+/// neighbours kept sorted from the one before; allocates.
 PeakSearch find_sinusoids(const Psd& psd, double false_alarm = 0.01);
 
 /// Cross-checks each peak with the nulls of the Allan deviation of a sinusoid (AVAR A^2 (sin^2 x /

@@ -3,11 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdlib>
 #include <future>
-#include <limits>
-#include <memory>
-#include <new>
 
 #include "confidence.hpp"
 #include "gyrochar/total.hpp"
@@ -232,15 +228,6 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
 }
 
 }  // namespace
-
-void FreeDoubles::operator()(double* p) const noexcept { std::free(p); }
-
-UninitializedDoubles uninitialized_doubles(std::size_t n) {
-  if (n > std::numeric_limits<std::size_t>::max() / sizeof(double)) throw std::bad_alloc();
-  void* p = std::malloc(n ? n * sizeof(double) : 1);
-  if (p == nullptr) throw std::bad_alloc();
-  return UninitializedDoubles(static_cast<double*>(p));
-}
 
 std::span<LagSumView> LagSumRecord::views(PhaseSpan x, bool frequencies, unsigned threads) {
   const std::size_t n = frequencies ? x.size() - 1 : x.size();

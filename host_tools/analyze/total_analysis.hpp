@@ -19,18 +19,9 @@
 
 #include "analysis.hpp"
 #include "gyrochar/total_fast.hpp"
+#include "held_memory.hpp"
 
 namespace gyrochar {
-
-/// Memory for the lag sums' workspaces (0.9 GB at 10^7 points), not zero-filled: each writes before
-/// it reads. Not offered to transparent huge pages: on this machine first touching them cost more
-/// system time than the faults they save (BENCHMARKS.md, "Transparent huge pages, measured
-/// again"). Throws std::bad_alloc.
-struct FreeDoubles {
-  void operator()(double* p) const noexcept;
-};
-using UninitializedDoubles = std::unique_ptr<double[], FreeDoubles>;
-UninitializedDoubles uninitialized_doubles(std::size_t n);
 
 /// One thread's access to the prepared record: the preparation itself, or a copy of it with an FFT
 /// buffer of its own (the rest is read only by the taus), and its MTOTVAR scratch.
@@ -54,7 +45,8 @@ class LagSumRecord {
   TheoBias theoh_bias;
 
  private:
-  UninitializedDoubles work_, scratch_, second_buffer_, second_scratch_;  // not zero-filled: each writes before it reads
+  // The lag sums' workspaces (0.9 GB at 10^7 points), not zero-filled: each writes before it reads.
+  UninitializedDoubles work_, scratch_, second_buffer_, second_scratch_;
   std::vector<double> y_;
   Theo1Workspace w_, second_;
   std::array<LagSumView, 2> views_{};

@@ -8,6 +8,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <new>
 #include <random>
@@ -18,6 +19,7 @@
 #include "analysis.hpp"
 #include "analysis_report.hpp"
 #include "datafile.hpp"
+#include "held_memory.hpp"
 #include "plan.hpp"
 #include "total_analysis.hpp"
 
@@ -486,7 +488,7 @@ TEST(AnalyzeEngine, TheFitsLongTauPointsReuseTheoHsBiasRatio) {
 }
 
 TEST(AnalyzeEngine, LagSumWorkspacesAreWholeOrRefused) {
-  // uninitialized_doubles()'s contract (total_analysis.hpp): n doubles, every one writable; an impossible size
+  // uninitialized_doubles()'s contract (held_memory.hpp): n doubles, every one writable; an impossible size
   // is std::bad_alloc, never a short buffer.
   for (const std::size_t n :
        {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{1} << 20, (std::size_t{3} << 20) + 5}) {
@@ -496,6 +498,27 @@ TEST(AnalyzeEngine, LagSumWorkspacesAreWholeOrRefused) {
     if (n > 0) a[n - 1] = 1.0;
   }
   EXPECT_THROW(uninitialized_doubles(std::numeric_limits<std::size_t>::max() / 4), std::bad_alloc);
+}
+
+// Oracle: held_memory.hpp's contract. From 4 MiB on a buffer starts on a 2 MiB huge-page boundary
+// (where the kernel can map it in huge pages); below that it is malloc's. A held vector that
+// grows across the boundary keeps its values.
+TEST(AnalyzeEngine, HeldMemoryIsAlignedToHugePagesFromFourMiB) {
+  constexpr std::size_t huge = std::size_t{1} << 21;
+  for (const std::size_t bytes : {2 * huge, 2 * huge + 1, 5 * huge + 8}) {
+    void* p = allocate_held(bytes);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(p) % huge, 0u) << bytes;
+    static_cast<unsigned char*>(p)[bytes - 1] = 1;  // the whole size is ours
+    std::free(p);
+  }
+  void* small = allocate_held(100);
+  ASSERT_NE(small, nullptr);
+  std::free(small);
+  Held<std::int32_t> v;
+  for (std::int32_t i = 0; i < (1 << 21) + 5; ++i) v.push_back(i);  // 8 MiB: past the boundary
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % huge, 0u);
+  for (std::int32_t i = 0; i < (1 << 21) + 5; i += 4099) ASSERT_EQ(v[static_cast<std::size_t>(i)], i);
+  EXPECT_THROW((void)allocate_held(SIZE_MAX - 10), std::bad_alloc);
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 // 2 sigma^2 tau0, each bin distributed as chi2_nu / nu with Welch's nu), a sinusoid's power A^2/2.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -97,6 +99,37 @@ TEST(WelchPsd, ASinusoidsPowerIsHalfItsAmplitudeSquaredAndIsFound) {
   EXPECT_LT(peak.amplitude_uncertainty, 0.01 * A);
   EXPECT_NEAR(peak.frequency_hz, f, 0.1 * p.bin_hz());
   EXPECT_GT(peak.ratio, peak.threshold);
+}
+
+TEST(WelchPsd, EachBinsBackgroundIsTheMedianOfItsNeighbours) {
+  // Oracle: the definition (psd.hpp): bin i's background is the median (the element of rank n / 2,
+  // here from a whole sort) of the bins 3 to m away on either side, m = min(64, i, bins - 1 - i),
+  // over chi2_nu's median / nu. Values from a small set, so that ties cross the window's edges.
+  Psd p;
+  p.edf = 20;
+  p.tau0_s = 1;
+  p.segment = 2 * 1001;
+  std::mt19937_64 rng(9);
+  std::uniform_int_distribution<int> level(1, 12);
+  for (std::size_t k = 0; k < 1000; ++k) p.psd.push_back(0.25 * level(rng));
+  const PeakSearch s = find_sinusoids(p);
+  const boost::math::chi_squared chi2(p.edf);
+  const double median_factor = boost::math::quantile(chi2, 0.5) / p.edf;
+  std::size_t tested = 0;
+  for (std::size_t i = 0; i < p.psd.size(); ++i) {
+    const std::size_t m = std::min<std::size_t>({64, i, p.psd.size() - 1 - i});
+    if (i < 7 || m < 6) {  // the 8th bin on, at least 4 neighbours each side
+      EXPECT_TRUE(std::isnan(s.background[i])) << i;
+      continue;
+    }
+    std::vector<double> near;
+    for (std::size_t d = 3; d <= m; ++d) near.insert(near.end(), {p.psd[i - d], p.psd[i + d]});
+    std::sort(near.begin(), near.end());
+    ASSERT_EQ(s.background[i], near[near.size() / 2] / median_factor) << "bin " << i;
+    ++tested;
+  }
+  EXPECT_EQ(s.bins_tested, tested);
+  EXPECT_GT(tested, 900u);
 }
 
 TEST(WelchPsd, APeakIsCrossCheckedWithTheAllanNullAtOneOverF) {
