@@ -1,9 +1,10 @@
 #pragma once
 // The analyzer's large buffers: the held records (held_engines.cpp, the record kept for the total
-// family) and the lag sums' workspaces (total_analysis.hpp). From 4 MiB on they are aligned to
-// 2 MiB and offered to transparent huge pages (madvise; the system's default is to be asked): a
-// first touch faults once a 2 MiB page instead of 512 times, and the FFTs' and the Theo1 terms'
-// far-apart reads miss the TLB far less (BENCHMARKS.md, "Huge pages for the workspaces").
+// family), the lag sums' workspaces (total_analysis.hpp) and the PSD's transform buffer (psd.cpp).
+// From 4 MiB on they are aligned to 2 MiB and offered to transparent huge pages (madvise; the
+// system's default is to be asked): a first touch faults once a 2 MiB page instead of 512 times,
+// and the FFTs' and the Theo1 terms' far-apart reads miss the TLB far less (BENCHMARKS.md, "Huge
+// pages for the workspaces").
 // Uninitialized: every element is written before it is read.
 #include <cstddef>
 #include <cstdint>
