@@ -107,13 +107,6 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
   // count above (the last bins test with fewer). Their median: the element of rank n / 2.
   std::vector<double> near;
   std::vector<std::uint8_t> neighbours(bins, 0);  // at most 2 (max_neighbours - lobe): a byte a bin
-  const auto gather = [&](std::size_t i, std::size_t m) {
-    near.clear();
-    for (std::size_t d = lobe + 1; d <= m; ++d) {
-      near.push_back(psd.psd[i - d]);
-      near.push_back(psd.psd[i + d]);
-    }
-  };
   // Where every bin has all 2 (max_neighbours - lobe) neighbours, they are kept sorted from one bin
   // to the next (two leave, two come: O(128) a bin where nth_element took a few thousand
   // comparisons), the same element of rank n / 2. Values that do not order (NaN) take nth_element.
@@ -122,7 +115,7 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
   for (std::size_t i = first_bin; i < bins; ++i) {
     const std::size_t m = std::min({max_neighbours, i, bins - 1 - i});
     if (m < lobe + 1 + 3) continue;  // at least 4 neighbours each side
-    if (ordered && m == max_neighbours && sorted) {
+    if (sorted && m == max_neighbours) {
       // From bin i - 1's neighbours to bin i's: i - 1 - m and i + lobe leave, i - 1 - lobe and i + m come.
       const auto replace = [&](double gone, double come) {
         near.erase(std::lower_bound(near.begin(), near.end(), gone));
@@ -132,7 +125,11 @@ PeakSearch find_sinusoids(const Psd& psd, double false_alarm) {
       replace(psd.psd[i + lobe], psd.psd[i + m]);
       out.background[i] = near[near.size() / 2] / median_factor;
     } else {
-      gather(i, m);
+      near.clear();
+      for (std::size_t d = lobe + 1; d <= m; ++d) {
+        near.push_back(psd.psd[i - d]);
+        near.push_back(psd.psd[i + d]);
+      }
       const auto mid = near.begin() + static_cast<std::ptrdiff_t>(near.size() / 2);
       sorted = ordered && m == max_neighbours;
       if (sorted) {
