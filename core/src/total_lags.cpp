@@ -70,14 +70,27 @@ double load(PhaseSpan x, int order, Index values, Index from, Index count, doubl
 }
 
 // partial[d] += sum_{j < block} a[j] r[j + d] for every d < lags (a multiple of four): four lags
-// at a time, four products a lag in vector lanes. On x86-64 with AVX2 (checked at run time) the
-// lanes are one register, else two. Integers within exact_products: every sum is exact either way.
+// at a time, W products a lag in vector lanes. On x86-64 (checked at run time) the lanes are one
+// register: eight with AVX-512, four with AVX2, both with fused multiply-adds; else two registers
+// of two. Integers within exact_products: every sum is exact, so every path gives the same bits.
+template <Index W>
+struct LanesOf;  // W doubles in one vector (a vector_size that depends on W is not kept by GCC 12)
+template <>
+struct LanesOf<4> {
+  using type = double __attribute__((vector_size(32)));
+};
+template <>
+struct LanesOf<8> {
+  using type = double __attribute__((vector_size(64)));
+};
+template <Index W>
 [[gnu::always_inline]] inline void block_products(const double* a, const double* r, Index lags, double* partial) {
-  using Four = double __attribute__((vector_size(4 * sizeof(double))));
+  using Lanes = typename LanesOf<W>::type;
+  static_assert(block % W == 0);
   for (Index d = 0; d < lags; d += 4) {
-    Four s0 = {}, s1 = {}, s2 = {}, s3 = {};
-    for (Index j = 0; j < block; j += 4) {
-      Four v, r0, r1, r2, r3;
+    Lanes s0 = {}, s1 = {}, s2 = {}, s3 = {};
+    for (Index j = 0; j < block; j += W) {
+      Lanes v, r0, r1, r2, r3;
       __builtin_memcpy(&v, a + j, sizeof v);
       __builtin_memcpy(&r0, r + j + d, sizeof r0);
       __builtin_memcpy(&r1, r + j + d + 1, sizeof r1);
@@ -85,19 +98,24 @@ double load(PhaseSpan x, int order, Index values, Index from, Index count, doubl
       __builtin_memcpy(&r3, r + j + d + 3, sizeof r3);
       s0 += v * r0, s1 += v * r1, s2 += v * r2, s3 += v * r3;
     }
-    partial[d] += (s0[0] + s0[1]) + (s0[2] + s0[3]);
-    partial[d + 1] += (s1[0] + s1[1]) + (s1[2] + s1[3]);
-    partial[d + 2] += (s2[0] + s2[1]) + (s2[2] + s2[3]);
-    partial[d + 3] += (s3[0] + s3[1]) + (s3[2] + s3[3]);
+    const Lanes* s[4] = {&s0, &s1, &s2, &s3};
+    for (Index q = 0; q < 4; ++q) {
+      double sum = 0;
+      for (Index i = 0; i < W; ++i) sum += (*s[q])[i];
+      partial[d + q] += sum;
+    }
   }
 }
 void block_products_scalar(const double* a, const double* r, Index lags, double* partial) {
-  block_products(a, r, lags, partial);
+  block_products<4>(a, r, lags, partial);
 }
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define GYROCHAR_LAGS_AVX 1
-[[gnu::target("avx2")]] void block_products_avx2(const double* a, const double* r, Index lags, double* partial) {
-  block_products(a, r, lags, partial);
+[[gnu::target("avx512f")]] void block_products_avx512(const double* a, const double* r, Index lags, double* partial) {
+  block_products<8>(a, r, lags, partial);
+}
+[[gnu::target("avx2,fma")]] void block_products_avx2(const double* a, const double* r, Index lags, double* partial) {
+  block_products<4>(a, r, lags, partial);
 }
 #endif
 
@@ -128,7 +146,11 @@ void stripe(const Pass& p, Index s) {
     for (Index d = 0; d < lags; ++d) partial[d] = 0.0;
     for (Index b = 0; b < rounded; b += block) {
 #ifdef GYROCHAR_LAGS_AVX
-      if (__builtin_cpu_supports("avx2")) {
+      if (__builtin_cpu_supports("avx512f")) {
+        block_products_avx512(left + b, right + b, lags, partial);
+        continue;
+      }
+      if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
         block_products_avx2(left + b, right + b, lags, partial);
         continue;
       }
