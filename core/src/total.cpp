@@ -101,17 +101,17 @@ template <class T>
 // The same runs eight lanes a register (AVX-512): thirty-two k a step in four vectors, one
 // division for their four weights, r = 1 / (A B) with A = k (k + 8), B = (k + 16)(k + 24): 1 / k =
 // (k + 8) B r, 1 / (k + 8) = k B r, 1 / (k + 16) = (k + 24) A r, 1 / (k + 24) = (k + 16) A r; at
-// most six roundings, each weight within 3 ulp of the quotient. A division of eight lanes takes as
-// long as two of four: one for four weights keeps it off the path. A run's last k (fewer than 32) go
-// four lanes at a time as above.
+// most six roundings, each weight within 3 ulp of the quotient. (On Intel's cores a division of
+// eight lanes takes as long as two of four: one for four weights keeps it off the path.) A run's
+// last k (fewer than 32) go four lanes at a time as above.
 using Lanes8 = double __attribute__((vector_size(64)));
 template <class T>
-[[gnu::always_inline]] inline void load8(Lanes8& v, const T* p) {
+[[gnu::always_inline]] inline void load(Lanes8& v, const T* p) {
   v = Lanes8{static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]), static_cast<double>(p[3]),
              static_cast<double>(p[4]), static_cast<double>(p[5]), static_cast<double>(p[6]), static_cast<double>(p[7])};
 }
 template <class T>
-[[gnu::always_inline]] inline void load8_backwards(Lanes8& v, const T* p) {
+[[gnu::always_inline]] inline void load_backwards(Lanes8& v, const T* p) {
   v = Lanes8{static_cast<double>(p[7]), static_cast<double>(p[6]), static_cast<double>(p[5]), static_cast<double>(p[4]),
              static_cast<double>(p[3]), static_cast<double>(p[2]), static_cast<double>(p[1]), static_cast<double>(p[0])};
 }
@@ -124,14 +124,14 @@ template <class T>
   Index j = k0;
   for (; j + 31 <= k1; j += 32) {
     Lanes8 a0, a1, a2, a3, b0, b1, b2, b3;
-    load8(a0, p + j);
-    load8(a1, p + j + 8);
-    load8(a2, p + j + 16);
-    load8(a3, p + j + 24);
-    load8_backwards(b0, p + M - j - 7);
-    load8_backwards(b1, p + M - j - 15);
-    load8_backwards(b2, p + M - j - 23);
-    load8_backwards(b3, p + M - j - 31);
+    load(a0, p + j);
+    load(a1, p + j + 8);
+    load(a2, p + j + 16);
+    load(a3, p + j + 24);
+    load_backwards(b0, p + M - j - 7);
+    load_backwards(b1, p + M - j - 15);
+    load_backwards(b2, p + M - j - 23);
+    load_backwards(b3, p + M - j - 31);
     const Lanes8 k8 = k + 8.0, k16 = k + 16.0, k24 = k + 24.0, A = k * k8, B = k16 * k24;
     const Lanes8 r = 1.0 / (A * B), Br = B * r, Ar = A * r;
     const Lanes8 t0 = ((first - a0) - b0) + last, t1 = ((first - a1) - b1) + last;

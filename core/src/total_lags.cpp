@@ -70,26 +70,25 @@ double load(PhaseSpan x, int order, Index values, Index from, Index count, doubl
 }
 
 // partial[d] += sum_{j < block} a[j] r[j + d] for every d < lags (a multiple of four): four lags
-// at a time, W products a lag in vector lanes. On x86-64 (checked at run time) the lanes are one
-// register: eight with AVX-512, four with AVX2, both with fused multiply-adds; else two registers
-// of two. Integers within exact_products: every sum is exact, so every path gives the same bits.
-template <Index W>
-struct LanesOf;  // W doubles in one vector (a vector_size that depends on W is not kept by GCC 12)
-template <>
-struct LanesOf<4> {
-  using type = double __attribute__((vector_size(32)));
-};
-template <>
-struct LanesOf<8> {
-  using type = double __attribute__((vector_size(64)));
-};
-template <Index W>
+// at a time, a vector of products a lag. On x86-64 (checked at run time) the vector is one
+// register: eight lanes with AVX-512, four with AVX2, both with fused multiply-adds; else two
+// registers of two. Integers within exact_products: every sum is exact, so every path gives the
+// same bits.
+using Four = double __attribute__((vector_size(4 * sizeof(double))));
+using Eight = double __attribute__((vector_size(8 * sizeof(double))));
+template <class Lanes>
+[[gnu::always_inline]] inline double lane_sum(const Lanes& s) {
+  double sum = 0;
+  for (Index i = 0; i < sizeof s / sizeof sum; ++i) sum += s[i];
+  return sum;
+}
+template <class Lanes>
 [[gnu::always_inline]] inline void block_products(const double* a, const double* r, Index lags, double* partial) {
-  using Lanes = typename LanesOf<W>::type;
-  static_assert(block % W == 0);
+  constexpr Index width = sizeof(Lanes) / sizeof(double);
+  static_assert(block % width == 0);
   for (Index d = 0; d < lags; d += 4) {
     Lanes s0 = {}, s1 = {}, s2 = {}, s3 = {};
-    for (Index j = 0; j < block; j += W) {
+    for (Index j = 0; j < block; j += width) {
       Lanes v, r0, r1, r2, r3;
       __builtin_memcpy(&v, a + j, sizeof v);
       __builtin_memcpy(&r0, r + j + d, sizeof r0);
@@ -98,24 +97,22 @@ template <Index W>
       __builtin_memcpy(&r3, r + j + d + 3, sizeof r3);
       s0 += v * r0, s1 += v * r1, s2 += v * r2, s3 += v * r3;
     }
-    const Lanes* s[4] = {&s0, &s1, &s2, &s3};
-    for (Index q = 0; q < 4; ++q) {
-      double sum = 0;
-      for (Index i = 0; i < W; ++i) sum += (*s[q])[i];
-      partial[d + q] += sum;
-    }
+    partial[d] += lane_sum(s0);
+    partial[d + 1] += lane_sum(s1);
+    partial[d + 2] += lane_sum(s2);
+    partial[d + 3] += lane_sum(s3);
   }
 }
 void block_products_scalar(const double* a, const double* r, Index lags, double* partial) {
-  block_products<4>(a, r, lags, partial);
+  block_products<Four>(a, r, lags, partial);
 }
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define GYROCHAR_LAGS_AVX 1
 [[gnu::target("avx512f")]] void block_products_avx512(const double* a, const double* r, Index lags, double* partial) {
-  block_products<8>(a, r, lags, partial);
+  block_products<Eight>(a, r, lags, partial);
 }
 [[gnu::target("avx2,fma")]] void block_products_avx2(const double* a, const double* r, Index lags, double* partial) {
-  block_products<4>(a, r, lags, partial);
+  block_products<Four>(a, r, lags, partial);
 }
 #endif
 
