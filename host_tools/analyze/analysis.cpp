@@ -97,16 +97,19 @@ std::string dev_stat_names(const char* separator) {
   return names;
 }
 
-bool valid_stride_factor(std::uint32_t s) { return s >= 2 && std::has_single_bit(s) && s <= (1u << 24); }
+bool valid_stride_factor(std::uint32_t s, bool held) {
+  return s >= 2 && std::has_single_bit(s) && s <= (held ? held_stride_cap : 1u << 24);
+}
 
 std::uint32_t resolve_stride_factor(std::uint32_t requested, std::uint64_t m_max) {
   if (requested != 0) return requested;
   return static_cast<std::uint32_t>(std::bit_ceil(std::clamp<std::uint64_t>(m_max, 2, full_stride_cap)));
 }
 
-std::uint32_t full_stride_factor(std::uint64_t n_phase) {
+std::uint32_t full_stride_factor(std::uint64_t n_phase, bool held) {
   if (n_phase == 0) return full_stride_cap;
-  return static_cast<std::uint32_t>(std::bit_ceil(std::clamp<std::uint64_t>(n_phase / 4, 2, std::uint64_t{1} << 24)));
+  const std::uint64_t cap = held ? held_stride_cap : 1u << 24;
+  return static_cast<std::uint32_t>(std::bit_ceil(std::clamp<std::uint64_t>(n_phase / 4, 2, cap)));
 }
 
 std::uint64_t history_bytes(DataType type, std::uint32_t stride_factor, std::uint64_t m_max) {
@@ -428,8 +431,10 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   for (std::size_t i = 0; i < o.m_list.size(); ++i)
     if (o.m_list[i] == 0 || (i > 0 && o.m_list[i] <= o.m_list[i - 1]))
       throw std::invalid_argument("averaging factors must be positive and strictly increasing");
-  if (o.stride_factor != 0 && !valid_stride_factor(o.stride_factor))
-    throw std::invalid_argument("the stride factor must be a power of two from 2 to 2^24");
+  const bool held = o.type == DataType::counts ? o.hold_counts : o.hold_phase;
+  if (o.stride_factor != 0 && !valid_stride_factor(o.stride_factor, held))
+    throw std::invalid_argument(held ? "the stride factor must be a power of two from 2 to 2^31"
+                                     : "the stride factor must be a power of two from 2 to 2^24");
   const std::uint32_t s = resolve_stride_factor(o.stride_factor, o.m_list.back());
   for (const std::uint64_t m : o.m_list)
     if (!tau_representable(m, s))
@@ -441,9 +446,8 @@ Analyzer::Analyzer(const AnalysisOptions& options) : impl_(std::make_unique<Impl
   impl_->options = o;
   const bool keep_record = o.keep_record ||
                            std::any_of(o.stats.begin(), o.stats.end(), [](DevStat s) { return is_total(s); });
-  if (o.type == DataType::counts && o.hold_counts)
-    impl_->engine = make_count_batch_engine(s, o.m_list, keep_record, o.values_hint);
-  else if (o.type != DataType::counts && o.hold_phase)
+  if (held && o.type == DataType::counts) impl_->engine = make_count_batch_engine(s, o.m_list, keep_record, o.values_hint);
+  else if (held)
     impl_->engine = make_float_batch_engine(o.type, s, o.m_list, keep_record, o.values_hint, o.hold_prefix_sums);
   else if (o.type == DataType::counts)
     impl_->engine = std::make_unique<Engine<CountArith>>(o.type, s, o.m_list, keep_record, o.checkpoint_tag);

@@ -43,9 +43,15 @@ std::string dev_stat_names(const char* separator);
 /// length; taus above it are strided (terms every m/S points) and their EDF says so.
 inline constexpr std::uint32_t full_stride_cap = 1u << 16;
 
+/// Largest stride factor "full" resolves to when the record is held: the batch kernels keep no
+/// history, so every tau up to N/4 stays fully overlapped at any length (2^31: the largest power
+/// of two a std::uint32_t holds).
+inline constexpr std::uint32_t held_stride_cap = 1u << 31;
+
 /// True for a stride factor the core's characterizer accepts: a power of two from 2 to 2^24
-/// (ConfigureStatus::bad_stride_factor otherwise). O(1).
-bool valid_stride_factor(std::uint32_t s);
+/// (ConfigureStatus::bad_stride_factor otherwise); with `held` (the batch kernels over a held
+/// record), up to held_stride_cap. O(1).
+bool valid_stride_factor(std::uint32_t s, bool held = false);
 
 /// The stride factor used for a request: `requested` (a power of two >= 2) as is; 0 means "full":
 /// the smallest power of two >= m_max (so every tau is fully overlapped), at least 2 and at most
@@ -54,9 +60,10 @@ std::uint32_t resolve_stride_factor(std::uint32_t requested, std::uint64_t m_max
 
 /// The stride factor of "full" for an input of at most n_phase phase points: the smallest power
 /// of two >= n_phase / 4, so that every tau up to N/4 is fully overlapped (the history then holds
-/// 3N/4 to 3N/2 points, of which the pages the data reaches are used), within [2, 2^24];
-/// full_stride_cap when the length is unknown (0). O(1).
-std::uint32_t full_stride_factor(std::uint64_t n_phase);
+/// 3N/4 to 3N/2 points, of which the pages the data reaches are used), within [2, 2^24], or
+/// within [2, held_stride_cap] when the record is `held` (no history); full_stride_cap when the
+/// length is unknown (0). O(1).
+std::uint32_t full_stride_factor(std::uint64_t n_phase, bool held = false);
 
 /// Bytes of history the characterizer of `type` needs for stride factor S and taus up to m_max
 /// (calloc'd: pages the data never reaches are not used). O(log m_max).

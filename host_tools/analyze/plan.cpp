@@ -101,8 +101,8 @@ TauPlan plan_taus(AnalysisOptions& o, TauRule rule, StrideFactor stride, const s
   o.hold_prefix_sums = o.hold_phase && rule == TauRule::all;
   plan.held = o.hold_counts || o.hold_phase;
   // "full" resolved, here only: every tau up to N/4 fully overlapped; for "all" every m up to N/2
-  // (all of them).
-  if (stride.is_full()) o.stride_factor = full_stride_factor(rule == TauRule::all ? 2 * n_phase : n_phase);
+  // (all of them). A held record has no history to bound S.
+  if (stride.is_full()) o.stride_factor = full_stride_factor(rule == TauRule::all ? 2 * n_phase : n_phase, plan.held);
   const std::uint32_t s = o.stride_factor;
   plan.generated = rule != TauRule::list;
   o.m_list.clear();

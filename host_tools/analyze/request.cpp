@@ -86,7 +86,8 @@ Taus (averaging factors m, tau = m tau0) and memory:
   The taus are sized from the file's length (an upper bound: rows the data does not reach are
   left out) and cover any length on standard input. --stride-factor full (the default) makes
   every tau up to N/4 fully overlapped (Stable32's estimators, same number of terms): the history
-  then grows with N, up to S = 2^24 (3S points of 24 bytes); on standard input, whose length is
+  then grows with N, up to S = 2^24 (3S points of 24 bytes); a file's record held in memory
+  needs no history, and there S has no such limit; on standard input, whose length is
   unknown, every tau up to 2^16 is fully overlapped and taus above it are strided, their terms
   m/2^16 points apart, with the EDF of the strided estimator. A stride factor S keeps the history
   at about 3S (1 + levels/2) points whatever the length. adev and hdev are Stable32's

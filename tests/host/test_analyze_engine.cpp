@@ -22,6 +22,7 @@
 #include "held_memory.hpp"
 #include "plan.hpp"
 #include "total_analysis.hpp"
+#include "gyrochar/batch.hpp"
 
 namespace gyrochar {
 namespace {
@@ -36,6 +37,9 @@ TEST(AnalyzeEngine, StrideFactorParsesFullAndWhatTheCharacterizerAccepts) {
   for (const char* text : {"", "0", "1", "3", "12", "33554432", "4294967296", "8x", " 8", "+8", "-8", "Full"})
     EXPECT_FALSE(StrideFactor::parse(text).has_value()) << "'" << text << "'";
   for (std::uint32_t s = 1; s != 0; s <<= 1) EXPECT_EQ(valid_stride_factor(s), s >= 2 && s <= (1u << 24)) << s;
+  // Over a held record (the batch kernels: no history) any power of two from 2 a uint32 holds.
+  for (std::uint32_t s = 1; s != 0; s <<= 1) EXPECT_EQ(valid_stride_factor(s, true), s >= 2) << s;
+  EXPECT_FALSE(valid_stride_factor(3, true));
 }
 
 TEST(AnalyzeEngine, TauRuleAndListParsedOnce) {
@@ -64,6 +68,17 @@ TEST(AnalyzeEngine, FullIsResolvedInThePlanningStep) {
   plan_taus(o, TauRule::octave, StrideFactor::full(), {}, 4000, std::uint64_t{1} << 40);
   EXPECT_EQ(o.stride_factor, full_stride_factor(4000));  // 1024: every tau up to N/4 fully overlapped
   EXPECT_EQ(o.m_list.back(), 1024u);                     // octaves up to N/2 = 2000
+  // Counts of a 120 h, 1 kHz file are held (batch kernel, no history): every octave tau up to
+  // N/4 is fully overlapped, past the characterizer's 2^24.
+  o.type = DataType::counts;
+  o.values_hint = 432'000'000;
+  plan_taus(o, TauRule::octave, StrideFactor::full(), {}, 432'000'001, std::uint64_t{1} << 40);
+  EXPECT_TRUE(o.hold_counts);
+  EXPECT_EQ(o.stride_factor, 1u << 27);
+  EXPECT_EQ(o.m_list.back(), 1u << 27);  // octaves up to N/2
+  for (const std::uint64_t m : o.m_list) EXPECT_EQ(stride_of(m, o.stride_factor), 1u) << m;
+  o.type = DataType::phase;
+  o.values_hint = 0;
   plan_taus(o, TauRule::list, *StrideFactor::parse("8"), {1, 16}, 4000, std::uint64_t{1} << 40);
   EXPECT_EQ(o.stride_factor, 8u);
   EXPECT_EQ(o.m_list, (std::vector<std::uint64_t>{1, 16}));
@@ -88,6 +103,10 @@ TEST(AnalyzeEngine, StrideFactorAndRepresentableTaus) {
   EXPECT_EQ(full_stride_factor(5), 2u);
   EXPECT_EQ(full_stride_factor(10'000'001), 1u << 22);  // N/4 = 2.5e6 <= 2^22
   EXPECT_EQ(full_stride_factor(std::uint64_t{1} << 40), 1u << 24);
+  // A held record has no history: N/4 at any length, up to 2^31.
+  EXPECT_EQ(full_stride_factor(432'000'001, true), 1u << 27);  // 120 h at 1 kHz: N/4 = 1.08e8 <= 2^27
+  EXPECT_EQ(full_stride_factor(std::uint64_t{1} << 40, true), held_stride_cap);
+  EXPECT_EQ(full_stride_factor(10'000'001, true), 1u << 22);
   // History: 3S points for ring 0, 3S/2 for each level above (24 bytes a point, counts or floats).
   EXPECT_EQ(history_bytes(DataType::counts, 8, 8), 24u * 24u);
   EXPECT_EQ(history_bytes(DataType::phase, 8, 32), (24u + 2u * 12u) * 24u);
