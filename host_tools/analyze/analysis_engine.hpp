@@ -52,6 +52,11 @@ unsigned sums_needed(const AnalysisOptions& o);
 // to about one rounding.
 struct KeptRecord {
   KeptRecord(DataType data_type, bool keep_it) : type(data_type), on(keep_it) {}
+  // Room for `values` (a bound; untouched room costs no memory): the points are not copied as
+  // they grow, nor written to fresh pages twice.
+  void reserve(std::uint64_t values) {
+    if (on) points.reserve(values + 1);
+  }
   void keep(double value) {
     if (!on) return;
     if (type == DataType::phase) {

@@ -182,6 +182,7 @@ class FloatBatchEngine final : public EngineBase {
                    std::uint64_t values_hint, bool prefix_sums)
       : type_(type), stride_factor_(stride_factor), m_list_(m_list), record_(type, keep_record), prefix_sums_(prefix_sums) {
     x_.reserve(values_hint + 1);
+    record_.reserve(values_hint);
     if (prefix_sums_)
       for (Held<double>* v : {&p_hi_, &p_lo_}) v->reserve(values_hint + 1);
   }
