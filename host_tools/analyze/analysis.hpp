@@ -134,10 +134,12 @@ struct AnalysisOptions {
   // The caller's configuration fingerprint, kept in checkpoints (Analyzer::checkpoint): a
   // checkpoint restores only under the same tag.
   std::uint32_t checkpoint_tag = 0;
-  // Told, from the thread that calls result(), how many of the held record's taus are summed, of
-  // how many (the sums of every tau, --taus all, take minutes at 10^6 values). May be empty. May
-  // throw to stop result() (the Python module's KeyboardInterrupt): the exception comes out of it.
-  std::function<void(std::size_t done, std::size_t total)> on_summed;
+  // Told, from the thread that calls result(), how far its long stages are: "summing", the held
+  // record's taus (the sums of every tau, --taus all, take minutes at 10^6 values), then each
+  // statistic of the total family by its name ("theoh bias ratio" for TheoBR's ratio), its taus
+  // done of how many; each stage ends with done = total. May be empty. May throw to stop result()
+  // (the Python module's KeyboardInterrupt): the exception comes out of it.
+  std::function<void(const char* stage, std::size_t done, std::size_t total)> on_progress;
 };
 
 struct AnalysisRow {

@@ -19,7 +19,7 @@ namespace {
 
 // The sums of taus 0 .. taus - 1, `block` consecutive ones at a time by sum_block(first, out)
 // into out = sums[first .. first + block) (shorter at the end; independent: each thread takes the
-// next block left until none is), on o.threads threads (0: one per core), telling o.on_summed.
+// next block left until none is), on o.threads threads (0: one per core), telling o.on_progress.
 template <class SumBlock>
 std::vector<TauSums> sum_every_tau(std::size_t taus, std::size_t block, const AnalysisOptions& o, SumBlock sum_block) {
   std::vector<TauSums> sums(taus);
@@ -30,13 +30,13 @@ std::vector<TauSums> sum_every_tau(std::size_t taus, std::size_t block, const An
       const std::size_t first = b * block, count = std::min(block, taus - first);
       sum_block(first, std::span<TauSums>(sums.data() + first, count));
       const std::size_t summed = done += count;
-      if (tell && o.on_summed && summed < taus) o.on_summed(summed, taus);
+      if (tell && o.on_progress && summed < taus) o.on_progress("summing", summed, taus);
     }
   };
   const unsigned threads = static_cast<unsigned>(std::min<std::size_t>(thread_count(o.threads), blocks));
   std::vector<std::thread> helpers;
   for (unsigned k = 1; k < threads; ++k) helpers.emplace_back(sum_taus, false);
-  std::exception_ptr stopped;  // on_summed threw (the caller stops the work): the helpers end first
+  std::exception_ptr stopped;  // on_progress threw (the caller stops the work): the helpers end first
   try {
     sum_taus(true);
   } catch (...) {
@@ -45,7 +45,7 @@ std::vector<TauSums> sum_every_tau(std::size_t taus, std::size_t block, const An
   }
   for (std::thread& t : helpers) t.join();
   if (stopped) std::rethrow_exception(stopped);
-  if (o.on_summed) o.on_summed(taus, taus);
+  if (o.on_progress) o.on_progress("summing", taus, taus);
   return sums;
 }
 

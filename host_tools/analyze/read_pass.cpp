@@ -78,12 +78,12 @@ void Progress::values(std::size_t n, std::uint64_t bytes_read) {
   else std::fprintf(stderr, "\rgyrochar-analyze: reading: %llu values", static_cast<unsigned long long>(values_));
 }
 
-std::function<void(std::size_t, std::size_t)> summing_progress() {
-  return [shown = std::size_t{0}](std::size_t done, std::size_t total) mutable {
+std::function<void(const char*, std::size_t, std::size_t)> stage_progress() {
+  return [shown = std::size_t{0}](const char* stage, std::size_t done, std::size_t total) mutable {
     if (done < total && 1000 * done / total == 1000 * shown / total) return;  // every 0.1 %
-    shown = done;
+    shown = done < total ? done : 0;                                          // the next stage starts from 0
     progress_line_open = done < total;
-    std::fprintf(stderr, "\rgyrochar-analyze: summing: %zu of %zu taus%s", done, total, done < total ? "" : "\n");
+    std::fprintf(stderr, "\rgyrochar-analyze: %s: %zu of %zu taus%s", stage, done, total, done < total ? "" : "\n");
   };
 }
 

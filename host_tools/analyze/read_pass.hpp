@@ -64,8 +64,9 @@ class Progress {
   std::uint64_t values_ = 0, next_ = 1u << 20;
 };
 
-/// The engine's progress callback (AnalysisOptions::on_summed): "summing: k of n taus" on stderr.
-std::function<void(std::size_t, std::size_t)> summing_progress();
+/// The engine's progress callback (AnalysisOptions::on_progress): "summing: k of n taus", "theoh: k
+/// of n taus", ... on stderr.
+std::function<void(const char*, std::size_t, std::size_t)> stage_progress();
 /// Ends a progress line left open on stderr, before an error line. O(1).
 void end_progress_line();
 

@@ -220,7 +220,9 @@ void add_options(CLI::App& app, OptionText& t, Request& r) {
       ->option_text("FILE.csv");
   app.add_option("--report", r.report_path, "write a self-contained HTML report (plots, tables, fit, verdicts)")
       ->option_text("FILE.html");
-  app.add_flag("--progress", t.progress, "show progress on stderr (default: when stderr is a terminal)");
+  app.add_flag("--progress", t.progress,
+               "show progress on stderr: the file read, the taus summed, then each total-family statistic's taus "
+               "(TheoH's bias ratio apart) (default: when stderr is a terminal)");
 }
 
 // No output may overwrite an input or another output (output_paths.hpp).

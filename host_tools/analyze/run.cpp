@@ -80,7 +80,7 @@ RunPlan plan_run(Request& r) {
   AnalysisOptions& o = r.options;
   // The taus, the stride factor "full" resolves to and the held record (plan.hpp).
   o.values_hint = r.taus == TauRule::all ? p.kept.size() : p.file->values_bound();
-  if (r.show_progress) o.on_summed = summing_progress();
+  if (r.show_progress) o.on_progress = stage_progress();
   p.budget = memory_budget();
   p.taus = plan_taus(o, r.taus, r.stride, r.listed, p.n_phase, p.budget);
   if (o.m_list.empty()) bad(r.source, fmt::format("{} phase points are too few for any tau", p.n_phase));

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <exception>
 #include <future>
 
 #include "confidence.hpp"
@@ -49,15 +51,75 @@ bool known(const AnalysisRow* r) { return r != nullptr && r->alpha.has_value(); 
 // The threads of the total family's taus: as --threads asks, at most two (the lag sums have two views).
 unsigned total_threads(const AnalysisOptions& o) { return std::min(thread_count(o.threads), 2u); }
 
+// A stage's progress (AnalysisOptions::on_progress): its pieces (`per_tau` a tau) finished on any
+// thread, the taus they make told from the calling thread (worker 0) after each of its own pieces
+// that finds more of them done, and once at the end. What
+// the callback throws (the Python module's KeyboardInterrupt) stops the stage: on_threads lets the
+// other threads finish their piece, then rethrows it.
+class Tally {
+ public:
+  Tally(const AnalysisOptions& o, const char* stage, std::size_t taus, std::size_t per_tau = 1)
+      : o_(o), stage_(stage), taus_(taus), per_tau_(per_tau) {}
+  void piece_done(unsigned worker) {
+    const std::size_t taus = ++pieces_ / per_tau_;
+    if (worker != 0 || !o_.on_progress || taus == told_ || taus >= taus_) return;
+    told_ = taus;
+    o_.on_progress(stage_, taus, taus_);
+  }
+  void finish() const {
+    if (o_.on_progress && taus_ > 0) o_.on_progress(stage_, taus_, taus_);
+  }
+
+ private:
+  const AnalysisOptions& o_;
+  const char* stage_;
+  std::size_t taus_, per_tau_;
+  std::atomic<std::size_t> pieces_{0};
+  std::size_t told_ = 0;  // worker 0's alone
+};
+
+// Core's rows (TheoBR's bias ratio) on the run's threads, as ThreadRows, each a piece of `tally`.
+// What the callback throws must not cross core's frames (built without exceptions): it is kept,
+// the rows left are skipped (core then gives no ratio), and rethrow() raises it once core returns.
+class TalliedRows final : public RowRunner {
+ public:
+  TalliedRows(unsigned threads, Tally& tally) : threads_(threads), tally_(tally) {}
+  void run(const Rows& rows, std::size_t count) const override {
+    on_threads(threads_, count, [&](unsigned worker, std::size_t i) {
+      if (stop_) return;
+      rows.row(i);
+      try {
+        tally_.piece_done(worker);
+      } catch (...) {
+        stopped_ = std::current_exception();  // worker 0's alone; read after the threads end
+        stop_ = true;
+      }
+    });
+  }
+  void rethrow() const {
+    if (stopped_) std::rethrow_exception(stopped_);
+  }
+
+ private:
+  unsigned threads_;
+  Tally& tally_;
+  mutable std::atomic<bool> stop_{false};
+  mutable std::exception_ptr stopped_;
+};
+
 // estimate(worker, m) at every m, the largest first (the dearest: threads then finish together), on
-// `threads` threads. Each m's estimate is the same bits on any thread.
+// `threads` threads, told to `stage`. Each m's estimate is the same bits on any thread.
 template <class Estimate>
-std::vector<TotalVariance> estimates(const std::vector<std::uint64_t>& ms, unsigned threads, const Estimate& estimate) {
+std::vector<TotalVariance> estimates(const std::vector<std::uint64_t>& ms, unsigned threads, const AnalysisOptions& o,
+                                     const char* stage, const Estimate& estimate) {
   std::vector<TotalVariance> v(ms.size());
+  Tally tally(o, stage, ms.size());
   on_threads(threads, ms.size(), [&](unsigned worker, std::size_t i) {
     const std::size_t k = ms.size() - 1 - i;
     v[k] = estimate(worker, ms[k]);
+    tally.piece_done(worker);
   });
+  tally.finish();
   return v;
 }
 
@@ -92,25 +154,33 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, PhaseSpan x, double k2, const A
     // bits, sooner.
     std::future<void> prepared;
     if (!decimated && !ms.empty()) prepared = std::async(std::launch::async, [&] { lag_sums.views(x, false, threads); });
-    const ThreadRows runner(threads);
-    ratio = theo_bias_ratio(x, tau0, S, theo_bias_taus(N, S), &runner).ratio;
+    const std::uint64_t bias_taus = theo_bias_taus(N, S);
+    Tally bias(o, "theoh bias ratio", static_cast<std::size_t>(std::min(bias_taus, theo_bias_last(N) + 1)));
+    const TalliedRows runner(threads, bias);
+    ratio = theo_bias_ratio(x, tau0, S, bias_taus, &runner).ratio;
     if (prepared.valid()) prepared.get();
+    runner.rethrow();
+    bias.finish();
     if (!(ratio > 0)) return rows;
     lag_sums.theoh_bias = {ratio, S};
   }
   if (ms.empty()) return rows;
   std::vector<TotalVariance> v;
   if (decimated) {
-    v = estimates(ms, threads, [&](unsigned, std::uint64_t m) { return theo1(x, m, tau0, theo1_stride(m, N, S)); });
+    v = estimates(ms, threads, o, name(stat),
+                  [&](unsigned, std::uint64_t m) { return theo1(x, m, tau0, theo1_stride(m, N, S)); });
   } else {
     // Each tau in its pieces (total_fast.hpp): the largest tau's two triangles, its dearest work,
     // go on both threads at once.
     const std::span<LagSumView> views = lag_sums.views(x, false, threads);
     std::vector<Theo1Pieces> pieces(ms.size());
+    Tally tally(o, name(stat), ms.size(), theo1_pieces);
     on_threads(views.size(), theo1_pieces * ms.size(), [&](unsigned t, std::size_t i) {
       const std::size_t k = ms.size() - 1 - i / theo1_pieces;  // the largest m first, its triangles first
       theo1_piece(*views[t].work, ms[k], static_cast<int>(i % theo1_pieces + 1) % theo1_pieces, pieces[k]);
+      tally.piece_done(t);
     });
+    tally.finish();
     for (std::size_t k = 0; k < ms.size(); ++k) v.push_back(theo1_from_pieces(*views[0].work, ms[k], tau0, pieces[k]));
   }
   for (std::size_t i = 0; i < ms.size(); ++i) {
@@ -149,17 +219,20 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
                                8 * (static_cast<std::uint64_t>(fast_size) + N) > memory_budget();
   std::vector<TotalVariance> v;
   if (stat == DevStat::totdev) {
-    v = estimates(ms, threads, [&](unsigned, std::uint64_t m) { return totvar(x, m, tau0); });
+    v = estimates(ms, threads, o, name(stat), [&](unsigned, std::uint64_t m) { return totvar(x, m, tau0); });
   } else if (!total_decimated) {
     // Each tau in its two pieces (total_fast.hpp), the largest tau first and its FFTs first: its two
     // pieces, the dearest work, go on both threads at once.
     const std::span<LagSumView> views = lag_sums.views(x, hadamard, threads);  // HTOTVAR: the frequencies times tau0
     std::vector<MtotPieces> pieces(ms.size());
+    Tally tally(o, name(stat), ms.size(), mtotvar_pieces);
     on_threads(views.size(), mtotvar_pieces * ms.size(), [&](unsigned t, std::size_t i) {
       const std::size_t k = ms.size() - 1 - i / mtotvar_pieces;
       const int piece = mtotvar_pieces - 1 - static_cast<int>(i % mtotvar_pieces);
       mtotvar_piece(*views[t].work, views[t].scratch, ms[k], piece, pieces[k]);
+      tally.piece_done(t);
     });
+    tally.finish();
     for (std::size_t k = 0; k < ms.size(); ++k) {
       if (!hadamard) {
         v.push_back(mtotvar_from_pieces(*views[0].work, ms[k], tau0, pieces[k]));
@@ -189,7 +262,7 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
     }
     // Per thread: the plan's block sums and prefix sums, or the table's coefficients.
     std::array<std::vector<double>, 2> scratch;
-    v = estimates(ms, threads, [&](unsigned worker, std::uint64_t m) {
+    v = estimates(ms, threads, o, name(stat), [&](unsigned worker, std::uint64_t m) {
       std::vector<double>& own = scratch[worker];
       if (table.ready && from_table(m)) {
         own.resize(lagged_scratch_size(m));

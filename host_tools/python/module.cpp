@@ -209,9 +209,9 @@ std::unique_ptr<Analyzer> planned_analyzer(Setup& s, const std::string& taus, co
         fmt::format("stride factor {} with taus up to {} needs more memory than this process may use "
                     "({}): give a smaller stride factor or fewer taus",
                     o.stride_factor, o.m_list.back(), memory_budget_reason()));
-  // The sums of a held record (taus "all", counts of a known length) may take minutes: between
-  // blocks of taus a pending KeyboardInterrupt stops them (results()).
-  o.on_summed = [](std::size_t, std::size_t) {
+  // The sums of a held record (taus "all", counts of a known length) and the total family's taus
+  // may take minutes: between blocks of taus a pending KeyboardInterrupt stops them (results()).
+  o.on_progress = [](const char*, std::size_t, std::size_t) {
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) throw Interrupted{};
   };

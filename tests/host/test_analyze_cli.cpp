@@ -722,6 +722,32 @@ TEST(AnalyzeCli, ProgressOnRequestForLongInputs) {
     ASSERT_EQ(all.code, 0) << all.err;
     EXPECT_NE(all.err.find("summing: 100 of 100 taus\n"), std::string::npos) << all.err;
   }
+  // The total family says how far each statistic is, each stage ending with all its taus done (as
+  // many as its rows; TheoH's Theo1 taus and its bias ratio's, whose counts the rows do not show).
+  const Outcome total = run("--type phase --tau0 1 --stats oadev,totdev,mtotdev,theoh --progress --format csv " +
+                            good_phase());
+  ASSERT_EQ(total.code, 0) << total.err;
+  for (const std::string stat : {"totdev", "mtotdev"}) {
+    std::size_t rows = 0;
+    for (std::size_t at = total.out.find("\n" + stat + ","); at != std::string::npos;
+         at = total.out.find("\n" + stat + ",", at + 1))
+      ++rows;
+    ASSERT_GT(rows, 3u) << total.out;
+    const std::string n = std::to_string(rows);
+    EXPECT_NE(total.err.find("\rgyrochar-analyze: " + stat + ": " + n + " of " + n + " taus\n"), std::string::npos)
+        << stat << "\n"
+        << total.err;
+  }
+  for (const std::string stage : {"theoh bias ratio", "theoh"}) {
+    const std::string line = "\rgyrochar-analyze: " + stage + ": ";
+    const std::size_t at = total.err.rfind(line);  // the stage's last line
+    ASSERT_NE(at, std::string::npos) << stage << "\n" << total.err;
+    std::size_t done = 0, of = 0;
+    ASSERT_EQ(std::sscanf(total.err.c_str() + at + line.size(), "%zu of %zu taus\n", &done, &of), 2) << total.err;
+    EXPECT_EQ(done, of) << stage << "\n" << total.err;
+    EXPECT_GT(of, 0u) << stage;
+  }
+  EXPECT_EQ(total.out.find("gyrochar-analyze"), std::string::npos);
 }
 
 // The rows of --format csv: stat, m, n, dev.

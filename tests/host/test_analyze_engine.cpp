@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <map>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
@@ -401,7 +402,8 @@ TEST(AnalyzeEngine, HeldPhaseGivesTheCharacterizersRowsForEveryTau) {
       o.values_hint = clock.size();
       o.threads = 3;
       std::size_t told = 0, total = 0;
-      o.on_summed = [&](std::size_t done, std::size_t of) {
+      o.on_progress = [&](const char* stage, std::size_t done, std::size_t of) {
+        EXPECT_STREQ(stage, "summing");
         EXPECT_GT(done, told);
         told = done;
         total = of;
@@ -470,6 +472,43 @@ TEST(AnalyzeEngine, TheTotalFamilyOnTwoThreadsGivesTheBitsOfOne) {
           << name(one.rows[i].stat) << " m=" << one.rows[i].m << (decimated ? " (decimated)" : "");
     }
   }
+}
+
+TEST(AnalyzeEngine, TheTotalFamilyTellsHowFarItIsAndStopsWhenTold) {
+  // Oracle: AnalysisOptions::on_progress's contract. Each statistic of the total family is a stage
+  // (TheoH two: its bias ratio's taus, then its Theo1 taus) whose count rises to its total, told
+  // once with done = total, in the order of --stats; what the callback throws in any stage comes
+  // out of result(), on one thread and on two. The bias ratio's taus run in core, which the
+  // exception must not cross: it is held until core returns.
+  const std::vector<double> x = walk_and_white(6000, 11, 10);
+  struct Stop {};
+  for (const unsigned threads : {1u, 2u})
+    for (const std::string stop_at : {"", "totdev", "theoh bias ratio", "theoh"}) {
+      AnalysisOptions o;
+      o.type = DataType::phase;
+      o.stats = {DevStat::oadev, DevStat::totdev, DevStat::theoh};
+      o.m_list = octave_taus(x.size());
+      o.theo_m_list = theo_taus("octave", o.m_list, x.size());
+      o.threads = threads;
+      std::vector<std::string> ended;
+      std::map<std::string, std::size_t> told;
+      o.on_progress = [&](const char* stage, std::size_t done, std::size_t total) {
+        EXPECT_GT(done, told[stage]) << stage;
+        EXPECT_LE(done, total) << stage;
+        told[stage] = done;
+        if (done == total) ended.push_back(stage);
+        if (stage == stop_at) throw Stop{};
+      };
+      Analyzer a(o);
+      for (const double v : x) a.add(v);
+      if (stop_at.empty()) {
+        EXPECT_GT(a.result().rows.size(), 20u);
+        EXPECT_EQ(ended, (std::vector<std::string>{"totdev", "theoh bias ratio", "theoh"})) << threads;
+        EXPECT_GT(told["theoh bias ratio"], 1u);
+      } else {
+        EXPECT_THROW(a.result(), Stop) << stop_at << ", " << threads << " threads";
+      }
+    }
 }
 
 TEST(AnalyzeEngine, TheFitsLongTauPointsReuseTheoHsBiasRatio) {
