@@ -60,6 +60,7 @@ class CountBatchEngine final : public EngineBase {
       : stride_factor_(stride_factor), m_list_(m_list), keep_record_(keep_record) {
     narrow_.reserve(values_hint + 1);
     narrow_.push_back(0);  // x_0 = 0
+    prefault_.start(narrow_.data(), narrow_.capacity() * sizeof(std::int32_t));
   }
 
   void add(std::span<const double> values) override {
@@ -67,6 +68,7 @@ class CountBatchEngine final : public EngineBase {
     if (i == 1) add_one(values[0], 0);
     if (wide_.empty()) i = add_narrow(values, i);
     for (; i < values.size(); ++i) add_one(values[i], i);
+    prefault_.written(wide_.empty() ? narrow_.size() * sizeof(std::int32_t) : wide_.size() * sizeof(std::int64_t));
   }
 
   Analysis result(const AnalysisOptions& o) const override {
@@ -143,9 +145,11 @@ class CountBatchEngine final : public EngineBase {
       narrow_.push_back(static_cast<std::int32_t>(r));
     } else {
       if (wide_.empty()) {
+        prefault_.stop();  // before narrow_ goes
         wide_.reserve(narrow_.capacity());
         wide_.assign(narrow_.begin(), narrow_.end());
         Held<std::int32_t>().swap(narrow_);
+        prefault_.start(wide_.data(), wide_.capacity() * sizeof(std::int64_t));
       }
       wide_.push_back(r);
     }
@@ -168,6 +172,7 @@ class CountBatchEngine final : public EngineBase {
   std::int32_t lowest_ = INT32_MAX, highest_ = INT32_MIN;  // the counts' range: it bounds the terms
   Held<std::int32_t> narrow_;                              // the residuals while they fit in int32, x_0 first
   Held<std::int64_t> wide_;                                // all of them from the first that does not
+  Prefault prefault_;  // the residuals' pages faulted in ahead of the read pass (after them: goes first)
 };
 
 // Phase or frequency with the record held: the points as the characterizer stages them (relative

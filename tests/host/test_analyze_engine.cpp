@@ -3,18 +3,21 @@
 // estimator, the floating phase reference (a line added to phase changes nothing), and the lag
 // sums' workspace memory, the same bits on one thread or two, TheoH's bias ratio shared with the fit.
 #include <gtest/gtest.h>
+#include <sys/mman.h>
 
 #include <algorithm>
 #include <cfloat>
+#include <chrono>
 #include <cmath>
-#include <map>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <new>
 #include <random>
 #include <span>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "analysis.hpp"
@@ -577,6 +580,49 @@ TEST(AnalyzeEngine, HeldMemoryIsAlignedToHugePagesFromFourMiB) {
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % huge, 0u);
   for (std::int32_t i = 0; i < (1 << 21) + 5; i += 4099) ASSERT_EQ(v[static_cast<std::size_t>(i)], i);
   EXPECT_THROW((void)allocate_held(SIZE_MAX - 10), std::bad_alloc);
+}
+
+// Oracle: mincore(2), the kernel's own account of which pages are in memory, and the values
+// written. Prefault (held_memory.hpp) brings in the pages up to its lead past what is written,
+// not the rest of the buffer, and never changes what the writer wrote, while both run. A buffer
+// below 4 MiB is left alone.
+TEST(AnalyzeEngine, PrefaultBringsInThePagesAheadOfTheWriterAndNoMore) {
+  constexpr std::size_t mib = std::size_t{1} << 20, bytes = 64 * mib;
+  void* p = allocate_held(bytes);
+  auto* v = static_cast<std::uint32_t*>(p);
+  const auto resident = [&](std::size_t from, std::size_t to) {  // every 4 KiB page of [from, to)
+    std::vector<unsigned char> in((to - from) / 4096);
+    EXPECT_EQ(mincore(static_cast<char*>(p) + from, to - from, in.data()), 0);
+    return std::all_of(in.begin(), in.end(), [](unsigned char c) { return (c & 1) != 0; });
+  };
+  const auto nothing_in = [&](std::size_t from, std::size_t to) {
+    std::vector<unsigned char> in((to - from) / 4096);
+    EXPECT_EQ(mincore(static_cast<char*>(p) + from, to - from, in.data()), 0);
+    return std::none_of(in.begin(), in.end(), [](unsigned char c) { return (c & 1) != 0; });
+  };
+  {
+    Prefault ahead;
+    ahead.start(p, bytes);
+    const std::size_t written = 4 * mib;
+    for (std::size_t i = 0; i < written / 4; ++i) v[i] = static_cast<std::uint32_t>(i * 2654435761u);
+    ahead.written(written);
+    bool in = false;  // the thread's work: waited for, at most 10 s
+    for (int tries = 0; tries < 1000 && !(in = resident(written, written + Prefault::lead)); ++tries)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    EXPECT_TRUE(in);
+    EXPECT_TRUE(nothing_in(written + Prefault::lead + 2 * mib, bytes));  // past the lead, rounded to 2 MiB
+    for (std::size_t i = written / 4; i < bytes / 4; ++i) {              // the rest, the thread running beside
+      v[i] = static_cast<std::uint32_t>(i * 2654435761u);
+      if (i % (1 << 18) == 0) ahead.written(4 * i);
+    }
+  }
+  for (std::size_t i = 0; i < bytes / 4; ++i) ASSERT_EQ(v[i], static_cast<std::uint32_t>(i * 2654435761u)) << i;
+  std::free(p);
+  void* small = allocate_held(mib);
+  Prefault none;
+  none.start(small, mib);
+  none.written(0);  // nothing to do, nothing to wait for
+  std::free(small);
 }
 
 }  // namespace
