@@ -53,9 +53,9 @@ unsigned total_threads(const AnalysisOptions& o) { return std::min(thread_count(
 
 // A stage's progress (AnalysisOptions::on_progress): its pieces (`per_tau` a tau) finished on any
 // thread, the taus they make told from the calling thread (worker 0) after each of its own pieces
-// that finds more of them done, and once at the end. What
-// the callback throws (the Python module's KeyboardInterrupt) stops the stage: on_threads lets the
-// other threads finish their piece, then rethrows it.
+// that finds more of them done, and once at the end. What the callback throws (the Python module's
+// KeyboardInterrupt) stops the stage: on_threads lets the other threads finish their piece, then
+// rethrows it.
 class Tally {
  public:
   Tally(const AnalysisOptions& o, const char* stage, std::size_t taus, std::size_t per_tau = 1)
