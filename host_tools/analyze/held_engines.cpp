@@ -64,6 +64,9 @@ class CountBatchEngine final : public EngineBase {
   }
 
   void add(std::span<const double> values) override {
+    const std::size_t held = wide_.empty() ? narrow_.size() : wide_.size();
+    if (held + values.size() > (wide_.empty() ? narrow_.capacity() : wide_.capacity()))
+      prefault_.stop();  // past the bound reserved (a gzip member's size is a hint): the buffer moves
     std::size_t i = counts_ == 0 && !values.empty() ? 1 : 0;  // the first count sets the line
     if (i == 1) add_one(values[0], 0);
     if (wide_.empty()) i = add_narrow(values, i);
