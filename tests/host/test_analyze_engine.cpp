@@ -548,6 +548,40 @@ TEST(AnalyzeEngine, TheFitsLongTauPointsReuseTheoHsBiasRatio) {
   EXPECT_GE(long_tau, 2u);
 }
 
+TEST(AnalyzeEngine, HeldCountsPastTheirReserveAreTheSameBits) {
+  // Oracle: the same counts held under a bound that holds them. Under a short bound (a gzip
+  // member's stated size can be one) the held residuals move past their reserve while their pages
+  // are being faulted in ahead (held_memory.hpp's Prefault, from 4 MiB on): every row is the same
+  // bits, with int32 residuals and across the switch to int64 ones.
+  const std::size_t n = std::size_t{3} << 20;
+  std::mt19937_64 rng(5);
+  std::vector<double> counts(n);
+  for (double& c : counts) c = 3600.0 + static_cast<double>(rng() % 21) - 10.0;
+  for (const bool step : {false, true}) {
+    if (step)
+      for (std::size_t k = n / 2; k < n; ++k) counts[k] += 2.0e6;  // residuals past int32 within 1100 counts
+    const auto analysis = [&](std::uint64_t hint) {
+      AnalysisOptions o;
+      o.type = DataType::counts;
+      o.stats = {DevStat::oadev, DevStat::mdev};
+      o.stride_factor = full_stride_factor(n + 1);
+      o.m_list = octave_taus(n + 1);
+      o.hold_counts = true;
+      o.values_hint = hint;
+      Analyzer a(o);
+      for (std::size_t k = 0; k < n; k += std::size_t{1} << 16)
+        a.add(std::span<const double>(counts.data() + k, std::min(std::size_t{1} << 16, n - k)));
+      return a.result();
+    };
+    const Analysis held = analysis(n), outgrown = analysis((std::size_t{1} << 20) + 10);
+    ASSERT_EQ(held.rows.size(), outgrown.rows.size());
+    ASSERT_GT(held.rows.size(), 30u);
+    for (std::size_t i = 0; i < held.rows.size(); ++i)
+      EXPECT_EQ(held.rows[i].dev, outgrown.rows[i].dev)
+          << name(held.rows[i].stat) << " m=" << held.rows[i].m << " step " << step;
+  }
+}
+
 TEST(AnalyzeEngine, LagSumWorkspacesAreWholeOrRefused) {
   // uninitialized_doubles()'s contract (held_memory.hpp): n doubles, every one writable; an impossible size
   // is std::bad_alloc, never a short buffer.
