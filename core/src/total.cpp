@@ -306,7 +306,7 @@ bool block_ok(std::uint64_t block, std::uint64_t m) {
 }
 
 template <class T>
-TotalVariance totvar_of(std::span<const T> x, std::uint64_t m, double tau0_s) {
+TotalVariance totvar_of(std::span<const T> x, std::uint64_t m, double tau0_s, const double* interior) {
   const Index N = x.size();
   if (N < 3 || m < 1 || m > N - 1 || !(tau0_s > 0)) return {};
   const Index M = as_index(m), last = N - 1;
@@ -326,7 +326,7 @@ TotalVariance totvar_of(std::span<const T> x, std::uint64_t m, double tau0_s) {
   // reflect at the end (i > last - M).
   double sum = 0.0;
   if (M <= last - M) {
-    sum = terms(1, M) + totvar_interior(x.data(), M, last - M + 1, M);
+    sum = terms(1, M) + (interior ? *interior : totvar_interior(x.data(), M, last - M + 1, M));
     sum += terms(last - M + 1, last);
   } else {
     sum = terms(1, last);
@@ -430,7 +430,13 @@ TotalVariance oavar_of(std::span<const T> x, std::uint64_t m, double tau0_s, std
 }  // namespace
 
 TotalVariance totvar(PhaseSpan x, std::uint64_t m, double tau0_s) {
-  return x.visit([&](auto v) { return totvar_of(v, m, tau0_s); });
+  return x.visit([&](auto v) { return totvar_of(v, m, tau0_s, nullptr); });
+}
+
+TotalVariance totvar_from_interior(PhaseSpan x, std::uint64_t m, double tau0_s, double interior) {
+  const std::uint64_t N = x.size();
+  if (N < 3 || m < 1 || 2 * m > N - 1 || !(interior >= 0)) return {};
+  return x.visit([&](auto v) { return totvar_of(v, m, tau0_s, &interior); });
 }
 
 TotalVariance mtotvar(PhaseSpan x, std::uint64_t block, std::uint64_t m, double tau0_s, std::span<double> scratch) {

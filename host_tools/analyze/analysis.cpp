@@ -312,7 +312,10 @@ void read_out(Analysis& a, const std::vector<TauSums>& sums, DataType type, cons
       rows_of(stat, a.rows);
       continue;
     }
-    const auto total = total_rows(stat, record, options.unit, o, allan, lag_sums);
+    // Counts' sums are exact integer sums of the held record's own terms (CountArith, batch.hpp).
+    const std::span<const TauSums> exact = type == DataType::counts ? std::span<const TauSums>(sums)
+                                                                    : std::span<const TauSums>();
+    const auto total = total_rows(stat, record, options.unit, o, allan, exact, lag_sums);
     a.rows.insert(a.rows.end(), total.begin(), total.end());
   }
   a.theoh_bias = lag_sums.theoh_bias;

@@ -193,9 +193,22 @@ std::vector<AnalysisRow> theo_rows(DevStat stat, PhaseSpan x, double k2, const A
   return rows;
 }
 
+// The sum of the overlapping AVAR's N - 2m terms at m, (x_{i+2m} - 2 x_{i+m} + x_i)^2, from the
+// engine's exact sums of the held record (total_rows()), or -1 where they do not hold it.
+double avar_terms(std::span<const TauSums> exact_sums, std::uint64_t m, std::uint64_t N) {
+  const auto k = static_cast<std::size_t>(SumKind::avar);
+  for (const TauSums& t : exact_sums)
+    if (t.m == m && t.stride == 1 && t.clean && 2 * m < N && t.n[k] == N - 2 * m) {
+      const double md = static_cast<double>(m);  // variance[k]: the sum / (2 n m^2) (estimates.hpp)
+      return t.variance[k] * (2.0 * static_cast<double>(t.n[k]) * md * md);
+    }
+  return -1.0;
+}
+
 // TOTDEV, MTOTDEV, TTOTDEV or HTOTDEV at o.m_list: k2 is phase_scale squared.
 std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2, const AnalysisOptions& o,
-                                           const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums) {
+                                           const std::vector<AnalysisRow>& allan, std::span<const TauSums> exact_sums,
+                                           LagSumRecord& lag_sums) {
   std::vector<AnalysisRow> rows;
   const std::uint64_t N = x.size();
   const double n = static_cast<double>(N), tau0 = o.tau0_s;
@@ -219,7 +232,12 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
                                8 * (static_cast<std::uint64_t>(fast_size) + N) > memory_budget();
   std::vector<TotalVariance> v;
   if (stat == DevStat::totdev) {
-    v = estimates(ms, threads, o, name(stat), [&](unsigned, std::uint64_t m) { return totvar(x, m, tau0); });
+    // TOTVAR's terms that need no reflection are the overlapping AVAR's at the same m: where the
+    // engine summed those exactly, only the 2 (m - 1) reflected ones are left, O(m) and not O(N).
+    v = estimates(ms, threads, o, name(stat), [&](unsigned, std::uint64_t m) {
+      const double interior = avar_terms(exact_sums, m, N);
+      return interior >= 0 ? totvar_from_interior(x, m, tau0, interior) : totvar(x, m, tau0);
+    });
   } else if (!total_decimated) {
     // Each tau in its two pieces (total_fast.hpp), the largest tau first and its FFTs first: its two
     // pieces, the dearest work, go on both threads at once.
@@ -340,10 +358,11 @@ std::span<LagSumView> LagSumRecord::views(PhaseSpan x, bool frequencies, unsigne
 }
 
 std::vector<AnalysisRow> total_rows(DevStat stat, PhaseSpan x, double phase_scale, const AnalysisOptions& o,
-                                    const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums) {
+                                    const std::vector<AnalysisRow>& allan, std::span<const TauSums> exact_sums,
+                                    LagSumRecord& lag_sums) {
   const double k2 = phase_scale * phase_scale;
   if (stat == DevStat::theo1 || stat == DevStat::theoh) return theo_rows(stat, x, k2, o, allan, lag_sums);
-  return total_family_rows(stat, x, k2, o, allan, lag_sums);
+  return total_family_rows(stat, x, k2, o, allan, exact_sums, lag_sums);
 }
 
 }  // namespace gyrochar

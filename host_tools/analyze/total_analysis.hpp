@@ -60,10 +60,13 @@ class LagSumRecord {
 /// Theo1 (and TheoBR's Theo1 factor) exact at every tau by lag sums (total_fast.hpp) unless
 /// o.theo_decimated, and MTOTDEV/TTOTDEV/HTOTDEV the same unless o.total_decimated (each also falls
 /// back to the plan when its lag-sum workspace would pass the memory budget).
-/// `allan`: the run's oadev, mdev and ohdev rows at its taus. Allocates the kernels' scratch and the
-/// rows; O(N) per tau for TOTDEV, O(N S) to O(N S^2 / m) for the others (docs/total.md).
-/// `lag_sums`: the run's one LagSumRecord.
+/// `allan`: the run's oadev, mdev and ohdev rows at its taus. `exact_sums`: the engine's sums where
+/// they are exact sums of the held record's own terms (counts; else empty): TOTDEV takes its
+/// unreflected terms from the overlapping AVAR's sum at the same m. Allocates the kernels' scratch
+/// and the rows; O(N) per tau for TOTDEV (O(m) with exact sums), O(N S) to O(N S^2 / m) for the
+/// others (docs/total.md). `lag_sums`: the run's one LagSumRecord.
 std::vector<AnalysisRow> total_rows(DevStat stat, PhaseSpan phase, double phase_scale, const AnalysisOptions& o,
-                                    const std::vector<AnalysisRow>& allan, LagSumRecord& lag_sums);
+                                    const std::vector<AnalysisRow>& allan, std::span<const TauSums> exact_sums,
+                                    LagSumRecord& lag_sums);
 
 }  // namespace gyrochar

@@ -142,6 +142,22 @@ TEST(Total, TotvarEqualsTheDefinition) {
   EXPECT_EQ(totvar(std::vector<double>{1, 2}, 1, 1.0).n, 0u);
 }
 
+TEST(Total, TotvarFromTheAvarTermsSumEqualsTheDefinition) {
+  // The unreflected terms given as the overlapping AVAR's sum (oracle: that sum in long double from
+  // its definition, SP 1065 eq. 25 for the whole), at every m the AVAR has.
+  const auto x = record(257, 2);
+  for (std::uint64_t m = 1; 2 * m <= x.size() - 1; ++m) {
+    const LD tau = static_cast<LD>(m) * 0.5;
+    const LD avar_terms = oavar_oracle(x, m, 0.5) * 2 * static_cast<LD>(x.size() - 2 * m) * tau * tau;
+    const TotalVariance t = totvar_from_interior(x, m, 0.5, static_cast<double>(avar_terms));
+    EXPECT_EQ(t.n, 255u);
+    expect_rel(t.var, totvar_oracle(x, m, 0.5), 1e-11, "totvar from the AVAR's terms", m);
+  }
+  EXPECT_EQ(totvar_from_interior(x, 129, 0.5, 1.0).n, 0u);  // 2m > N - 1: no AVAR term
+  EXPECT_EQ(totvar_from_interior(x, 4, 0.5, -1.0).n, 0u);
+  EXPECT_EQ(totvar_from_interior(x, 4, 0.5, NAN).n, 0u);
+}
+
 TEST(Total, MtotvarAndTtotvarEqualTheDefinition) {
   const auto x = record(200, 2);
   std::vector<double> scratch(total_scratch_size(66, 1));

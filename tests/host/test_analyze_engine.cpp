@@ -305,11 +305,12 @@ TEST(AnalyzeEngine, FrequencyOffsetChangesNoTotalStatistic) {
 TEST(AnalyzeEngine, CountsEqualTheirPhaseExactly) {
   // Counts c_k and the phase x_k = sum_{i<k} c_i (with x_0 = 0) are the same data: equal n and
   // deviations (oracle: the definitions; integer phase below 2^53 is exact in double as well).
+  // Counts' TOTDEV takes its unreflected terms from the exact AVAR sums, phase's sums them.
   std::mt19937_64 rng(3);
   std::uniform_int_distribution<int> count(-1000, 1000);
   AnalysisOptions o;
   o.m_list = {1, 3, 16, 100};
-  o.stats = {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::hdev, DevStat::ohdev};
+  o.stats = {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::hdev, DevStat::ohdev, DevStat::totdev};
   o.alpha = 0;
   AnalysisOptions p = o;
   o.type = DataType::counts;
@@ -345,7 +346,7 @@ TEST(AnalyzeEngine, HeldCountsGiveTheCharacterizersRowsBitForBit) {
     const std::size_t n = step ? counts.size() : 3000;
     AnalysisOptions o;
     o.type = DataType::counts;
-    o.stats = {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::tdev, DevStat::hdev, DevStat::ohdev};
+    o.stats = {DevStat::adev, DevStat::oadev, DevStat::mdev, DevStat::tdev, DevStat::hdev, DevStat::ohdev, DevStat::totdev};
     o.stride_factor = full_stride_factor(n + 1);
     o.m_list = octave_taus(n + 1);
     Analyzer pyramid(o);

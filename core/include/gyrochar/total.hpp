@@ -105,6 +105,13 @@ struct TotalVariance {
 /// Undefined input (N < 3, m out of range, tau0_s <= 0) gives n = 0.
 TotalVariance totvar(PhaseSpan x, std::uint64_t m, double tau0_s);
 
+/// TOTVAR as totvar() with the terms that need no reflection given: those of m <= i <= N - 1 - m,
+/// (x_{i-m} - 2 x_i + x_{i+m})^2, are the overlapping AVAR's N - 2m terms at the same m, and
+/// `interior` is their sum (an Allan engine's, exact for counts: docs/total.md). Only the 2 (m - 1)
+/// reflected terms are summed here: O(m), reads x only. Needs 1 <= m and 2m <= N - 1 (else, or
+/// with a negative or NaN sum, n = 0).
+TotalVariance totvar_from_interior(PhaseSpan x, std::uint64_t m, double tau0_s, double interior);
+
 /// The block sums MTOTVAR's decimated variant holds at a time: those of this many sub-sequence
 /// starts (and the 3 m / block - 1 more the last one reaches), not the whole record's.
 inline constexpr std::size_t total_window = 65536;
