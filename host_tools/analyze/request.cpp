@@ -103,9 +103,10 @@ are exact at every tau (lag sums, O(N log N) once and about O(m log^2 m) per tau
 that passes the memory budget); --theo-decimated takes the decimated estimator instead where the
 direct one costs over 2^26 operations. Mtotdev, ttotdev and htotdev rows are exact at every tau
 the same way (lag sums, about O(m log m) per tau, holding 4 N doubles more than Theo1;
---total-decimated takes the plan below instead). TheoBR's bias ratio, and totdev (and mtotdev,
-ttotdev, htotdev under --total-decimated), are exact where that costs at most 2^26 operations at their
-tau and decimated beyond (blocks or sub-sequences every m/S samples, S from
+--total-decimated takes the plan below instead). Totdev rows are exact at every tau (O(N) a tau;
+for counts O(m), the overlapping AVAR's exact sum standing for the terms it shares). TheoBR's bias
+ratio (and mtotdev, ttotdev, htotdev under --total-decimated) is exact where that costs at most
+2^26 operations at its tau and decimated beyond (blocks or sub-sequences every m/S samples, S from
 --total-stride-factor, 16 by default; 'exact' never decimates), except that for counts mtotdev,
 ttotdev and htotdev rows up to m = 128 stay exact (one pass over the record's differences, then
 O(m^3) a tau): the stride column says which. Where the noise is identified the deviations carry Stable32's bias
