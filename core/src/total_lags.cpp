@@ -55,15 +55,40 @@ double difference(const T* x, Index j, int order) {
   return static_cast<double>((c - b) - (b - a));
 }
 
-// out[i] = w[from + i] for i < count, zero past the last difference; the largest |w| loaded.
-double load(PhaseSpan x, int order, Index values, Index from, Index count, double* out) {
+// The sum of x over group k of `group` samples, modulo 2^64 (so its differences are exact while
+// they are below 2^63).
+template <class T>
+std::uint64_t group_sum(const T* x, Index k, Index group) {
+  std::uint64_t sum = 0;
+  for (const T* p = x + k * group; p < x + (k + 1) * group; ++p) sum += static_cast<std::uint64_t>(std::int64_t{*p});
+  return sum;
+}
+
+// out[i] = w[from + i] for i < count, zero past the last difference, w the differences of the
+// record's sums over groups of `group` samples (1: of x itself); the largest |w| loaded.
+double load(PhaseSpan x, Index group, int order, Index values, Index from, Index count, double* out) {
   double largest = 0;
   x.visit([&]<class T>(std::span<const T> v) {
     if constexpr (!std::is_floating_point_v<T>) {
-      for (Index i = 0; i < count; ++i) {
-        out[i] = from + i < values ? difference(v.data(), from + i, order) : 0.0;
-        largest = out[i] > largest ? out[i] : -out[i] > largest ? -out[i] : largest;
+      const Index have = from < values ? (values - from < count ? values - from : count) : 0;
+      if (group == 1) {
+        for (Index i = 0; i < have; ++i) out[i] = difference(v.data(), from + i, order);
+      } else {
+        // The group sums from `from` on, each once: g holds the last order + 1 of them. Their
+        // differences modulo 2^64, as the sums.
+        const auto less = [](std::uint64_t a, std::uint64_t b) { return a - b; };
+        std::uint64_t g[4];
+        for (Index k = 0; k < static_cast<Index>(order) && k < have; ++k) g[k] = group_sum(v.data(), from + k, group);
+        for (Index i = 0; i < have; ++i) {
+          g[order] = group_sum(v.data(), from + i + static_cast<Index>(order), group);
+          const std::uint64_t a = less(g[1], g[0]), b = less(g[2], g[1]);
+          const std::uint64_t w = order == 2 ? less(b, a) : less(less(less(g[3], g[2]), b), less(b, a));
+          out[i] = static_cast<double>(static_cast<std::int64_t>(w));
+          for (int k = 0; k < order; ++k) g[k] = g[k + 1];
+        }
       }
+      for (Index i = 0; i < have; ++i) largest = out[i] > largest ? out[i] : -out[i] > largest ? -out[i] : largest;
+      for (Index i = have; i < count; ++i) out[i] = 0.0;
     }
   });
   return largest;
@@ -118,6 +143,7 @@ void block_products_scalar(const double* a, const double* r, Index lags, double*
 
 struct Pass {
   PhaseSpan x;
+  Index group;
   int order;
   Index lags, values;
   ExactSum* sums;   // stripes x lags
@@ -136,9 +162,8 @@ void stripe(const Pass& p, Index s) {
   double largest = 0;
   for (Index c0 = j0; c0 < j1; c0 += chunk) {
     const Index n = j1 - c0 < chunk ? j1 - c0 : chunk, rounded = (n + block - 1) / block * block;
-    load(p.x, p.order, p.values, c0, n, left);
-    for (Index i = n; i < rounded; ++i) left[i] = 0.0;  // the next stripe's products
-    const double most = load(p.x, p.order, p.values, c0, rounded + lags + 4, right);
+    const double most = load(p.x, p.group, p.order, p.values, c0, rounded + lags + 4, right);
+    for (Index i = 0; i < rounded; ++i) left[i] = i < n ? right[i] : 0.0;  // past n: the next stripe's products
     largest = most > largest ? most : largest;
     for (Index d = 0; d < lags; ++d) partial[d] = 0.0;
     for (Index b = 0; b < rounded; b += block) {
@@ -232,17 +257,18 @@ double window_mean(const LagTable& t, std::uint64_t m, std::span<double> scratch
 
 std::size_t lag_table_size(std::size_t lags) { return lags * (2 * lags + 1 + stripes); }
 
-LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum> work, const RowRunner* runner) {
+LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum> work, const RowRunner* runner,
+                   std::uint64_t group) {
   LagTable t;
-  if ((order != 2 && order != 3) || !x.integers() || x.size() <= static_cast<Index>(order) || lags < 1 || lags > max_lags ||
-      work.size() < lag_table_size(lags))
+  if ((order != 2 && order != 3) || !x.integers() || group < 1 || x.size() / group <= static_cast<Index>(order) ||
+      lags < 1 || lags > max_lags || work.size() < lag_table_size(lags))
     return t;
-  const Index values = x.size() - static_cast<Index>(order);
+  const Index values = x.size() / group - static_cast<Index>(order);
   ExactSum* total = work.data();
   ExactSum* head = total + lags;
   ExactSum* tail = head + lags * lags;
   double largest[stripes];
-  Pass pass{x, order, lags, values, tail + lags * lags, largest};
+  Pass pass{x, static_cast<Index>(group), order, lags, values, tail + lags * lags, largest};
   run_rows(runner, Rows{[](void* p, std::size_t s) { stripe(*static_cast<const Pass*>(p), s); }, &pass}, stripes);
   for (Index s = 0; s < stripes; ++s)
     if (!(largest[s] * largest[s] < exact_products)) return t;  // a chunk's sums might have rounded
@@ -253,8 +279,8 @@ LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum>
   // The ends: the first and the last 2 lags differences (or fewer), their products directly.
   const Index span = 2 * lags < values ? 2 * lags : values;
   double first[2 * max_lags], last[2 * max_lags];
-  load(x, order, values, 0, span, first);
-  load(x, order, values, values - span, span, last);
+  load(x, static_cast<Index>(group), order, values, 0, span, first);
+  load(x, static_cast<Index>(group), order, values, values - span, span, last);
   for (Index d = 0; d < lags; ++d) {
     ExactSum* h = head + d * lags;
     ExactSum* e = tail + d * lags;

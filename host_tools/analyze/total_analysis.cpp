@@ -205,6 +205,26 @@ double avar_terms(std::span<const TauSums> exact_sums, std::uint64_t m, std::uin
   return -1.0;
 }
 
+// The decimated MTOTVAR of integer record x on blocks of b samples (b a power of two, m / b even, 3 m
+// / b - 2 lags at most the table's) from the lag table of the block sums, exactly as mtotvar(x, b,
+// m) computes it, rounded once; n = 0 where the table cannot hold the sums exactly. `work` and
+// `scratch`: the caller's, resized here.
+TotalVariance mtotvar_of_blocks(PhaseSpan x, std::uint64_t b, std::uint64_t m, double tau0, std::vector<ExactSum>& work,
+                                std::vector<double>& scratch) {
+  const std::uint64_t S = m / b, lags = 3 * S - 2;
+  if (S > lag_table_max_m || 3 * S > x.size() / b) return {};
+  work.resize(lag_table_size(lags));
+  const LagTable table = lag_table(x, 2, lags, work, nullptr, b);
+  if (!table.ready) return {};
+  scratch.resize(lagged_scratch_size(S));
+  TotalVariance t = mtotvar_lagged(table, S, tau0, scratch);
+  int shift = 0;
+  while ((std::uint64_t{1} << shift) < b) ++shift;
+  t.var = std::ldexp(t.var, -4 * shift);  // (S / m)^4 = b^-4: tau and the 1 / m^2 of the definition
+  t.stride = b;
+  return t;
+}
+
 // TOTDEV, MTOTDEV, TTOTDEV or HTOTDEV at o.m_list: k2 is phase_scale squared.
 std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2, const AnalysisOptions& o,
                                            const std::vector<AnalysisRow>& allan, std::span<const TauSums> exact_sums,
@@ -278,8 +298,10 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
       const ThreadRows runner(threads);
       table = lag_table(x, hadamard ? 3 : 2, 3 * table_m - 2, table_work, &runner);
     }
-    // Per thread: the plan's block sums and prefix sums, or the table's coefficients.
+    // Per thread: the plan's block sums and prefix sums, or the table's coefficients; for counts'
+    // decimated MTOTVAR the lag table of the block sums.
     std::array<std::vector<double>, 2> scratch;
+    std::array<std::vector<ExactSum>, 2> blocks_work;
     v = estimates(ms, threads, o, name(stat), [&](unsigned worker, std::uint64_t m) {
       std::vector<double>& own = scratch[worker];
       if (table.ready && from_table(m)) {
@@ -287,6 +309,13 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
         return hadamard ? htotvar_lagged(table, m, tau0, own) : mtotvar_lagged(table, m, tau0, own);
       }
       const std::uint64_t b = total_block(m, N, S);
+      if (!hadamard && b > 1 && x.integers()) {
+        // The decimated MTOTVAR is MTOTVAR at m / b of the record's sums over blocks of b samples,
+        // times b^-4 (docs/total.md). Counts' block sums are integers: their lag table gives it
+        // exactly, O((N / b) (3 m / b)), where the table can hold their differences' products.
+        const TotalVariance t = mtotvar_of_blocks(x, b, m, tau0, blocks_work[worker], own);
+        if (t.n != 0) return t;
+      }
       own.resize(total_scratch_size(m, b));
       return hadamard ? htotvar(x, b, m, tau0, own) : mtotvar(x, b, m, tau0, own);
     });

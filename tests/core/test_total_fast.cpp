@@ -599,14 +599,11 @@ TEST(TotalLags, EqualsTheDefinitionAtEveryM) {
   }
 }
 
-TEST(TotalLags, CountsGiveExactSumsOnAnyThreads) {
-  // A counter's phase as int32 residuals from a line (the analyzer's record): the differences are
-  // integers, so every sum of the table is exact. Oracle: the same sums in int64, written out; the
-  // table built on a runner (its stripes in reverse order) against the table built in turn: the
-  // same bits.
-  std::mt19937_64 rng(9);
+// A counter's phase in int32 (x_0 = 0): counts of a random-walk rate plus white noise, rounded.
+std::vector<std::int32_t> counter_phase(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
   std::normal_distribution<double> z;
-  std::vector<std::int32_t> x(40000);
+  std::vector<std::int32_t> x(n);
   double walk = 0;
   std::int64_t phase = 0;
   for (std::size_t i = 1; i < x.size(); ++i) {
@@ -614,6 +611,15 @@ TEST(TotalLags, CountsGiveExactSumsOnAnyThreads) {
     phase += std::lround(walk + 3.0 * z(rng));
     x[i] = static_cast<std::int32_t>(phase);
   }
+  return x;
+}
+
+TEST(TotalLags, CountsGiveExactSumsOnAnyThreads) {
+  // A counter's phase as int32 residuals from a line (the analyzer's record): the differences are
+  // integers, so every sum of the table is exact. Oracle: the same sums in int64, written out; the
+  // table built on a runner (its stripes in reverse order) against the table built in turn: the
+  // same bits.
+  const std::vector<std::int32_t> x = counter_phase(40000, 9);
   constexpr std::size_t lags = 3 * 64 - 2;
   std::vector<ExactSum> work(lag_table_size(lags)), again(lag_table_size(lags));
   const LagTable t = lag_table(x, 2, lags, work);
@@ -646,6 +652,47 @@ TEST(TotalLags, CountsGiveExactSumsOnAnyThreads) {
   std::vector<std::int64_t> wide(100);
   wide[50] = std::int64_t{1} << 40;
   EXPECT_FALSE(lag_table(wide, 2, lags, work).ready);
+}
+
+TEST(TotalLags, GroupSumsGiveTheDecimatedEstimator) {
+  // The table of a counter's sums over groups of g samples, formed as they are read. Oracles: the
+  // group sums' products written out in int64 (exact), and the decimated estimator mtotvar(x, g,
+  // m) (total.hpp, direct double sums: their own rounding), which is MTOTVAR at m / g of the group
+  // sums over g^4. N = 40001 is a multiple of none of the groups: the last partial group is left out.
+  const std::vector<std::int32_t> x = counter_phase(40001, 10);
+  constexpr std::size_t lags = 3 * 16 - 2;
+  std::vector<ExactSum> work(lag_table_size(lags));
+  std::vector<double> scratch(lagged_scratch_size(16)), direct_scratch;
+  const auto value = [](ExactSum e) { return static_cast<std::int64_t>(e.hi) + static_cast<std::int64_t>(e.lo); };
+  for (const std::uint64_t g : {2u, 3u, 16u, 64u}) {
+    const LagTable t = lag_table(x, 2, lags, work, nullptr, g);
+    ASSERT_TRUE(t.ready) << g;
+    std::vector<std::int64_t> sums(x.size() / g, 0), w;
+    for (std::size_t k = 0; k < sums.size(); ++k)
+      for (std::size_t i = 0; i < g; ++i) sums[k] += x[k * g + i];
+    for (std::size_t j = 0; j + 2 < sums.size(); ++j) w.push_back(sums[j + 2] - 2 * sums[j + 1] + sums[j]);
+    ASSERT_EQ(t.values, w.size()) << g;
+    for (const std::size_t d : {0u, 1u, 17u, 45u}) {
+      std::int64_t total = 0, head = 0, tail = 0;
+      for (std::size_t j = 0; j + d < w.size(); ++j) total += w[j] * w[j + d];
+      for (std::size_t c = 0; c < 20; ++c) head += w[c] * w[c + d], tail += w[w.size() - 1 - d - c] * w[w.size() - 1 - c];
+      EXPECT_EQ(value(t.total[d]), total) << g << " " << d;
+      EXPECT_EQ(value(t.head[d * lags + 20]), head) << g << " " << d;
+      EXPECT_EQ(value(t.tail[d * lags + 20]), tail) << g << " " << d;
+    }
+    if (g % 2 != 0) continue;  // the decimated estimator takes blocks of a power of two
+    for (const std::uint64_t s : {2u, 4u, 16u}) {
+      const std::uint64_t m = s * g;
+      direct_scratch.resize(total_scratch_size(m, g));
+      const TotalVariance lagged = mtotvar_lagged(t, s, 0.5, scratch), direct = mtotvar(x, g, m, 0.5, direct_scratch);
+      ASSERT_GT(direct.n, 0u);
+      EXPECT_EQ(lagged.n, direct.n) << g << " " << m;
+      const double g4 = static_cast<double>(g * g * g * g);
+      EXPECT_NEAR(lagged.var / g4, direct.var, 1e-12 * direct.var) << g << " " << m;  // the direct sums' rounding
+    }
+  }
+  EXPECT_FALSE(lag_table(x, 2, lags, work, nullptr, 0).ready);
+  EXPECT_FALSE(lag_table(x, 2, lags, work, nullptr, x.size() / 2).ready);  // two sums: no difference of order 2
 }
 
 TEST(TotalLags, UndefinedInputGivesNoTerms) {

@@ -545,7 +545,7 @@ TEST(AnalyzeCli, CountsKeepExactMtotRowsUpToM128UnderThePlan) {
   // and 8); for counts they now come exact from the lag table of the differences (total_lags.hpp),
   // stride 1; m = 256 stays decimated. Oracle: the direct exact mtotvar and htotvar (total.hpp) on
   // the phase, as the ratio of the m = 64 and 128 rows to the m = 16 row (direct and exact either
-  // way), free of units.
+  // way), free of units; the same for the decimated MTOTDEV rows against the decimated estimator.
   std::mt19937_64 rng(8);
   std::normal_distribution<double> z;
   std::string s;
@@ -583,6 +583,20 @@ TEST(AnalyzeCli, CountsKeepExactMtotRowsUpToM128UnderThePlan) {
       EXPECT_NEAR(got / want, 1.0, 1e-11) << stat << " m=" << m;  // the direct sums' rounding
     }
   }
+  // MTOTDEV's decimated rows come from the lag tables of the block sums: the estimator mtotvar(x, b,
+  // m) computes (total.hpp, the oracle here, summed directly in double), at every decimated m.
+  int decimated = 0;
+  for (const auto& [m, row] : rows["mtotdev"]) {
+    const std::uint64_t b = gyrochar::total_block(m, x.size(), 16);
+    if (m <= 128) continue;  // exact, above
+    ++decimated;
+    EXPECT_EQ(row["stride"], b) << "m=" << m;
+    std::vector<double> own(gyrochar::total_scratch_size(m, b));
+    const double want = std::sqrt(gyrochar::mtotvar(x, b, m, 1.0, own).var / gyrochar::mtotvar(x, 1, 16, 1.0, scratch).var);
+    const double got = row["dev"].get<double>() / rows["mtotdev"][16]["dev"].get<double>();
+    EXPECT_NEAR(got / want, 1.0, 1e-11) << "mtotdev m=" << m;
+  }
+  EXPECT_EQ(decimated, 7);  // m = 256 .. 16384
 }
 
 TEST(AnalyzeCli, UnwritableOutputIsOutputFailed) {

@@ -64,7 +64,12 @@ std::size_t lag_table_size(std::size_t lags);
 /// record x, at every lag below `lags` (at most 3 lag_table_max_m - 2), in `work`
 /// (lag_table_size(lags)), exactly. The record goes in 16 stripes, run as rows on `runner` (null: in
 /// turn): exact sums, the same on any number of threads. O(N lags), 150 KB of stack a row.
-LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum> work, const RowRunner* runner = nullptr);
+/// With `group` > 1 the table is that of the record's sums over consecutive groups of `group`
+/// samples (floor(N / group) of them, formed as they are read, never held): MTOTVAR at m of those
+/// sums is the decimated mtotvar(x, group, m group) times group^4 (docs/total.md). O(N + (N /
+/// group) lags).
+LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum> work, const RowRunner* runner = nullptr,
+                   std::uint64_t group = 1);
 
 /// Doubles of scratch mtotvar_lagged and htotvar_lagged need at averaging factor m.
 std::size_t lagged_scratch_size(std::uint64_t m);
