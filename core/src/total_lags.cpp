@@ -263,7 +263,7 @@ LagTable lag_table(PhaseSpan x, int order, std::size_t lags, std::span<ExactSum>
   if ((order != 2 && order != 3) || !x.integers() || group < 1 || x.size() / group <= static_cast<Index>(order) ||
       lags < 1 || lags > max_lags || work.size() < lag_table_size(lags))
     return t;
-  const Index values = x.size() / group - static_cast<Index>(order);
+  const Index values = static_cast<Index>(x.size() / group) - static_cast<Index>(order);
   ExactSum* total = work.data();
   ExactSum* head = total + lags;
   ExactSum* tail = head + lags * lags;
