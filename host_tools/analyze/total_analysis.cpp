@@ -6,6 +6,8 @@
 #include <cmath>
 #include <exception>
 #include <future>
+#include <optional>
+#include <type_traits>
 
 #include "confidence.hpp"
 #include "gyrochar/total.hpp"
@@ -205,16 +207,24 @@ double avar_terms(std::span<const TauSums> exact_sums, std::uint64_t m, std::uin
   return -1.0;
 }
 
+// The smallest group GroupSums holds for the decimated MTOTVAR: a 64th of the record's values, at
+// most a sixteenth of its bytes while the sums fit in int32 (27 MB at 4.3 10^8 counts; a group of
+// 16 would add 108 MB to the 120-hour job's peak, BENCHMARKS.md).
+constexpr std::uint64_t held_group = 64;
+
 // The decimated MTOTVAR of integer record x on blocks of b samples (b a power of two, m / b even, 3 m
 // / b - 2 lags at most the table's) from the lag table of the block sums, exactly as mtotvar(x, b,
-// m) computes it, rounded once; n = 0 where the table cannot hold the sums exactly. `work` and
-// `scratch`: the caller's, resized here.
-TotalVariance mtotvar_of_blocks(PhaseSpan x, std::uint64_t b, std::uint64_t m, double tau0, std::vector<ExactSum>& work,
-                                std::vector<double>& scratch) {
+// m) computes it, rounded once; n = 0 where the table cannot hold the sums exactly. The blocks are
+// summed from `held` (x's sums over groups dividing b) where given. `work` and `scratch`: the
+// caller's, resized here.
+TotalVariance mtotvar_of_blocks(PhaseSpan x, const GroupSums* held, std::uint64_t b, std::uint64_t m, double tau0,
+                                std::vector<ExactSum>& work, std::vector<double>& scratch) {
   const std::uint64_t S = m / b, lags = 3 * S - 2;
   if (S > lag_table_max_m || 3 * S > x.size() / b) return {};
   work.resize(lag_table_size(lags));
-  const LagTable table = lag_table(x, 2, lags, work, nullptr, b);
+  const bool from_held = held != nullptr && b % held->group() == 0;
+  const LagTable table = from_held ? lag_table(held->sums(), 2, lags, work, nullptr, b / held->group())
+                                   : lag_table(x, 2, lags, work, nullptr, b);
   if (!table.ready) return {};
   scratch.resize(lagged_scratch_size(S));
   TotalVariance t = mtotvar_lagged(table, S, tau0, scratch);
@@ -298,6 +308,14 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
       const ThreadRows runner(threads);
       table = lag_table(x, hadamard ? 3 : 2, 3 * table_m - 2, table_work, &runner);
     }
+    // Counts' decimated MTOTVAR: the record's sums over the plan's smallest block of at least
+    // held_group samples held once, the blocks of each tau whose block it divides summed from them.
+    std::uint64_t smallest = 0;
+    for (const std::uint64_t m : ms)
+      if (const std::uint64_t b = total_block(m, N, S); !from_table(m) && b >= held_group)
+        smallest = smallest == 0 ? b : std::min(smallest, b);
+    std::optional<GroupSums> held;
+    if (!hadamard && x.integers() && smallest > 0) held.emplace(x, smallest);
     // Per thread: the plan's block sums and prefix sums, or the table's coefficients; for counts'
     // decimated MTOTVAR the lag table of the block sums.
     std::array<std::vector<double>, 2> scratch;
@@ -313,7 +331,7 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
         // The decimated MTOTVAR is MTOTVAR at m / b of the record's sums over blocks of b samples,
         // times b^-4 (docs/total.md). Counts' block sums are integers: their lag table gives it
         // exactly, O((N / b) (3 m / b)), where the table can hold their differences' products.
-        const TotalVariance t = mtotvar_of_blocks(x, b, m, tau0, blocks_work[worker], own);
+        const TotalVariance t = mtotvar_of_blocks(x, held ? &*held : nullptr, b, m, tau0, blocks_work[worker], own);
         if (t.n != 0) return t;
       }
       own.resize(total_scratch_size(m, b));
@@ -348,6 +366,29 @@ std::vector<AnalysisRow> total_family_rows(DevStat stat, PhaseSpan x, double k2,
 }
 
 }  // namespace
+
+GroupSums::GroupSums(PhaseSpan x, std::uint64_t g) : g_(g) {
+  x.visit([&]<class T>(std::span<const T> v) {
+    if constexpr (std::is_integral_v<T>) {
+      const std::size_t groups = g > 0 ? v.size() / g : 0;
+      narrow_.reserve(groups);
+      for (std::size_t k = 0; k < groups; ++k) {
+        std::int64_t sum = 0;
+        for (std::size_t i = k * g; i < (k + 1) * g; ++i) sum += v[i];
+        if (wide_.empty() && sum >= INT32_MIN && sum <= INT32_MAX) {
+          narrow_.push_back(static_cast<std::int32_t>(sum));
+          continue;
+        }
+        if (wide_.empty()) {  // the first that does not fit: every sum as int64 from here on
+          wide_.reserve(groups);
+          wide_.assign(narrow_.begin(), narrow_.end());
+          narrow_ = {};
+        }
+        wide_.push_back(sum);
+      }
+    }
+  });
+}
 
 std::span<LagSumView> LagSumRecord::views(PhaseSpan x, bool frequencies, unsigned threads) {
   const std::size_t n = frequencies ? x.size() - 1 : x.size();

@@ -4,7 +4,7 @@
 // when one of them is asked for: a counter's residuals as the batch engine holds them (4 bytes a
 // point while they fit in int32), else the phase as doubles (8 bytes a point; counts stay exact up
 // to 2^53 pulses). Nothing else the size of the record: the decimated MTOTDEV sums its blocks a
-// window at a time.
+// window at a time (for counts, from their sums over a block of 64 or more: GroupSums).
 //
 // Each row borrows from the Allan-family row of the same run at the same tau (for Theo1 and
 // TheoBR, at the largest tau at or below 0.75 m tau0): its noise identification, and its EDF where
@@ -13,6 +13,7 @@
 // corrections (TOTDEV for flicker and random-walk FM, HTOTDEV for alpha <= 0). TheoH's rows below
 // its switch point are the overlapping ADEV rows themselves.
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
@@ -51,6 +52,23 @@ class LagSumRecord {
   Theo1Workspace w_, second_;
   std::array<LagSumView, 2> views_{};
   bool frequencies_ = false;
+};
+
+/// The sums of an integer record over consecutive groups of g samples (floor(N / g) of them), held
+/// as int32 while every one fits and as int64 otherwise: the lag tables of counts' decimated
+/// MTOTDEV (total_lags.hpp) read their blocks' sums from these, g times fewer values than the record,
+/// instead of summing the record again for every tau. Sums over groups of k g of the record are the
+/// sums over groups of k of these, the same integers. O(N), 4 N / g bytes (8 N / g when wide).
+class GroupSums {
+ public:
+  GroupSums(PhaseSpan x, std::uint64_t g);
+  std::uint64_t group() const { return g_; }
+  PhaseSpan sums() const { return wide_.empty() ? PhaseSpan(narrow_) : PhaseSpan(wide_); }
+
+ private:
+  std::uint64_t g_;
+  std::vector<std::int32_t> narrow_;
+  std::vector<std::int64_t> wide_;
 };
 
 /// The rows of total statistic `stat` (is_total(stat)) of phase points `phase` (phase unit /

@@ -583,8 +583,9 @@ TEST(AnalyzeCli, CountsKeepExactMtotRowsUpToM128UnderThePlan) {
       EXPECT_NEAR(got / want, 1.0, 1e-11) << stat << " m=" << m;  // the direct sums' rounding
     }
   }
-  // MTOTDEV's decimated rows come from the lag tables of the block sums: the estimator mtotvar(x, b,
-  // m) computes (total.hpp, the oracle here, summed directly in double), at every decimated m.
+  // MTOTDEV's decimated rows come from the lag tables of the block sums (from m = 1024, b = 64, summed
+  // from the record's sums over 64 samples held once: GroupSums): the estimator mtotvar(x, b, m)
+  // computes (total.hpp, the oracle here, summed directly in double), at every decimated m.
   int decimated = 0;
   for (const auto& [m, row] : rows["mtotdev"]) {
     const std::uint64_t b = gyrochar::total_block(m, x.size(), 16);

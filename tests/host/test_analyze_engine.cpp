@@ -18,6 +18,8 @@
 #include <span>
 #include <stdexcept>
 #include <thread>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "analysis.hpp"
@@ -27,6 +29,7 @@
 #include "plan.hpp"
 #include "total_analysis.hpp"
 #include "gyrochar/batch.hpp"
+#include "gyrochar/total_lags.hpp"
 
 namespace gyrochar {
 namespace {
@@ -581,6 +584,59 @@ TEST(AnalyzeEngine, HeldCountsPastTheirReserveAreTheSameBits) {
       EXPECT_EQ(held.rows[i].dev, outgrown.rows[i].dev)
           << name(held.rows[i].stat) << " m=" << held.rows[i].m << " step " << step;
   }
+}
+
+TEST(AnalyzeEngine, GroupSumsAreTheRecordsBlockSumsNarrowOrWide) {
+  // Oracle: the sums over each group written out in int64 from the record, and the lag table of
+  // the record's own block sums (total_lags.hpp's group), which counts' decimated MTOTDEV read
+  // from GroupSums instead: the same integers, so the same tables bit for bit. A record whose
+  // group sums all fit in int32 keeps them narrow; one that passes 2^31 goes wide from the group
+  // it passes on, keeping the sums before it; a record of doubles has none.
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<std::int32_t> step(-40, 40);
+  std::vector<std::int32_t> small{0}, large{0};
+  for (int i = 0; i < 20000; ++i) small.push_back(small.back() + step(rng));
+  for (int i = 0; i < 20000; ++i)
+    large.push_back(i < 9000 ? step(rng) : (1 << 29) + step(rng));  // four sum to about 2^31: some pass it
+  const std::vector<std::int64_t> wide(large.begin(), large.end());
+  std::vector<ExactSum> held_work, direct_work;
+  for (const auto& [record, g, narrow] :
+       {std::tuple{PhaseSpan(small), 16u, true}, std::tuple{PhaseSpan(small), 64u, true},
+        std::tuple{PhaseSpan(large), 4u, false}, std::tuple{PhaseSpan(wide), 64u, false}}) {
+    const GroupSums held(record, g);
+    EXPECT_EQ(held.group(), g);
+    const PhaseSpan sums = held.sums();
+    ASSERT_EQ(sums.size(), record.size() / g) << g;
+    record.visit([&](auto x) {
+      sums.visit([&](auto y) {
+        using Held = typename decltype(y)::value_type;
+        EXPECT_EQ((std::is_same_v<Held, std::int32_t>), narrow) << g;
+        for (std::size_t k = 0; k < y.size(); ++k) {
+          std::int64_t want = 0;
+          for (std::size_t i = k * g; i < (k + 1) * g; ++i) want += x[i];
+          ASSERT_EQ(static_cast<std::int64_t>(y[k]), want) << "group " << k << " of " << g;
+        }
+      });
+    });
+    for (const std::uint64_t k : {1u, 2u, 4u}) {
+      held_work.resize(lag_table_size(22));
+      direct_work.resize(lag_table_size(22));
+      const LagTable from_held = lag_table(sums, 2, 22, held_work, nullptr, k);
+      const LagTable direct = lag_table(record, 2, 22, direct_work, nullptr, k * g);
+      ASSERT_EQ(from_held.ready, direct.ready) << g << " x " << k;
+      ASSERT_EQ(from_held.values, direct.values);
+      for (std::size_t d = 0; d < direct.total.size(); ++d) {
+        EXPECT_EQ(from_held.total[d].hi, direct.total[d].hi) << d;
+        EXPECT_EQ(from_held.total[d].lo, direct.total[d].lo) << d;
+      }
+      for (std::size_t i = 0; i < direct.head.size(); ++i) {
+        EXPECT_EQ(from_held.head[i].hi, direct.head[i].hi) << i;
+        EXPECT_EQ(from_held.tail[i].hi, direct.tail[i].hi) << i;
+      }
+    }
+  }
+  const std::vector<double> doubles(1000, 1.0);
+  EXPECT_EQ(GroupSums(PhaseSpan(doubles), 16).sums().size(), 0u);
 }
 
 TEST(AnalyzeEngine, LagSumWorkspacesAreWholeOrRefused) {
