@@ -373,8 +373,9 @@ GroupSums::GroupSums(PhaseSpan x, std::uint64_t g) : g_(g) {
       const std::size_t groups = g > 0 ? v.size() / g : 0;
       narrow_.reserve(groups);
       for (std::size_t k = 0; k < groups; ++k) {
-        std::int64_t sum = 0;
-        for (std::size_t i = k * g; i < (k + 1) * g; ++i) sum += v[i];
+        std::uint64_t total = 0;  // modulo 2^64, as lag_table sums the record's own groups
+        for (std::size_t i = k * g; i < (k + 1) * g; ++i) total += static_cast<std::uint64_t>(std::int64_t{v[i]});
+        const auto sum = static_cast<std::int64_t>(total);
         if (wide_.empty() && sum >= INT32_MIN && sum <= INT32_MAX) {
           narrow_.push_back(static_cast<std::int32_t>(sum));
           continue;

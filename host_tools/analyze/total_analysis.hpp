@@ -54,8 +54,8 @@ class LagSumRecord {
   bool frequencies_ = false;
 };
 
-/// The sums of an integer record over consecutive groups of g samples (floor(N / g) of them), held
-/// as int32 while every one fits and as int64 otherwise: the lag tables of counts' decimated
+/// The sums of an integer record over consecutive groups of g samples (floor(N / g) of them, modulo
+/// 2^64 as total_lags.hpp forms them), held as int32 while every one fits and as int64 otherwise: the lag tables of counts' decimated
 /// MTOTDEV (total_lags.hpp) read their blocks' sums from these, g times fewer values than the record,
 /// instead of summing the record again for every tau. Sums over groups of k g of the record are the
 /// sums over groups of k of these, the same integers. O(N), 4 N / g bytes (8 N / g when wide).

@@ -587,7 +587,7 @@ TEST(AnalyzeEngine, HeldCountsPastTheirReserveAreTheSameBits) {
 }
 
 TEST(AnalyzeEngine, GroupSumsAreTheRecordsBlockSumsNarrowOrWide) {
-  // Oracle: the sums over each group written out in int64 from the record, and the lag table of
+  // Oracle: the sums over each group written out modulo 2^64 from the record, and the lag table of
   // the record's own block sums (total_lags.hpp's group), which counts' decimated MTOTDEV read
   // from GroupSums instead: the same integers, so the same tables bit for bit. A record whose
   // group sums all fit in int32 keeps them narrow; one that passes 2^31 goes wide from the group
@@ -599,10 +599,12 @@ TEST(AnalyzeEngine, GroupSumsAreTheRecordsBlockSumsNarrowOrWide) {
   for (int i = 0; i < 20000; ++i)
     large.push_back(i < 9000 ? step(rng) : (1 << 29) + step(rng));  // four sum to about 2^31: some pass it
   const std::vector<std::int64_t> wide(large.begin(), large.end());
+  std::vector<std::int64_t> huge(wide);  // groups of 16 whose sums pass 2^63: modulo 2^64, no overflow
+  for (std::int64_t& v : huge) v += std::int64_t{1} << 61;
   std::vector<ExactSum> held_work, direct_work;
-  for (const auto& [record, g, narrow] :
-       {std::tuple{PhaseSpan(small), 16u, true}, std::tuple{PhaseSpan(small), 64u, true},
-        std::tuple{PhaseSpan(large), 4u, false}, std::tuple{PhaseSpan(wide), 64u, false}}) {
+  for (const auto& [record, g, narrow] : {std::tuple{PhaseSpan(small), 16u, true}, std::tuple{PhaseSpan(small), 64u, true},
+                                          std::tuple{PhaseSpan(large), 4u, false}, std::tuple{PhaseSpan(wide), 64u, false},
+                                          std::tuple{PhaseSpan(huge), 16u, false}}) {
     const GroupSums held(record, g);
     EXPECT_EQ(held.group(), g);
     const PhaseSpan sums = held.sums();
@@ -612,9 +614,10 @@ TEST(AnalyzeEngine, GroupSumsAreTheRecordsBlockSumsNarrowOrWide) {
         using Held = typename decltype(y)::value_type;
         EXPECT_EQ((std::is_same_v<Held, std::int32_t>), narrow) << g;
         for (std::size_t k = 0; k < y.size(); ++k) {
-          std::int64_t want = 0;
-          for (std::size_t i = k * g; i < (k + 1) * g; ++i) want += x[i];
-          ASSERT_EQ(static_cast<std::int64_t>(y[k]), want) << "group " << k << " of " << g;
+          std::uint64_t want = 0;
+          for (std::size_t i = k * g; i < (k + 1) * g; ++i)
+            want += static_cast<std::uint64_t>(static_cast<std::int64_t>(x[i]));
+          ASSERT_EQ(static_cast<std::uint64_t>(static_cast<std::int64_t>(y[k])), want) << "group " << k << " of " << g;
         }
       });
     });
