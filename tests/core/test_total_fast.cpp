@@ -7,6 +7,7 @@
 // 1e-12 noise (where expanding raw phase products fails).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -618,28 +619,36 @@ TEST(TotalLags, CountsGiveExactSumsOnAnyThreads) {
   // A counter's phase as int32 residuals from a line (the analyzer's record): the differences are
   // integers, so every sum of the table is exact. Oracle: the same sums in int64, written out; the
   // table built on a runner (its stripes in reverse order) against the table built in turn: the
-  // same bits.
+  // same bits. The same with a pulse of 5000 counts every 7919 samples: the stripes it reaches have
+  // differences past the int16 products' limit (2048) and take the doubles, the others the int16.
   const std::vector<std::int32_t> x = counter_phase(40000, 9);
+  std::vector<std::int32_t> pulsed(x);
+  for (std::size_t j = 3000; j < pulsed.size(); j += 7919) pulsed[j] += 5000;
   constexpr std::size_t lags = 3 * 64 - 2;
   std::vector<ExactSum> work(lag_table_size(lags)), again(lag_table_size(lags));
-  const LagTable t = lag_table(x, 2, lags, work);
-  const ReverseRows reverse;
-  const LagTable u = lag_table(x, 2, lags, again, &reverse);
-  ASSERT_TRUE(t.ready && u.ready);
-  std::vector<std::int64_t> w(x.size() - 2);
-  for (std::size_t j = 0; j < w.size(); ++j) w[j] = std::int64_t{x[j + 2]} - 2 * std::int64_t{x[j + 1]} + x[j];
   const auto value = [](ExactSum e) { return static_cast<std::int64_t>(e.hi) + static_cast<std::int64_t>(e.lo); };
-  for (std::size_t d = 0; d < lags; ++d) {
-    std::int64_t total = 0, head = 0, tail = 0;
-    for (std::size_t j = 0; j + d < w.size(); ++j) total += w[j] * w[j + d];
-    EXPECT_EQ(value(t.total[d]), total) << d;
-    for (std::size_t c = 0; c < lags; ++c) {
-      EXPECT_EQ(value(t.head[d * lags + c]), head) << d << " " << c;
-      EXPECT_EQ(value(t.tail[d * lags + c]), tail) << d << " " << c;
-      head += w[c] * w[c + d], tail += w[w.size() - 1 - d - c] * w[w.size() - 1 - c];
+  for (const std::vector<std::int32_t>* record : {static_cast<const std::vector<std::int32_t>*>(&pulsed), &x}) {
+    const LagTable t = lag_table(*record, 2, lags, work);
+    const ReverseRows reverse;
+    const LagTable u = lag_table(*record, 2, lags, again, &reverse);
+    ASSERT_TRUE(t.ready && u.ready);
+    const std::vector<std::int32_t>& r = *record;
+    std::vector<std::int64_t> w(r.size() - 2);
+    for (std::size_t j = 0; j < w.size(); ++j) w[j] = std::int64_t{r[j + 2]} - 2 * std::int64_t{r[j + 1]} + r[j];
+    EXPECT_EQ(*std::max_element(w.begin(), w.end()) >= 2048, record == &pulsed);
+    for (std::size_t d = 0; d < lags; ++d) {
+      std::int64_t total = 0, head = 0, tail = 0;
+      for (std::size_t j = 0; j + d < w.size(); ++j) total += w[j] * w[j + d];
+      EXPECT_EQ(value(t.total[d]), total) << d;
+      for (std::size_t c = 0; c < lags; ++c) {
+        EXPECT_EQ(value(t.head[d * lags + c]), head) << d << " " << c;
+        EXPECT_EQ(value(t.tail[d * lags + c]), tail) << d << " " << c;
+        head += w[c] * w[c + d], tail += w[w.size() - 1 - d - c] * w[w.size() - 1 - c];
+      }
     }
+    for (std::size_t i = 0; i < work.size(); ++i) ASSERT_TRUE(work[i].hi == again[i].hi && work[i].lo == again[i].lo) << i;
   }
-  for (std::size_t i = 0; i < work.size(); ++i) ASSERT_TRUE(work[i].hi == again[i].hi && work[i].lo == again[i].lo) << i;
+  const LagTable t = lag_table(x, 2, lags, work);
   std::vector<double> scratch(lagged_scratch_size(64));
   std::vector<double> phase_doubles(x.begin(), x.end()), direct_scratch(total_scratch_size(64, 1));
   for (const std::uint64_t m : {1u, 2u, 7u, 16u, 64u}) {

@@ -63,7 +63,7 @@ std::size_t lag_table_size(std::size_t lags);
 /// The lag products of the differences of order `order` (2: MTOTVAR's, 3: HTOTVAR's) of the integer
 /// record x, at every lag below `lags` (at most 3 lag_table_max_m - 2), in `work`
 /// (lag_table_size(lags)), exactly. The record goes in 16 stripes, run as rows on `runner` (null: in
-/// turn): exact sums, the same on any number of threads. O(N lags), 150 KB of stack a row.
+/// turn): exact sums, the same on any number of threads. O(N lags), 190 KB of stack a row.
 /// With `group` > 1 the table is that of the record's sums over consecutive groups of `group`
 /// samples (floor(N / group) of them, formed as they are read, never held): MTOTVAR at m of those
 /// sums is the decimated mtotvar(x, group, m group) times group^4 (docs/total.md). O(N + (N /
